@@ -1,0 +1,169 @@
+#pragma once
+/// \file irradiance_gradients.hpp
+/// Irradiance, its rotation and translation gradients and the harmonic mean distance from
+/// one stratified hemisphere of radiance samples (Ward and Heckbert 1992; the improved
+/// translation gradient of Krivanek et al. 2005).
+///
+/// Strata: M rings in theta with equal projected solid angle (theta_j^- = asin sqrt(j/M)),
+/// N wedges in phi (phi_k^- = 2 pi k / N); sample (j, k) lies inside cell (j, k) and is
+/// stored at index j * N + k. Radiance is taken as constant over each cell (the assumption
+/// behind both gradient formulas), so each cell's weights are its exact integrals: the
+/// irradiance weight pi / (M N), and the rotation weight int sin^2(theta) dtheta *
+/// int v(phi) dphi. That keeps the rotation gradient finite for samples at grazing angles,
+/// where the per-sample form tan(theta) diverges.
+///
+/// Conventions (derived in docs/irradiance-splatting.md, tested in tests/core):
+///  - rotation gradient grad_r: for a normal turned by a small angle alpha about a unit
+///    tangent axis t, E changes by alpha * dot(t, grad_r); the new normal n satisfies
+///    n_k x n = alpha t, hence E(n) ~ E_k + dot(n_k x n, grad_r) (seed Algorithm 4).
+///  - translation gradient grad_t: E(p) ~ E_k + dot(p - p_k, grad_t).
+
+#include <bounce/errors.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace bounce {
+
+/// Radiance and hit distance of a stratified set of hemisphere directions around a normal,
+/// in the local frame (z along the normal).
+struct hemisphere_samples {
+    std::uint32_t rings = 0;              ///< M: strata in theta (equal projected solid angle)
+    std::uint32_t wedges = 0;             ///< N: strata in phi
+    std::vector<glm::vec3> direction;     ///< unit local direction of sample j * N + k
+    std::vector<glm::vec3> radiance;      ///< incoming radiance (RGB) of each sample
+    std::vector<float> distance;          ///< hit distance, +infinity where the ray escaped
+
+    std::size_t size() const noexcept { return std::size_t(rings) * wedges; }
+    /// Throws parameter_error on inconsistent sizes, non-finite radiance or a non-positive
+    /// distance.
+    void validate() const;
+};
+
+/// Cell (j, k) directions for an M x N stratification, jittered from `u` (one [0,1)^2 point
+/// per cell, row-major), as local unit vectors: theta = asin(sqrt((j + u.y) / M)),
+/// phi = 2 pi (k + u.x) / N; cosine-distributed within the hemisphere.
+std::vector<glm::vec3> stratified_cosine_directions(std::uint32_t rings, std::uint32_t wedges,
+                                                    const std::vector<glm::vec2>& u);
+
+/// Which translation-gradient formula to use.
+enum class translation_gradient_kind {
+    ward_heckbert_1992,  ///< Ward and Heckbert 1992, Eq. for stratified samples
+    krivanek_2005,       ///< Krivanek et al. 2005: the azimuthal walls weighted by projected solid angle
+};
+
+/// What a record needs from its hemisphere, in the LOCAL frame (x, y tangent, z normal).
+struct hemisphere_estimate {
+    glm::dvec3 irradiance{0};                    ///< E per channel (W/m^2)
+    std::array<glm::dvec3, 3> rotation{};        ///< grad_r per channel (R, G, B)
+    std::array<glm::dvec3, 3> translation{};     ///< grad_t per channel
+    double harmonic_mean_distance = std::numeric_limits<double>::infinity();  ///< R; inf if nothing was hit
+};
+
+/// Irradiance, gradients and harmonic mean distance of one hemisphere (see file comment).
+hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s,
+                                        translation_gradient_kind kind = translation_gradient_kind::krivanek_2005);
+
+// ---------------------------------------------------------------------------------------
+// Definitions
+
+inline void hemisphere_samples::validate() const {
+    require(rings > 0 && wedges > 0, "rings/wedges", "need at least one stratum in each direction");
+    require(direction.size() == size() && radiance.size() == size() && distance.size() == size(), "samples",
+            "direction, radiance and distance must hold rings * wedges entries");
+    for (std::size_t i = 0; i < size(); ++i) {
+        const auto& L = radiance[i];
+        require(std::isfinite(L.x) && std::isfinite(L.y) && std::isfinite(L.z), "radiance",
+                "non-finite radiance sample");
+        require(distance[i] > 0.f && !std::isnan(distance[i]), "distance", "hit distance must be positive");
+    }
+}
+
+inline std::vector<glm::vec3> stratified_cosine_directions(std::uint32_t rings, std::uint32_t wedges,
+                                                           const std::vector<glm::vec2>& u) {
+    require(rings > 0 && wedges > 0, "rings/wedges", "need at least one stratum in each direction");
+    require(u.size() == std::size_t(rings) * wedges, "u", "need one jitter point per cell");
+    std::vector<glm::vec3> dirs(u.size());
+    for (std::uint32_t j = 0; j < rings; ++j)
+        for (std::uint32_t k = 0; k < wedges; ++k) {
+            const auto& uj = u[j * wedges + k];
+            const double sin2 = (j + double(uj.y)) / rings, sin_t = std::sqrt(sin2);
+            const double cos_t = std::sqrt(std::max(0.0, 1.0 - sin2));
+            const double phi = 2 * std::numbers::pi * (k + double(uj.x)) / wedges;
+            dirs[j * wedges + k] = glm::vec3(float(sin_t * std::cos(phi)), float(sin_t * std::sin(phi)), float(cos_t));
+        }
+    return dirs;
+}
+
+inline hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, translation_gradient_kind kind) {
+    s.validate();
+    const std::uint32_t M = s.rings, N = s.wedges;
+    const double pi = std::numbers::pi, dphi = 2 * pi / N;
+    auto L = [&](std::uint32_t j, std::uint32_t k) { return glm::dvec3(s.radiance[j * N + k]); };
+    auto r = [&](std::uint32_t j, std::uint32_t k) { return double(s.distance[j * N + k]); };
+    // Ring boundaries: sin^2(theta_j^-) = j / M.
+    auto sin_lo = [&](std::uint32_t j) { return std::sqrt(double(j) / M); };
+    auto cos_lo = [&](std::uint32_t j) { return std::sqrt(1.0 - double(j) / M); };
+    auto theta_lo = [&](std::uint32_t j) { return std::asin(sin_lo(j)); };
+
+    hemisphere_estimate e;
+    double inverse_distance_sum = 0;
+    for (std::uint32_t j = 0; j < M; ++j) {
+        // int_{theta^-}^{theta^+} sin^2 = [theta/2 - sin(2 theta)/4], sin(2t) = 2 sin cos.
+        const double t0 = theta_lo(j), t1 = theta_lo(j + 1);
+        const double sin2_integral = (t1 - t0) / 2 - (sin_lo(j + 1) * cos_lo(j + 1) - sin_lo(j) * cos_lo(j)) / 2;
+        for (std::uint32_t k = 0; k < N; ++k) {
+            const glm::dvec3 Ljk = L(j, k);
+            e.irradiance += Ljk * (pi / (double(M) * N));
+            // int v(phi) dphi with v = (-sin phi, cos phi, 0): (cos phi+ - cos phi-, sin phi+ - sin phi-).
+            const double p0 = dphi * k, p1 = dphi * (k + 1);
+            const glm::dvec3 v_integral(std::cos(p1) - std::cos(p0), std::sin(p1) - std::sin(p0), 0);
+            for (int c = 0; c < 3; ++c) e.rotation[c] += v_integral * (sin2_integral * Ljk[c]);
+            inverse_distance_sum += 1.0 / r(j, k);  // 0 for escaped rays
+        }
+    }
+    if (inverse_distance_sum > 0) e.harmonic_mean_distance = double(M) * N / inverse_distance_sum;
+
+    // Translation: each wall between neighbouring cells sweeps over the geometry at the
+    // nearer of the two hit distances as the point moves; the radiance difference across the
+    // wall times the rate of change of projected solid angle gives the gradient.
+    for (std::uint32_t k = 0; k < N; ++k) {
+        const double phi_lo = dphi * k, phi_c = dphi * (k + 0.5);
+        const glm::dvec3 u_c(std::cos(phi_c), std::sin(phi_c), 0);        // into wedge k, horizontal
+        const glm::dvec3 v_lo(-std::sin(phi_lo), std::cos(phi_lo), 0);   // normal to the wall at phi_k^-
+        const std::uint32_t km = (k + N - 1) % N;
+        // Walls between rings j-1 and j (at theta_j^-): rate sin cos^2 / r per unit azimuth.
+        for (std::uint32_t j = 1; j < M; ++j) {
+            const double sl = sin_lo(j), cl = cos_lo(j);
+            const double rate = sl * cl * cl / std::min(r(j, k), r(j - 1, k));
+            const double azimuth = kind == translation_gradient_kind::krivanek_2005
+                                       ? 2 * std::sin(dphi / 2)  // |int u(phi) dphi| over the wedge
+                                       : dphi;
+            const glm::dvec3 dL = L(j, k) - L(j - 1, k);
+            for (int c = 0; c < 3; ++c) e.translation[c] += u_c * (azimuth * rate * dL[c]);
+        }
+        // Walls between wedges k-1 and k (at phi_k^-), one per ring.
+        for (std::uint32_t j = 0; j < M; ++j) {
+            const double rmin = std::min(r(j, k), r(j, km));
+            double rate;
+            if (kind == translation_gradient_kind::krivanek_2005) {
+                rate = (sin_lo(j + 1) - sin_lo(j)) / rmin;  // int cos(theta) dtheta / r
+            } else {
+                const auto& d = s.direction[j * N + k];
+                const double sin_t = std::max(std::sqrt(double(d.x) * d.x + double(d.y) * d.y), 1e-12);
+                rate = (cos_lo(j) - cos_lo(j + 1)) / (sin_t * rmin);
+            }
+            const glm::dvec3 dL = L(j, k) - L(j, km);
+            for (int c = 0; c < 3; ++c) e.translation[c] += v_lo * (rate * dL[c]);
+        }
+    }
+    return e;
+}
+
+}  // namespace bounce
