@@ -48,6 +48,12 @@ struct camera {
         return forward() + sx * right() + sy * true_up();
     }
 
+    /// World size of one pixel at distance `depth` along the view axis, for an image
+    /// `height` pixels tall (the footprint used to clamp record radii in pixels).
+    float pixel_footprint(float depth, std::size_t height) const {
+        return 2.f * depth * tan_half_fov() / float(height);
+    }
+
     glm::mat4 view_matrix() const { return glm::lookAt(position, look_at, up); }
     /// OpenGL projection (clip z in [-1, 1]).
     glm::mat4 projection_matrix(std::size_t width, std::size_t height) const {

@@ -57,6 +57,29 @@ V uniform_hemisphere(const V2& u) {
     return V(r * cos(phi), r * sin(phi), z);
 }
 
+/// Direction of sample (j, k) of an M x N stratified cosine-weighted hemisphere around +z
+/// (Ward & Heckbert 1992, "Irradiance Gradients", section 3): theta_j = asin(sqrt((j + u) / M)),
+/// phi_k = 2 pi (k + v) / N, with jitter (u, v) in [0,1)^2. Each of the M N cells carries
+/// the same cosine-weighted solid angle, so E ~ pi / (M N) * sum of the sampled radiances.
+/// `j`, `k`, `m`, `n` are passed as reals so that the kernel also instantiates for GLSL.
+template <real T, vec3_of<T> V>
+V stratified_cosine_direction(T j, T k, T m, T n, T u, T v) {
+    const T sin2 = (j + u) / m;
+    const T sin_theta = sqrt(sin2), cos_theta = sqrt(max(T(0), T(1) - sin2));
+    const T phi = T(2 * std::numbers::pi) * (k + v) / n;
+    return V(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+}
+
+/// Barycentric weights (b1, b2) of a uniformly distributed point on a triangle from u in
+/// [0,1)^2 (the square-root map, Shirley 1990; pbrt 4th ed. section A.5.4): the point is
+/// (1 - b1 - b2) v0 + b1 v1 + b2 v2. The map is area preserving up to a constant, so
+/// strata in u stay strata of equal area on the triangle.
+template <real T, vec2_of<T> V2>
+V2 uniform_triangle(const V2& u) {
+    const T s = sqrt(u.x);
+    return V2(s * (T(1) - u.y), s * u.y);
+}
+
 /// Local direction d (around +z) to world space around the unit normal n.
 template <real T, vec3_of<T> V>
 V to_world(const V& d, const V& n) {

@@ -92,6 +92,9 @@ struct gpu_ward_weight {
     static T influence_radius(T r, T a) { return a * r; }
 };
 
+/// The seed shader's variant exactly as printed (normal term 0.2 (1 - n.nk)).
+using gpu_ward_shader_weight = gpu_ward_weight<1, 5>;
+
 /// Tabellion and Lamorlette 2004: w = 1 - kappa max(|p - pk| / R_k, sqrt(1 - n.nk) /
 /// sqrt(1 - cos 10 deg)), kappa = 1/a, contributing where w > 0. R_k is the record's
 /// (already clamped) radius; the normal term reaches its limit at 10 degrees of divergence

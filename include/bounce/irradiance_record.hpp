@@ -1,0 +1,133 @@
+#pragma once
+/// \file irradiance_record.hpp
+/// Irradiance records: what a record holds, how it extrapolates to a nearby point with its
+/// gradients (seed Algorithms 1 and 4), what it adds to the splat buffer, and how its
+/// radius R is limited.
+
+#include <bounce/irradiance_gradients.hpp>
+#include <bounce/sampling.hpp>
+#include <bounce/vocabulary.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <glm/glm.hpp>
+
+namespace bounce {
+
+/// One irradiance cache record, in world space. View-independent: a record computed for
+/// one camera is valid for every camera.
+struct irradiance_record {
+    glm::vec3 position{0.f};                    ///< p_k
+    glm::vec3 normal{0, 0, 1};                  ///< n_k, unit
+    glm::vec3 irradiance{0.f};                  ///< E_k per channel (W/m^2)
+    std::array<glm::vec3, 3> rotation{};        ///< grad_r per channel R, G, B (W/m^2 per radian)
+    std::array<glm::vec3, 3> translation{};     ///< grad_t per channel (W/m^2 per world unit)
+    float radius = 1.f;                         ///< R_k, world units, after every clamp
+};
+
+/// E_k(p) = E_k + (n_k x n) . grad_r + (p - p_k) . grad_t per channel (seed Algorithm 4),
+/// with the gradient term clamped to +-max_extrapolation * E_k per channel so that a record
+/// never extrapolates to negative or runaway irradiance far from where it was measured.
+/// Typical max_extrapolation: 1 (E_k(p) within [0, 2 E_k]).
+template <real T, vec3_of<T> V>
+V extrapolated_irradiance(const V& p, const V& n, const V& pk, const V& nk, const V& e,
+                          const V& rot_r, const V& rot_g, const V& rot_b,
+                          const V& tr_r, const V& tr_g, const V& tr_b, T max_extrapolation) {
+    const V c = cross(nk, n);
+    const V d = p - pk;
+    const V delta(dot(c, rot_r) + dot(d, tr_r), dot(c, rot_g) + dot(d, tr_g), dot(c, rot_b) + dot(d, tr_b));
+    const V limit = e * max_extrapolation;
+    return e + clamp(delta, -limit, limit);
+}
+
+/// Irradiance without gradients, for `--gradients off`: same signature, E_k unchanged.
+template <real T, vec3_of<T> V>
+V constant_irradiance(const V&, const V&, const V&, const V&, const V& e, const V&, const V&, const V&,
+                      const V&, const V&, const V&, T) {
+    return e;
+}
+
+/// What record k adds to the splat buffer at a pixel (seed Algorithm 1): the weighted
+/// outgoing radiance w * (rho_d / pi) * E_k(p) in rgb and the weight w in the fourth
+/// component. `Weight` is a policy of weighting.hpp; `Gradients` is true to extrapolate
+/// with the record's gradients. Returns all zeros where the record does not contribute.
+template <class Weight, bool Gradients, real T, vec3_of<T> V>
+std::array<T, 4> splat_contribution(const V& p, const V& n, const V& albedo, const V& pk, const V& nk, T inv_r,
+                                    T a, const V& e, const V& rot_r, const V& rot_g, const V& rot_b,
+                                    const V& tr_r, const V& tr_g, const V& tr_b, T max_extrapolation) {
+    const T w = Weight::template weight<T, V>(p, n, pk, nk, inv_r, a);
+    V ek = e;
+    if constexpr (Gradients)
+        ek = extrapolated_irradiance<T, V>(p, n, pk, nk, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation);
+    const V lo = albedo * ek * (w * T(1.0 / std::numbers::pi));
+    return {lo.x, lo.y, lo.z, w};
+}
+
+/// Limits on a record's radius R (Tabellion and Lamorlette 2004; Krivanek et al. 2006).
+/// Every value is optional; defaults leave R unchanged.
+struct radius_limits {
+    float min_world = 0.f;  ///< R >= this (world units)
+    float max_world = std::numeric_limits<float>::infinity();  ///< R <= this (world units)
+    /// R >= min_pixels * footprint: stops records piling up where geometry is close.
+    /// Typical: 1-3 pixels (0 disables).
+    float min_pixels = 0.f;
+    /// R <= max_pixels * footprint: stops one record covering a whole image region with
+    /// a single value. Typical: 20-100 pixels (infinity disables).
+    float max_pixels = std::numeric_limits<float>::infinity();
+    /// R <= E / |grad_t E| per channel: the distance over which the first-order
+    /// extrapolation would change E by 100% (Ward and Heckbert 1992). Typical: on.
+    bool gradient_limit = true;
+};
+
+/// R from a hemisphere's harmonic mean distance and translation gradient, with the limits
+/// applied in order: gradient limit, world clamp, pixel-footprint clamp (the footprint is
+/// the world size of one pixel at the record, see camera::pixel_footprint). A hemisphere
+/// that saw nothing (R = infinity) gets the largest radius the limits allow.
+inline float limit_radius(double harmonic_mean, const glm::dvec3& e, const std::array<glm::dvec3, 3>& translation,
+                          const radius_limits& lim, double pixel_footprint) {
+    double r = harmonic_mean;
+    if (lim.gradient_limit)
+        for (int c = 0; c < 3; ++c) {
+            const double g = glm::length(translation[c]);
+            if (g > 0 && e[c] > 0) r = std::min(r, e[c] / g);
+        }
+    r = std::clamp(r, double(lim.min_world), double(lim.max_world));
+    if (pixel_footprint > 0 && std::isfinite(pixel_footprint))
+        r = std::clamp(r, lim.min_pixels * pixel_footprint, std::max(lim.min_pixels * pixel_footprint, lim.max_pixels * pixel_footprint));
+    return float(r);
+}
+
+/// Neighbour clamping (Krivanek et al. 2006): R_i <= R_j + |p_i - p_j|, so the radius
+/// field is 1-Lipschitz and a small record is never surrounded by much larger ones that
+/// hide the detail it found. Returns the clamped R of `rec` against `others`.
+template <class Range>
+float neighbour_clamped_radius(const irradiance_record& rec, const Range& others) {
+    float r = rec.radius;
+    for (const irradiance_record& o : others) r = std::min(r, o.radius + glm::length(rec.position - o.position));
+    return r;
+}
+
+/// A record at (p, n) from a hemisphere estimate in the local frame of n (see
+/// irradiance_gradients.hpp), with its radius limited as above.
+inline irradiance_record make_record(const glm::vec3& p, const glm::vec3& n, const hemisphere_estimate& est,
+                                     const radius_limits& lim, double pixel_footprint) {
+    const auto tb = orthonormal_basis<float, glm::vec3>(n);
+    const glm::dmat3 to_world{glm::dvec3(tb[0]), glm::dvec3(tb[1]), glm::dvec3(n)};
+    irradiance_record r;
+    r.position = p;
+    r.normal = n;
+    r.irradiance = glm::vec3(est.irradiance);
+    std::array<glm::dvec3, 3> translation_world;
+    for (int c = 0; c < 3; ++c) {
+        r.rotation[c] = glm::vec3(to_world * est.rotation[c]);
+        translation_world[c] = to_world * est.translation[c];
+        r.translation[c] = glm::vec3(translation_world[c]);
+    }
+    r.radius = limit_radius(est.harmonic_mean_distance, est.irradiance, translation_world, lim, pixel_footprint);
+    return r;
+}
+
+}  // namespace bounce
