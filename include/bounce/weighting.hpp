@@ -113,4 +113,21 @@ struct tabellion_weight {
     static T influence_radius(T r, T a) { return a * r; }
 };
 
+/// The weighting functions a program can choose at run time.
+enum class weighting_kind { ward, ward_smooth, ward_gpu, ward_gpu_shader, tabellion };
+
+/// Calls `f(Policy{})` with the policy type for `k`, so run-time choices reach compile-time
+/// kernels: `with_weighting(k, [&](auto w) { splat<decltype(w)>(...); })`.
+template <class F>
+decltype(auto) with_weighting(weighting_kind k, F&& f) {
+    switch (k) {
+        case weighting_kind::ward_smooth: return f(ward_smooth_weight{});
+        case weighting_kind::ward_gpu: return f(gpu_ward_weight<>{});
+        case weighting_kind::ward_gpu_shader: return f(gpu_ward_shader_weight{});
+        case weighting_kind::tabellion: return f(tabellion_weight{});
+        case weighting_kind::ward: break;
+    }
+    return f(ward_weight{});
+}
+
 }  // namespace bounce

@@ -1,0 +1,202 @@
+#pragma once
+/// \file splatting.hpp
+/// Irradiance splatting on the CPU (seed Algorithms 1 and 5): splat records onto a splat
+/// buffer, scan it for cache misses, normalize and compose.
+///
+/// The splat buffer holds (sum of w * rho_d/pi * E_k(p) in rgb, sum of w) per pixel as
+/// float32, the layout of the GL adapter's RGBA32F texture. Records are binned into
+/// screen tiles and each tile adds its records in index order, so every pixel sums the same
+/// terms in the same order whatever the thread count, and the same order as splatting the
+/// records one by one: results are bitwise reproducible.
+
+#include <bounce/camera.hpp>
+#include <bounce/gbuffer.hpp>
+#include <bounce/image.hpp>
+#include <bounce/irradiance_record.hpp>
+#include <bounce/splat_bounds.hpp>
+#include <bounce/weighting.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace bounce::cpu {
+
+/// Parameters shared by every splat of a frame.
+struct splat_params {
+    float a = 0.2f;                  ///< accuracy a of Eq. 8.3; typical 0.1-0.4 (smaller: more records)
+    bool gradients = true;           ///< extrapolate with the records' gradients
+    float max_extrapolation = 1.f;   ///< gradient term clamped to +-this * E_k per channel
+
+    void validate() const {
+        require(std::isfinite(a) && a > 0.f, "a", "accuracy must be a positive number");
+        require(std::isfinite(max_extrapolation) && max_extrapolation >= 0.f, "max_extrapolation",
+                "must be a non-negative number");
+    }
+};
+
+/// Inclusive pixel rectangle; empty when x0 > x1 or y0 > y1.
+struct pixel_rect {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    bool empty() const noexcept { return x0 > x1 || y0 > y1; }
+};
+
+/// Pixels whose centres the record's sphere of influence (radius `zone`) can cover, clipped
+/// to a width x height image and widened by one pixel so that pixels whose centres lie on
+/// the box edge are never lost to rounding (outside the sphere every weight is 0 anyway).
+inline pixel_rect splat_rect(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float zone,
+                             std::size_t width, std::size_t height) {
+    const glm::vec3 c = glm::vec3(view * glm::vec4(centre, 1.f));
+    const auto b = sphere_ndc_bounds<float, glm::vec3>(c, zone, cam.near_plane, cam.tan_half_fov(),
+                                                       float(width) / float(height));
+    if (!(b[0] <= b[2]) || b[0] >= 2.f) return {};
+    // Pixel x covers ndc [2x/W - 1, 2(x+1)/W - 1]; row 0 is the top (ndc y = +1).
+    auto px = [&](float ndc) { return double(ndc + 1.f) * 0.5 * double(width); };
+    auto py = [&](float ndc) { return double(1.f - ndc) * 0.5 * double(height); };
+    pixel_rect r;
+    r.x0 = int(std::max(0.0, std::floor(px(b[0]) - 0.5) - 1));
+    r.x1 = int(std::min(double(width) - 1, std::ceil(px(b[2]) - 0.5) + 1));
+    r.y0 = int(std::max(0.0, std::floor(py(b[3]) - 0.5) - 1));
+    r.y1 = int(std::min(double(height) - 1, std::ceil(py(b[1]) - 0.5) + 1));
+    return r;
+}
+
+namespace detail {
+template <class Weight>
+inline void splat_into(const gbuffer_view<float>& gb, const irradiance_record& rec, const splat_params& sp,
+                       const pixel_rect& r, image_view<glm::vec4> out) {
+    const float inv_r = 1.f / rec.radius;
+    for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) {
+            if (!gb.covered(std::size_t(x), std::size_t(y))) continue;
+            const glm::vec3 p = gb.position(x, y), n = gb.normal(x, y), albedo = gb.albedo(x, y);
+            const auto c =
+                sp.gradients
+                    ? splat_contribution<Weight, true, float, glm::vec3>(
+                          p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance, rec.rotation[0],
+                          rec.rotation[1], rec.rotation[2], rec.translation[0], rec.translation[1],
+                          rec.translation[2], sp.max_extrapolation)
+                    : splat_contribution<Weight, false, float, glm::vec3>(
+                          p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance, rec.rotation[0],
+                          rec.rotation[1], rec.rotation[2], rec.translation[0], rec.translation[1],
+                          rec.translation[2], sp.max_extrapolation);
+            if (c[3] > 0.f) out(x, y) += glm::vec4(c[0], c[1], c[2], c[3]);
+        }
+}
+}  // namespace detail
+
+/// Splats one record (seed Algorithm 1) onto `out`, sequentially. Used by the cache-miss
+/// scan, where each new record must be visible to the next pixel at once.
+template <class Weight>
+void splat_record(const gbuffer_view<float>& gb, const camera& cam, const irradiance_record& rec,
+                  const splat_params& sp, image_view<glm::vec4> out) {
+    const pixel_rect r = splat_rect(cam, cam.view_matrix(), rec.position,
+                                    Weight::template influence_radius<float>(rec.radius, sp.a), gb.width(), gb.height());
+    if (!r.empty()) detail::splat_into<Weight>(gb, rec, sp, r, out);
+}
+
+/// Splats every record onto `out` (added to what it holds) in parallel over screen tiles.
+/// `out` must be the G-buffer's size. Throws parameter_error on bad parameters or sizes.
+template <class Weight>
+void splat_records(const gbuffer_view<float>& gb, const camera& cam, std::span<const irradiance_record> records,
+                   const splat_params& sp, image_view<glm::vec4> out, int tile = 32) {
+    sp.validate();
+    require(out.width() == gb.width() && out.height() == gb.height(), "out", "splat buffer and G-buffer sizes differ");
+    require(tile > 0, "tile", "must be positive");
+    if (gb.width() == 0 || gb.height() == 0 || records.empty()) return;
+    const int tw = int((gb.width() + tile - 1) / tile), th = int((gb.height() + tile - 1) / tile);
+    const glm::mat4 view = cam.view_matrix();
+
+    std::vector<pixel_rect> rects(records.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, records.size()), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i)
+            rects[i] = splat_rect(cam, view, records[i].position,
+                                  Weight::template influence_radius<float>(records[i].radius, sp.a), gb.width(),
+                                  gb.height());
+    });
+    // Bin in record order: each tile's list is ascending, which fixes the summation order.
+    std::vector<std::vector<std::uint32_t>> bins(std::size_t(tw) * th);
+    for (std::size_t i = 0; i < records.size(); ++i) {
+        const auto& r = rects[i];
+        if (r.empty()) continue;
+        for (int ty = r.y0 / tile; ty <= r.y1 / tile; ++ty)
+            for (int tx = r.x0 / tile; tx <= r.x1 / tile; ++tx) bins[std::size_t(ty) * tw + tx].push_back(std::uint32_t(i));
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bins.size()), [&](const auto& range) {
+        for (std::size_t t = range.begin(); t != range.end(); ++t) {
+            const int tx = int(t % std::size_t(tw)), ty = int(t / std::size_t(tw));
+            const pixel_rect tile_rect{tx * tile, ty * tile, std::min(int(gb.width()), (tx + 1) * tile) - 1,
+                                       std::min(int(gb.height()), (ty + 1) * tile) - 1};
+            for (std::uint32_t i : bins[t]) {
+                const auto& r = rects[i];
+                const pixel_rect clipped{std::max(r.x0, tile_rect.x0), std::max(r.y0, tile_rect.y0),
+                                         std::min(r.x1, tile_rect.x1), std::min(r.y1, tile_rect.y1)};
+                if (!clipped.empty()) detail::splat_into<Weight>(gb, records[i], sp, clipped, out);
+            }
+        }
+    });
+}
+
+/// The cache-miss scan (seed Algorithm 5, step 4): visits covered pixels in `order` (row
+/// by row when empty; any permutation of pixel indices y * width + x otherwise), and where
+/// the accumulated weight is below `min_weight` asks `create(x, y)` for a record
+/// (std::optional<irradiance_record>; nullopt skips the pixel), appends it to `records` and
+/// splats it at once so later pixels see it. Stops after `max_new` records (progressive
+/// mode). Returns the number of records created.
+/// The seed tests the weight sum against a itself (Eq. 8.8); pass `min_weight = a` for that.
+template <class Weight, class Create>
+std::size_t scan_cache_misses(const gbuffer_view<float>& gb, const camera& cam, const splat_params& sp,
+                              float min_weight, Create&& create, std::vector<irradiance_record>& records,
+                              image_view<glm::vec4> splat, std::span<const std::uint32_t> order = {},
+                              std::size_t max_new = std::size_t(-1)) {
+    sp.validate();
+    require(std::isfinite(min_weight) && min_weight > 0.f, "min_weight", "must be a positive number");
+    require(splat.width() == gb.width() && splat.height() == gb.height(), "splat", "splat buffer and G-buffer sizes differ");
+    const std::size_t w = gb.width(), n = w * gb.height();
+    require(order.empty() || order.size() == n, "order", "must list every pixel once");
+    std::size_t created = 0;
+    for (std::size_t i = 0; i < n && created < max_new; ++i) {
+        const std::size_t idx = order.empty() ? i : order[i];
+        require(idx < n, "order", "pixel index out of range");
+        const std::size_t x = idx % w, y = idx / w;
+        if (!gb.covered(x, y) || splat(x, y).w >= min_weight) continue;
+        std::optional<irradiance_record> rec = create(x, y);
+        if (!rec) continue;
+        records.push_back(*rec);
+        splat_record<Weight>(gb, cam, records.back(), sp, splat);
+        ++created;
+    }
+    return created;
+}
+
+/// Normalization (seed Algorithm 5, last loop): indirect radiance = sum / weight, 0 where
+/// no record reached the pixel.
+inline void normalize_splats(image_view<const glm::vec4> splat, image_view<glm::vec3> indirect) {
+    require(splat.width() == indirect.width() && splat.height() == indirect.height(), "indirect",
+            "size differs from the splat buffer");
+    tbb::parallel_for(std::size_t(0), splat.height(), [&](std::size_t y) {
+        for (std::size_t x = 0; x < splat.width(); ++x) {
+            const glm::vec4 s = splat(x, y);
+            indirect(x, y) = s.w > 0.f ? glm::vec3(s) / s.w : glm::vec3(0.f);
+        }
+    });
+}
+
+/// Final image = direct + indirect radiance.
+inline void compose(image_view<const glm::vec3> direct, image_view<const glm::vec3> indirect, image_view<glm::vec3> out) {
+    require(direct.width() == out.width() && indirect.width() == out.width() && direct.height() == out.height() &&
+                indirect.height() == out.height(),
+            "out", "direct, indirect and output sizes differ");
+    tbb::parallel_for(std::size_t(0), out.height(), [&](std::size_t y) {
+        for (std::size_t x = 0; x < out.width(); ++x) out(x, y) = direct(x, y) + indirect(x, y);
+    });
+}
+
+}  // namespace bounce::cpu

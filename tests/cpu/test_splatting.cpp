@@ -1,0 +1,188 @@
+// CPU irradiance splatting on analytic G-buffers: zones of influence land where the math
+// says, the scan leaves no pixel under-covered, and results do not depend on threads.
+#include <bounce/cpu/splatting.hpp>
+#include <bounce/sampling.hpp>
+
+#include <catch2/catch.hpp>
+#include <tbb/global_control.h>
+
+#include <cstring>
+#include <numbers>
+
+using namespace bounce;
+
+namespace {
+// A camera looking down at the plane z = 0 from height 4, and the exact G-buffer of that plane.
+struct plane_view {
+    camera cam;
+    gbuffer<float> gb;
+    plane_view(std::size_t w, std::size_t h) : gb(w, h) {
+        cam.position = {0.3f, -0.2f, 4.f};
+        cam.look_at = {0.f, 0.f, 0.f};
+        cam.up = {0, 1, 0};
+        cam.fov_y_deg = 60.f;
+        const glm::vec3 f = cam.forward();
+        for (std::size_t y = 0; y < h; ++y)
+            for (std::size_t x = 0; x < w; ++x) {
+                const glm::vec3 d = cam.direction(float(x) + 0.5f, float(y) + 0.5f, w, h);
+                if (d.z >= 0.f) continue;
+                const float t = -cam.position.z / d.z;
+                const glm::vec3 p = cam.position + t * d;
+                gb.position(x, y) = p;
+                gb.normal(x, y) = {0, 0, 1};
+                gb.albedo(x, y) = {0.5f, 0.25f, 1.f};
+                gb.depth(x, y) = glm::dot(p - cam.position, f);
+            }
+    }
+};
+
+irradiance_record record_at(glm::vec3 p, float radius, glm::vec3 e) {
+    irradiance_record r;
+    r.position = p;
+    r.normal = {0, 0, 1};
+    r.irradiance = e;
+    r.radius = radius;
+    return r;
+}
+}  // namespace
+
+TEST_CASE("one Ward record covers exactly the pixels within a R of it, with rho/pi E", "[splat][cpu]") {
+    plane_view v(96, 64);
+    pcg32 rng(4);
+    for (int trial = 0; trial < 20; ++trial) {
+        const glm::vec3 pk(2.f * rng.next_float() - 1.f, 2.f * rng.next_float() - 1.f, 0.f);
+        const float radius = 0.2f + 2.f * rng.next_float(), a = 0.1f + 0.5f * rng.next_float();
+        const auto rec = record_at(pk, radius, {1.f, 2.f, 3.f});
+        image<glm::vec4> splat(96, 64, glm::vec4(0.f));
+        cpu::splat_params sp;
+        sp.a = a;
+        cpu::splat_records<ward_weight>(v.gb.view(), v.cam, std::span(&rec, 1), sp, splat.view());
+        for (std::size_t y = 0; y < 64; ++y)
+            for (std::size_t x = 0; x < 96; ++x) {
+                const float d = glm::length(v.gb.position(x, y) - pk);
+                const glm::vec4 s = splat(x, y);
+                // Same normals, so w = R/d, contributing where d <= aR. Pixels within float
+                // rounding of the border may go either way.
+                if (d < a * radius * (1 - 1e-5f)) {
+                    REQUIRE(s.w > 0.f);
+                    const float w = 1.f / std::max(float(inverse_weight_floor), d / radius);
+                    CHECK(s.w == Approx(w).epsilon(1e-5));
+                    CHECK(s.x / s.w == Approx(0.5f * 1.f / std::numbers::pi).epsilon(1e-5));
+                    CHECK(s.z / s.w == Approx(1.f * 3.f / std::numbers::pi).epsilon(1e-5));
+                } else if (d > a * radius * (1 + 1e-5f)) {
+                    REQUIRE(s.w == 0.f);
+                }
+            }
+    }
+}
+
+TEST_CASE("splatting is bitwise identical for any thread count and tile size", "[splat][cpu][determinism]") {
+    plane_view v(128, 96);
+    pcg32 rng(12);
+    std::vector<irradiance_record> recs;
+    for (int i = 0; i < 3000; ++i) {
+        auto r = record_at({4.f * rng.next_float() - 2.f, 4.f * rng.next_float() - 2.f, 0.f}, 0.1f + rng.next_float(),
+                           {rng.next_float(), rng.next_float(), rng.next_float()});
+        r.translation[0] = {rng.next_float() - 0.5f, rng.next_float() - 0.5f, 0.f};
+        recs.push_back(r);
+    }
+    cpu::splat_params sp;
+    sp.a = 0.3f;
+    auto run = [&](int threads, int tile) {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        image<glm::vec4> splat(128, 96, glm::vec4(0.f));
+        cpu::splat_records<ward_smooth_weight>(v.gb.view(), v.cam, recs, sp, splat.view(), tile);
+        return splat;
+    };
+    const auto one = run(1, 32), two = run(2, 32), odd = run(2, 7);
+    image<glm::vec4> seq(128, 96, glm::vec4(0.f));
+    for (const auto& r : recs) cpu::splat_record<ward_smooth_weight>(v.gb.view(), v.cam, r, sp, seq.view());
+    CHECK(std::memcmp(one.data(), two.data(), 128 * 96 * sizeof(glm::vec4)) == 0);
+    CHECK(std::memcmp(one.data(), odd.data(), 128 * 96 * sizeof(glm::vec4)) == 0);
+    CHECK(std::memcmp(one.data(), seq.data(), 128 * 96 * sizeof(glm::vec4)) == 0);
+}
+
+TEST_CASE("after the cache-miss scan every covered pixel meets the weight threshold", "[splat][cpu][scan]") {
+    plane_view v(80, 60);
+    const float a = GENERATE(0.4f, 0.2f, 0.1f);
+    const bool shuffled = GENERATE(false, true);
+    cpu::splat_params sp;
+    sp.a = a;
+    image<glm::vec4> splat(80, 60, glm::vec4(0.f));
+    std::vector<irradiance_record> recs;
+    std::vector<std::uint32_t> order;
+    if (shuffled) {
+        order.resize(80 * 60);
+        for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+        pcg32 rng(1);
+        for (std::size_t i = order.size() - 1; i > 0; --i) std::swap(order[i], order[rng.next_u32() % (i + 1)]);
+    }
+    auto create = [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
+        return record_at(v.gb.position(x, y), 0.5f, {1.f, 1.f, 1.f});
+    };
+    const auto n = cpu::scan_cache_misses<ward_smooth_weight>(v.gb.view(), v.cam, sp, a, create, recs, splat.view(), order);
+    CHECK(n == recs.size());
+    CHECK(n > 0);
+    for (std::size_t y = 0; y < 60; ++y)
+        for (std::size_t x = 0; x < 80; ++x)
+            if (v.gb.view().covered(x, y)) REQUIRE(splat(x, y).w >= a);
+    // The final splat of all records equals what the scan accumulated (same order).
+    image<glm::vec4> again(80, 60, glm::vec4(0.f));
+    cpu::splat_records<ward_smooth_weight>(v.gb.view(), v.cam, recs, sp, again.view());
+    CHECK(std::memcmp(again.data(), splat.data(), 80 * 60 * sizeof(glm::vec4)) == 0);
+    // Smaller a means smaller zones, hence more records: a must cost records.
+    CHECK(n >= (a < 0.3f ? 4u : 1u));
+}
+
+TEST_CASE("progressive scans stop at the record budget and resume where coverage is missing", "[splat][cpu][scan]") {
+    plane_view v(64, 48);
+    cpu::splat_params sp;
+    sp.a = 0.15f;
+    image<glm::vec4> splat(64, 48, glm::vec4(0.f));
+    std::vector<irradiance_record> recs;
+    auto create = [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
+        return record_at(v.gb.position(x, y), 0.4f, {1.f, 1.f, 1.f});
+    };
+    std::size_t frames = 0, total = 0;
+    for (;; ++frames) {
+        // Each frame re-splats the whole cache, then scans with a budget of 5 new records.
+        std::fill(splat.data(), splat.data() + 64 * 48, glm::vec4(0.f));
+        cpu::splat_records<ward_weight>(v.gb.view(), v.cam, recs, sp, splat.view());
+        const auto n = cpu::scan_cache_misses<ward_weight>(v.gb.view(), v.cam, sp, sp.a, create, recs, splat.view(), {}, 5);
+        CHECK(n <= 5);
+        total += n;
+        if (n == 0) break;
+        REQUIRE(frames < 1000);
+    }
+    CHECK(total == recs.size());
+    CHECK(frames >= 2);
+}
+
+TEST_CASE("normalization divides by the weight and leaves uncovered pixels black", "[splat][cpu]") {
+    image<glm::vec4> splat(3, 1, glm::vec4(0.f));
+    splat(0, 0) = {2.f, 4.f, 6.f, 2.f};
+    splat(1, 0) = {1e-30f, 0.f, 0.f, 1e-30f};
+    image<glm::vec3> out(3, 1);
+    cpu::normalize_splats(splat.view(), out.view());
+    CHECK(out(0, 0) == glm::vec3(1.f, 2.f, 3.f));
+    CHECK(out(1, 0).x == Approx(1.f));
+    CHECK(out(2, 0) == glm::vec3(0.f));
+}
+
+TEST_CASE("bad splatting parameters are refused with the parameter named", "[splat][cpu][bad-input]") {
+    plane_view v(8, 8);
+    image<glm::vec4> splat(8, 8), small(4, 4);
+    const auto rec = record_at({0, 0, 0}, 1.f, {1, 1, 1});
+    cpu::splat_params sp;
+    for (float a : {0.f, -1.f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        sp.a = a;
+        try {
+            cpu::splat_records<ward_weight>(v.gb.view(), v.cam, std::span(&rec, 1), sp, splat.view());
+            FAIL("accepted a = " << a);
+        } catch (const parameter_error& e) {
+            CHECK(e.parameter() == "a");
+        }
+    }
+    sp.a = 0.2f;
+    CHECK_THROWS_AS(cpu::splat_records<ward_weight>(v.gb.view(), v.cam, std::span(&rec, 1), sp, small.view()), parameter_error);
+}
