@@ -1,0 +1,153 @@
+#pragma once
+/// \file octree_cache.hpp
+/// The classical irradiance cache (Ward et al. 1988; the octree of pbrt-v2): records
+/// stored in an octree by their zone of influence, looked up per pixel. It is the baseline
+/// irradiance splatting must beat; it uses the same records, weights and a.
+///
+/// A record is stored in every node that overlaps its zone's bounding box, at the first
+/// depth whose node diagonal is smaller than the zone's (pbrt-v2's rule); a lookup walks
+/// from the root to the leaf containing p and tests the records met on the way. The tree
+/// depends on a (zones are a * R): changing a means rebuilding it, which splatting avoids.
+
+#include <bounce/camera.hpp>
+#include <bounce/gbuffer.hpp>
+#include <bounce/irradiance_record.hpp>
+#include <bounce/weighting.hpp>
+#include <bounce/cpu/splatting.hpp>
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <tbb/parallel_for.h>
+
+namespace bounce::cpu {
+
+template <class Weight>
+class octree_cache {
+public:
+    /// An empty cache over the box [lo, hi] (the scene bounds; records outside are clamped
+    /// into the root), for accuracy `sp.a`.
+    octree_cache(glm::vec3 lo, glm::vec3 hi, const splat_params& sp, int max_depth = 16)
+        : lo_(lo), hi_(hi), sp_(sp), max_depth_(max_depth), root_(std::make_unique<node>()) {
+        sp.validate();
+        require(hi.x >= lo.x && hi.y >= lo.y && hi.z >= lo.z, "bounds", "hi must not be below lo");
+        // A cube, slightly enlarged, so every record's centre falls inside.
+        const glm::vec3 c = 0.5f * (lo + hi);
+        const float half = 0.5f * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, 1e-6f}) * 1.001f;
+        lo_ = c - half;
+        hi_ = c + half;
+    }
+
+    const std::vector<irradiance_record>& records() const noexcept { return records_; }
+    const splat_params& params() const noexcept { return sp_; }
+
+    /// Adds a record (copied) to the tree.
+    void insert(const irradiance_record& rec) {
+        records_.push_back(rec);
+        const auto idx = std::uint32_t(records_.size() - 1);
+        const float zone = Weight::template influence_radius<float>(rec.radius, sp_.a);
+        insert(*root_, lo_, hi_, rec.position - zone, rec.position + zone, 2.f * zone * std::sqrt(3.f), idx, 0);
+    }
+
+    /// (sum of w * rho/pi * E_k(p), sum of w) over the records reaching p: the same value a
+    /// splat buffer holds at that pixel, summed in the same (record index) order.
+    glm::vec4 lookup(const glm::vec3& p, const glm::vec3& n, const glm::vec3& albedo) const {
+        // Collect candidates along the root-to-leaf path, then sum in index order so the
+        // result matches splatting bit for bit.
+        thread_local std::vector<std::uint32_t> hits;
+        hits.clear();
+        const node* nd = root_.get();
+        glm::vec3 lo = lo_, hi = hi_;
+        while (nd) {
+            hits.insert(hits.end(), nd->items.begin(), nd->items.end());
+            const glm::vec3 mid = 0.5f * (lo + hi);
+            const int child = (p.x > mid.x) | ((p.y > mid.y) << 1) | ((p.z > mid.z) << 2);
+            if (!nd->children[child]) break;
+            child_box(lo, hi, child, lo, hi);
+            nd = nd->children[child].get();
+        }
+        std::sort(hits.begin(), hits.end());
+        glm::vec4 sum(0.f);
+        for (std::uint32_t i : hits) {
+            const auto& r = records_[i];
+            const auto c = sp_.gradients
+                               ? splat_contribution<Weight, true, float, glm::vec3>(
+                                     p, n, albedo, r.position, r.normal, 1.f / r.radius, sp_.a, r.irradiance,
+                                     r.rotation[0], r.rotation[1], r.rotation[2], r.translation[0], r.translation[1],
+                                     r.translation[2], sp_.max_extrapolation)
+                               : splat_contribution<Weight, false, float, glm::vec3>(
+                                     p, n, albedo, r.position, r.normal, 1.f / r.radius, sp_.a, r.irradiance,
+                                     r.rotation[0], r.rotation[1], r.rotation[2], r.translation[0], r.translation[1],
+                                     r.translation[2], sp_.max_extrapolation);
+            if (c[3] > 0.f) sum += glm::vec4(c[0], c[1], c[2], c[3]);
+        }
+        return sum;
+    }
+
+    /// Classical first pass: visit pixels in row order; where the cache's weight is below
+    /// `min_weight`, create a record and insert it. Later pixels see it; earlier ones do
+    /// not, which is why the classical method needs the second pass (`render`).
+    template <class Create>
+    std::size_t fill(const gbuffer_view<float>& gb, float min_weight, Create&& create) {
+        std::size_t created = 0;
+        for (std::size_t y = 0; y < gb.height(); ++y)
+            for (std::size_t x = 0; x < gb.width(); ++x) {
+                if (!gb.covered(x, y)) continue;
+                if (lookup(gb.position(x, y), gb.normal(x, y), gb.albedo(x, y)).w >= min_weight) continue;
+                if (auto rec = create(x, y)) {
+                    insert(*rec);
+                    ++created;
+                }
+            }
+        return created;
+    }
+
+    /// Second pass: the (sum, weight) of every pixel by lookups, in parallel.
+    void render(const gbuffer_view<float>& gb, image_view<glm::vec4> out) const {
+        require(out.width() == gb.width() && out.height() == gb.height(), "out", "size differs from the G-buffer");
+        tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t y) {
+            for (std::size_t x = 0; x < gb.width(); ++x)
+                out(x, y) = gb.covered(x, y) ? lookup(gb.position(x, y), gb.normal(x, y), gb.albedo(x, y)) : glm::vec4(0.f);
+        });
+    }
+
+private:
+    struct node {
+        std::vector<std::uint32_t> items;
+        std::array<std::unique_ptr<node>, 8> children;
+    };
+
+    static void child_box(glm::vec3 lo, glm::vec3 hi, int child, glm::vec3& clo, glm::vec3& chi) {
+        const glm::vec3 mid = 0.5f * (lo + hi);
+        clo = {child & 1 ? mid.x : lo.x, child & 2 ? mid.y : lo.y, child & 4 ? mid.z : lo.z};
+        chi = {child & 1 ? hi.x : mid.x, child & 2 ? hi.y : mid.y, child & 4 ? hi.z : mid.z};
+    }
+
+    void insert(node& nd, glm::vec3 lo, glm::vec3 hi, glm::vec3 blo, glm::vec3 bhi, float diag, std::uint32_t idx, int depth) {
+        // Store here once the node is no larger than the zone (or at the depth limit).
+        if (depth == max_depth_ || glm::length(hi - lo) < diag) {
+            nd.items.push_back(idx);
+            return;
+        }
+        for (int c = 0; c < 8; ++c) {
+            glm::vec3 clo, chi;
+            child_box(lo, hi, c, clo, chi);
+            if (bhi.x < clo.x || blo.x > chi.x || bhi.y < clo.y || blo.y > chi.y || bhi.z < clo.z || blo.z > chi.z)
+                continue;
+            if (!nd.children[c]) nd.children[c] = std::make_unique<node>();
+            insert(*nd.children[c], clo, chi, blo, bhi, diag, idx, depth + 1);
+        }
+    }
+
+    glm::vec3 lo_, hi_;
+    splat_params sp_;
+    int max_depth_;
+    std::unique_ptr<node> root_;
+    std::vector<irradiance_record> records_;
+};
+
+}  // namespace bounce::cpu
