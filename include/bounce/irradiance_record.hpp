@@ -66,6 +66,13 @@ std::array<T, 4> splat_contribution(const V& p, const V& n, const V& albedo, con
     return {lo.x, lo.y, lo.z, w};
 }
 
+/// Normalization of the splat buffer (seed Algorithm 5, last loop): sum / weight, black
+/// where no record reached the pixel.
+template <real T, vec3_of<T> V>
+V normalized_splat(const V& sum, T weight) {
+    return select(weight > T(0), sum / select(weight > T(0), weight, T(1)), sum * T(0));
+}
+
 /// Limits on a record's radius R (Tabellion and Lamorlette 2004; Krivanek et al. 2006).
 /// Every value is optional; defaults leave R unchanged.
 struct radius_limits {

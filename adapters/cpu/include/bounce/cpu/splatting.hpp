@@ -184,7 +184,7 @@ inline void normalize_splats(image_view<const glm::vec4> splat, image_view<glm::
     tbb::parallel_for(std::size_t(0), splat.height(), [&](std::size_t y) {
         for (std::size_t x = 0; x < splat.width(); ++x) {
             const glm::vec4 s = splat(x, y);
-            indirect(x, y) = s.w > 0.f ? glm::vec3(s) / s.w : glm::vec3(0.f);
+            indirect(x, y) = normalized_splat<float, glm::vec3>(glm::vec3(s), s.w);
         }
     });
 }
