@@ -1,0 +1,135 @@
+#pragma once
+// Save-and-restore of the context state a pass changes, so the adapter works inside a
+// renderer's own context without disturbing it (private to the adapter).
+#define GL_GLEXT_PROTOTYPES
+#include <GL/glcorearb.h>
+
+#include <array>
+
+namespace bounce::gl::detail {
+
+/// Pixel-pack state set to tightly packed client memory (no pack buffer) for reads.
+class pack_state {
+public:
+    pack_state() {
+        glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &buffer_);
+        for (std::size_t i = 0; i < names_.size(); ++i) glGetIntegerv(names_[i], &values_[i]);
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        for (std::size_t i = 0; i < names_.size(); ++i) glPixelStorei(names_[i], names_[i] == GL_PACK_ALIGNMENT ? 4 : 0);
+    }
+    ~pack_state() {
+        for (std::size_t i = 0; i < names_.size(); ++i) glPixelStorei(names_[i], values_[i]);
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, GLuint(buffer_));
+    }
+    pack_state(const pack_state&) = delete;
+    pack_state& operator=(const pack_state&) = delete;
+
+private:
+    static constexpr std::array<GLenum, 8> names_ = {GL_PACK_ALIGNMENT,  GL_PACK_ROW_LENGTH,  GL_PACK_SKIP_ROWS,
+                                                     GL_PACK_SKIP_PIXELS, GL_PACK_IMAGE_HEIGHT, GL_PACK_SKIP_IMAGES,
+                                                     GL_PACK_SWAP_BYTES, GL_PACK_LSB_FIRST};
+    GLint buffer_ = 0;
+    std::array<GLint, 8> values_{};
+};
+
+/// The program in use and one indexed shader-storage binding (with its range).
+class program_and_storage_state {
+public:
+    explicit program_and_storage_state(std::initializer_list<GLuint> storage_indices) {
+        glGetIntegerv(GL_CURRENT_PROGRAM, &program_);
+        glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
+        for (GLuint i : storage_indices) {
+            binding b{i};
+            glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &b.buffer);
+            glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, i, &b.start);
+            glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, i, &b.size);
+            bindings_[count_++] = b;
+        }
+    }
+    ~program_and_storage_state() {
+        for (std::size_t k = 0; k < count_; ++k) {
+            const auto& b = bindings_[k];
+            if (b.size > 0) glBindBufferRange(GL_SHADER_STORAGE_BUFFER, b.index, GLuint(b.buffer), b.start, b.size);
+            else glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b.index, GLuint(b.buffer));
+        }
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(generic_));
+        glUseProgram(GLuint(program_));
+    }
+    program_and_storage_state(const program_and_storage_state&) = delete;
+    program_and_storage_state& operator=(const program_and_storage_state&) = delete;
+
+private:
+    struct binding {
+        GLuint index = 0;
+        GLint buffer = 0;
+        GLint64 start = 0, size = 0;
+    };
+    GLint program_ = 0, generic_ = 0;
+    std::array<binding, 4> bindings_{};
+    std::size_t count_ = 0;
+};
+
+/// Fixed-function state of a raster pass: framebuffers, viewport, vertex array, the
+/// capabilities that would change what a pass draws (set to the pass's needs: depth test
+/// on with GL_LESS and writes, everything else off), masks, polygon mode, clip control.
+class raster_state {
+public:
+    raster_state() {
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_fb_);
+        glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read_fb_);
+        glGetIntegerv(GL_VIEWPORT, viewport_.data());
+        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &vao_);
+        for (std::size_t i = 0; i < caps_.size(); ++i) enabled_[i] = glIsEnabled(caps_[i]);
+        glGetIntegerv(GL_DEPTH_FUNC, &depth_func_);
+        glGetBooleanv(GL_DEPTH_WRITEMASK, &depth_mask_);
+        glGetDoublev(GL_DEPTH_RANGE, depth_range_.data());
+        glGetBooleanv(GL_COLOR_WRITEMASK, color_mask_.data());
+        glGetIntegerv(GL_POLYGON_MODE, polygon_mode_.data());
+        glGetIntegerv(GL_CLIP_ORIGIN, &clip_origin_);
+        glGetIntegerv(GL_CLIP_DEPTH_MODE, &clip_depth_);
+
+        for (std::size_t i = 0; i < caps_.size(); ++i)
+            if (caps_[i] == GL_DEPTH_TEST) glEnable(caps_[i]);
+            else glDisable(caps_[i]);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glDepthRange(0.0, 1.0);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+        glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    }
+    ~raster_state() {
+        glClipControl(GLenum(clip_origin_), GLenum(clip_depth_));
+        glPolygonMode(GL_FRONT_AND_BACK, GLenum(polygon_mode_[0]));
+        glColorMask(color_mask_[0], color_mask_[1], color_mask_[2], color_mask_[3]);
+        glDepthRange(depth_range_[0], depth_range_[1]);
+        glDepthMask(depth_mask_);
+        glDepthFunc(GLenum(depth_func_));
+        for (std::size_t i = 0; i < caps_.size(); ++i)
+            if (enabled_[i]) glEnable(caps_[i]);
+            else glDisable(caps_[i]);
+        glBindVertexArray(GLuint(vao_));
+        glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(read_fb_));
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(draw_fb_));
+    }
+    raster_state(const raster_state&) = delete;
+    raster_state& operator=(const raster_state&) = delete;
+
+private:
+    static constexpr std::array<GLenum, 13> caps_ = {
+        GL_DEPTH_TEST,      GL_BLEND,           GL_CULL_FACE,          GL_SCISSOR_TEST,
+        GL_STENCIL_TEST,    GL_RASTERIZER_DISCARD, GL_DEPTH_CLAMP,     GL_POLYGON_OFFSET_FILL,
+        GL_SAMPLE_ALPHA_TO_COVERAGE, GL_SAMPLE_COVERAGE, GL_COLOR_LOGIC_OP, GL_PRIMITIVE_RESTART,
+        GL_PRIMITIVE_RESTART_FIXED_INDEX};
+    GLint draw_fb_ = 0, read_fb_ = 0, vao_ = 0, depth_func_ = GL_LESS, clip_origin_ = GL_LOWER_LEFT,
+          clip_depth_ = GL_NEGATIVE_ONE_TO_ONE;
+    std::array<GLint, 4> viewport_{};
+    std::array<GLboolean, 13> enabled_{};
+    GLboolean depth_mask_ = GL_TRUE;
+    std::array<GLdouble, 2> depth_range_{0, 1};
+    std::array<GLboolean, 4> color_mask_{GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE};
+    std::array<GLint, 2> polygon_mode_{GL_FILL, GL_FILL};
+};
+
+}  // namespace bounce::gl::detail
