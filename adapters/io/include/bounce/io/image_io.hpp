@@ -3,21 +3,36 @@
 /// Images through OpenImageIO: EXR (float, linear) for data, PNG (tone-mapped, sRGB) for
 /// people; and the error figures every technique reports against its reference.
 
+#include <bounce/errors.hpp>
 #include <bounce/image.hpp>
 
 #include <filesystem>
+#include <string>
 #include <glm/vec3.hpp>
 
 namespace bounce::io {
+
+/// An image file that cannot be read or written; `file()` names it.
+struct image_error : bounce::error {
+    image_error(std::filesystem::path file, const std::string& what);
+    const std::filesystem::path& file() const noexcept { return file_; }
+
+private:
+    std::filesystem::path file_;
+};
 
 /// Writes linear RGB float pixels as OpenEXR (any extension OIIO knows works).
 /// Throws io::image_error naming the file on failure.
 void write_exr(const std::filesystem::path& file, image_view<const glm::vec3> rgb);
 /// Writes a single-channel float image as OpenEXR.
 void write_exr(const std::filesystem::path& file, image_view<const float> value);
-/// Reads an RGB(A) image as linear float RGB. Throws io::image_error.
+/// Reads an image as linear float RGB: the first three channels (one channel: grey, two:
+/// grey and alpha), 8/16-bit files tagged sRGB decoded to linear. Throws io::image_error.
 image<glm::vec3> read_rgb(const std::filesystem::path& file);
-/// Writes `rgb * exposure`, clamped and sRGB-encoded, as an 8-bit PNG.
+/// Writes `rgb * exposure`, clamped to [0, 1] and sRGB-encoded (IEC 61966-2-1), as an 8-bit
+/// PNG (any 8-bit format OIIO knows by the extension). Non-finite pixels are written black.
+/// \param exposure linear scale before clamping, finite and > 0; typical: 1.
+/// \throws parameter_error on a bad exposure or an empty image, io::image_error on I/O.
 void write_png(const std::filesystem::path& file, image_view<const glm::vec3> rgb, float exposure = 1.f);
 
 /// Error of an image against a reference, on luminance (Rec. 709 weights), over the
@@ -26,9 +41,13 @@ struct error_figures {
     double rel_rms = 0;  ///< sqrt(mean((x - ref)^2)) / sqrt(mean(ref^2))
     double max_abs = 0;  ///< max |x - ref|
     double sum_sq = 0;   ///< sum of squared differences (some seeds report it)
-    std::size_t pixels = 0;
+    std::size_t pixels = 0;  ///< pixels compared (non-zero in the mask)
 };
-/// Throws parameter_error when sizes differ or an image is empty.
+/// Computed with OIIO's ImageBufAlgo::compare on luminance images whose unmasked pixels are
+/// 0 in both (the pixel count cancels in the ratio). rel_rms is 0 when x and ref are both
+/// 0 on the mask, and +infinity when ref alone is. `mask`, when given, has their size.
+/// Throws parameter_error when sizes differ, an image is empty, a value is not finite, or
+/// the mask selects no pixel.
 error_figures compare_luminance(image_view<const glm::vec3> x, image_view<const glm::vec3> ref,
                                 image_view<const float> mask = {});
 

@@ -21,6 +21,8 @@ namespace bounce::io {
 /// A malformed, truncated, empty or missing scene file. `file()` and `line()` say where
 /// (line 0 when the fault is not tied to a line, e.g. a missing file or a JSON field).
 struct scene_error : bounce::error {
+    /// \param file the file at fault; \param line 1-based line, 0 when not tied to a line;
+    /// \param what the fault, starting with the field for JSON faults ("camera.fov_y_deg: ...").
     scene_error(std::filesystem::path file, std::size_t line, const std::string& what);
     const std::filesystem::path& file() const noexcept { return file_; }
     std::size_t line() const noexcept { return line_; }
@@ -30,6 +32,7 @@ private:
     std::size_t line_;
 };
 
+/// A diffuse material: MTL `Kd` and `Ke`.
 struct material {
     std::string name;
     glm::vec3 kd{0.8f};  ///< diffuse reflectance rho_d, each channel in [0, 1]
@@ -57,6 +60,7 @@ struct directional_light {
 
 using light = std::variant<point_light, spot_light, directional_light>;
 
+/// A triangle mesh with per-vertex normals, per-triangle materials, lights and a camera.
 struct scene {
     std::string name;                        ///< "cornell" or the scene folder's name
     std::filesystem::path source;            ///< the scene.json or OBJ it came from (empty if built in)
@@ -68,6 +72,9 @@ struct scene {
     std::vector<light> lights;
     bool use_emission = false;  ///< faces whose material has ke > 0 are area lights too
     bounce::camera camera;
+    /// What the loader repaired or dropped without failing (degenerate triangles, repeated
+    /// triangles, zero normals), one line each, for programs to print.
+    std::vector<std::string> warnings;
 
     /// Indices of triangles that emit (only when use_emission).
     std::vector<std::uint32_t> emissive_triangles() const;
@@ -75,16 +82,28 @@ struct scene {
     std::pair<glm::vec3, glm::vec3> bounds() const;
 };
 
-/// Loads a scene.json (and the OBJ+MTL it names). Throws scene_error.
+/// Loads a scene.json (and the OBJ+MTL it names), as docs/scenes.md specifies.
+/// \param scene_json path of the JSON file; the OBJ path inside it is relative to its folder.
+/// \throws scene_error naming the file and the line (OBJ, MTL, JSON syntax) or the field
+///         (e.g. "lights[0].intensity: expected 3 numbers").
 scene load_scene(const std::filesystem::path& scene_json);
-/// Loads an OBJ (+MTL) alone with default camera/lights fitted to its bounds.
+/// Loads an OBJ (+MTL) alone. The camera sits on the +z side of the bounds looking at their
+/// centre (fov_y 45 deg, bounding sphere in view); the light is a point light at the camera
+/// giving about 1 W/m^2 at the centre, or none with use_emission when a used material has Ke.
+/// \param default_material the material of faces without `usemtl`.
+/// \throws scene_error naming the file and line.
 scene load_obj(const std::filesystem::path& obj, const material& default_material = {});
-/// The Cornell box from its published dimensions and reflectances, with camera and light.
+/// The Cornell box from its published dimensions (Cornell University Program of Computer
+/// Graphics, "Cornell Box Data"), in metres, with the published camera, the light quad as
+/// an emissive material (Ke = (17, 12, 4), use_emission false) and a cosine spot of the same
+/// power just below it. 38 triangles, all facing into the box (see docs/scenes.md).
 scene cornell_box();
-/// What every program's `--scene` accepts: `cornell` for the built-in box, or a path to a
-/// scene.json (or an .obj).
+/// What every program's `--scene` accepts: `cornell` for the built-in box, a path to a
+/// scene.json, a folder holding a scene.json, or an .obj (loaded with load_obj).
+/// \throws scene_error
 scene load_scene_arg(std::string_view arg);
-/// Where the shared scenes live: $BOUNCE_SCENES, else "../shared/scenes".
+/// Where the shared scenes live: $BOUNCE_SCENES when set and non-empty, else
+/// "../shared/scenes" (relative to the working directory).
 std::filesystem::path scenes_dir();
 
 }  // namespace bounce::io

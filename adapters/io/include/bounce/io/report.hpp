@@ -1,0 +1,126 @@
+#pragma once
+/// \file report.hpp
+/// The run report every example writes with `--json PATH` (design.md section 6), and the
+/// stage timer whose medians fill its `timings_ms`.
+///
+/// The JSON object, keys in this order:
+/// ```
+/// { "technique": "ic_splatting", "scene": "cornell", "width": 512, "height": 512,
+///   "backend": "cpu",
+///   "parameters": { "a": 0.15, "weight": "ward", ... },     // whatever the run was given
+///   "repeat": 5,                                            // samples per stage
+///   "timings_ms": { "gbuffer": 3.1, "interpolate": 8.2, ..., "total": 40.2 },  // medians
+///   "error": { "rel_rms": 0.041, "max_abs": 0.8, "sum_sq": 12.5, "pixels": 251234 },
+///   "records": 1834, "vpls": 0, ... }                       // counts, top level
+/// ```
+/// `error` is absent when the run had no reference. Non-finite numbers are written as null
+/// (JSON has no infinity). Timings keep the order in which the stages first started.
+
+#include <bounce/errors.hpp>
+#include <bounce/io/image_io.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace bounce::io {
+
+/// A report file that cannot be written; `file()` names it.
+struct report_error : bounce::error {
+    report_error(std::filesystem::path file, const std::string& what);
+    const std::filesystem::path& file() const noexcept { return file_; }
+
+private:
+    std::filesystem::path file_;
+};
+
+/// Wall-clock samples per named stage (std::chrono::steady_clock, milliseconds); the
+/// report takes their medians, which a single slow repeat (page faults, a shader compile)
+/// does not move.
+class stage_timer {
+public:
+    /// Times from construction to destruction (or `stop()`) and adds the sample to its stage.
+    class scope {
+    public:
+        scope(stage_timer& timer, std::string stage);
+        scope(scope&& other) noexcept;
+        scope(const scope&) = delete;
+        scope& operator=(const scope&) = delete;
+        scope& operator=(scope&&) = delete;
+        ~scope();
+        /// Ends the sample now; later calls and the destructor do nothing. Returns its ms.
+        double stop();
+
+    private:
+        stage_timer* timer_;
+        std::string stage_;
+        std::chrono::steady_clock::time_point start_;
+    };
+
+    /// Starts a sample of `stage` ("gbuffer", "interpolate", "total" ...) that ends when the
+    /// returned scope does.
+    [[nodiscard]] scope measure(std::string stage) { return scope(*this, std::move(stage)); }
+
+    /// Calls `f()`, adds its duration to `stage`, and returns what `f` returns.
+    template <class F>
+    decltype(auto) time(std::string_view stage, F&& f) {
+        scope s(*this, std::string(stage));
+        return std::forward<F>(f)();
+    }
+
+    /// Adds one sample of `ms` milliseconds (finite, >= 0) to `stage`.
+    /// Throws parameter_error otherwise or when `stage` is empty.
+    void add_sample(std::string_view stage, double ms);
+    /// The samples of `stage` in the order they were taken (empty if never timed).
+    std::vector<double> samples(std::string_view stage) const;
+    /// Median of the samples of `stage` (mean of the middle two for an even count).
+    /// Throws parameter_error when `stage` has no sample.
+    double median_ms(std::string_view stage) const;
+    /// Names of the stages with samples, in the order they were first started.
+    std::vector<std::string> stages() const;
+    /// The largest number of samples of any stage (the `--repeat` count in practice).
+    std::size_t repeats() const;
+    /// Forgets every sample.
+    void clear() noexcept { stages_.clear(); }
+
+private:
+    std::vector<double>& open_stage(std::string_view stage);
+    std::vector<std::pair<std::string, std::vector<double>>> stages_;
+};
+
+/// The measurement record of one run of one technique (design.md section 6).
+struct run_report {
+    std::string technique;  ///< the program, e.g. "ic_splatting", "reference"
+    std::string scene;      ///< scene name: "cornell", "sponza" ...
+    std::size_t width = 0;  ///< image width in pixels
+    std::size_t height = 0; ///< image height in pixels
+    std::string backend;    ///< "cpu", "gl", "embree" ...
+    /// The run's parameters as given, e.g. `parameters["a"] = 0.15`.
+    nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+    /// Per stage, the median in milliseconds over the repeats (see set_timings).
+    std::vector<std::pair<std::string, double>> timings_ms;
+    std::size_t repeat = 1;  ///< samples behind each timing
+    std::optional<error_figures> error;  ///< against the reference, when one was computed
+    /// Counts written at the top level: "records", "vpls", "probes", "elements" ...
+    std::vector<std::pair<std::string, std::uint64_t>> counts;
+
+    /// Fills timings_ms with the medians of `timer`'s stages and repeat with its repeats().
+    void set_timings(const stage_timer& timer);
+    /// Sets (or replaces) the count `name`.
+    void set_count(std::string name, std::uint64_t value);
+    /// The JSON object above. Throws parameter_error when technique, scene or backend is
+    /// empty, a size is 0, or a count's name is one of the other keys.
+    nlohmann::ordered_json to_json() const;
+    /// Writes to_json() to `file`, indented, creating its parent folder.
+    /// Throws report_error when the file cannot be written.
+    void write(const std::filesystem::path& file) const;
+};
+
+}  // namespace bounce::io

@@ -1,0 +1,127 @@
+// io::scene basics, the OBJ-only loader, and what `--scene` accepts.
+#include "scene_assembly.hpp"
+
+#include <bounce/io/scene.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+
+namespace bounce::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+// "bounce: FILE:LINE: WHAT", or "bounce: FILE: WHAT" for line 0. (fmt rather than string
+// operator+, which trips GCC 12's false -Wrestrict, bug 105651.)
+std::string located(const fs::path& file, std::size_t line, const std::string& what) {
+    return line > 0 ? fmt::format("bounce: {}:{}: {}", file.string(), line, what)
+                    : fmt::format("bounce: {}: {}", file.string(), what);
+}
+}  // namespace
+
+scene_error::scene_error(fs::path file, std::size_t line, const std::string& what)
+    : bounce::error(located(file, line, what)), file_(std::move(file)), line_(line) {}
+
+std::vector<std::uint32_t> scene::emissive_triangles() const {
+    std::vector<std::uint32_t> out;
+    if (!use_emission) return out;
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        const auto m = t < material_of.size() ? material_of[t] : std::uint32_t(materials.size());
+        if (m < materials.size()) {
+            const glm::vec3 ke = materials[m].ke;
+            if (ke.r > 0.f || ke.g > 0.f || ke.b > 0.f) out.push_back(std::uint32_t(t));
+        }
+    }
+    return out;
+}
+
+std::pair<glm::vec3, glm::vec3> scene::bounds() const {
+    if (positions.empty()) return {glm::vec3(0.f), glm::vec3(0.f)};
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const auto& p : positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    return {lo, hi};
+}
+
+namespace detail {
+void fit_clip_planes(bounce::camera& camera, const std::pair<glm::vec3, glm::vec3>& bounds) {
+    float farthest = 0.f;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 corner((i & 1) ? bounds.second.x : bounds.first.x, (i & 2) ? bounds.second.y : bounds.first.y,
+                               (i & 4) ? bounds.second.z : bounds.first.z);
+        farthest = std::max(farthest, glm::length(corner - camera.position));
+    }
+    const float far_plane = 2.f * farthest, near_plane = 1e-4f * far_plane;
+    // Keep the defaults where the scene's scale leaves float's normal range.
+    if (!std::isfinite(far_plane) || !(near_plane >= std::numeric_limits<float>::min())) return;
+    camera.far_plane = far_plane;
+    camera.near_plane = near_plane;
+}
+}  // namespace detail
+
+scene load_obj(const fs::path& obj, const material& default_material) {
+    scene s;
+    s.name = obj.stem().string();
+    s.source = obj;
+    detail::load_obj_mesh(obj, default_material, s);
+
+    // Frame the bounding sphere in a 45 degree view from +z: distance r / sin(22.5 deg),
+    // with 5% to spare. In double: a mesh near the float range would overflow.
+    const auto [lo, hi] = s.bounds();
+    const glm::dvec3 centre = 0.5 * (glm::dvec3(lo) + glm::dvec3(hi));
+    const double radius = 0.5 * glm::length(glm::dvec3(hi) - glm::dvec3(lo));
+    const double distance = 1.05 * radius / std::sin(glm::radians(22.5));
+    const glm::dvec3 eye = centre + glm::dvec3(0.0, 0.0, distance);
+    const double limit = double(std::numeric_limits<float>::max());
+    if (!(std::abs(eye.z) < limit && distance * distance < limit))
+        throw scene_error(obj, 0, "the mesh is too large (extent " + std::to_string(2 * radius) +
+                                      ") to place a camera and a light around it in float");
+    s.camera.position = glm::vec3(eye);
+    s.camera.look_at = glm::vec3(centre);
+    s.camera.up = {0.f, 1.f, 0.f};
+    s.camera.fov_y_deg = 45.f;
+    detail::fit_clip_planes(s.camera, s.bounds());
+    try {
+        s.camera.validate();
+    } catch (const parameter_error&) {
+        // The eye rounds onto the centre: a mesh far smaller than float's resolution at its position.
+        throw scene_error(obj, 0, "the mesh is too small (extent " + std::to_string(2 * radius) +
+                                      ") for float to place a camera around it");
+    }
+
+    s.use_emission = true;
+    if (s.emissive_triangles().empty()) {
+        s.use_emission = false;
+        // A head light: E = I / d^2 = 1 W/m^2 at the centre.
+        s.lights.emplace_back(point_light{s.camera.position, glm::vec3(float(distance * distance))});
+    }
+    return s;
+}
+
+scene load_scene_arg(std::string_view arg) {
+    if (arg == "cornell") return cornell_box();
+    if (arg.empty()) throw scene_error("", 0, "--scene: empty argument (expected cornell or a path)");
+    fs::path p{std::string(arg)};
+    std::error_code ec;
+    if (fs::is_directory(p, ec)) p /= "scene.json";
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".obj") return load_obj(p);
+    return load_scene(p);
+}
+
+fs::path scenes_dir() {
+    const char* env = std::getenv("BOUNCE_SCENES");
+    if (env && *env) return fs::path(env);
+    return fs::path("..") / "shared" / "scenes";
+}
+
+}  // namespace bounce::io
