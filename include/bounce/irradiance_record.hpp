@@ -117,12 +117,13 @@ float neighbour_clamped_radius(const irradiance_record& rec, const Range& others
     return r;
 }
 
-/// A record at (p, n) from a hemisphere estimate in the local frame of n (see
-/// irradiance_gradients.hpp), with its radius limited as above.
-inline irradiance_record make_record(const glm::vec3& p, const glm::vec3& n, const hemisphere_estimate& est,
+/// A record at (p, n) from a hemisphere estimate in the local frame (tangent, bitangent, n)
+/// the samples were taken in (see irradiance_gradients.hpp), with its radius limited as
+/// above.
+inline irradiance_record make_record(const glm::vec3& p, const glm::vec3& n, const glm::vec3& tangent,
+                                     const glm::vec3& bitangent, const hemisphere_estimate& est,
                                      const radius_limits& lim, double pixel_footprint) {
-    const auto tb = orthonormal_basis<float, glm::vec3>(n);
-    const glm::dmat3 to_world{glm::dvec3(tb[0]), glm::dvec3(tb[1]), glm::dvec3(n)};
+    const glm::dmat3 to_world{glm::dvec3(tangent), glm::dvec3(bitangent), glm::dvec3(n)};
     irradiance_record r;
     r.position = p;
     r.normal = n;

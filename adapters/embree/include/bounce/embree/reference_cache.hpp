@@ -1,0 +1,52 @@
+#pragma once
+/// \file reference_cache.hpp
+/// Reference images cached on disk, so every example computes its ground truth once.
+///
+/// A cache entry is `<dir>/<key>.direct.exr` and `<key>.indirect.exr` (linear float RGB),
+/// with `<key>.json` describing what it was computed from. The key names the scene, the
+/// size and the sample count for people, and ends in a 64-bit FNV-1a hash of everything
+/// the images depend on: the scene's geometry, normals, materials, lights and
+/// use_emission, the camera, the size, the integrator settings (samples, environment,
+/// ray offset, seed) and the integrator's version. Change any of them and the key changes.
+
+#include <bounce/camera.hpp>
+#include <bounce/embree/accel.hpp>
+#include <bounce/embree/reference.hpp>
+#include <bounce/io/scene.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace bounce::embree {
+
+/// $BOUNCE_CACHE when set; else `cache/` beside the `bin/` folder the running program lives
+/// in (build/bin/reference -> build/cache); else ./build/cache.
+std::filesystem::path default_cache_dir();
+
+/// The cache key of a reference render of `scene` seen by `cam` at `width` x `height` with
+/// `settings`: "<scene name>-<W>x<H>-<spp>spp-<16 hex digits>" (file-name safe).
+std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                                std::size_t height, const reference_settings& settings);
+
+/// The cached images under `key` in `dir`, or nothing when an entry is missing, unreadable
+/// or of another size than `width` x `height` (the caller then recomputes). The combined
+/// image is recomputed as direct + indirect.
+std::optional<reference_images> load_cached_reference(const std::filesystem::path& dir, const std::string& key,
+                                                      std::size_t width, std::size_t height,
+                                                      const reference_settings& settings);
+
+/// Writes `images` under `key` in `dir` (created when missing). Each file is written to a
+/// temporary name and renamed, so a reader never sees half an entry. Throws bounce::error
+/// (from the image writer) when the directory or a file cannot be written.
+void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
+                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings);
+
+/// The reference images of `scene` through `cam`: from the cache when present, else ray
+/// cast G-buffer + render_reference, stored for next time. `from_cache` (optional)
+/// receives whether the cache answered.
+reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
+                                  std::size_t width, std::size_t height, const reference_settings& settings,
+                                  const std::filesystem::path& dir = default_cache_dir(), bool* from_cache = nullptr);
+
+}  // namespace bounce::embree

@@ -1,0 +1,224 @@
+// Reference images cached as EXR under a content hash of everything they depend on.
+#include <bounce/embree/reference_cache.hpp>
+
+#include <bounce/embree/ray_cast_gbuffer.hpp>
+#include <bounce/io/image_io.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cctype>
+#include <fstream>
+#include <system_error>
+#include <type_traits>
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+namespace bounce::embree {
+
+namespace {
+
+// Bump when the estimator changes in a way that changes its images.
+constexpr const char* integrator_version = "bounce-reference-1";
+
+// FNV-1a, 64 bit: a stable, dependency-free hash (the key only has to change when the
+// inputs do; it is not a security boundary).
+class fnv1a {
+public:
+    void bytes(const void* data, std::size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < n; ++i) h_ = (h_ ^ p[i]) * 0x100000001b3ULL;
+    }
+    template <class T>
+        requires std::is_trivially_copyable_v<T>
+    void value(const T& v) {
+        bytes(&v, sizeof(T));
+    }
+    void vec(const glm::vec3& v) {
+        value(v.x);
+        value(v.y);
+        value(v.z);
+    }
+    void text(const std::string& s) {
+        value(s.size());
+        bytes(s.data(), s.size());
+    }
+    std::uint64_t digest() const { return h_; }
+
+private:
+    std::uint64_t h_ = 0xcbf29ce484222325ULL;
+};
+
+std::string safe_name(const std::string& name) {
+    std::string s;
+    for (char c : name) s += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
+    return s.empty() ? std::string("scene") : s;
+}
+
+nlohmann::json json_of(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+std::filesystem::path entry(const std::filesystem::path& dir, const std::string& key, const char* suffix) {
+    return dir / (key + suffix);
+}
+
+// Writes through a temporary name in the same directory, then renames (atomic on POSIX).
+template <class Write>
+void write_atomically(const std::filesystem::path& final_path, const char* extension, Write write) {
+    const auto tmp = final_path.parent_path() /
+                     (final_path.filename().string() + ".tmp" + std::to_string(::getpid()) + extension);
+    write(tmp);
+    std::error_code ec;
+    std::filesystem::rename(tmp, final_path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        throw bounce::error("bounce::embree: cannot move " + tmp.string() + " to " + final_path.string());
+    }
+}
+
+}  // namespace
+
+std::filesystem::path default_cache_dir() {
+    if (const char* env = std::getenv("BOUNCE_CACHE"); env && *env) return env;
+    std::error_code ec;
+    const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (!ec && exe.parent_path().filename() == "bin") return exe.parent_path().parent_path() / "cache";
+    return std::filesystem::path("build") / "cache";
+}
+
+std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                                std::size_t height, const reference_settings& settings) {
+    fnv1a h;
+    h.text(integrator_version);
+    h.value(scene.positions.size());
+    for (const auto& p : scene.positions) h.vec(p);
+    h.value(scene.normals.size());
+    for (const auto& n : scene.normals) h.vec(n);
+    h.value(scene.triangles.size());
+    for (const auto& t : scene.triangles) {
+        h.value(t.x);
+        h.value(t.y);
+        h.value(t.z);
+    }
+    for (auto m : scene.material_of) h.value(m);
+    h.value(scene.materials.size());
+    for (const auto& m : scene.materials) {
+        h.vec(m.kd);
+        h.vec(m.ke);
+    }
+    h.value(scene.lights.size());
+    for (const auto& l : scene.lights) {
+        h.value(l.index());
+        if (const auto* p = std::get_if<io::point_light>(&l)) {
+            h.vec(p->position);
+            h.vec(p->intensity);
+        } else if (const auto* s = std::get_if<io::spot_light>(&l)) {
+            h.vec(s->position);
+            h.vec(s->direction);
+            h.vec(s->intensity);
+            h.value(s->cone_deg);
+            h.value(int(s->falloff));
+        } else {
+            const auto& d = std::get<io::directional_light>(l);
+            h.vec(d.direction);
+            h.vec(d.irradiance);
+        }
+    }
+    h.value(scene.use_emission);
+    h.vec(cam.position);
+    h.vec(cam.look_at);
+    h.vec(cam.up);
+    h.value(cam.fov_y_deg);
+    h.value(cam.near_plane);
+    h.value(cam.far_plane);
+    h.value(width);
+    h.value(height);
+    h.value(settings.hemisphere_samples);
+    h.value(settings.area_samples);
+    h.value(settings.secondary_area_samples);
+    h.vec(settings.environment);
+    h.value(settings.ray_epsilon);
+    h.value(settings.seed);
+
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
+    return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
+           std::to_string(settings.hemisphere_samples) + "spp-" + hex;
+}
+
+std::optional<reference_images> load_cached_reference(const std::filesystem::path& dir, const std::string& key,
+                                                      std::size_t width, std::size_t height,
+                                                      const reference_settings& settings) {
+    const auto direct_file = entry(dir, key, ".direct.exr"), indirect_file = entry(dir, key, ".indirect.exr");
+    std::error_code ec;
+    if (!std::filesystem::exists(direct_file, ec) || !std::filesystem::exists(indirect_file, ec)) return std::nullopt;
+    reference_images r;
+    try {
+        r.direct = io::read_rgb(direct_file);
+        r.indirect = io::read_rgb(indirect_file);
+    } catch (const bounce::error&) {
+        return std::nullopt;  // unreadable or truncated: recompute and overwrite
+    }
+    if (r.direct.width() != width || r.direct.height() != height || r.indirect.width() != width ||
+        r.indirect.height() != height)
+        return std::nullopt;
+    r.combined = image<glm::vec3>(width, height);
+    for (std::size_t y = 0; y < height; ++y)
+        for (std::size_t x = 0; x < width; ++x) r.combined(x, y) = r.direct(x, y) + r.indirect(x, y);
+    r.grid = hemisphere_grid_for(settings.hemisphere_samples);
+    return r;
+}
+
+void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
+                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw bounce::error("bounce::embree: cannot create the cache directory " + dir.string() + ": " + ec.message());
+    write_atomically(entry(dir, key, ".direct.exr"), ".exr",
+                     [&](const std::filesystem::path& p) { io::write_exr(p, images.direct.view()); });
+    write_atomically(entry(dir, key, ".indirect.exr"), ".exr",
+                     [&](const std::filesystem::path& p) { io::write_exr(p, images.indirect.view()); });
+
+    const nlohmann::json description = {
+        {"key", key},
+        {"integrator", integrator_version},
+        {"scene", scene.name},
+        {"source", scene.source.string()},
+        {"triangles", scene.triangles.size()},
+        {"width", images.direct.width()},
+        {"height", images.direct.height()},
+        {"camera",
+         {{"position", json_of(cam.position)},
+          {"look_at", json_of(cam.look_at)},
+          {"up", json_of(cam.up)},
+          {"fov_y_deg", cam.fov_y_deg}}},
+        {"hemisphere_samples", settings.hemisphere_samples},
+        {"grid", {images.grid.m, images.grid.n}},
+        {"area_samples", settings.area_samples},
+        {"secondary_area_samples", settings.secondary_area_samples},
+        {"environment", json_of(settings.environment)},
+        {"ray_epsilon", settings.ray_epsilon},
+        {"seed", settings.seed},
+    };
+    write_atomically(entry(dir, key, ".json"), ".json", [&](const std::filesystem::path& p) {
+        std::ofstream f(p);
+        f << description.dump(2) << '\n';
+        if (!f) throw bounce::error("bounce::embree: cannot write " + p.string());
+    });
+}
+
+reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
+                                  std::size_t width, std::size_t height, const reference_settings& settings,
+                                  const std::filesystem::path& dir, bool* from_cache) {
+    const std::string key = reference_cache_key(scene, cam, width, height, settings);
+    if (auto cached = load_cached_reference(dir, key, width, height, settings)) {
+        if (from_cache) *from_cache = true;
+        return std::move(*cached);
+    }
+    auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
+    reference_images r = render_reference(bvh, scene, g.view(), settings);
+    store_cached_reference(dir, key, r, scene, cam, settings);
+    if (from_cache) *from_cache = false;
+    return r;
+}
+
+}  // namespace bounce::embree
