@@ -1,0 +1,399 @@
+// ic_splatting: irradiance caching by splatting (seed 000, Algorithm 5), its classical
+// octree baseline, and the figures that compare them against the reference integrator.
+//
+//   build/bin/ic_splatting --scene cornell --width 512 --height 512 --a 0.15
+//       --weight ward-smooth --gradients on --interp splat-cpu --json ic.json --out ic.png
+//
+// Stages (the names of timings_ms): gbuffer, splat_existing (step 2), scan (step 4 minus
+// record computation), compute_records, interpolate (making the indirect image from the
+// cache: the final splat of step 5, or the octree's lookups), normalize, total.
+#include <bounce/cpu/octree_cache.hpp>
+#include <bounce/cpu/splatting.hpp>
+#include <bounce/embree/accel.hpp>
+#include <bounce/embree/ray_cast_gbuffer.hpp>
+#include <bounce/embree/record_sampler.hpp>
+#include <bounce/embree/reference.hpp>
+#include <bounce/embree/reference_cache.hpp>
+#include <bounce/io/image_io.hpp>
+#include <bounce/io/record_cache.hpp>
+#include <bounce/io/report.hpp>
+#include <bounce/io/scene.hpp>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <chrono>
+#include <cmath>
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace bounce;
+
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+double ms_since(clock_type::time_point t0) {
+    return std::chrono::duration<double, std::milli>(clock_type::now() - t0).count();
+}
+
+struct options {
+    std::string scene = "cornell";
+    std::size_t width = 512, height = 512;
+    float a = 0.15f;
+    std::string weight = "ward-smooth";
+    bool gradients = true;
+    std::string sampler = "embree";
+    std::string interp = "splat-cpu";
+    std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
+    std::size_t frames = 8;
+    std::vector<float> a_sweep;
+    std::uint32_t record_samples = 1024, ref_spp = 1024;
+    float min_pixels = 1.5f, max_pixels = 64.f;
+    bool neighbour_clamp = false;
+    float max_extrapolation = 1.f;
+    float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
+    int repeat = 1;
+    bool mc_compare = false;
+    fs::path json, out, exr, cache_in, cache_out;
+};
+
+weighting_kind parse_weight(const std::string& w) {
+    if (w == "ward") return weighting_kind::ward;
+    if (w == "ward-smooth") return weighting_kind::ward_smooth;
+    if (w == "ward-gpu") return weighting_kind::ward_gpu;
+    if (w == "ward-gpu-shader") return weighting_kind::ward_gpu_shader;
+    if (w == "tabellion") return weighting_kind::tabellion;
+    throw parameter_error("--weight", "unknown weighting function '" + w + "'");
+}
+
+// Everything a frame needs that does not change with a or the camera.
+struct context {
+    const options& opt;
+    const io::scene& scene;
+    const embree::accel& bvh;
+    const embree::reference_integrator& integrator;
+    embree::record_sampler& sampler;
+};
+
+// The parameters records depend on (not a: records are valid for every a).
+nlohmann::json cache_parameters(const options& o, const io::scene& s) {
+    return {{"scene", s.name},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
+            {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
+            {"height", o.height}};
+}
+
+// One frame of the chosen interpolation for `cam`: Algorithm 5 with the splat buffer, or
+// the classical two passes with the octree. `records` grows with the new records.
+struct frame_result {
+    image<glm::vec3> indirect;
+    std::size_t new_records = 0;
+};
+
+frame_result render_frame(const context& ctx, const camera& cam, const gbuffer<float>& g, float a,
+                          std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
+    const options& o = ctx.opt;
+    cpu::splat_params sp;
+    sp.a = a;
+    sp.gradients = o.gradients;
+    sp.max_extrapolation = o.max_extrapolation;
+    const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
+    const auto gv = const_cast<gbuffer<float>&>(g).view();
+
+    double record_ms = 0;
+    auto create = [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
+        const auto t0 = clock_type::now();
+        const glm::vec3 p = g.position(x, y), n = g.normal(x, y);
+        auto rec = ctx.sampler(p, n, cam.pixel_footprint(g.depth(x, y), g.height()));
+        if (rec && o.neighbour_clamp) rec->radius = neighbour_clamped_radius(*rec, records);
+        record_ms += ms_since(t0);
+        return rec;
+    };
+
+    frame_result fr;
+    fr.indirect = image<glm::vec3>(g.width(), g.height());
+    image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
+    with_weighting(parse_weight(o.weight), [&](auto w) {
+        using W = decltype(w);
+        if (o.interp == "octree") {
+            // Classical: the tree depends on a, so it is built for this frame's a.
+            const auto [lo, hi] = ctx.scene.bounds();
+            cpu::octree_cache<W> tree(lo, hi, sp);
+            {
+                auto t = timer.measure("splat_existing");  // (re)inserting existing records
+                for (const auto& r : records) tree.insert(r);
+            }
+            {
+                const auto t0 = clock_type::now();
+                std::size_t created = 0;
+                for (std::size_t y = 0; y < g.height() && created < max_new; ++y)
+                    for (std::size_t x = 0; x < g.width() && created < max_new; ++x) {
+                        if (!gv.covered(x, y) || tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w >= min_weight)
+                            continue;
+                        if (auto rec = create(x, y)) {
+                            records.push_back(*rec);
+                            tree.insert(*rec);
+                            ++created;
+                        }
+                    }
+                fr.new_records = created;
+                timer.add_sample("scan", ms_since(t0) - record_ms);
+                timer.add_sample("compute_records", record_ms);
+            }
+            auto t = timer.measure("interpolate");
+            tree.render(gv, splat.view());
+        } else {
+            {
+                auto t = timer.measure("splat_existing");
+                cpu::splat_records<W>(gv, cam, records, sp, splat.view());
+            }
+            const auto t0 = clock_type::now();
+            fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), {}, max_new);
+            timer.add_sample("scan", ms_since(t0) - record_ms);
+            timer.add_sample("compute_records", record_ms);
+            // Step 5: the image comes from splatting every record (on the GPU in the seed).
+            auto t = timer.measure("interpolate");
+            std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
+            cpu::splat_records<W>(gv, cam, records, sp, splat.view());
+        }
+    });
+    auto t = timer.measure("normalize");
+    cpu::normalize_splats(splat.view(), fr.indirect.view());
+    return fr;
+}
+
+image<float> coverage_mask(const gbuffer<float>& g) {
+    image<float> m(g.width(), g.height(), 0.f);
+    for (std::size_t y = 0; y < g.height(); ++y)
+        for (std::size_t x = 0; x < g.width(); ++x) m(x, y) = std::isfinite(g.depth(x, y)) ? 1.f : 0.f;
+    return m;
+}
+
+nlohmann::ordered_json error_json(const io::error_figures& e) {
+    return {{"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}, {"sum_sq", e.sum_sq}, {"pixels", e.pixels}};
+}
+
+embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64_t seed) {
+    embree::reference_settings s;
+    s.hemisphere_samples = spp;
+    s.seed = seed;
+    return s;
+}
+
+// Exposure mapping the 99th percentile of covered luminance to 1 (PNG only).
+float auto_exposure(const image<glm::vec3>& img, const image<float>& mask) {
+    std::vector<float> lum;
+    for (std::size_t y = 0; y < img.height(); ++y)
+        for (std::size_t x = 0; x < img.width(); ++x)
+            if (mask(x, y) > 0.f) lum.push_back(0.2126f * img(x, y).x + 0.7152f * img(x, y).y + 0.0722f * img(x, y).z);
+    if (lum.empty()) return 1.f;
+    const auto k = std::size_t(0.99 * double(lum.size() - 1));
+    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
+    return lum[k] > 0.f ? 1.f / lum[k] : 1.f;
+}
+
+int run(const options& o) {
+    io::stage_timer setup;
+    const io::scene scene = io::load_scene_arg(o.scene);
+    std::optional<embree::accel> bvh_storage;
+    setup.time("bvh", [&] { bvh_storage.emplace(scene); });
+    const embree::accel& bvh = *bvh_storage;
+    const embree::reference_integrator integrator(bvh, scene, reference_settings_for(64, 1));
+    radius_limits limits;
+    limits.min_pixels = o.min_pixels;
+    limits.max_pixels = o.max_pixels;
+    embree::record_sampler sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
+    const context ctx{o, scene, bvh, integrator, sampler};
+
+    if (o.sampler != "embree")
+        throw parameter_error("--sampler", "'" + o.sampler + "' is not available in this build (only 'embree')");
+    if (o.interp != "splat-cpu" && o.interp != "octree")
+        throw parameter_error("--interp", "'" + o.interp + "' is not available in this build (splat-cpu, octree)");
+
+    std::vector<irradiance_record> records;
+    const nlohmann::json cache_params = cache_parameters(o, scene);
+    if (!o.cache_in.empty()) records = io::load_records(o.cache_in, cache_params);
+    const std::size_t loaded = records.size();
+
+    io::run_report report;
+    report.technique = "ic_splatting";
+    report.scene = scene.name;
+    report.width = o.width;
+    report.height = o.height;
+    report.backend = o.interp == "octree" ? "cpu-octree" : "cpu";
+    report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
+                         {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
+                         {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
+                         {"neighbour_clamp", o.neighbour_clamp}, {"max_extrapolation", o.max_extrapolation},
+                         {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive}};
+
+    auto reference_for = [&](const camera& cam) {
+        bool hit = false;
+        auto ref = embree::cached_reference(bvh, scene, cam, o.width, o.height, reference_settings_for(o.ref_spp, 1),
+                                            embree::default_cache_dir(), &hit);
+        fmt::print(stderr, "reference {}x{} at {} spp: {}\n", o.width, o.height, o.ref_spp, hit ? "from cache" : "computed");
+        return ref;
+    };
+
+    nlohmann::ordered_json extra = nlohmann::ordered_json::object();
+    io::stage_timer timer;
+
+    if (o.progressive > 0) {
+        // Progressive mode: a camera path orbiting the view axis's target; records are
+        // view-independent, so each frame reuses the cache and adds at most N records.
+        nlohmann::ordered_json frames = nlohmann::ordered_json::array();
+        const camera base = scene.camera;
+        for (std::size_t f = 0; f < o.frames; ++f) {
+            camera cam = base;
+            const float angle = glm::radians(20.f) * (float(f) / float(std::max<std::size_t>(1, o.frames - 1)) - 0.5f);
+            const glm::vec3 off = cam.position - cam.look_at;
+            cam.position = cam.look_at + glm::vec3(off.x * std::cos(angle) + off.z * std::sin(angle), off.y,
+                                                   -off.x * std::sin(angle) + off.z * std::cos(angle));
+            io::stage_timer ft;
+            const auto t0 = clock_type::now();
+            gbuffer<float> g;
+            ft.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
+            const auto fr = render_frame(ctx, cam, g, o.a, records, ft, o.progressive);
+            const double frame_ms = ms_since(t0);
+            const auto ref = reference_for(cam);
+            const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), coverage_mask(g).view());
+            fmt::print("frame {:2}: {:5} records (+{:3}), {:8.1f} ms ({:5.2f} fps), indirect rel_rms {:.4f}\n", f,
+                       records.size(), fr.new_records, frame_ms, 1000.0 / frame_ms, err.rel_rms);
+            frames.push_back({{"frame", f}, {"records", records.size()}, {"new_records", fr.new_records},
+                              {"ms", frame_ms}, {"fps", 1000.0 / frame_ms}, {"rel_rms", err.rel_rms}});
+            for (const auto& s : ft.stages()) timer.add_sample(s, ft.median_ms(s));
+            timer.add_sample("total", frame_ms);
+        }
+        extra["frames"] = frames;
+        report.set_timings(timer);
+        report.set_count("records", records.size());
+    } else {
+        const camera& cam = scene.camera;
+        const auto ref = reference_for(cam);
+        gbuffer<float> g;
+        frame_result fr;
+        const std::vector<float> as = o.a_sweep.empty() ? std::vector<float>{o.a} : o.a_sweep;
+        nlohmann::ordered_json sweep = nlohmann::ordered_json::array();
+        image<float> mask;
+        for (float a : as) {
+            io::stage_timer at;
+            // Each repeat starts from the same cache: what was loaded, or what earlier
+            // sweep entries built (records are valid for every a).
+            const std::vector<irradiance_record> start = records;
+            for (int r = 0; r < o.repeat; ++r) {
+                records = start;
+                const auto t0 = clock_type::now();
+                at.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
+                fr = render_frame(ctx, cam, g, a, records, at, std::size_t(-1));
+                at.add_sample("total", ms_since(t0));
+            }
+            mask = coverage_mask(g);
+            const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
+            fmt::print("a = {:.3f}: {:6} records (+{:5}), total {:9.1f} ms (interpolate {:8.2f}, records {:9.1f}), "
+                       "indirect rel_rms {:.4f}\n",
+                       a, records.size(), fr.new_records, at.median_ms("total"), at.median_ms("interpolate"),
+                       at.median_ms("compute_records"), err.rel_rms);
+            nlohmann::ordered_json entry = {{"a", a}, {"records", records.size()}, {"new_records", fr.new_records},
+                                            {"timings_ms", nlohmann::ordered_json::object()}, {"error", error_json(err)}};
+            for (const auto& s : at.stages()) entry["timings_ms"][s] = at.median_ms(s);
+            sweep.push_back(entry);
+            timer = at;
+            report.error = err;
+        }
+        if (!o.a_sweep.empty()) extra["a_sweep"] = sweep;
+        report.set_timings(timer);
+        report.set_count("records", records.size());
+
+        if (o.mc_compare) {
+            // Brute-force Monte Carlo indirect light at doubling sample counts (an independent
+            // seed), until its error reaches this run's: the time it needs at equal error.
+            nlohmann::ordered_json mc = nlohmann::ordered_json::array();
+            const double target = report.error->rel_rms;
+            for (std::uint32_t spp = 1; spp <= o.ref_spp / 2; spp *= 2) {
+                const embree::reference_integrator mci(bvh, scene, reference_settings_for(spp, 99));
+                const auto t0 = clock_type::now();
+                const auto ind = mci.indirect_image(const_cast<gbuffer<float>&>(g).view());
+                const double ms = ms_since(t0);
+                const auto err = io::compare_luminance(ind.view(), ref.indirect.view(), mask.view());
+                fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f}\n", spp, ms, err.rel_rms);
+                mc.push_back({{"spp", spp}, {"ms", ms}, {"rel_rms", err.rel_rms}});
+                if (err.rel_rms <= target) {
+                    extra["mc_equal_error"] = {{"spp", spp}, {"ms", ms}, {"rel_rms", err.rel_rms},
+                                               {"speedup", ms / timer.median_ms("total")}};
+                    fmt::print("at equal error Monte Carlo takes {:.1f} ms: {:.1f}x the cache's {:.1f} ms\n", ms,
+                               ms / timer.median_ms("total"), timer.median_ms("total"));
+                    break;
+                }
+            }
+            extra["mc_sweep"] = mc;
+        }
+
+        if (!o.out.empty() || !o.exr.empty()) {
+            image<glm::vec3> combined(o.width, o.height);
+            cpu::compose(ref.direct.view(), fr.indirect.view(), combined.view());
+            if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
+            if (!o.out.empty()) io::write_png(o.out, combined.view(), auto_exposure(combined, mask));
+        }
+    }
+
+    if (!o.cache_out.empty()) io::save_records(o.cache_out, records, cache_params);
+    if (loaded) report.set_count("records_loaded", loaded);
+    fmt::print("{} records; total {:.1f} ms", records.size(), timer.median_ms("total"));
+    if (report.error) fmt::print("; indirect rel_rms {:.4f}", report.error->rel_rms);
+    fmt::print("\n");
+    if (!o.json.empty()) {
+        auto j = report.to_json();
+        j["timings_ms"]["bvh"] = setup.median_ms("bvh");
+        for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
+        std::ofstream(o.json) << j.dump(2) << '\n';
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"bounce: irradiance caching by splatting (Gautron, SIGGRAPH 2008 course, ch. 8)"};
+    options o;
+    std::string gradients = "on";
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, or an .obj")->capture_default_str();
+    app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--weight", o.weight, "ward | ward-smooth | ward-gpu | ward-gpu-shader | tabellion")
+        ->check(CLI::IsMember({"ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion"}))->capture_default_str();
+    app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+    app.add_option("--sampler", o.sampler, "record sampler: embree | raster")->check(CLI::IsMember({"embree", "raster"}))->capture_default_str();
+    app.add_option("--interp", o.interp, "splat-cpu | splat-gl | octree")
+        ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree"}))->capture_default_str();
+    app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)");
+    app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--a-sweep", o.a_sweep, "comma-separated a values rendered from one growing cache")->delimiter(',');
+    app.add_option("--record-samples", o.record_samples, "hemisphere rays per record")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
+    app.add_option("--ref-spp", o.ref_spp, "reference integrator samples per pixel")->check(CLI::Range(1u, 1u << 20))->capture_default_str();
+    app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
+    app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(CLI::NonNegativeNumber);
+    app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
+    app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");
+    app.add_option("--json", o.json, "write the run report here");
+    app.add_option("--out", o.out, "write the final image (direct + indirect) as PNG");
+    app.add_option("--exr", o.exr, "write the final image as EXR");
+    app.add_option("--cache-in", o.cache_in, "start from the records saved in this file");
+    app.add_option("--cache-out", o.cache_out, "save the records to this file");
+    CLI11_PARSE(app, argc, argv);
+    o.gradients = gradients == "on";
+    try {
+        return run(o);
+    } catch (const bounce::error& e) {
+        fmt::print(stderr, "ic_splatting: {}\n", e.what());
+        return 2;
+    }
+}
