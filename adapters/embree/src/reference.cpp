@@ -283,12 +283,18 @@ void reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemispher
             out.phi[i] = float(2 * pi) * (float(k) + v) / nn;
             out.direction[i] = glm::normalize(local.x * out.tangent + local.y * out.bitangent + local.z * n);
         }
-    ray r;
-    r.origin = p + epsilon_ * n;
-    for (std::size_t i = 0; i < count; ++i) {
-        r.direction = out.direction[i];
-        out.radiance[i] = incoming_radiance(r, derive_seed(seed, stage_secondary, i), &out.distance[i]);
-    }
+    // Each ray has its own stream, so splitting them across threads (one record's rays are
+    // the unit of work of the irradiance cache's sequential scan) changes no bit. Nested
+    // in an image pass it only adds tasks to the same TBB pool.
+    const glm::vec3 origin = p + epsilon_ * n;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& b) {
+        ray r;
+        r.origin = origin;
+        for (std::size_t i = b.begin(); i != b.end(); ++i) {
+            r.direction = out.direction[i];
+            out.radiance[i] = incoming_radiance(r, derive_seed(seed, stage_secondary, i), &out.distance[i]);
+        }
+    });
 }
 
 hemisphere_samples reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid,

@@ -53,37 +53,23 @@ public:
         insert(*root_, lo_, hi_, rec.position - zone, rec.position + zone, 2.f * zone * std::sqrt(3.f), idx, 0);
     }
 
-    /// (sum of w * rho/pi * E_k(p), sum of w) over the records reaching p: the same value a
-    /// splat buffer holds at that pixel, summed in the same (record index) order.
+    /// (sum of w * rho/pi * E_k(p), sum of w) over the records reaching p: the value a
+    /// splat buffer holds at that pixel, up to the order of the float additions (records
+    /// are met root to leaf here, in index order there).
     glm::vec4 lookup(const glm::vec3& p, const glm::vec3& n, const glm::vec3& albedo) const {
-        // Collect candidates along the root-to-leaf path, then sum in index order so the
-        // result matches splatting bit for bit.
-        thread_local std::vector<std::uint32_t> hits;
-        hits.clear();
+        glm::vec4 sum(0.f);
         const node* nd = root_.get();
         glm::vec3 lo = lo_, hi = hi_;
         while (nd) {
-            hits.insert(hits.end(), nd->items.begin(), nd->items.end());
+            for (std::uint32_t i : nd->items) {
+                const auto& r = records_[i];
+                sum += detail::contribution<Weight>(r, p, n, albedo, sp_, detail::culling_radius2<Weight>(r, sp_.a));
+            }
             const glm::vec3 mid = 0.5f * (lo + hi);
             const int child = (p.x > mid.x) | ((p.y > mid.y) << 1) | ((p.z > mid.z) << 2);
             if (!nd->children[child]) break;
             child_box(lo, hi, child, lo, hi);
             nd = nd->children[child].get();
-        }
-        std::sort(hits.begin(), hits.end());
-        glm::vec4 sum(0.f);
-        for (std::uint32_t i : hits) {
-            const auto& r = records_[i];
-            const auto c = sp_.gradients
-                               ? splat_contribution<Weight, true, float, glm::vec3>(
-                                     p, n, albedo, r.position, r.normal, 1.f / r.radius, sp_.a, r.irradiance,
-                                     r.rotation[0], r.rotation[1], r.rotation[2], r.translation[0], r.translation[1],
-                                     r.translation[2], sp_.max_extrapolation)
-                               : splat_contribution<Weight, false, float, glm::vec3>(
-                                     p, n, albedo, r.position, r.normal, 1.f / r.radius, sp_.a, r.irradiance,
-                                     r.rotation[0], r.rotation[1], r.rotation[2], r.translation[0], r.translation[1],
-                                     r.translation[2], sp_.max_extrapolation);
-            if (c[3] > 0.f) sum += glm::vec4(c[0], c[1], c[2], c[3]);
         }
         return sum;
     }

@@ -69,25 +69,43 @@ inline pixel_rect splat_rect(const camera& cam, const glm::mat4& view, const glm
 }
 
 namespace detail {
+/// Squared radius beyond which `Weight` gives a record no weight, widened by a relative
+/// 1e-5 so that rounding in |p - pk|^2 never culls a point the weight itself would keep.
+template <class Weight>
+inline float culling_radius2(const irradiance_record& rec, float a) {
+    const float zone = Weight::template influence_radius<float>(rec.radius, a);
+    return zone * zone * (1.f + 1e-5f);
+}
+
+/// What record `rec` adds at a point: splat_contribution (the kernel) behind a
+/// squared-distance rejection, which removes most candidates (other surfaces, the corners
+/// of a splat box, the far side of an octree node) before the weight's square roots.
+template <class Weight>
+inline glm::vec4 contribution(const irradiance_record& rec, const glm::vec3& p, const glm::vec3& n,
+                              const glm::vec3& albedo, const splat_params& sp, float cull2) {
+    const glm::vec3 d = p - rec.position;
+    if (!(glm::dot(d, d) <= cull2)) return glm::vec4(0.f);
+    const float inv_r = 1.f / rec.radius;
+    const auto c = sp.gradients ? splat_contribution<Weight, true, float, glm::vec3>(
+                                      p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance,
+                                      rec.rotation[0], rec.rotation[1], rec.rotation[2], rec.translation[0],
+                                      rec.translation[1], rec.translation[2], sp.max_extrapolation)
+                                : splat_contribution<Weight, false, float, glm::vec3>(
+                                      p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance,
+                                      rec.rotation[0], rec.rotation[1], rec.rotation[2], rec.translation[0],
+                                      rec.translation[1], rec.translation[2], sp.max_extrapolation);
+    return c[3] > 0.f ? glm::vec4(c[0], c[1], c[2], c[3]) : glm::vec4(0.f);
+}
+
 template <class Weight>
 inline void splat_into(const gbuffer_view<float>& gb, const irradiance_record& rec, const splat_params& sp,
                        const pixel_rect& r, image_view<glm::vec4> out) {
-    const float inv_r = 1.f / rec.radius;
+    const float cull2 = culling_radius2<Weight>(rec, sp.a);
     for (int y = r.y0; y <= r.y1; ++y)
         for (int x = r.x0; x <= r.x1; ++x) {
             if (!gb.covered(std::size_t(x), std::size_t(y))) continue;
-            const glm::vec3 p = gb.position(x, y), n = gb.normal(x, y), albedo = gb.albedo(x, y);
-            const auto c =
-                sp.gradients
-                    ? splat_contribution<Weight, true, float, glm::vec3>(
-                          p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance, rec.rotation[0],
-                          rec.rotation[1], rec.rotation[2], rec.translation[0], rec.translation[1],
-                          rec.translation[2], sp.max_extrapolation)
-                    : splat_contribution<Weight, false, float, glm::vec3>(
-                          p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance, rec.rotation[0],
-                          rec.rotation[1], rec.rotation[2], rec.translation[0], rec.translation[1],
-                          rec.translation[2], sp.max_extrapolation);
-            if (c[3] > 0.f) out(x, y) += glm::vec4(c[0], c[1], c[2], c[3]);
+            const glm::vec4 c = contribution<Weight>(rec, gb.position(x, y), gb.normal(x, y), gb.albedo(x, y), sp, cull2);
+            if (c.w > 0.f) out(x, y) += c;
         }
 }
 }  // namespace detail
