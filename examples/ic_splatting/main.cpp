@@ -60,7 +60,7 @@ struct options {
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
     int repeat = 1;
     bool mc_compare = false;
-    fs::path json, out, exr, cache_in, cache_out;
+    fs::path json, out, exr, indirect_out, cache_in, cache_out;
 };
 
 weighting_kind parse_weight(const std::string& w) {
@@ -339,6 +339,16 @@ int run(const options& o) {
             if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
             if (!o.out.empty()) io::write_png(o.out, combined.view(), auto_exposure(combined, mask));
         }
+        if (!o.indirect_out.empty()) {
+            // The indirect images side by side with one exposure: the cache's, the reference's.
+            image<glm::vec3> pair(2 * o.width, o.height);
+            for (std::size_t y = 0; y < o.height; ++y)
+                for (std::size_t x = 0; x < o.width; ++x) {
+                    pair(x, y) = fr.indirect(x, y);
+                    pair(o.width + x, y) = ref.indirect(x, y);
+                }
+            io::write_png(o.indirect_out, pair.view(), auto_exposure(ref.indirect, mask));
+        }
     }
 
     if (!o.cache_out.empty()) io::save_records(o.cache_out, records, cache_params);
@@ -386,6 +396,7 @@ int main(int argc, char** argv) {
     app.add_option("--json", o.json, "write the run report here");
     app.add_option("--out", o.out, "write the final image (direct + indirect) as PNG");
     app.add_option("--exr", o.exr, "write the final image as EXR");
+    app.add_option("--indirect-out", o.indirect_out, "write the indirect image beside the reference's as PNG");
     app.add_option("--cache-in", o.cache_in, "start from the records saved in this file");
     app.add_option("--cache-out", o.cache_out, "save the records to this file");
     CLI11_PARSE(app, argc, argv);

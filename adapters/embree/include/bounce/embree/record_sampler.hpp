@@ -12,7 +12,7 @@
 #include <bounce/irradiance_gradients.hpp>
 #include <bounce/irradiance_record.hpp>
 
-#include <atomic>
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -45,6 +45,9 @@ public:
         }
         hemisphere_samples_.radiance = samples_.radiance;
         hemisphere_samples_.distance = samples_.distance;
+        // Distances are measured from p + eps n and can be 0 where another surface touches
+        // p (a corner); no surface is nearer than the offset itself, so floor them there.
+        for (float& d : hemisphere_samples_.distance) d = std::max(d, integrator_.ray_epsilon());
         const hemisphere_estimate est = estimate_hemisphere(hemisphere_samples_, kind_);
         irradiance_record rec = make_record(p, samples_.normal, samples_.tangent, samples_.bitangent, est, limits_,
                                             pixel_footprint);
