@@ -16,6 +16,8 @@
 #include <bounce/concepts.hpp>
 #include <bounce/vocabulary.hpp>
 
+#include <numbers>
+
 namespace bounce {
 
 /// Irradiance (W/m^2) at `p` with unit normal `n` from an isotropic point light at
@@ -86,6 +88,13 @@ V area_light_irradiance_sample(const V& p, const V& n, const V& q, const V& nq, 
     // cos theta cos theta_q / d^2 = dot(n, d) dot(nq, -d) / d^4.
     const T geometry = max(T(0), dot(n, d)) * max(T(0), -dot(nq, d)) / (safe_d2 * safe_d2);
     return radiance * (select(apart, geometry, T(0)) * inv_pdf_area);
+}
+
+/// Outgoing radiance (W/(m^2 sr)) of a Lambertian surface of diffuse reflectance `albedo`
+/// (rho_d per channel, in [0, 1]) under irradiance `irradiance` (W/m^2): L = rho_d E / pi.
+template <real T, vec3_of<T> V>
+V lambertian_radiance(const V& albedo, const V& irradiance) {
+    return albedo * irradiance * T(1.0 / std::numbers::pi);
 }
 
 }  // namespace bounce

@@ -5,6 +5,7 @@
 #include <GL/glcorearb.h>
 
 #include <array>
+#include <vector>
 
 namespace bounce::gl::detail {
 
@@ -130,6 +131,102 @@ private:
     std::array<GLdouble, 2> depth_range_{0, 1};
     std::array<GLboolean, 4> color_mask_{GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE};
     std::array<GLint, 2> polygon_mode_{GL_FILL, GL_FILL};
+};
+
+/// Pixel-unpack state set to tightly packed client memory (no unpack buffer) for uploads.
+class unpack_state {
+public:
+    unpack_state() {
+        glGetIntegerv(GL_PIXEL_UNPACK_BUFFER_BINDING, &buffer_);
+        for (std::size_t i = 0; i < names_.size(); ++i) glGetIntegerv(names_[i], &values_[i]);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        for (std::size_t i = 0; i < names_.size(); ++i) glPixelStorei(names_[i], names_[i] == GL_UNPACK_ALIGNMENT ? 4 : 0);
+    }
+    ~unpack_state() {
+        for (std::size_t i = 0; i < names_.size(); ++i) glPixelStorei(names_[i], values_[i]);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, GLuint(buffer_));
+    }
+    unpack_state(const unpack_state&) = delete;
+    unpack_state& operator=(const unpack_state&) = delete;
+
+private:
+    static constexpr std::array<GLenum, 8> names_ = {GL_UNPACK_ALIGNMENT,  GL_UNPACK_ROW_LENGTH,  GL_UNPACK_SKIP_ROWS,
+                                                     GL_UNPACK_SKIP_PIXELS, GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_IMAGES,
+                                                     GL_UNPACK_SWAP_BYTES, GL_UNPACK_LSB_FIRST};
+    GLint buffer_ = 0;
+    std::array<GLint, 8> values_{};
+};
+
+/// What raster_state leaves alone and blending, shadow and cube-map passes change: blend
+/// equations and factors, dithering, polygon-offset factor and units, seamless cube-map
+/// filtering. Saved as found, restored on destruction; nothing is set here.
+class blend_offset_state {
+public:
+    blend_offset_state() {
+        glGetIntegerv(GL_BLEND_EQUATION_RGB, &equation_rgb_);
+        glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &equation_alpha_);
+        glGetIntegerv(GL_BLEND_SRC_RGB, &src_rgb_);
+        glGetIntegerv(GL_BLEND_DST_RGB, &dst_rgb_);
+        glGetIntegerv(GL_BLEND_SRC_ALPHA, &src_alpha_);
+        glGetIntegerv(GL_BLEND_DST_ALPHA, &dst_alpha_);
+        dither_ = glIsEnabled(GL_DITHER);
+        seamless_ = glIsEnabled(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+        glGetFloatv(GL_POLYGON_OFFSET_FACTOR, &offset_factor_);
+        glGetFloatv(GL_POLYGON_OFFSET_UNITS, &offset_units_);
+    }
+    ~blend_offset_state() {
+        glPolygonOffset(offset_factor_, offset_units_);
+        if (seamless_) glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+        else glDisable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
+        if (dither_) glEnable(GL_DITHER);
+        else glDisable(GL_DITHER);
+        glBlendFuncSeparate(GLenum(src_rgb_), GLenum(dst_rgb_), GLenum(src_alpha_), GLenum(dst_alpha_));
+        glBlendEquationSeparate(GLenum(equation_rgb_), GLenum(equation_alpha_));
+    }
+    blend_offset_state(const blend_offset_state&) = delete;
+    blend_offset_state& operator=(const blend_offset_state&) = delete;
+
+private:
+    GLint equation_rgb_ = GL_FUNC_ADD, equation_alpha_ = GL_FUNC_ADD, src_rgb_ = GL_ONE, dst_rgb_ = GL_ZERO,
+          src_alpha_ = GL_ONE, dst_alpha_ = GL_ZERO;
+    GLboolean dither_ = GL_TRUE, seamless_ = GL_FALSE;
+    GLfloat offset_factor_ = 0.f, offset_units_ = 0.f;
+};
+
+/// The 2D and cube-map texture bindings and the sampler object of texture units
+/// [first, first + count), and the active unit.
+class texture_unit_state {
+public:
+    texture_unit_state(GLuint first, GLuint count) : first_(first) {
+        glGetIntegerv(GL_ACTIVE_TEXTURE, &active_);
+        units_.resize(count);
+        for (GLuint i = 0; i < count; ++i) {
+            glActiveTexture(GL_TEXTURE0 + first + i);
+            glGetIntegerv(GL_TEXTURE_BINDING_2D, &units_[i].texture_2d);
+            glGetIntegerv(GL_TEXTURE_BINDING_CUBE_MAP, &units_[i].texture_cube);
+            glGetIntegerv(GL_SAMPLER_BINDING, &units_[i].sampler);
+        }
+        glActiveTexture(GLenum(active_));
+    }
+    ~texture_unit_state() {
+        for (GLuint i = 0; i < GLuint(units_.size()); ++i) {
+            glActiveTexture(GL_TEXTURE0 + first_ + i);
+            glBindTexture(GL_TEXTURE_2D, GLuint(units_[i].texture_2d));
+            glBindTexture(GL_TEXTURE_CUBE_MAP, GLuint(units_[i].texture_cube));
+            glBindSampler(first_ + i, GLuint(units_[i].sampler));
+        }
+        glActiveTexture(GLenum(active_));
+    }
+    texture_unit_state(const texture_unit_state&) = delete;
+    texture_unit_state& operator=(const texture_unit_state&) = delete;
+
+private:
+    struct unit {
+        GLint texture_2d = 0, texture_cube = 0, sampler = 0;
+    };
+    GLuint first_;
+    GLint active_ = GL_TEXTURE0;
+    std::vector<unit> units_;
 };
 
 }  // namespace bounce::gl::detail
