@@ -18,6 +18,13 @@
 #include <bounce/io/record_cache.hpp>
 #include <bounce/io/report.hpp>
 #include <bounce/io/scene.hpp>
+#ifdef BOUNCE_IC_WITH_GL
+#include <bounce/gl/context.hpp>
+#include <bounce/gl/direct_light.hpp>
+#include <bounce/gl/gbuffer_pass.hpp>
+#include <bounce/gl/objects.hpp>
+#include <bounce/gl/splat_pass.hpp>
+#endif
 
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>
@@ -56,6 +63,7 @@ struct options {
     std::uint32_t record_samples = 1024, ref_spp = 1024;
     float min_pixels = 1.5f, max_pixels = 64.f;
     bool neighbour_clamp = false;
+    bool gradient_limit = true;
     float max_extrapolation = 1.f;
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
     int repeat = 1;
@@ -85,35 +93,50 @@ struct context {
 nlohmann::json cache_parameters(const options& o, const io::scene& s) {
     return {{"scene", s.name},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
-            {"height", o.height}};
+            {"gradient_limit", o.gradient_limit}, {"height", o.height}};
 }
 
 // One frame of the chosen interpolation for `cam`: Algorithm 5 with the splat buffer, or
 // the classical two passes with the octree. `records` grows with the new records.
 struct frame_result {
-    image<glm::vec3> indirect;
+    gbuffer<float> g;                      // what the frame saw
+    image<glm::vec3> indirect;             // rho/pi * E from the cache
+    std::optional<image<glm::vec3>> combined;  // direct + indirect, when the backend composed it
     std::size_t new_records = 0;
 };
 
-frame_result render_frame(const context& ctx, const camera& cam, const gbuffer<float>& g, float a,
-                          std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
-    const options& o = ctx.opt;
+cpu::splat_params splat_params_for(const options& o, float a) {
     cpu::splat_params sp;
     sp.a = a;
     sp.gradients = o.gradients;
     sp.max_extrapolation = o.max_extrapolation;
+    return sp;
+}
+
+// The record-creation callback of the scans: the sampler at the pixel's point, with the
+// pixel footprint for radius clamps; adds its time to `record_ms`.
+auto record_creator(const context& ctx, const camera& cam, const gbuffer<float>& g,
+                    const std::vector<irradiance_record>& records, double& record_ms) {
+    return [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
+        const auto t0 = clock_type::now();
+        auto rec = ctx.sampler(g.position(x, y), g.normal(x, y), cam.pixel_footprint(g.depth(x, y), g.height()));
+        if (rec && ctx.opt.neighbour_clamp) rec->radius = neighbour_clamped_radius(*rec, records);
+        record_ms += ms_since(t0);
+        return rec;
+    };
+}
+
+// CPU backends: splat-cpu (Algorithm 5 on the CPU) and octree (the classical two passes).
+frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> g_in, float a,
+                          std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
+    const gbuffer<float>& g = g_in;
+    const options& o = ctx.opt;
+    const cpu::splat_params sp = splat_params_for(o, a);
     const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
     const auto gv = const_cast<gbuffer<float>&>(g).view();
 
     double record_ms = 0;
-    auto create = [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
-        const auto t0 = clock_type::now();
-        const glm::vec3 p = g.position(x, y), n = g.normal(x, y);
-        auto rec = ctx.sampler(p, n, cam.pixel_footprint(g.depth(x, y), g.height()));
-        if (rec && o.neighbour_clamp) rec->radius = neighbour_clamped_radius(*rec, records);
-        record_ms += ms_since(t0);
-        return rec;
-    };
+    auto create = record_creator(ctx, cam, g, records, record_ms);
 
     frame_result fr;
     fr.indirect = image<glm::vec3>(g.width(), g.height());
@@ -162,10 +185,94 @@ frame_result render_frame(const context& ctx, const camera& cam, const gbuffer<f
             cpu::splat_records<W>(gv, cam, records, sp, splat.view());
         }
     });
-    auto t = timer.measure("normalize");
-    cpu::normalize_splats(splat.view(), fr.indirect.view());
+    {
+        auto t = timer.measure("normalize");
+        cpu::normalize_splats(splat.view(), fr.indirect.view());
+    }
+    fr.g = std::move(g_in);
     return fr;
 }
+
+#ifdef BOUNCE_IC_WITH_GL
+// Everything the GL backend keeps across frames: context, mesh, passes, and how many
+// records the GPU copy of the cache holds.
+struct gl_backend {
+    gl::context gl_context;
+    gl::scene_mesh mesh;
+    gl::gbuffer_pass gbuffer;
+    gl::direct_light light;
+    gl::splat_pass splats;
+    gl::compose_pass compose;
+    std::size_t on_gpu = 0;
+
+    explicit gl_backend(const io::scene& s) : mesh(s), light(s, mesh, 2048) {}
+};
+
+// Algorithm 5 as the seed runs it: G-buffer, direct light and splatting on the GPU, the
+// cache-miss scan on the CPU over the read-back splat buffer.
+frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& cam, float a,
+                             std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
+    const options& o = ctx.opt;
+    const cpu::splat_params sp = splat_params_for(o, a);
+    const gl::splat_params gsp{sp.a, sp.gradients, sp.max_extrapolation};
+    const weighting_kind kind = parse_weight(o.weight);
+    frame_result fr;
+    {  // step 1
+        auto t = timer.measure("gbuffer");
+        gb.gbuffer.render(gb.mesh, cam, o.width, o.height);
+        gl::finish();
+    }
+    const gl::gbuffer_textures tex = gl::textures_of(gb.gbuffer);
+    {
+        auto t = timer.measure("direct");
+        gb.light.render(tex);
+        gl::finish();
+    }
+    image<glm::vec4> splat(o.width, o.height);
+    {  // step 2: the records the GPU already holds
+        auto t = timer.measure("splat_existing");
+        if (gb.on_gpu < records.size()) gb.splats.append(std::span(records).subspan(gb.on_gpu));
+        gb.on_gpu = records.size();
+        gb.splats.clear(o.width, o.height);
+        gb.splats.splat(tex, cam, gsp, kind);
+        gl::finish();
+    }
+    {  // step 3
+        auto t = timer.measure("readback");
+        fr.g = gb.gbuffer.read();
+        gb.splats.read_splat(splat.view());
+    }
+    const std::size_t before = records.size();
+    {  // step 4
+        double record_ms = 0;
+        const auto t0 = clock_type::now();
+        with_weighting(kind, [&](auto w) {
+            fr.new_records = cpu::scan_cache_misses<decltype(w)>(fr.g.view(), cam, sp, o.min_weight > 0.f ? o.min_weight : a,
+                                                                 record_creator(ctx, cam, fr.g, records, record_ms),
+                                                                 records, splat.view(), {}, max_new);
+        });
+        timer.add_sample("scan", ms_since(t0) - record_ms);
+        timer.add_sample("compute_records", record_ms);
+    }
+    {  // step 5: upload the new records and splat them on top of step 2's buffer
+        auto t = timer.measure("interpolate");
+        gb.splats.append(std::span(records).subspan(before));
+        gb.on_gpu = records.size();
+        gb.splats.splat(tex, cam, gsp, kind, before);
+        gl::finish();
+    }
+    {
+        auto t = timer.measure("normalize");
+        fr.indirect = image<glm::vec3>(o.width, o.height);
+        fr.combined = image<glm::vec3>(o.width, o.height);
+        gb.compose.compose(gb.splats.splat_texture());
+        gb.compose.read(fr.indirect.view());
+        gb.compose.compose(gb.splats.splat_texture(), &gb.light.radiance());
+        gb.compose.read(fr.combined->view());
+    }
+    return fr;
+}
+#endif
 
 image<float> coverage_mask(const gbuffer<float>& g) {
     image<float> m(g.width(), g.height(), 0.f);
@@ -207,15 +314,30 @@ int run(const options& o) {
     radius_limits limits;
     limits.min_pixels = o.min_pixels;
     limits.max_pixels = o.max_pixels;
+    limits.gradient_limit = o.gradient_limit;
     embree::record_sampler sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     const context ctx{o, scene, bvh, integrator, sampler};
+    std::vector<irradiance_record> records;
 
     if (o.sampler != "embree")
         throw parameter_error("--sampler", "'" + o.sampler + "' is not available in this build (only 'embree')");
-    if (o.interp != "splat-cpu" && o.interp != "octree")
-        throw parameter_error("--interp", "'" + o.interp + "' is not available in this build (splat-cpu, octree)");
+#ifdef BOUNCE_IC_WITH_GL
+    std::optional<gl_backend> gl_state;
+    if (o.interp == "splat-gl") setup.time("gl_setup", [&] { gl_state.emplace(scene); });
+#else
+    if (o.interp == "splat-gl")
+        throw parameter_error("--interp", "'splat-gl' needs the GL adapter, which this build does not have");
+#endif
+    // One frame for `cam` with the chosen backend; the G-buffer is part of its timing.
+    auto frame = [&](const camera& cam, float a, io::stage_timer& t, std::size_t max_new) -> frame_result {
+#ifdef BOUNCE_IC_WITH_GL
+        if (gl_state) return render_frame_gl(ctx, *gl_state, cam, a, records, t, max_new);
+#endif
+        gbuffer<float> g;
+        t.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
+        return render_frame(ctx, cam, std::move(g), a, records, t, max_new);
+    };
 
-    std::vector<irradiance_record> records;
     const nlohmann::json cache_params = cache_parameters(o, scene);
     if (!o.cache_in.empty()) records = io::load_records(o.cache_in, cache_params);
     const std::size_t loaded = records.size();
@@ -225,11 +347,12 @@ int run(const options& o) {
     report.scene = scene.name;
     report.width = o.width;
     report.height = o.height;
-    report.backend = o.interp == "octree" ? "cpu-octree" : "cpu";
+    report.backend = o.interp == "octree" ? "cpu-octree" : o.interp == "splat-gl" ? "gl" : "cpu";
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
-                         {"neighbour_clamp", o.neighbour_clamp}, {"max_extrapolation", o.max_extrapolation},
+                         {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
+                         {"max_extrapolation", o.max_extrapolation},
                          {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive}};
 
     auto reference_for = [&](const camera& cam) {
@@ -256,12 +379,10 @@ int run(const options& o) {
                                                    -off.x * std::sin(angle) + off.z * std::cos(angle));
             io::stage_timer ft;
             const auto t0 = clock_type::now();
-            gbuffer<float> g;
-            ft.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
-            const auto fr = render_frame(ctx, cam, g, o.a, records, ft, o.progressive);
+            const auto fr = frame(cam, o.a, ft, o.progressive);
             const double frame_ms = ms_since(t0);
             const auto ref = reference_for(cam);
-            const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), coverage_mask(g).view());
+            const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), coverage_mask(fr.g).view());
             fmt::print("frame {:2}: {:5} records (+{:3}), {:8.1f} ms ({:5.2f} fps), indirect rel_rms {:.4f}\n", f,
                        records.size(), fr.new_records, frame_ms, 1000.0 / frame_ms, err.rel_rms);
             frames.push_back({{"frame", f}, {"records", records.size()}, {"new_records", fr.new_records},
@@ -275,7 +396,6 @@ int run(const options& o) {
     } else {
         const camera& cam = scene.camera;
         const auto ref = reference_for(cam);
-        gbuffer<float> g;
         frame_result fr;
         const std::vector<float> as = o.a_sweep.empty() ? std::vector<float>{o.a} : o.a_sweep;
         nlohmann::ordered_json sweep = nlohmann::ordered_json::array();
@@ -287,12 +407,17 @@ int run(const options& o) {
             const std::vector<irradiance_record> start = records;
             for (int r = 0; r < o.repeat; ++r) {
                 records = start;
+#ifdef BOUNCE_IC_WITH_GL
+                if (gl_state) {  // the GPU copy restarts from the same cache
+                    gl_state->splats.upload(records);
+                    gl_state->on_gpu = records.size();
+                }
+#endif
                 const auto t0 = clock_type::now();
-                at.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
-                fr = render_frame(ctx, cam, g, a, records, at, std::size_t(-1));
+                fr = frame(cam, a, at, std::size_t(-1));
                 at.add_sample("total", ms_since(t0));
             }
-            mask = coverage_mask(g);
+            mask = coverage_mask(fr.g);
             const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
             fmt::print("a = {:.3f}: {:6} records (+{:5}), total {:9.1f} ms (interpolate {:8.2f}, records {:9.1f}), "
                        "indirect rel_rms {:.4f}\n",
@@ -317,7 +442,7 @@ int run(const options& o) {
             for (std::uint32_t spp = 1; spp <= o.ref_spp / 2; spp *= 2) {
                 const embree::reference_integrator mci(bvh, scene, reference_settings_for(spp, 99));
                 const auto t0 = clock_type::now();
-                const auto ind = mci.indirect_image(const_cast<gbuffer<float>&>(g).view());
+                const auto ind = mci.indirect_image(fr.g.view());
                 const double ms = ms_since(t0);
                 const auto err = io::compare_luminance(ind.view(), ref.indirect.view(), mask.view());
                 fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f}\n", spp, ms, err.rel_rms);
@@ -335,7 +460,8 @@ int run(const options& o) {
 
         if (!o.out.empty() || !o.exr.empty()) {
             image<glm::vec3> combined(o.width, o.height);
-            cpu::compose(ref.direct.view(), fr.indirect.view(), combined.view());
+            if (fr.combined) combined = *fr.combined;
+            else cpu::compose(ref.direct.view(), fr.indirect.view(), combined.view());
             if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
             if (!o.out.empty()) io::write_png(o.out, combined.view(), auto_exposure(combined, mask));
         }
@@ -389,6 +515,7 @@ int main(int argc, char** argv) {
     app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(CLI::NonNegativeNumber)->capture_default_str();
     app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(CLI::PositiveNumber)->capture_default_str();
     app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
+    app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
     app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(CLI::NonNegativeNumber)->capture_default_str();
     app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(CLI::NonNegativeNumber);
     app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();

@@ -78,6 +78,11 @@ void check_error(const char* call) {
     if (first != GL_NO_ERROR) throw gl_error(std::string("bounce::gl: ") + call + " failed: " + error_name(first));
 }
 
+void finish() {
+    glFinish();
+    check_error("glFinish");
+}
+
 namespace detail {
 
 object::~object() {

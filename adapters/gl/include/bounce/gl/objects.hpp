@@ -29,6 +29,10 @@ using object_id = unsigned int;
 /// drained, so an older error is reported too).
 void check_error(const char* call);
 
+/// Blocks until the current context has executed every command issued so far (glFinish):
+/// a stage timing that ends without it measures only the driver's queueing.
+void finish();
+
 namespace detail {
 enum class object_kind { shader, program, buffer, texture, framebuffer, vertex_array };
 /// The owned name and how to delete it.
