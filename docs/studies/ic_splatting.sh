@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Runs the irradiance-splatting measurements behind docs/irradiance-splatting.md and
+# docs/report.md, writing one JSON per run into docs/data/ (small, committed), then
+# regenerates the report. Usage: docs/studies/ic_splatting.sh [cornell|sponza|all]
+# Takes minutes on 2 cores (Sponza's reference is computed once and cached).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+bin=build/bin/ic_splatting
+scenes="${BOUNCE_SCENES:-../shared/scenes}"
+which="${1:-all}"
+mkdir -p docs/data docs/figures
+
+run() {  # run NAME ARGS...: one measured run
+  local name=$1; shift
+  echo "== $name: $*"
+  "$bin" "$@" --json "docs/data/$name.json"
+}
+
+study() {  # study TAG SCENE REFSPP
+  local tag=$1 scene=$2 spp=$3
+  local common=(--scene "$scene" --width 512 --height 512 --ref-spp "$spp")
+  for a in 0.4 0.3 0.2 0.15 0.1; do
+    run "$tag-a$a" "${common[@]}" --a "$a" --weight ward-smooth
+  done
+  run "$tag-nograd" "${common[@]}" --a 0.15 --weight ward-smooth --gradients off
+  run "$tag-ward" "${common[@]}" --a 0.15 --weight ward --indirect-out "docs/figures/$tag-ward.png"
+  run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth --indirect-out "docs/figures/$tag-smooth.png" --out "docs/figures/$tag.png"
+  run "$tag-octree" "${common[@]}" --a 0.15 --weight ward-smooth --interp octree
+  run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
+  run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
+  # Every frame of the camera path needs its own reference: smaller images, fewer samples.
+  run "$tag-progressive" --scene "$scene" --width 256 --height 256 --ref-spp 256 --a 0.15 --weight ward-smooth \
+      --progressive 300 --frames 6
+}
+
+[[ $which == cornell || $which == all ]] && study cornell cornell 4096
+[[ $which == sponza || $which == all ]] && study sponza "$scenes/sponza/scene.json" 2048
+python3 docs/make_report.py
