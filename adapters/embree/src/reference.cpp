@@ -105,27 +105,17 @@ reference_integrator::reference_integrator(const accel& bvh, const io::scene& sc
             "must be finite and non-negative");
     epsilon_ = settings_.ray_epsilon > 0.f ? settings_.ray_epsilon : bvh.ray_epsilon();
 
-    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-        const std::string name = "scene.lights[" + std::to_string(i) + "]";
-        auto fail = [&](const char* what) { throw parameter_error(name, what); };
+    io::validate_lights(scene);
+    for (const io::light& light : scene.lights) {
         prepared_light l{};
-        if (const auto* pl = std::get_if<io::point_light>(&scene.lights[i])) {
-            if (!finite3(pl->position)) fail("position is not finite");
-            if (!non_negative3(pl->intensity)) fail("intensity must be finite and non-negative");
+        if (const auto* pl = std::get_if<io::point_light>(&light)) {
             l = {0, pl->position, glm::vec3(0.f), pl->intensity, 0.f, 0.f};
-        } else if (const auto* sl = std::get_if<io::spot_light>(&scene.lights[i])) {
-            if (!finite3(sl->position)) fail("position is not finite");
-            if (!non_negative3(sl->intensity)) fail("intensity must be finite and non-negative");
-            if (!finite3(sl->direction) || glm::length(sl->direction) == 0.f) fail("direction must be finite and non-zero");
-            if (!(std::isfinite(sl->cone_deg) && sl->cone_deg > 0.f && sl->cone_deg <= 180.f))
-                fail("cone_deg must lie in (0, 180]");
+        } else if (const auto* sl = std::get_if<io::spot_light>(&light)) {
             const float falloff = sl->falloff == io::spot_light::falloff_kind::cosine ? 1.f : 0.f;
             l = {1, sl->position, glm::normalize(sl->direction), sl->intensity,
                  float(std::cos(glm::radians(double(sl->cone_deg)))), falloff};
         } else {
-            const auto& dl = std::get<io::directional_light>(scene.lights[i]);
-            if (!non_negative3(dl.irradiance)) fail("irradiance must be finite and non-negative");
-            if (!finite3(dl.direction) || glm::length(dl.direction) == 0.f) fail("direction must be finite and non-zero");
+            const auto& dl = std::get<io::directional_light>(light);
             l = {2, glm::vec3(0.f), glm::normalize(dl.direction), dl.irradiance, 0.f, 0.f};
         }
         lights_.push_back(l);

@@ -62,8 +62,6 @@ void main() {
 }
 )";
 
-bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool non_negative3(const glm::vec3& v) { return finite3(v) && v.x >= 0.f && v.y >= 0.f && v.z >= 0.f; }
 
 // An up vector not parallel to the unit view direction `d`.
 glm::vec3 up_for(const glm::vec3& d) { return std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0); }
@@ -131,6 +129,7 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
     const int res = options.shadow_resolution;
     auto [lo, hi] = scene.bounds();
     if (scene.positions.empty()) lo = hi = glm::vec3(0.f);
+    io::validate_lights(scene);
     std::vector<light_entry> lights;
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const std::string name = "scene.lights[" + std::to_string(i) + "]";
@@ -138,18 +137,11 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
         light_entry l;
         bool cube = false;
         if (const auto* pl = std::get_if<io::point_light>(&scene.lights[i])) {
-            if (!finite3(pl->position)) fail("position is not finite");
-            if (!non_negative3(pl->intensity)) fail("intensity must be finite and non-negative");
             l.kind = 0;
             l.position = pl->position;
             l.intensity = pl->intensity;
             cube = true;
         } else if (const auto* sl = std::get_if<io::spot_light>(&scene.lights[i])) {
-            if (!finite3(sl->position)) fail("position is not finite");
-            if (!non_negative3(sl->intensity)) fail("intensity must be finite and non-negative");
-            if (!finite3(sl->direction) || glm::length(sl->direction) == 0.f) fail("direction must be finite and non-zero");
-            if (!(std::isfinite(sl->cone_deg) && sl->cone_deg > 0.f && sl->cone_deg <= 180.f))
-                fail("cone_deg must lie in (0, 180]");
             l.kind = 1;
             l.position = sl->position;
             l.vector = glm::normalize(sl->direction);
@@ -170,8 +162,6 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
             }
         } else {
             const auto& dl = std::get<io::directional_light>(scene.lights[i]);
-            if (!non_negative3(dl.irradiance)) fail("irradiance must be finite and non-negative");
-            if (!finite3(dl.direction) || glm::length(dl.direction) == 0.f) fail("direction must be finite and non-zero");
             l.kind = 2;
             l.map = map_kind::orthographic;
             l.vector = glm::normalize(dl.direction);

@@ -82,6 +82,12 @@ struct scene {
     std::pair<glm::vec3, glm::vec3> bounds() const;
 };
 
+/// Throws parameter_error naming "scene.lights[i]" and the field unless every light can
+/// be rendered: finite positions, finite non-negative intensities and irradiances, finite
+/// non-zero directions, spot cones in (0, 180] degrees. Code that builds scenes by hand
+/// gets the same check from every adapter that shades lights.
+void validate_lights(const scene& s);
+
 /// Loads a scene.json (and the OBJ+MTL it names), as docs/scenes.md specifies.
 /// \param scene_json path of the JSON file; the OBJ path inside it is relative to its folder.
 /// \throws scene_error naming the file and the line (OBJ, MTL, JSON syntax) or the field
