@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Builds docs/report.md and its speed-against-error plots from the run reports in
 docs/data/*.json (written by the examples' --json option; see docs/studies/)."""
 import glob
@@ -26,8 +26,39 @@ def row(name, r):
     e = r.get("error", {}).get("rel_rms", float("nan"))
     p = r["parameters"]
     return (f"| {name} | {r['backend']} | {p.get('weight', '')} | {'on' if p.get('gradients') else 'off'} | "
-            f"{p.get('a', '')} | {r.get('records', '')} | {t.get('interpolate', float('nan')):.1f} | "
+            f"{p.get('a', 0):.3g} | {r.get('records', '')} | {t.get('interpolate', float('nan')):.1f} | "
             f"{t.get('compute_records', float('nan')):.0f} | {t.get('total', float('nan')):.0f} | {e:.4f} |")
+
+
+def headline(scene, mine):
+    """The comparisons of the irradiance-splatting issue, from the runs that exist."""
+    def err(name):
+        r = mine.get(f"{scene}-{name}")
+        return r and r.get("error", {}).get("rel_rms")
+
+    out = []
+    if err("smooth") is not None:
+        out.append(f"- indirect rel_rms with gradients: {err('smooth'):.4f} (target <= 0.06)")
+    if err("smooth") and err("nograd"):
+        out.append(f"- gradients lower the error by {100 * (1 - err('smooth') / err('nograd')):.0f}% "
+                   f"({err('nograd'):.4f} without; target >= 25%)")
+    if err("smooth") and err("ward"):
+        out.append(f"- smoothed weight {err('smooth'):.4f} against Ward's {err('ward'):.4f} (target: not above)")
+    s, o = mine.get(f"{scene}-smooth"), mine.get(f"{scene}-octree")
+    if s and o:
+        out.append(f"- interpolation: splatting {s['timings_ms']['interpolate']:.1f} ms, octree lookups "
+                   f"{o['timings_ms']['interpolate']:.1f} ms on the same records: "
+                   f"{o['timings_ms']['interpolate'] / s['timings_ms']['interpolate']:.2f}x (target >= 2x); whole frame "
+                   f"{s['timings_ms']['total']:.0f} ms against {o['timings_ms']['total']:.0f} ms")
+    g = mine.get(f"{scene}-gl")
+    if g:
+        out.append(f"- GL splatting (llvmpipe, no GPU): interpolate {g['timings_ms']['interpolate']:.1f} ms, "
+                   f"rel_rms {g['error']['rel_rms']:.4f}")
+    m = mine.get(f"{scene}-mc")
+    if m and "mc_equal_error" in m:
+        out.append(f"- at equal error brute-force Monte Carlo takes {m['mc_equal_error']['speedup']:.1f}x "
+                   f"the cache's time (target >= 20x)")
+    return out
 
 
 def main():
@@ -45,6 +76,9 @@ def main():
         for name, r in mine.items():
             lines.append(row(name, r))
         lines.append("")
+        head = headline(scene, mine)
+        if head:
+            lines += ["Figures the irradiance-splatting issue asks for (a = 0.15):", ""] + head + [""]
         mc = [r for r in mine.values() if "mc_sweep" in r]
         if mc:
             r = mc[0]

@@ -23,16 +23,22 @@ study() {  # study TAG SCENE REFSPP
     run "$tag-a$a" "${common[@]}" --a "$a" --weight ward-smooth
   done
   run "$tag-nograd" "${common[@]}" --a 0.15 --weight ward-smooth --gradients off
-  run "$tag-ward" "${common[@]}" --a 0.15 --weight ward --indirect-out "docs/figures/$tag-ward.png"
-  run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth --indirect-out "docs/figures/$tag-smooth.png" --out "docs/figures/$tag.png"
+  run "$tag-ward" "${common[@]}" --a 0.15 --weight ward
+  run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
+  # Pictures (small, to stay under 300 KB): indirect light beside the reference's, at a
+  # large a where Ward's circular seams show, and the final image.
+  for w in ward ward-smooth; do
+    "$bin" --scene "$scene" --width 256 --height 256 --ref-spp 1024 --a 0.4 --weight "$w" \
+        --indirect-out "docs/figures/$tag-$w-a0.4.png" --out "docs/figures/$tag-$w-final.png"
+  done
   run "$tag-octree" "${common[@]}" --a 0.15 --weight ward-smooth --interp octree
   run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
   run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
   # Every frame of the camera path needs its own reference: smaller images, fewer samples.
   run "$tag-progressive" --scene "$scene" --width 256 --height 256 --ref-spp 256 --a 0.15 --weight ward-smooth \
-      --progressive 300 --frames 6
+      --progressive 400 --frames 20
 }
 
 [[ $which == cornell || $which == all ]] && study cornell cornell 4096
 [[ $which == sponza || $which == all ]] && study sponza "$scenes/sponza/scene.json" 2048
-python3 docs/make_report.py
+/usr/bin/python3 docs/make_report.py  # Debian python3 with python3-matplotlib
