@@ -87,7 +87,8 @@ def main():
             lines += [f"| {m['spp']} | {m['ms']:.0f} | {m['rel_rms']:.4f} |" for m in r["mc_sweep"]]
             if "mc_equal_error" in r:
                 m = r["mc_equal_error"]
-                lines += ["", f"At equal error Monte Carlo needs {m['spp']} spp, {m['ms']:.0f} ms: "
+                lines += ["", f"At equal error Monte Carlo needs about {m['spp']:.0f} spp, {m['ms']:.0f} ms "
+                              f"(log-log interpolation between the last two points): "
                               f"{m['speedup']:.1f}x the cache's total time."]
             lines.append("")
         prog = [r for r in mine.values() if "frames" in r]

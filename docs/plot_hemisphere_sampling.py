@@ -1,0 +1,69 @@
+#!/usr/bin/env python3
+"""Plots the hemisphere study's sweep (examples/hemisphere_study --sweep --json X.json).
+
+    python3 docs/plot_hemisphere_sampling.py docs/hemisphere-sampling-sweep.json \
+        docs/hemisphere-sampling.png
+
+Left: RMS error of the four weightings against the plane resolution at the aperture of the
+main run (126 degrees by default), ray-cast sampler solid, raster sampler dashed.
+Right: border stretching's error against resolution, one line per aperture (ray-cast).
+Needs matplotlib (Debian: python3-matplotlib; run with /usr/bin/python3).
+"""
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+METHODS = [("rms_plane", "plane only"), ("rms_coverage", "coverage ratio [LC04]"),
+           ("rms_stretch", "border stretching"), ("rms_falloff", "fall-off stretching")]
+COLOURS = ["#777777", "#1f77b4", "#d62728", "#2ca02c"]
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.exit(__doc__)
+    with open(argv[1]) as f:
+        study = json.load(f)
+    rows = study["sweep"]
+    aperture = study["parameters"]["aperture_deg"]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4), dpi=90)
+    for sampler, style in (("ray_cast", "-"), ("raster", "--")):
+        sel = sorted((r for r in rows if r["sampler"] == sampler and r["aperture"] == aperture),
+                     key=lambda r: r["resolution"])
+        if not sel:
+            continue
+        for (key, label), colour in zip(METHODS, COLOURS):
+            left.plot([r["resolution"] for r in sel], [100 * r[key] for r in sel], style, color=colour,
+                      marker="o", markersize=3,
+                      label=f"{label} ({sampler.replace('_', '-')})")
+    left.set_xscale("log", base=2)
+    left.set_xlabel("plane resolution N (N x N pixels)")
+    left.set_ylabel("RMS error of irradiance (%)")
+    left.set_title(f"{study['scene']}, aperture {aperture:g} deg, {study.get('sweep_points', '?')} points")
+    left.grid(True, alpha=0.3)
+    left.legend(fontsize=7)
+
+    apertures = sorted({r["aperture"] for r in rows})
+    cmap = plt.get_cmap("viridis")
+    for i, ap in enumerate(apertures):
+        sel = sorted((r for r in rows if r["sampler"] == "ray_cast" and r["aperture"] == ap),
+                     key=lambda r: r["resolution"])
+        if sel:
+            right.plot([r["resolution"] for r in sel], [100 * r["rms_stretch"] for r in sel], "-",
+                       color=cmap(i / max(1, len(apertures) - 1)), marker="o", markersize=3,
+                       label=f"{ap:g} deg")
+    right.set_xscale("log", base=2)
+    right.set_xlabel("plane resolution N")
+    right.set_ylabel("RMS error, border stretching (%)")
+    right.set_title("aperture choice (ray-cast sampler)")
+    right.grid(True, alpha=0.3)
+    right.legend(fontsize=7, title="aperture")
+    fig.tight_layout()
+    fig.savefig(argv[2])
+
+
+if __name__ == "__main__":
+    main(sys.argv)
