@@ -159,27 +159,24 @@ void write_texture(const texture& t, image_view<const glm::vec4> image) {
     upload_rows(t, flipped(image));
 }
 
-void read_texture(const texture& t, image_view<glm::vec4> out) {
+namespace {
+// RGBA32F texels into the first Pixel::length() channels of `out`, rows flipped to top first.
+template <class Pixel>
+void read_texels(const texture& t, image_view<Pixel> out) {
     require_rgba32f(t, "t");
     require(out.width() == t.width() && out.height() == t.height(), "out", "size differs from the texture");
     const auto f = t.read_floats();
     for (std::size_t y = 0; y < out.height(); ++y)
         for (std::size_t x = 0; x < out.width(); ++x) {
             const std::size_t i = 4 * ((out.height() - 1 - y) * out.width() + x);
-            out(x, y) = {f[i], f[i + 1], f[i + 2], f[i + 3]};
+            for (int c = 0; c < Pixel::length(); ++c) out(x, y)[c] = f[i + std::size_t(c)];
         }
 }
+}  // namespace
 
-void read_texture(const texture& t, image_view<glm::vec3> out) {
-    require_rgba32f(t, "t");
-    require(out.width() == t.width() && out.height() == t.height(), "out", "size differs from the texture");
-    const auto f = t.read_floats();
-    for (std::size_t y = 0; y < out.height(); ++y)
-        for (std::size_t x = 0; x < out.width(); ++x) {
-            const std::size_t i = 4 * ((out.height() - 1 - y) * out.width() + x);
-            out(x, y) = {f[i], f[i + 1], f[i + 2]};
-        }
-}
+void read_texture(const texture& t, image_view<glm::vec4> out) { read_texels(t, out); }
+
+void read_texture(const texture& t, image_view<glm::vec3> out) { read_texels(t, out); }
 
 void splat_params::validate() const {
     require(std::isfinite(a) && a > 0.f, "a", "accuracy must be a positive number");
