@@ -29,7 +29,7 @@ def main(argv):
         study = json.load(f)
     rows = study["sweep"]
     aperture = study["parameters"]["aperture_deg"]
-    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4), dpi=90)
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 5), dpi=90)
     for sampler, style in (("ray_cast", "-"), ("raster", "--")):
         sel = sorted((r for r in rows if r["sampler"] == sampler and r["aperture"] == aperture),
                      key=lambda r: r["resolution"])
@@ -44,7 +44,7 @@ def main(argv):
     left.set_ylabel("RMS error of irradiance (%)")
     left.set_title(f"{study['scene']}, aperture {aperture:g} deg, {study.get('sweep_points', '?')} points")
     left.grid(True, alpha=0.3)
-    left.legend(fontsize=7)
+    left.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
 
     apertures = sorted({r["aperture"] for r in rows})
     cmap = plt.get_cmap("viridis")
@@ -60,7 +60,7 @@ def main(argv):
     right.set_ylabel("RMS error, border stretching (%)")
     right.set_title("aperture choice (ray-cast sampler)")
     right.grid(True, alpha=0.3)
-    right.legend(fontsize=7, title="aperture")
+    right.legend(fontsize=7, title="aperture", ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     fig.tight_layout()
     fig.savefig(argv[2])
 

@@ -1,0 +1,98 @@
+// The ray-cast plane sampler (sample_plane over the Embree reference integrator's
+// incoming_radiance): the same planes as the analytic ceiling away from its edge, and
+// irradiance and its translation gradient close to the closed forms of the half-lit ceiling.
+#include "../core/half_lit_ceiling.hpp"
+
+#include <bounce/embree/accel.hpp>
+#include <bounce/embree/reference.hpp>
+#include <bounce/hemisphere.hpp>
+#include <bounce/sampling.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace bounce;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+// The ceiling of test_hemisphere_raster.cpp: y = H facing down, Kd for x > x_edge, black
+// elsewhere, lit from below by a directional light (E_perp), so its radiance is Kd E_perp / pi.
+io::scene ceiling(float H, float x_edge, float kd, float E_perp, float extent = 2000.f) {
+    io::scene s;
+    s.name = "half-lit-ceiling";
+    io::material lit, dark;
+    lit.name = "lit";
+    lit.kd = glm::vec3(kd);
+    dark.name = "dark";
+    dark.kd = glm::vec3(0.f);
+    s.materials = {lit, dark};
+    const auto quad = [&](float x0, float x1, std::uint32_t m) {
+        const auto base = std::uint32_t(s.positions.size());
+        for (const glm::vec3 p : {glm::vec3(x0, H, -extent), glm::vec3(x1, H, -extent), glm::vec3(x1, H, extent),
+                                  glm::vec3(x0, H, extent)}) {
+            s.positions.push_back(p);
+            s.normals.emplace_back(0, -1, 0);
+        }
+        s.triangles.emplace_back(base, base + 1, base + 2);
+        s.triangles.emplace_back(base, base + 2, base + 3);
+        s.material_of.insert(s.material_of.end(), {m, m});
+    };
+    quad(x_edge, extent, 0);
+    quad(-extent, x_edge, 1);
+    s.lights.push_back(io::directional_light{glm::vec3(0, 1, 0), glm::vec3(E_perp)});
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("ray-cast planes of a half-lit ceiling give the closed-form irradiance and gradient", "[hemisphere][embree]") {
+    const float H = 1.5f, x_edge = 0.25f, kd = 0.6f, E_perp = 3.f;
+    const double L = double(kd) * E_perp / pi;
+    const io::scene s = ceiling(H, x_edge, kd, E_perp);
+    const embree::accel bvh(s);
+    const embree::reference_integrator ref(bvh, s);
+    const plane_camera cam{64, 126.0};
+    const auto stretch = make_plane_weights(cam, plane_weighting::stretch);
+    const glm::vec3 n(0, 1, 0);
+    const auto tb = orthonormal_basis<float, glm::vec3>(n);
+    pcg32 rng(8);
+    for (int c = 0; c < 12; ++c) {
+        const glm::vec3 p(float(2 * rng.next_double() - 1), 0.f, float(2 * rng.next_double() - 1));
+        image<glm::vec3> radiance(cam.resolution, cam.resolution);
+        image<float> distance(cam.resolution, cam.resolution);
+        const glm::vec3 origin = p + ref.ray_epsilon() * n;
+        sample_plane(
+            cam,
+            [&](const glm::dvec3& d) {
+                embree::ray r;
+                r.origin = origin;
+                r.direction = glm::normalize(tb[0] * float(d.x) + tb[1] * float(d.y) + n * float(d.z));
+                float t = 0;
+                const glm::vec3 Li = ref.incoming_radiance(r, 0, &t);
+                return std::pair{Li, t};
+            },
+            radiance.view(), distance.view());
+        const auto e = estimate_plane(stretch, {radiance.view(), distance.view()});
+        // The record at p sees the lit side where world x > x_edge. In the plane's frame the
+        // edge direction is (t.x, b.x) (a unit vector, n being +y), so this is the core
+        // test's ceiling with h = H - offset, x0 = p.x - x_edge and rot = atan2(b.x, t.x):
+        // its rigorous bound on E (mixed cells) and its translation budget for N = 64.
+        const double h = double(H) - ref.ray_epsilon();
+        const ceiling_test::half_lit_ceiling hc{h, double(p.x) - x_edge, L, std::atan2(double(tb[1].x), double(tb[0].x))};
+        const auto bound = ceiling_test::mixed_cells(cam, hc, true);
+        CAPTURE(p.x, p.z, e.irradiance.x, hc.E(), bound.E);
+        // Float radiance (relative 1e-7 of E) on top of the bound.
+        CHECK(std::abs(e.irradiance.x - hc.E()) <= L * bound.E + 1e-6 * hc.E());
+        CHECK(glm::length(e.rotation[0] - hc.rot_y() * hc.across()) <= L * bound.rotation + 1e-6 * hc.E());
+        CHECK(glm::length(e.translation[0] - hc.dE_dx() * hc.along()) < 0.044 * pi * L / (2 * h));
+        const double E = hc.E();
+        // And the full-hemisphere reference integrator agrees with the same closed form
+        // (its stratified estimate of a step: ~1/M of the scale with M = 18 at 1024 rays).
+        const glm::vec3 Eref = ref.indirect_irradiance(p, n, 1024, 1000 + c);
+        CHECK(std::abs(double(Eref.x) - E) < 1.0 / 18 * pi * L / 2);
+    }
+}
