@@ -2,11 +2,6 @@
 // emitted kernels agree with their CPU instantiation; planes of a half-lit ceiling match the
 // analytic plane texel by texel away from the edge; the GPU reduction agrees with the CPU
 // sum; tiles of an atlas do not bleed; asynchronous read-backs come back in order.
-// GCC 12 reports a false -Wrestrict inside std::string's operator+ as inlined into
-// kernel_map.hpp's result names for a 7-tuple result (GCC bug 105329); nothing overlaps.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wrestrict"
-#endif
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/direct_light.hpp>

@@ -127,19 +127,19 @@ struct result_lanes<Tuple<E...>> {
     static constexpr bool returned = false;
     static std::vector<std::string> names() {
         std::vector<std::string> n;
-        for (std::size_t i = 0; i < sizeof...(E); ++i) n.push_back("r" + std::to_string(i));
+        for (std::size_t i = 0; i < sizeof...(E); ++i) n.push_back(std::string("r") + std::to_string(i));
         return n;
     }
     static std::string declarations() {
         return [&]<std::size_t... I>(std::index_sequence<I...>) {
-            return ((std::string("    ") + lane<E>::declare("r" + std::to_string(I)) + ";\n") + ...);
+            return ((std::string("    ") + lane<E>::declare(std::string("r") + std::to_string(I)) + ";\n") + ...);
         }(std::index_sequence_for<E...>{});
     }
     static std::string stores() {
         std::string s;
         std::size_t at = 0;
         [&]<std::size_t... I>(std::index_sequence<I...>) {
-            ((s += lane<E>::store_statements("r" + std::to_string(I), at), at += lane<E>::floats), ...);
+            ((s += lane<E>::store_statements(std::string("r") + std::to_string(I), at), at += lane<E>::floats), ...);
         }(std::index_sequence_for<E...>{});
         return s;
     }
@@ -187,7 +187,7 @@ std::string map_kernel_source(F&& fn) {
     std::string loads, call_args;
     std::size_t at = 0;
     [&]<std::size_t... I>(std::index_sequence<I...>) {
-        ((loads += detail::lane<std::tuple_element_t<I, args>>::load_statements("a" + std::to_string(I), at),
+        ((loads += detail::lane<std::tuple_element_t<I, args>>::load_statements(std::string("a") + std::to_string(I), at),
           at += detail::lane<std::tuple_element_t<I, args>>::floats,
           call_args += (I ? ", a" : "a") + std::to_string(I)),
          ...);
@@ -197,14 +197,14 @@ std::string map_kernel_source(F&& fn) {
     std::string call;
     if constexpr (results::returned) {
         function = [&]<std::size_t... I>(std::index_sequence<I...>) {
-            return glsl::emit("bounce_kernel", fn, ("a" + std::to_string(I))...);
+            return glsl::emit("bounce_kernel", fn, (std::string("a") + std::to_string(I))...);
         }(std::make_index_sequence<arity>{});
         using R = typename sig::result;
         call = "    " + detail::lane<R>::declare("r0") + " = bounce_kernel(" + call_args + ");\n";
     } else {
         const auto outs = results::names();
         function = [&]<std::size_t... I, std::size_t... O>(std::index_sequence<I...>, std::index_sequence<O...>) {
-            return glsl::emit("bounce_kernel", fn, ("a" + std::to_string(I))..., outs[O]...);
+            return glsl::emit("bounce_kernel", fn, (std::string("a") + std::to_string(I))..., outs[O]...);
         }(std::make_index_sequence<arity>{}, std::make_index_sequence<glsl::detail::result_traits<typename sig::result>::outs>{});
         for (const auto& o : outs) call_args += (call_args.empty() ? "" : ", ") + o;
         call = results::declarations() + "    bounce_kernel(" + call_args + ");\n";
