@@ -133,7 +133,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
     const options& o = ctx.opt;
     const cpu::splat_params sp = splat_params_for(o, a);
     const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
-    const auto gv = const_cast<gbuffer<float>&>(g).view();
+    const auto gv = g_in.view();
 
     double record_ms = 0;
     auto create = record_creator(ctx, cam, g, records, record_ms);
