@@ -22,7 +22,9 @@
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
+#include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/objects.hpp>
+#include <bounce/gl/raster_record_sampler.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #endif
 
@@ -30,6 +32,7 @@
 #include <fmt/core.h>
 
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <algorithm>
 #include <filesystem>
@@ -86,7 +89,8 @@ struct context {
     const io::scene& scene;
     const embree::accel& bvh;
     const embree::reference_integrator& integrator;
-    embree::record_sampler& sampler;
+    /// The record sampler (Embree rays or the GL plane rasterizer): a record at (p, n).
+    std::function<std::optional<irradiance_record>(glm::vec3, glm::vec3, double)> sampler;
 };
 
 // The parameters records depend on (not a: records are valid for every a).
@@ -204,6 +208,8 @@ struct gl_backend {
     gl::splat_pass splats;
     gl::compose_pass compose;
     std::size_t on_gpu = 0;
+
+    std::optional<gl::hemisphere_raster> raster;  // the record sampler, for --sampler raster
 
     explicit gl_backend(const io::scene& s) : mesh(s), light(s, mesh, 2048) {}
 };
@@ -330,23 +336,31 @@ int run(const options& o) {
     limits.min_pixels = o.min_pixels;
     limits.max_pixels = o.max_pixels;
     limits.gradient_limit = o.gradient_limit;
-    embree::record_sampler sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
-    const context ctx{o, scene, bvh, integrator, sampler};
+    embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
+    context ctx{o, scene, bvh, integrator, std::ref(embree_sampler)};
     std::vector<irradiance_record> records;
 
-    if (o.sampler != "embree")
-        throw parameter_error("--sampler", "'" + o.sampler + "' is not available in this build (only 'embree')");
 #ifdef BOUNCE_IC_WITH_GL
     std::optional<gl_backend> gl_state;
-    if (o.interp == "splat-gl") setup.time("gl_setup", [&] { gl_state.emplace(scene); });
+    if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene); });
+    std::optional<gl::raster_record_sampler> raster_sampler;
+    if (o.sampler == "raster") {
+        // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4).
+        gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, 1});
+        raster_sampler.emplace(*gl_state->raster, limits);
+        ctx.sampler = std::ref(*raster_sampler);
+    }
+    const bool gl_frames = o.interp == "splat-gl";
 #else
+    if (o.sampler != "embree")
+        throw parameter_error("--sampler", "'raster' needs the GL adapter, which this build does not have");
     if (o.interp == "splat-gl")
         throw parameter_error("--interp", "'splat-gl' needs the GL adapter, which this build does not have");
 #endif
     // One frame for `cam` with the chosen backend; the G-buffer is part of its timing.
     auto frame = [&](const camera& cam, float a, io::stage_timer& t, std::size_t max_new) -> frame_result {
 #ifdef BOUNCE_IC_WITH_GL
-        if (gl_state) return render_frame_gl(ctx, *gl_state, cam, a, records, t, max_new);
+        if (gl_frames) return render_frame_gl(ctx, *gl_state, cam, a, records, t, max_new);
 #endif
         gbuffer<float> g;
         t.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
@@ -430,7 +444,7 @@ int run(const options& o) {
             for (int r = 0; r < o.repeat; ++r) {
                 records = start;
 #ifdef BOUNCE_IC_WITH_GL
-                if (gl_state) {  // the GPU copy restarts from the same cache
+                if (gl_frames) {  // the GPU copy restarts from the same cache
                     gl_state->splats.upload(records);
                     gl_state->on_gpu = records.size();
                 }
