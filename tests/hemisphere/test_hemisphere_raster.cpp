@@ -3,6 +3,7 @@
 // analytic plane texel by texel away from the edge; the GPU reduction agrees with the CPU
 // sum; tiles of an atlas do not bleed; asynchronous read-backs come back in order.
 #include "../gl/shared_context.hpp"
+#include "half_lit_ceiling_scene.hpp"
 
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
@@ -19,6 +20,7 @@
 #include <vector>
 
 using namespace bounce;
+using hemisphere_test::half_lit_ceiling_scene;
 
 namespace {
 
@@ -27,36 +29,6 @@ constexpr double pi = std::numbers::pi;
 template <real T>
 T atan_kernel(T y, T x) {
     return atan(y, x);
-}
-
-// A ceiling at height y = H facing down, Kd = kd_lit for x > x_edge and 0 elsewhere,
-// 2 * extent wide, lit from below by a directional light travelling +y that delivers E_perp:
-// the lit part has radiance kd / pi * E_perp. Records sit at y = 0 looking up (n = +y).
-io::scene half_lit_ceiling_scene(float H, float x_edge, float kd_lit, float E_perp, float extent = 2000.f) {
-    io::scene s;
-    s.name = "half-lit-ceiling";
-    io::material lit, dark;
-    lit.name = "lit";
-    lit.kd = glm::vec3(kd_lit);
-    dark.name = "dark";
-    dark.kd = glm::vec3(0.f);
-    s.materials = {lit, dark};
-    const glm::vec3 down(0, -1, 0);
-    const auto quad = [&](float x0, float x1, std::uint32_t m) {
-        const auto base = std::uint32_t(s.positions.size());
-        for (const glm::vec3 p : {glm::vec3(x0, H, -extent), glm::vec3(x1, H, -extent), glm::vec3(x1, H, extent),
-                                  glm::vec3(x0, H, extent)}) {
-            s.positions.push_back(p);
-            s.normals.push_back(down);
-        }
-        s.triangles.emplace_back(base, base + 1, base + 2);
-        s.triangles.emplace_back(base, base + 2, base + 3);
-        s.material_of.insert(s.material_of.end(), {m, m});
-    };
-    quad(x_edge, extent, 0);
-    quad(-extent, x_edge, 1);
-    s.lights.push_back(io::directional_light{glm::vec3(0, 1, 0), glm::vec3(E_perp)});
-    return s;
 }
 
 // The analytic plane of that ceiling for a record at (px, 0, pz) with n = +y, in the frame

@@ -2,6 +2,7 @@
 // incoming_radiance): the same planes as the analytic ceiling away from its edge, and
 // irradiance and its translation gradient close to the closed forms of the half-lit ceiling.
 #include "../core/half_lit_ceiling.hpp"
+#include "half_lit_ceiling_scene.hpp"
 
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
@@ -19,40 +20,12 @@ namespace {
 
 constexpr double pi = std::numbers::pi;
 
-// The ceiling of test_hemisphere_raster.cpp: y = H facing down, Kd for x > x_edge, black
-// elsewhere, lit from below by a directional light (E_perp), so its radiance is Kd E_perp / pi.
-io::scene ceiling(float H, float x_edge, float kd, float E_perp, float extent = 2000.f) {
-    io::scene s;
-    s.name = "half-lit-ceiling";
-    io::material lit, dark;
-    lit.name = "lit";
-    lit.kd = glm::vec3(kd);
-    dark.name = "dark";
-    dark.kd = glm::vec3(0.f);
-    s.materials = {lit, dark};
-    const auto quad = [&](float x0, float x1, std::uint32_t m) {
-        const auto base = std::uint32_t(s.positions.size());
-        for (const glm::vec3 p : {glm::vec3(x0, H, -extent), glm::vec3(x1, H, -extent), glm::vec3(x1, H, extent),
-                                  glm::vec3(x0, H, extent)}) {
-            s.positions.push_back(p);
-            s.normals.emplace_back(0, -1, 0);
-        }
-        s.triangles.emplace_back(base, base + 1, base + 2);
-        s.triangles.emplace_back(base, base + 2, base + 3);
-        s.material_of.insert(s.material_of.end(), {m, m});
-    };
-    quad(x_edge, extent, 0);
-    quad(-extent, x_edge, 1);
-    s.lights.push_back(io::directional_light{glm::vec3(0, 1, 0), glm::vec3(E_perp)});
-    return s;
-}
-
 }  // namespace
 
 TEST_CASE("ray-cast planes of a half-lit ceiling give the closed-form irradiance and gradient", "[hemisphere][embree]") {
     const float H = 1.5f, x_edge = 0.25f, kd = 0.6f, E_perp = 3.f;
     const double L = double(kd) * E_perp / pi;
-    const io::scene s = ceiling(H, x_edge, kd, E_perp);
+    const io::scene s = hemisphere_test::half_lit_ceiling_scene(H, x_edge, kd, E_perp);
     const embree::accel bvh(s);
     const embree::reference_integrator ref(bvh, s);
     const plane_camera cam{64, 126.0};
