@@ -14,6 +14,7 @@
 // sqrt(mean((E - E_ref)^2)) / sqrt(mean(E_ref^2)), as in the seed's Table 8.1.
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
+#include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/embree/reference_cache.hpp>
 #include <bounce/hemisphere.hpp>
@@ -217,24 +218,9 @@ estimates ray_cast(const embree::reference_integrator& ref, const std::vector<st
     const auto t0 = clock_type::now();
     tbb::parallel_for(std::size_t(0), pts.size(), [&](std::size_t k) {
         const auto [p, n] = pts[k];
-        const auto tb = orthonormal_basis<float, glm::vec3>(n);
-        const glm::vec3 origin = p + ref.ray_epsilon() * n;
         image<glm::vec3> radiance(cam.resolution, cam.resolution);
         image<float> distance(cam.resolution, cam.resolution);
-        sample_plane(
-            cam,
-            [&](const glm::dvec3& d) {
-                embree::ray r;
-                r.origin = origin;
-                r.direction = glm::normalize(tb[0] * float(d.x) + tb[1] * float(d.y) + n * float(d.z));
-                float hit = 0;
-                const glm::vec3 L = ref.incoming_radiance(r, 0, &hit);
-                // An origin that lies on another surface (a record in a corner) can hit it
-                // at t = 0; the plane's distances must be positive, as plane_hit_distance
-                // keeps them in the raster sampler.
-                return std::pair{L, std::max(hit, 1e-30f)};
-            },
-            radiance.view(), distance.view());
+        embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
         const plane_view v{radiance.view(), distance.view()};
         out.stretch[k] = estimate_plane(t.stretch, v).irradiance;
         out.plane[k] = estimate_plane(t.plane, v).irradiance;

@@ -5,6 +5,7 @@
 #include "half_lit_ceiling_scene.hpp"
 
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/hemisphere.hpp>
 #include <bounce/sampling.hpp>
@@ -37,18 +38,7 @@ TEST_CASE("ray-cast planes of a half-lit ceiling give the closed-form irradiance
         const glm::vec3 p(float(2 * rng.next_double() - 1), 0.f, float(2 * rng.next_double() - 1));
         image<glm::vec3> radiance(cam.resolution, cam.resolution);
         image<float> distance(cam.resolution, cam.resolution);
-        const glm::vec3 origin = p + ref.ray_epsilon() * n;
-        sample_plane(
-            cam,
-            [&](const glm::dvec3& d) {
-                embree::ray r;
-                r.origin = origin;
-                r.direction = glm::normalize(tb[0] * float(d.x) + tb[1] * float(d.y) + n * float(d.z));
-                float t = 0;
-                const glm::vec3 Li = ref.incoming_radiance(r, 0, &t);
-                return std::pair{Li, t};
-            },
-            radiance.view(), distance.view());
+        embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
         const auto e = estimate_plane(stretch, {radiance.view(), distance.view()});
         // The record at p sees the lit side where world x > x_edge. In the plane's frame the
         // edge direction is (t.x, b.x) (a unit vector, n being +y), so this is the core

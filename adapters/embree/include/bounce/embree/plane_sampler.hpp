@@ -1,0 +1,38 @@
+#pragma once
+/// \file plane_sampler.hpp
+/// The ray-cast counterpart of gl::hemisphere_raster: one hemisphere plane (bounce/
+/// hemisphere.hpp) filled by casting its pixel rays through Embree, each hit shaded by the
+/// reference integrator, so a plane estimator's error can be told from rasterization's.
+
+#include <bounce/embree/reference.hpp>
+#include <bounce/hemisphere.hpp>
+#include <bounce/sampling.hpp>
+
+#include <algorithm>
+#include <utility>
+
+namespace bounce::embree {
+
+/// Fills `radiance` and `distance` (resolution x resolution) with the plane of `camera` at
+/// the record (p, n), in the frame of orthonormal_basis(n), rays leaving p + ray_epsilon n.
+/// Distances are floored at 1e-30: an origin lying on another surface (a record in a
+/// corner) can hit it at t = 0, and plane distances must be positive, as
+/// plane_hit_distance keeps them in the raster sampler.
+inline void sample_plane(const reference_integrator& ref, const plane_camera& camera, glm::vec3 p, glm::vec3 n,
+                         image_view<glm::vec3> radiance, image_view<float> distance) {
+    const auto tb = orthonormal_basis<float, glm::vec3>(n);
+    const glm::vec3 origin = p + ref.ray_epsilon() * n;
+    bounce::sample_plane(
+        camera,
+        [&](const glm::dvec3& d) {
+            ray r;
+            r.origin = origin;
+            r.direction = glm::normalize(tb[0] * float(d.x) + tb[1] * float(d.y) + n * float(d.z));
+            float hit = 0;
+            const glm::vec3 L = ref.incoming_radiance(r, 0, &hit);
+            return std::pair{L, std::max(hit, 1e-30f)};
+        },
+        radiance, distance);
+}
+
+}  // namespace bounce::embree
