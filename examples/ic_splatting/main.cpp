@@ -313,18 +313,6 @@ embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64
     return s;
 }
 
-// Exposure mapping the 99th percentile of covered luminance to 1 (PNG only).
-float auto_exposure(const image<glm::vec3>& img, const image<float>& mask) {
-    std::vector<float> lum;
-    for (std::size_t y = 0; y < img.height(); ++y)
-        for (std::size_t x = 0; x < img.width(); ++x)
-            if (mask(x, y) > 0.f) lum.push_back(0.2126f * img(x, y).x + 0.7152f * img(x, y).y + 0.0722f * img(x, y).z);
-    if (lum.empty()) return 1.f;
-    const auto k = std::size_t(0.99 * double(lum.size() - 1));
-    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
-    return lum[k] > 0.f ? 1.f / lum[k] : 1.f;
-}
-
 int run(const options& o) {
     io::stage_timer setup;
     const io::scene scene = io::load_scene_arg(o.scene);
@@ -512,7 +500,7 @@ int run(const options& o) {
             if (fr.combined) combined = *fr.combined;
             else cpu::compose(ref.direct.view(), fr.indirect.view(), combined.view());
             if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
-            if (!o.out.empty()) io::write_png(o.out, combined.view(), auto_exposure(combined, mask));
+            if (!o.out.empty()) io::write_png(o.out, combined.view(), io::auto_exposure(combined.view(), mask.view()));
         }
         if (!o.indirect_out.empty()) {
             // The indirect images side by side with one exposure: the cache's, the reference's.
@@ -522,7 +510,7 @@ int run(const options& o) {
                     pair(x, y) = fr.indirect(x, y);
                     pair(o.width + x, y) = ref.indirect(x, y);
                 }
-            io::write_png(o.indirect_out, pair.view(), auto_exposure(ref.indirect, mask));
+            io::write_png(o.indirect_out, pair.view(), io::auto_exposure(ref.indirect.view(), mask.view()));
         }
     }
 

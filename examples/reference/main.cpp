@@ -31,22 +31,6 @@ fs::path sibling(const fs::path& file, const std::string& stage) {
     return p.replace_extension("." + stage + file.extension().string());
 }
 
-// Exposure that maps the 99th percentile of the luminance of covered pixels to 1, so the
-// PNG shows the scene whatever its light units (the EXR keeps the data).
-float auto_exposure(const image<glm::vec3>& img, const gbuffer<float>& g) {
-    std::vector<float> lum;
-    for (std::size_t y = 0; y < img.height(); ++y)
-        for (std::size_t x = 0; x < img.width(); ++x)
-            if (std::isfinite(g.depth(x, y))) {
-                const glm::vec3 c = img(x, y);
-                lum.push_back(0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z);
-            }
-    if (lum.empty()) return 1.f;
-    const auto k = std::size_t(0.99 * double(lum.size() - 1));
-    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
-    return lum[k] > 0.f ? 1.f / lum[k] : 1.f;
-}
-
 // Prints a stage's progress in steps of 10% on stderr.
 embree::reference_settings with_progress(embree::reference_settings s, const char* stage, bool quiet) {
     if (quiet) return s;
@@ -152,12 +136,12 @@ int main(int argc, char** argv) {
         io::write_exr(sibling(out, "direct"), images.direct.view());
         io::write_exr(sibling(out, "indirect"), images.indirect.view());
         if (!png.empty()) {
-            const float e = exposure > 0.f ? exposure : auto_exposure(images.combined, g);
+            const float e = exposure > 0.f ? exposure : io::auto_exposure(images.combined.view(), g.depth.view());
             io::write_png(png, images.combined.view(), e);
             io::write_png(sibling(png, "direct"), images.direct.view(), e);
             // The indirect image alone is dim; its own exposure shows the colour bleeding.
             io::write_png(sibling(png, "indirect"), images.indirect.view(),
-                          exposure > 0.f ? exposure : auto_exposure(images.indirect, g));
+                          exposure > 0.f ? exposure : io::auto_exposure(images.indirect.view(), g.depth.view()));
         }
 
         std::size_t covered = 0;

@@ -5,11 +5,13 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace bounce::io {
 
@@ -86,6 +88,22 @@ image<glm::vec3> read_rgb(const fs::path& file) {
     if (!rgb.get_pixels(OIIO::ROI(0, spec.width, 0, spec.height, 0, 1, 0, 3), OIIO::TypeDesc::FLOAT, out.data()))
         throw image_error(file, oiio_message(rgb.geterror()));
     return out;
+}
+
+float auto_exposure(image_view<const glm::vec3> rgb, image_view<const float> weight) {
+    require(weight.empty() || (weight.width() == rgb.width() && weight.height() == rgb.height()), "weight",
+            "size differs from the image");
+    std::vector<float> lum;
+    for (std::size_t y = 0; y < rgb.height(); ++y)
+        for (std::size_t x = 0; x < rgb.width(); ++x)
+            if (weight.empty() || (std::isfinite(weight(x, y)) && weight(x, y) > 0.f)) {
+                const glm::vec3 c = rgb(x, y);
+                lum.push_back(0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z);
+            }
+    if (lum.empty()) return 1.f;
+    const auto k = std::size_t(0.99 * double(lum.size() - 1));
+    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
+    return lum[k] > 0.f ? 1.f / lum[k] : 1.f;
 }
 
 void write_png(const fs::path& file, image_view<const glm::vec3> rgb, float exposure) {

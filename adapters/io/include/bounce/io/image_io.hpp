@@ -34,6 +34,11 @@ image<glm::vec3> read_rgb(const std::filesystem::path& file);
 /// \param exposure linear scale before clamping, finite and > 0; typical: 1.
 /// \throws parameter_error on a bad exposure or an empty image, io::image_error on I/O.
 void write_png(const std::filesystem::path& file, image_view<const glm::vec3> rgb, float exposure = 1.f);
+/// Exposure mapping the 99th percentile of luminance to 1, so a PNG shows the scene
+/// whatever its light units, over the pixels whose `weight` is finite and positive (a 0/1
+/// mask, or a G-buffer depth: +infinity marks background); all pixels when it is empty.
+/// 1 when no such pixel is lit.
+float auto_exposure(image_view<const glm::vec3> rgb, image_view<const float> weight = {});
 
 /// Error of an image against a reference, on luminance (Rec. 709 weights), over the
 /// pixels where `mask` is non-zero (all pixels when the mask is empty).
