@@ -7,6 +7,7 @@
 // Stages (the names of timings_ms): gbuffer, splat_existing (step 2), scan (step 4 minus
 // record computation), compute_records, interpolate (making the indirect image from the
 // cache: the final splat of step 5, or the octree's lookups), normalize, total.
+#include <bounce/cpu/neighbour_index.hpp>
 #include <bounce/cpu/octree_cache.hpp>
 #include <bounce/cpu/splatting.hpp>
 #include <bounce/embree/accel.hpp>
@@ -71,7 +72,7 @@ struct options {
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
     int repeat = 1;
     bool mc_compare = false;
-    fs::path json, out, exr, indirect_out, cache_in, cache_out;
+    fs::path json, out, exr, indirect_out, indirect_exr, cache_in, cache_out;
 };
 
 weighting_kind parse_weight(const std::string& w) {
@@ -91,6 +92,8 @@ struct context {
     const embree::reference_integrator& integrator;
     /// The record sampler (Embree rays or the GL plane rasterizer): a record at (p, n).
     std::function<std::optional<irradiance_record>(glm::vec3, glm::vec3, double)> sampler;
+    /// The records so far for --neighbour-clamp (null when off); mirrors `records`.
+    cpu::neighbour_index* clamp = nullptr;
 };
 
 // The parameters records depend on (not a: records are valid for every a).
@@ -124,7 +127,10 @@ auto record_creator(const context& ctx, const camera& cam, const gbuffer<float>&
     return [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
         const auto t0 = clock_type::now();
         auto rec = ctx.sampler(g.position(x, y), g.normal(x, y), cam.pixel_footprint(g.depth(x, y), g.height()));
-        if (rec && ctx.opt.neighbour_clamp) rec->radius = neighbour_clamped_radius(*rec, records);
+        if (rec && ctx.clamp) {
+            ctx.clamp->sync(records);
+            rec->radius = ctx.clamp->clamped_radius(*rec);
+        }
         record_ms += ms_since(t0);
         return rec;
     };
@@ -326,6 +332,8 @@ int run(const options& o) {
     limits.gradient_limit = o.gradient_limit;
     embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     context ctx{o, scene, bvh, integrator, std::ref(embree_sampler)};
+    cpu::neighbour_index clamp_index(scene.bounds().first, scene.bounds().second);
+    if (o.neighbour_clamp) ctx.clamp = &clamp_index;
     std::vector<irradiance_record> records;
 
 #ifdef BOUNCE_IC_WITH_GL
@@ -502,6 +510,7 @@ int run(const options& o) {
             if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
             if (!o.out.empty()) io::write_png(o.out, combined.view(), io::auto_exposure(combined.view(), mask.view()));
         }
+        if (!o.indirect_exr.empty()) io::write_exr(o.indirect_exr, fr.indirect.view());
         if (!o.indirect_out.empty()) {
             // The indirect images side by side with one exposure: the cache's, the reference's.
             image<glm::vec3> pair(2 * o.width, o.height);
@@ -561,6 +570,7 @@ int main(int argc, char** argv) {
     app.add_option("--out", o.out, "write the final image (direct + indirect) as PNG");
     app.add_option("--exr", o.exr, "write the final image as EXR");
     app.add_option("--indirect-out", o.indirect_out, "write the indirect image beside the reference's as PNG");
+    app.add_option("--indirect-exr", o.indirect_exr, "write the indirect image alone as EXR (linear, for error maps)");
     app.add_option("--cache-in", o.cache_in, "start from the records saved in this file");
     app.add_option("--cache-out", o.cache_out, "save the records to this file");
     CLI11_PARSE(app, argc, argv);
