@@ -321,7 +321,7 @@ int main(int argc, char** argv) {
     std::uint64_t seed = 1;
     int shadow_resolution = 4096;
     bool sweep = false, no_raster = false, no_ray_cast = false, no_cache = false;
-    fs::path json_path, cache_dir = embree::default_cache_dir();
+    fs::path json_path, points_csv, cache_dir = embree::default_cache_dir();
     app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--resolution", resolution, "plane resolution N (N x N pixels)")
@@ -351,6 +351,7 @@ int main(int argc, char** argv) {
     app.add_option("--cache-dir", cache_dir, "where the reference is cached ($BOUNCE_CACHE)")->capture_default_str();
     app.add_flag("--no-cache", no_cache, "neither read nor write the reference cache");
     app.add_option("--json", json_path, "run report");
+    app.add_option("--points-csv", points_csv, "per-point luminance of the reference and of every estimate (CSV)");
     CLI11_PARSE(app, argc, argv);
 
     try {
@@ -458,6 +459,32 @@ int main(int argc, char** argv) {
                     if (!no_raster) add_row("raster", run_raster(sp, c).cpu);
 #endif
                 }
+        }
+
+        if (!points_csv.empty()) {
+            // One row per point: where it is, the reference, and each sampler's four estimates
+            // (luminance), so outliers can be found and plotted.
+            std::ofstream csv(points_csv);
+            csv << "px,py,pz,nx,ny,nz,reference";
+            for (const auto& [name, e] : {std::pair{"raster", &raster_main}, std::pair{"ray_cast", &ray_main}})
+                if (*e) csv << fmt::format(",{0}_plane,{0}_coverage,{0}_stretch,{0}_falloff", name);
+            csv << "\n";
+            std::vector<std::vector<glm::dvec3>> falloffs;
+            for (const auto* e : {&raster_main, &ray_main})
+                if (*e) falloffs.push_back((*e)->falloff());
+            for (std::size_t k = 0; k < main_pts.size(); ++k) {
+                const auto& [p, n] = main_pts[k];
+                csv << fmt::format("{},{},{},{},{},{},{}", p.x, p.y, p.z, n.x, n.y, n.z, luminance(main_ref[k]));
+                std::size_t f = 0;
+                for (const auto* e : {&raster_main, &ray_main})
+                    if (*e) {
+                        const estimates& est = **e;
+                        csv << fmt::format(",{},{},{},{}", luminance(est.plane[k]), luminance(est.plane[k] * est.coverage_scale),
+                                           luminance(est.stretch[k]), luminance(falloffs[f++][k]));
+                    }
+                csv << "\n";
+            }
+            if (!csv) throw parameter_error("points-csv", "could not write " + points_csv.string());
         }
 
         if (!json_path.empty()) {

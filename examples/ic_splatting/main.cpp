@@ -7,6 +7,7 @@
 // Stages (the names of timings_ms): gbuffer, splat_existing (step 2), scan (step 4 minus
 // record computation), compute_records, interpolate (making the indirect image from the
 // cache: the final splat of step 5, or the octree's lookups), normalize, total.
+#include <bounce/cpu/batched_scan.hpp>
 #include <bounce/cpu/neighbour_index.hpp>
 #include <bounce/cpu/octree_cache.hpp>
 #include <bounce/cpu/splatting.hpp>
@@ -67,6 +68,8 @@ struct options {
     std::uint32_t record_samples = 1024, ref_spp = 1024;
     float min_pixels = 1.5f, max_pixels = 64.f;
     bool neighbour_clamp = false;
+    std::string scan = "batched";
+    std::size_t scan_batch = 0;
     bool gradient_limit = true;
     float max_extrapolation = 1.f;
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
@@ -94,6 +97,10 @@ struct context {
     std::function<std::optional<irradiance_record>(glm::vec3, glm::vec3, double)> sampler;
     /// The records so far for --neighbour-clamp (null when off); mirrors `records`.
     cpu::neighbour_index* clamp = nullptr;
+    /// The sampler is thread-safe and a pure function of the point (Embree): the scans may
+    /// measure records ahead in parallel (cpu::batched_scan).
+    bool pure_sampler = false;
+    cpu::scan_batch batch{};
 };
 
 // The parameters records depend on (not a: records are valid for every a).
@@ -110,6 +117,7 @@ struct frame_result {
     image<glm::vec3> indirect;             // rho/pi * E from the cache
     std::optional<image<glm::vec3>> combined;  // direct + indirect, when the backend composed it
     std::size_t new_records = 0;
+    std::size_t measured = 0, wasted = 0;  // batched scan: records measured, guesses dropped
 };
 
 cpu::splat_params splat_params_for(const options& o, float a) {
@@ -120,17 +128,32 @@ cpu::splat_params splat_params_for(const options& o, float a) {
     return sp;
 }
 
-// The record-creation callback of the scans: the sampler at the pixel's point, with the
-// pixel footprint for radius clamps; adds its time to `record_ms`.
+// A record at pixel (x, y): the sampler at its point, with the pixel footprint for radius
+// clamps. Thread-safe and pure when ctx.pure_sampler.
+auto record_measurer(const context& ctx, const camera& cam, const gbuffer<float>& g) {
+    return [&ctx, &cam, &g](std::size_t x, std::size_t y) {
+        return ctx.sampler(g.position(x, y), g.normal(x, y), cam.pixel_footprint(g.depth(x, y), g.height()));
+    };
+}
+
+// What a new record owes to the records before it, applied in scan order: neighbour clamping.
+auto record_committer(const context& ctx, const std::vector<irradiance_record>& records) {
+    return [&ctx, &records](irradiance_record& rec) {
+        if (!ctx.clamp) return;
+        ctx.clamp->sync(records);
+        rec.radius = ctx.clamp->clamped_radius(rec);
+    };
+}
+
+// The sequential scans' record-creation callback: measure then commit, adding the time to
+// `record_ms`.
 auto record_creator(const context& ctx, const camera& cam, const gbuffer<float>& g,
                     const std::vector<irradiance_record>& records, double& record_ms) {
-    return [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
+    return [measure = record_measurer(ctx, cam, g), commit = record_committer(ctx, records),
+            &record_ms](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
         const auto t0 = clock_type::now();
-        auto rec = ctx.sampler(g.position(x, y), g.normal(x, y), cam.pixel_footprint(g.depth(x, y), g.height()));
-        if (rec && ctx.clamp) {
-            ctx.clamp->sync(records);
-            rec->radius = ctx.clamp->clamped_radius(*rec);
-        }
+        auto rec = measure(x, y);
+        if (rec) commit(*rec);
         record_ms += ms_since(t0);
         return rec;
     };
@@ -161,8 +184,25 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 auto t = timer.measure("splat_existing");  // (re)inserting existing records
                 for (const auto& r : records) tree.insert(r);
             }
-            {
-                const auto t0 = clock_type::now();
+            const auto t0 = clock_type::now();
+            if (ctx.pure_sampler && o.scan == "batched") {
+                const glm::mat4 view = cam.view_matrix();
+                const auto stats = cpu::batched_scan(
+                    g.width(), g.height(), {}, max_new, ctx.batch,
+                    [&](std::size_t x, std::size_t y) {
+                        return gv.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
+                    },
+                    record_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
+                        records.push_back(rec);
+                        tree.insert(rec);
+                        return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, W::template influence_radius<float>(rec.radius, a),
+                                                                  g.width(), g.height()));
+                    });
+                fr.new_records = stats.created;
+                record_ms = stats.measure_ms;
+                fr.measured = stats.measured;
+                fr.wasted = stats.wasted;
+            } else {
                 std::size_t created = 0;
                 for (std::size_t y = 0; y < g.height() && created < max_new; ++y)
                     for (std::size_t x = 0; x < g.width() && created < max_new; ++x) {
@@ -175,9 +215,9 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                         }
                     }
                 fr.new_records = created;
-                timer.add_sample("scan", ms_since(t0) - record_ms);
-                timer.add_sample("compute_records", record_ms);
             }
+            timer.add_sample("scan", ms_since(t0) - record_ms);
+            timer.add_sample("compute_records", record_ms);
             auto t = timer.measure("interpolate");
             tree.render(gv, splat.view());
         } else {
@@ -186,7 +226,17 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 cpu::splat_records<W>(gv, cam, records, sp, splat.view());
             }
             const auto t0 = clock_type::now();
-            fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), {}, max_new);
+            if (ctx.pure_sampler && o.scan == "batched") {
+                const auto stats = cpu::scan_cache_misses_batched<W>(gv, cam, sp, min_weight, record_measurer(ctx, cam, g),
+                                                                     record_committer(ctx, records), records, splat.view(),
+                                                                     ctx.batch, {}, max_new);
+                fr.new_records = stats.created;
+                record_ms = stats.measure_ms;
+                fr.measured = stats.measured;
+                fr.wasted = stats.wasted;
+            } else {
+                fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), {}, max_new);
+            }
             timer.add_sample("scan", ms_since(t0) - record_ms);
             timer.add_sample("compute_records", record_ms);
             // Step 5: the image comes from splatting every record (on the GPU in the seed).
@@ -332,6 +382,8 @@ int run(const options& o) {
     limits.gradient_limit = o.gradient_limit;
     embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     context ctx{o, scene, bvh, integrator, std::ref(embree_sampler)};
+    ctx.pure_sampler = true;  // embree::record_sampler: seeded by the point, thread-safe
+    ctx.batch.max_records = o.scan_batch;
     cpu::neighbour_index clamp_index(scene.bounds().first, scene.bounds().second);
     if (o.neighbour_clamp) ctx.clamp = &clamp_index;
     std::vector<irradiance_record> records;
@@ -345,6 +397,7 @@ int run(const options& o) {
         gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, 1});
         raster_sampler.emplace(*gl_state->raster, limits);
         ctx.sampler = std::ref(*raster_sampler);
+        ctx.pure_sampler = false;  // one GL context: records one at a time
     }
     const bool gl_frames = o.interp == "splat-gl";
 #else
@@ -465,6 +518,11 @@ int run(const options& o) {
         if (!o.a_sweep.empty()) extra["a_sweep"] = sweep;
         report.set_timings(timer);
         report.set_count("records", records.size());
+        if (fr.measured > 0) {
+            // The batched scan's guesses: measured, and dropped because covered by then.
+            report.set_count("records_measured", fr.measured);
+            report.set_count("records_wasted", fr.wasted);
+        }
 
         if (o.mc_compare) {
             // Brute-force Monte Carlo indirect light at doubling sample counts (an independent
@@ -560,6 +618,12 @@ int main(int argc, char** argv) {
     app.add_option("--ref-spp", o.ref_spp, "reference integrator samples per pixel")->check(CLI::Range(1u, 1u << 20))->capture_default_str();
     app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(CLI::NonNegativeNumber)->capture_default_str();
     app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
+        ->check(CLI::IsMember({"batched", "sequential"}))
+        ->capture_default_str();
+    app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread)")
+        ->check(CLI::Range(0, 4096))
+        ->capture_default_str();
     app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
     app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
     app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(CLI::NonNegativeNumber)->capture_default_str();

@@ -111,13 +111,15 @@ inline void splat_into(const gbuffer_view<float>& gb, const irradiance_record& r
 }  // namespace detail
 
 /// Splats one record (seed Algorithm 1) onto `out`, sequentially. Used by the cache-miss
-/// scan, where each new record must be visible to the next pixel at once.
+/// scan, where each new record must be visible to the next pixel at once. Returns the
+/// pixel rectangle it touched (empty when the zone is off screen).
 template <class Weight>
-void splat_record(const gbuffer_view<float>& gb, const camera& cam, const irradiance_record& rec,
-                  const splat_params& sp, image_view<glm::vec4> out) {
+pixel_rect splat_record(const gbuffer_view<float>& gb, const camera& cam, const irradiance_record& rec,
+                        const splat_params& sp, image_view<glm::vec4> out) {
     const pixel_rect r = splat_rect(cam, cam.view_matrix(), rec.position,
                                     Weight::template influence_radius<float>(rec.radius, sp.a), gb.width(), gb.height());
     if (!r.empty()) detail::splat_into<Weight>(gb, rec, sp, r, out);
+    return r;
 }
 
 /// Splats every record onto `out` (added to what it holds) in parallel over screen tiles.

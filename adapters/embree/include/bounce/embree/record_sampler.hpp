@@ -13,7 +13,9 @@
 #include <bounce/irradiance_record.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 
 namespace bounce::embree {
@@ -21,7 +23,7 @@ namespace bounce::embree {
 class record_sampler {
 public:
     /// `grid`: the M x N strata per record (typical 16 x 50); `limits`: radius clamps;
-    /// `kind`: translation-gradient formula; `seed`: base of the per-record streams.
+    /// `kind`: translation-gradient formula; `seed`: base of the per-record streams (each keyed by its point).
     record_sampler(const reference_integrator& integrator, hemisphere_grid grid, radius_limits limits,
                    translation_gradient_kind kind = translation_gradient_kind::krivanek_2005, std::uint64_t seed = 7)
         : integrator_(integrator), grid_(grid), limits_(limits), kind_(kind), seed_(seed) {
@@ -29,33 +31,32 @@ public:
     }
 
     /// A record at (p, n); nullopt when the hemisphere yields no finite estimate.
-    /// Each call draws from its own stream (derive_seed of the call count), so a sequence
-    /// of calls is reproducible.
-    std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint) {
-        const std::uint64_t index = calls_++;
-        integrator_.sample_hemisphere(p, n, grid_, derive_seed(seed_, 0x1c, index), samples_);
-        hemisphere_samples_.rings = grid_.m;
-        hemisphere_samples_.wedges = grid_.n;
-        const std::size_t count = samples_.direction.size();
-        hemisphere_samples_.direction.resize(count);
+    /// The rays are seeded by the bits of (p, n), so a record is a pure function of its
+    /// point: the same whenever, and on whichever thread, it is asked for. That is what
+    /// lets cpu::scan_cache_misses_batched measure records ahead of the scan. Thread-safe.
+    std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint) const {
+        embree::hemisphere_samples samples;  // per call: nested TBB work may re-enter on this thread
+        integrator_.sample_hemisphere(p, n, grid_, derive_seed(seed_, 0x1c, point_key(p, n)), samples);
+        bounce::hemisphere_samples local;
+        local.rings = grid_.m;
+        local.wedges = grid_.n;
+        const std::size_t count = samples.direction.size();
+        local.direction.resize(count);
         for (std::size_t i = 0; i < count; ++i) {
-            const glm::vec3 d = samples_.direction[i];
-            hemisphere_samples_.direction[i] = {glm::dot(d, samples_.tangent), glm::dot(d, samples_.bitangent),
-                                                glm::dot(d, samples_.normal)};
+            const glm::vec3 d = samples.direction[i];
+            local.direction[i] = {glm::dot(d, samples.tangent), glm::dot(d, samples.bitangent), glm::dot(d, samples.normal)};
         }
-        hemisphere_samples_.radiance = samples_.radiance;
-        hemisphere_samples_.distance = samples_.distance;
+        local.radiance = std::move(samples.radiance);
+        local.distance = std::move(samples.distance);
         // Distances are measured from p + eps n and can be 0 where another surface touches
         // p (a corner); no surface is nearer than the offset itself, so floor them there.
-        for (float& d : hemisphere_samples_.distance) d = std::max(d, integrator_.ray_epsilon());
-        const hemisphere_estimate est = estimate_hemisphere(hemisphere_samples_, kind_);
-        irradiance_record rec = make_record(p, samples_.normal, samples_.tangent, samples_.bitangent, est, limits_,
+        for (float& d : local.distance) d = std::max(d, integrator_.ray_epsilon());
+        const hemisphere_estimate est = estimate_hemisphere(local, kind_);
+        irradiance_record rec = make_record(p, samples.normal, samples.tangent, samples.bitangent, est, limits_,
                                             pixel_footprint);
         if (!std::isfinite(rec.radius) || !(rec.radius > 0.f)) return std::nullopt;
         return rec;
     }
-
-    std::uint64_t calls() const noexcept { return calls_; }
 
 private:
     const reference_integrator& integrator_;
@@ -63,9 +64,20 @@ private:
     radius_limits limits_;
     translation_gradient_kind kind_;
     std::uint64_t seed_;
-    std::uint64_t calls_ = 0;
-    embree::hemisphere_samples samples_;               // reused buffers: no allocation per record
-    bounce::hemisphere_samples hemisphere_samples_;
+
+    // 64 bits from the six floats' bit patterns (splitmix64 steps): distinct points get
+    // independent streams, the same point the same stream.
+    static std::uint64_t point_key(const glm::vec3& p, const glm::vec3& n) noexcept {
+        std::uint64_t h = 0x9e3779b97f4a7c15ull;
+        for (float f : {p.x, p.y, p.z, n.x, n.y, n.z}) {
+            h ^= std::bit_cast<std::uint32_t>(f);
+            h += 0x9e3779b97f4a7c15ull;
+            h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+            h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+            h ^= h >> 31;
+        }
+        return h;
+    }
 };
 
 }  // namespace bounce::embree
