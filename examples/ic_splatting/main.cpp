@@ -69,6 +69,7 @@ struct options {
     float min_pixels = 1.5f, max_pixels = 64.f;
     bool neighbour_clamp = false;
     std::string scan = "batched";
+    std::string scan_order;  // linear | coarse-to-fine; empty: linear, coarse-to-fine when progressive
     std::size_t scan_batch = 0;
     bool gradient_limit = true;
     float max_extrapolation = 1.f;
@@ -101,6 +102,7 @@ struct context {
     /// measure records ahead in parallel (cpu::batched_scan).
     bool pure_sampler = false;
     cpu::scan_batch batch{};
+    std::vector<std::uint32_t> order{};  // the cache-miss scan's pixel order; empty: row by row
 };
 
 // The parameters records depend on (not a: records are valid for every a).
@@ -188,7 +190,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
             if (ctx.pure_sampler && o.scan == "batched") {
                 const glm::mat4 view = cam.view_matrix();
                 const auto stats = cpu::batched_scan(
-                    g.width(), g.height(), {}, max_new, ctx.batch,
+                    g.width(), g.height(), ctx.order, max_new, ctx.batch,
                     [&](std::size_t x, std::size_t y) {
                         return gv.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
                     },
@@ -204,16 +206,17 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 fr.wasted = stats.wasted;
             } else {
                 std::size_t created = 0;
-                for (std::size_t y = 0; y < g.height() && created < max_new; ++y)
-                    for (std::size_t x = 0; x < g.width() && created < max_new; ++x) {
-                        if (!gv.covered(x, y) || tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w >= min_weight)
-                            continue;
-                        if (auto rec = create(x, y)) {
-                            records.push_back(*rec);
-                            tree.insert(*rec);
-                            ++created;
-                        }
+                for (std::size_t i = 0; i < g.width() * g.height() && created < max_new; ++i) {
+                    const std::size_t idx = ctx.order.empty() ? i : ctx.order[i];
+                    const std::size_t x = idx % g.width(), y = idx / g.width();
+                    if (!gv.covered(x, y) || tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w >= min_weight)
+                        continue;
+                    if (auto rec = create(x, y)) {
+                        records.push_back(*rec);
+                        tree.insert(*rec);
+                        ++created;
                     }
+                }
                 fr.new_records = created;
             }
             timer.add_sample("scan", ms_since(t0) - record_ms);
@@ -229,13 +232,13 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
             if (ctx.pure_sampler && o.scan == "batched") {
                 const auto stats = cpu::scan_cache_misses_batched<W>(gv, cam, sp, min_weight, record_measurer(ctx, cam, g),
                                                                      record_committer(ctx, records), records, splat.view(),
-                                                                     ctx.batch, {}, max_new);
+                                                                     ctx.batch, ctx.order, max_new);
                 fr.new_records = stats.created;
                 record_ms = stats.measure_ms;
                 fr.measured = stats.measured;
                 fr.wasted = stats.wasted;
             } else {
-                fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), {}, max_new);
+                fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), ctx.order, max_new);
             }
             timer.add_sample("scan", ms_since(t0) - record_ms);
             timer.add_sample("compute_records", record_ms);
@@ -311,7 +314,7 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
         with_weighting(kind, [&](auto w) {
             fr.new_records = cpu::scan_cache_misses<decltype(w)>(fr.g.view(), cam, sp, o.min_weight > 0.f ? o.min_weight : a,
                                                                  record_creator(ctx, cam, fr.g, records, record_ms),
-                                                                 records, splat.view(), {}, max_new);
+                                                                 records, splat.view(), ctx.order, max_new);
         });
         timer.add_sample("scan", ms_since(t0) - record_ms);
         timer.add_sample("compute_records", record_ms);
@@ -384,6 +387,8 @@ int run(const options& o) {
     context ctx{o, scene, bvh, integrator, std::ref(embree_sampler)};
     ctx.pure_sampler = true;  // embree::record_sampler: seeded by the point, thread-safe
     ctx.batch.max_records = o.scan_batch;
+    const std::string scan_order = !o.scan_order.empty() ? o.scan_order : (o.progressive > 0 ? "coarse-to-fine" : "linear");
+    if (scan_order == "coarse-to-fine") ctx.order = cpu::coarse_to_fine_order(o.width, o.height);
     cpu::neighbour_index clamp_index(scene.bounds().first, scene.bounds().second);
     if (o.neighbour_clamp) ctx.clamp = &clamp_index;
     std::vector<irradiance_record> records;
@@ -431,7 +436,8 @@ int run(const options& o) {
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
                          {"max_extrapolation", o.max_extrapolation},
-                         {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive}};
+                         {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
+                         {"scan", ctx.pure_sampler ? o.scan : std::string("sequential")}, {"scan_order", scan_order}};
 
     auto reference_for = [&](const camera& cam) {
         bool hit = false;
@@ -621,6 +627,9 @@ int main(int argc, char** argv) {
     app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
         ->check(CLI::IsMember({"batched", "sequential"}))
         ->capture_default_str();
+    app.add_option("--scan-order", o.scan_order,
+                   "cache-miss scan order: linear | coarse-to-fine (default: linear; coarse-to-fine when progressive)")
+        ->check(CLI::IsMember({"linear", "coarse-to-fine"}));
     app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();

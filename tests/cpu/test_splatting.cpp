@@ -230,3 +230,51 @@ TEST_CASE("the classical fill leaves every pixel covered once both passes ran", 
         for (std::size_t x = 0; x < 64; ++x)
             if (v.gb.view().covered(x, y)) REQUIRE(out(x, y).w >= sp.a);
 }
+
+TEST_CASE("the coarse-to-fine order is a permutation that visits the coarse grid first", "[scan][cpu][order]") {
+    const std::size_t w = GENERATE(1, 7, 33, 64, 100), h = GENERATE(1, 5, 32, 61);
+    const std::size_t coarsest = GENERATE(1, 4, 32);
+    const auto order = cpu::coarse_to_fine_order(w, h, coarsest);
+    REQUIRE(order.size() == w * h);
+    std::vector<bool> seen(w * h, false);
+    for (auto i : order) {
+        REQUIRE(i < w * h);
+        REQUIRE_FALSE(seen[i]);
+        seen[i] = true;
+    }
+    // The first ceil(w/c) * ceil(h/c) entries are the coarsest grid, row by row; each later
+    // level's pixels lie on its own grid and no coarser one.
+    const std::size_t cw = (w + coarsest - 1) / coarsest, ch = (h + coarsest - 1) / coarsest;
+    for (std::size_t k = 0; k < cw * ch; ++k) REQUIRE(order[k] == (k / cw) * coarsest * w + (k % cw) * coarsest);
+    std::size_t level = coarsest;
+    for (std::size_t k = cw * ch; k < order.size(); ++k) {
+        const std::size_t x = order[k] % w, y = order[k] / w;
+        while (x % level != 0 || y % level != 0) level /= 2;  // levels only get finer
+        REQUIRE(level >= 1);
+    }
+}
+
+TEST_CASE("a coarse-to-fine progressive scan spreads its first records over the image", "[scan][cpu][order]") {
+    plane_view v(96, 64);
+    cpu::splat_params sp;
+    sp.a = 0.15f;
+    image<glm::vec4> splat(96, 64, glm::vec4(0.f));
+    std::vector<irradiance_record> recs;
+    std::size_t max_y = 0;
+    auto create = [&](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
+        max_y = std::max(max_y, y);
+        return record_at(v.gb.position(x, y), 0.4f, {1.f, 1.f, 1.f});
+    };
+    cpu::scan_cache_misses<ward_weight>(v.gb.view(), v.cam, sp, sp.a, create, recs, splat.view(), {}, 20);
+    REQUIRE(recs.size() == 20);
+    CHECK(max_y < 8);  // row by row: zones of ~1.3 pixels, so 20 records stay in the top rows
+    recs.clear();
+    max_y = 0;
+    std::fill(splat.data(), splat.data() + 96 * 64, glm::vec4(0.f));
+    const auto order = cpu::coarse_to_fine_order(96, 64, 16);
+    cpu::scan_cache_misses<ward_weight>(v.gb.view(), v.cam, sp, sp.a, create, recs, splat.view(), order, 20);
+    REQUIRE(recs.size() == 20);
+    CHECK(max_y >= 32);  // the 6 x 4 grid of 16-pixel steps: 20 records reach the bottom half
+    REQUIRE_THROWS_AS(cpu::coarse_to_fine_order(8, 8, 3), parameter_error);
+    REQUIRE_THROWS_AS(cpu::coarse_to_fine_order(8, 8, 0), parameter_error);
+}

@@ -164,6 +164,24 @@ void splat_records(const gbuffer_view<float>& gb, const camera& cam, std::span<c
     });
 }
 
+/// A scan order that visits a coarse grid first: pixels whose x and y are multiples of
+/// `coarsest` (a power of two), then of coarsest/2, ..., then every pixel, each level row by
+/// row. With a record budget (progressive mode) the first records spread over the whole
+/// image, each covering its zone at once, instead of filling the top rows and leaving the
+/// rest black. A permutation of 0 .. width*height-1 (indices y * width + x).
+inline std::vector<std::uint32_t> coarse_to_fine_order(std::size_t width, std::size_t height, std::size_t coarsest = 32) {
+    require(coarsest >= 1 && (coarsest & (coarsest - 1)) == 0, "coarsest", "must be a power of two");
+    require(width * height <= std::size_t(UINT32_MAX), "width/height", "more pixels than 32-bit indices hold");
+    std::vector<std::uint32_t> order;
+    order.reserve(width * height);
+    for (std::size_t s = coarsest; s >= 1; s /= 2)
+        for (std::size_t y = 0; y < height; y += s)
+            for (std::size_t x = 0; x < width; x += s)
+                // On this level's grid but not on the coarser one (listed already).
+                if (s == coarsest || x % (2 * s) != 0 || y % (2 * s) != 0) order.push_back(std::uint32_t(y * width + x));
+    return order;
+}
+
 /// The cache-miss scan (seed Algorithm 5, step 4): visits covered pixels in `order` (row
 /// by row when empty; any permutation of pixel indices y * width + x otherwise), and where
 /// the accumulated weight is below `min_weight` asks `create(x, y)` for a record
