@@ -73,6 +73,16 @@ V normalized_splat(const V& sum, T weight) {
     return select(weight > T(0), sum / select(weight > T(0), weight, T(1)), sum * T(0));
 }
 
+/// Progressive display, where a record budget leaves pixels no zone reaches: the splat at
+/// a blended with a splat of the same records at a wider a' (typically 4a), scaled by a
+/// small lambda (typically 1e-3). Where the a-zones reach, the result moves from the
+/// normalized splat by at most lambda W'/W relative; where they do not, it is the wide
+/// splat's normalized value; black only where neither reaches.
+template <real T, vec3_of<T> V>
+V hole_filled_splat(const V& sum, T weight, const V& wide_sum, T wide_weight, T lambda) {
+    return normalized_splat<T, V>(sum + wide_sum * lambda, weight + wide_weight * lambda);
+}
+
 /// Limits on a record's radius R (Tabellion and Lamorlette 2004; Krivanek et al. 2006).
 /// Every value is optional; defaults leave R unchanged.
 struct radius_limits {

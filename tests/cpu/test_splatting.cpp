@@ -169,6 +169,42 @@ TEST_CASE("normalization divides by the weight and leaves uncovered pixels black
     CHECK(out(2, 0) == glm::vec3(0.f));
 }
 
+TEST_CASE("hole filling keeps covered pixels within lambda W'/W and fills the rest from the wide splat", "[splat][cpu][fill]") {
+    pcg32 rng(12);
+    const float lambda = 1e-3f;
+    const std::size_t n = 400;
+    image<glm::vec4> splat(n, 1, glm::vec4(0.f)), wide(n, 1, glm::vec4(0.f));
+    for (std::size_t i = 0; i < n; ++i) {
+        const float w = i % 4 == 0 ? 0.f : std::exp(8.f * rng.next_float() - 4.f);  // a quarter uncovered
+        const float ww = i % 8 == 0 ? 0.f : std::exp(8.f * rng.next_float() - 2.f);  // some not even widely
+        const glm::vec3 e(rng.next_float(), rng.next_float(), rng.next_float()), f(rng.next_float() + 1.f);
+        splat(i, 0) = glm::vec4(e * w, w);
+        wide(i, 0) = glm::vec4(f * ww, ww);
+    }
+    image<glm::vec3> plain(n, 1), filled(n, 1);
+    cpu::normalize_splats(splat.view(), plain.view());
+    cpu::normalize_splats(splat.view(), wide.view(), lambda, filled.view());
+    for (std::size_t i = 0; i < n; ++i) {
+        const float w = splat(i, 0).w, ww = wide(i, 0).w;
+        const glm::vec3 wide_value = ww > 0.f ? glm::vec3(wide(i, 0)) / ww : glm::vec3(0.f);
+        if (w == 0.f) {
+            // Uncovered: the wide splat's value (black if it misses too), to float rounding.
+            for (int c = 0; c < 3; ++c) REQUIRE(filled(i, 0)[c] == Approx(wide_value[c]).epsilon(1e-5).margin(1e-30));
+        } else {
+            // Covered: a convex blend of the two values with the wide one's share
+            // lambda ww / (w + lambda ww), plus float rounding.
+            const float share = lambda * ww / (w + lambda * ww);
+            for (int c = 0; c < 3; ++c) {
+                const float expected = (1.f - share) * plain(i, 0)[c] + share * wide_value[c];
+                REQUIRE(filled(i, 0)[c] == Approx(expected).epsilon(1e-5));
+            }
+        }
+    }
+    REQUIRE_THROWS_AS(cpu::normalize_splats(splat.view(), wide.view(), 0.f, filled.view()), parameter_error);
+    image<glm::vec4> small(3, 1);
+    REQUIRE_THROWS_AS(cpu::normalize_splats(splat.view(), small.view(), lambda, filled.view()), parameter_error);
+}
+
 TEST_CASE("bad splatting parameters are refused with the parameter named", "[splat][cpu][bad-input]") {
     plane_view v(8, 8);
     image<glm::vec4> splat(8, 8), small(4, 4);

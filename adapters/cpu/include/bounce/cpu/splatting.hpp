@@ -227,6 +227,22 @@ inline void normalize_splats(image_view<const glm::vec4> splat, image_view<glm::
     });
 }
 
+/// Normalization with hole filling (progressive display; see hole_filled_splat): `wide`
+/// holds the same records splatted with a wider a.
+inline void normalize_splats(image_view<const glm::vec4> splat, image_view<const glm::vec4> wide, float lambda,
+                             image_view<glm::vec3> indirect) {
+    require(splat.width() == indirect.width() && splat.height() == indirect.height() && wide.width() == splat.width() &&
+                wide.height() == splat.height(),
+            "indirect", "size differs from the splat buffer");
+    require(std::isfinite(lambda) && lambda > 0.f, "lambda", "must be a positive number");
+    tbb::parallel_for(std::size_t(0), splat.height(), [&](std::size_t y) {
+        for (std::size_t x = 0; x < splat.width(); ++x) {
+            const glm::vec4 s = splat(x, y), w = wide(x, y);
+            indirect(x, y) = hole_filled_splat<float, glm::vec3>(glm::vec3(s), s.w, glm::vec3(w), w.w, lambda);
+        }
+    });
+}
+
 /// Final image = direct + indirect radiance.
 inline void compose(image_view<const glm::vec3> direct, image_view<const glm::vec3> indirect, image_view<glm::vec3> out) {
     require(direct.width() == out.width() && indirect.width() == out.width() && direct.height() == out.height() &&
