@@ -13,8 +13,8 @@
 /// Two hazards every policy handles, because rounding makes both happen in practice:
 ///  - the singularity at p = pk, n = nk (1/0 in Ward's weight): the inverse weight is
 ///    clamped to `inverse_weight_floor`, as the seed's shader clamps it to EPSILON;
-///  - n . nk slightly above 1 from rounding (unit vectors that are not quite unit): the
-///    argument of the normal term's square root is clamped at 0, never NaN.
+///  - n . nk slightly above or below 1 from rounding (unit vectors that are not quite unit):
+///    the normal term allows for the rounding and clamps at 0, never NaN.
 
 #include <bounce/vocabulary.hpp>
 
@@ -29,10 +29,19 @@ namespace bounce {
 /// singular record dominant without overflowing or swamping float accumulation.
 inline constexpr double inverse_weight_floor = 1e-4;
 
-/// The normal-divergence term sqrt(1 - n.nk) of Eq. 8.2, safe for n.nk > 1 from rounding.
+/// Rounding allowance of 1 - n.nk. Two float unit vectors (each unit to within a couple of
+/// ulps after normalize) have a dot product within ~5u of the exact one, u = 2^-24, so two
+/// copies of one normal can give 1 - n.nk = 6e-8 instead of 0. The square root turns that
+/// into 2.4e-4, above the inverse-weight floor: a record's weight at its own pixel would be
+/// 4089 on one backend and 9993 on another (seen between the CPU and GL splats on Sponza).
+/// Below 8u = 2^-21 (0.056 degrees) normals count as equal.
+inline constexpr double normal_rounding = 0x1p-21;
+
+/// The normal-divergence term sqrt(1 - n.nk) of Eq. 8.2, less the rounding allowance, so it
+/// is exactly 0 for equal normals on every backend and never NaN for n.nk > 1.
 template <real T, vec3_of<T> V>
 T normal_divergence(const V& n, const V& nk) {
-    return sqrt(max(T(0), T(1) - dot(n, nk)));
+    return sqrt(max(T(0), T(1) - dot(n, nk) - T(normal_rounding)));
 }
 
 /// Ward et al. 1988 (seed Eq. 8.2 with the test 8.3): w = 1 / (|p - pk| / R_k + sqrt(1 - n.nk)),
@@ -84,7 +93,7 @@ struct gpu_ward_weight {
     static T weight(const V& p, const V& n, const V& pk, const V& nk, T inv_r, T a) {
         const V d = p - pk;
         const T e1 = dot(d, d) * (inv_r * inv_r);
-        const T e2 = T(normal_scale) * max(T(0), T(1) - dot(n, nk));
+        const T e2 = T(normal_scale) * max(T(0), T(1) - dot(n, nk) - T(normal_rounding));
         const T inv_w = max(T(inverse_weight_floor), sqrt(e1) + sqrt(e2));
         return select(e1 + e2 > a * a, T(0), select(inv_w <= a, T(1) / inv_w, T(0)));
     }

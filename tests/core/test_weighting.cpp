@@ -76,7 +76,7 @@ TEST_CASE("Ward's weight is 1/inverse weight, contributes exactly where w >= 1/a
     const auto i = GENERATE(range<std::size_t>(0, 407));
     const auto& q = qs[i];
     const double inv = glm::length(glm::dvec3(q.p - q.pk)) / q.r +
-                       std::sqrt(std::max(0.0, 1.0 - glm::dot(glm::dvec3(q.n), glm::dvec3(q.nk))));
+                       std::sqrt(std::max(0.0, 1.0 - glm::dot(glm::dvec3(q.n), glm::dvec3(q.nk)) - normal_rounding));
     const double expected = inv <= q.a ? 1.0 / std::max(inv, inverse_weight_floor) : 0.0;
     const float w = w_of<ward_weight>(q);
     // Away from the border the float result matches the double closed form to float rounding
@@ -90,6 +90,29 @@ TEST_CASE("Ward's weight is 1/inverse weight, contributes exactly where w >= 1/a
     // rejection e1 + e2 > a^2 never removes a contributing record.
     const float wg = w_of<gpu_ward_weight<>>(q);
     if (std::abs(inv - q.a) > 1e-5 * q.a) CHECK(wg == Approx(w).epsilon(1e-5));
+}
+
+TEST_CASE("equal normals give the capped weight at a record's own position, whatever the rounding", "[weighting][stability]") {
+    // Normals as a G-buffer and a sampler would hold them: the same direction normalized
+    // from different float inputs, so n.nk is 1 only to within a few ulps.
+    pcg32 rng(31);
+    for (int i = 0; i < 2000; ++i) {
+        const glm::vec3 n = random_unit(rng);
+        const glm::vec3 nk = glm::normalize(n * (0.5f + 3.f * rng.next_float()));
+        const glm::vec3 p = 20.f * random_unit(rng);
+        const float r = 1e-3f + rng.next_float(), a = 0.05f + 0.5f * rng.next_float();
+        const float cap = float(1 / inverse_weight_floor);
+        REQUIRE(ward_weight::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap);
+        REQUIRE(ward_smooth_weight::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap - 1.f / a);
+        REQUIRE(gpu_ward_weight<>::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap);
+        REQUIRE(normal_divergence<float, glm::vec3>(n, nk) == 0.f);
+        // In double the same holds, and a real divergence of 0.1 degrees still counts.
+        REQUIRE(normal_divergence<double, glm::dvec3>(glm::dvec3(n), glm::normalize(glm::dvec3(nk))) == 0.0);
+    }
+    const double t = 0.1 * std::numbers::pi / 180;
+    const glm::dvec3 n(0, 0, 1), m(std::sin(t), 0, std::cos(t));
+    REQUIRE(normal_divergence<double, glm::dvec3>(n, m) == Approx(std::sqrt(1 - std::cos(t) - normal_rounding)).epsilon(1e-12));
+    REQUIRE(normal_divergence<double, glm::dvec3>(n, m) > 0.5 * std::sqrt(1 - std::cos(t)));
 }
 
 TEST_CASE("the smoothed weight falls continuously to zero at the border of the zone", "[weighting]") {
