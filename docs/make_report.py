@@ -45,6 +45,8 @@ def headline(scene, mine):
                    f"({err('nograd'):.4f} without; target >= 25%)")
     if err("smooth") and err("ward"):
         out.append(f"- smoothed weight {err('smooth'):.4f} against Ward's {err('ward'):.4f} (target: not above)")
+    if err("a0.4") and err("ward-a0.4"):
+        out.append(f"- at a = 0.4, where Ward's seams show: smoothed {err('a0.4'):.4f}, Ward's {err('ward-a0.4'):.4f}")
     s, o = mine.get(f"{scene}-smooth"), mine.get(f"{scene}-octree")
     if s and o:
         out.append(f"- interpolation: splatting {s['timings_ms']['interpolate']:.1f} ms, octree lookups "
@@ -106,7 +108,7 @@ def main():
                       f"{f['rel_rms']:.4f} |" for f in prog[0]["frames"]]
             lines.append("")
         # Plot: total time against error for the a sweep, plus the Monte Carlo curve.
-        sweep = sorted((v for k, v in mine.items() if "-a0" in k), key=lambda r: r["parameters"]["a"])
+        sweep = sorted((v for k, v in mine.items() if "-a0" in k and "ward-" not in k), key=lambda r: r["parameters"]["a"])
         if sweep:
             fig, ax = plt.subplots(figsize=(5, 3.4), dpi=100)
             ax.plot([r["error"]["rel_rms"] for r in sweep], [r["timings_ms"]["total"] for r in sweep], "o-",

@@ -27,6 +27,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-nograd" "${common[@]}" --a 0.15 --weight ward-smooth --gradients off
   run "$tag-ward" "${common[@]}" --a 0.15 --weight ward
   run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
+  run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show
   if [[ $clamp == on ]]; then
     run "$tag-$other" --scene "$scene" --width 512 --height 512 --ref-spp "$spp" --a 0.15 --weight ward-smooth
   else
