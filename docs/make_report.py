@@ -43,6 +43,9 @@ def headline(scene, mine):
     if err("smooth") and err("nograd"):
         out.append(f"- gradients lower the error by {100 * (1 - err('smooth') / err('nograd')):.0f}% "
                    f"({err('nograd'):.4f} without; target >= 25%)")
+    if err("r4096") and err("r4096-nograd"):
+        out.append(f"- with 4096 rays per record: {err('r4096'):.4f}, without gradients {err('r4096-nograd'):.4f}: "
+                   f"gradients lower the error by {100 * (1 - err('r4096') / err('r4096-nograd')):.0f}%")
     if err("smooth") and err("ward"):
         out.append(f"- smoothed weight {err('smooth'):.4f} against Ward's {err('ward'):.4f} (target: not above)")
     if err("a0.4") and err("ward-a0.4"):

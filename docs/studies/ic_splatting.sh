@@ -16,6 +16,12 @@ run() {  # run NAME ARGS...: one measured run
   "$bin" "$@" --json "docs/data/$name.json"
 }
 
+rays() {  # rays TAG ARGS...: gradients on/off with 4096 rays per record (less record noise)
+  local tag=$1; shift
+  run "$tag-r4096" "$@" --a 0.15 --weight ward-smooth --record-samples 4096
+  run "$tag-r4096-nograd" "$@" --a 0.15 --weight ward-smooth --record-samples 4096 --gradients off
+}
+
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor)
   local tag=$1 scene=$2 spp=$3 clamp=$4 fill=$5
   local flags=() other=clamp  # other: the cross-check run with the other clamping setting
@@ -28,6 +34,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-ward" "${common[@]}" --a 0.15 --weight ward
   run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
   run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show
+  rays "$tag" "${common[@]}"
   if [[ $clamp == on ]]; then
     run "$tag-$other" --scene "$scene" --width 512 --height 512 --ref-spp "$spp" --a 0.15 --weight ward-smooth
   else
