@@ -178,6 +178,12 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
     fr.indirect = image<glm::vec3>(g.width(), g.height());
     image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
     const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
+    auto take = [&](const cpu::scan_stats& stats) {  // what a batched scan reports
+        fr.new_records = stats.created;
+        record_ms = stats.measure_ms;
+        fr.measured = stats.measured;
+        fr.wasted = stats.wasted;
+    };
     std::optional<image<glm::vec4>> wide;  // hole filling's wide splat
     with_weighting(parse_weight(o.weight), [&](auto w) {
         using W = decltype(w);
@@ -200,13 +206,10 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                     record_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
                         records.push_back(rec);
                         tree.insert(rec);
-                        return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, W::template influence_radius<float>(rec.radius, a),
-                                                                  g.width(), g.height()));
+                        const float zone = W::template influence_radius<float>(rec.radius, a);
+                        return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
                     });
-                fr.new_records = stats.created;
-                record_ms = stats.measure_ms;
-                fr.measured = stats.measured;
-                fr.wasted = stats.wasted;
+                take(stats);
             } else {
                 std::size_t created = 0;
                 for (std::size_t i = 0; i < g.width() * g.height() && created < max_new; ++i) {
@@ -236,10 +239,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 const auto stats = cpu::scan_cache_misses_batched<W>(gv, cam, sp, min_weight, record_measurer(ctx, cam, g),
                                                                      record_committer(ctx, records), records, splat.view(),
                                                                      ctx.batch, ctx.order, max_new);
-                fr.new_records = stats.created;
-                record_ms = stats.measure_ms;
-                fr.measured = stats.measured;
-                fr.wasted = stats.wasted;
+                take(stats);
             } else {
                 fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), ctx.order, max_new);
             }
@@ -447,7 +447,8 @@ int run(const options& o) {
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
                          {"max_extrapolation", o.max_extrapolation},
-                         {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive}, {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
+                         {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
+                         {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
                          {"scan", ctx.pure_sampler ? o.scan : std::string("sequential")}, {"scan_order", scan_order}};
 
     auto reference_for = [&](const camera& cam) {
