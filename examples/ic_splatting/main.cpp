@@ -99,9 +99,12 @@ struct context {
     std::function<std::optional<irradiance_record>(glm::vec3, glm::vec3, double)> sampler;
     /// The records so far for --neighbour-clamp (null when off); mirrors `records`.
     cpu::neighbour_index* clamp = nullptr;
-    /// The sampler is thread-safe and a pure function of the point (Embree): the scans may
-    /// measure records ahead in parallel (cpu::batched_scan).
-    bool pure_sampler = false;
+    /// The sampler's batch form (the GL raster sampler: one atlas per batch); when empty,
+    /// batches are measured with `sampler` in parallel (Embree: thread-safe). Both samplers
+    /// are pure functions of the point, so the scans may measure records ahead.
+    std::function<void(std::span<const glm::vec3>, std::span<const glm::vec3>, std::span<const double>,
+                       std::span<std::optional<irradiance_record>>)>
+        batch_sampler{};
     cpu::scan_batch batch{};
     std::vector<std::uint32_t> order{};  // the cache-miss scan's pixel order; empty: row by row
 };
@@ -123,6 +126,14 @@ struct frame_result {
     std::size_t measured = 0, wasted = 0;  // batched scan: records measured, guesses dropped
 };
 
+// What a batched scan reports: its records, the wall time of its measuring, its guesses.
+void take_scan_stats(const cpu::scan_stats& stats, frame_result& fr, double& record_ms) {
+    fr.new_records = stats.created;
+    record_ms = stats.measure_ms;
+    fr.measured = stats.measured;
+    fr.wasted = stats.wasted;
+}
+
 cpu::splat_params splat_params_for(const options& o, float a) {
     cpu::splat_params sp;
     sp.a = a;
@@ -132,10 +143,32 @@ cpu::splat_params splat_params_for(const options& o, float a) {
 }
 
 // A record at pixel (x, y): the sampler at its point, with the pixel footprint for radius
-// clamps. Thread-safe and pure when ctx.pure_sampler.
+// clamps.
 auto record_measurer(const context& ctx, const camera& cam, const gbuffer<float>& g) {
     return [&ctx, &cam, &g](std::size_t x, std::size_t y) {
         return ctx.sampler(g.position(x, y), g.normal(x, y), cam.pixel_footprint(g.depth(x, y), g.height()));
+    };
+}
+
+// Records for a batch of pixels (the batched scans' guesses): one call of the batch sampler,
+// or the per-point sampler on the worker threads.
+auto record_batch_measurer(const context& ctx, const camera& cam, const gbuffer<float>& g) {
+    return [&ctx, &cam, &g](std::span<const cpu::pixel_xy> px, std::span<std::optional<irradiance_record>> out) {
+        if (ctx.batch_sampler) {
+            std::vector<glm::vec3> p(px.size()), n(px.size());
+            std::vector<double> footprint(px.size());
+            for (std::size_t k = 0; k < px.size(); ++k) {
+                p[k] = g.position(px[k].x, px[k].y);
+                n[k] = g.normal(px[k].x, px[k].y);
+                footprint[k] = cam.pixel_footprint(g.depth(px[k].x, px[k].y), g.height());
+            }
+            ctx.batch_sampler(p, n, footprint, out);
+            return;
+        }
+        tbb::parallel_for(std::size_t(0), px.size(), [&](std::size_t k) {
+            out[k] = ctx.sampler(g.position(px[k].x, px[k].y), g.normal(px[k].x, px[k].y),
+                                 cam.pixel_footprint(g.depth(px[k].x, px[k].y), g.height()));
+        });
     };
 }
 
@@ -178,12 +211,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
     fr.indirect = image<glm::vec3>(g.width(), g.height());
     image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
     const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
-    auto take = [&](const cpu::scan_stats& stats) {  // what a batched scan reports
-        fr.new_records = stats.created;
-        record_ms = stats.measure_ms;
-        fr.measured = stats.measured;
-        fr.wasted = stats.wasted;
-    };
+    auto take = [&](const cpu::scan_stats& stats) { take_scan_stats(stats, fr, record_ms); };
     std::optional<image<glm::vec4>> wide;  // hole filling's wide splat
     with_weighting(parse_weight(o.weight), [&](auto w) {
         using W = decltype(w);
@@ -196,14 +224,14 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 for (const auto& r : records) tree.insert(r);
             }
             const auto t0 = clock_type::now();
-            if (ctx.pure_sampler && o.scan == "batched") {
+            if (o.scan == "batched") {
                 const glm::mat4 view = cam.view_matrix();
                 const auto stats = cpu::batched_scan(
                     g.width(), g.height(), ctx.order, max_new, ctx.batch,
                     [&](std::size_t x, std::size_t y) {
                         return gv.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
                     },
-                    record_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
+                    record_batch_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
                         records.push_back(rec);
                         tree.insert(rec);
                         const float zone = W::template influence_radius<float>(rec.radius, a);
@@ -235,8 +263,8 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 cpu::splat_records<W>(gv, cam, records, sp, splat.view());
             }
             const auto t0 = clock_type::now();
-            if (ctx.pure_sampler && o.scan == "batched") {
-                const auto stats = cpu::scan_cache_misses_batched<W>(gv, cam, sp, min_weight, record_measurer(ctx, cam, g),
+            if (o.scan == "batched") {
+                const auto stats = cpu::scan_cache_misses_batched<W>(gv, cam, sp, min_weight, record_batch_measurer(ctx, cam, g),
                                                                      record_committer(ctx, records), records, splat.view(),
                                                                      ctx.batch, ctx.order, max_new);
                 take(stats);
@@ -322,10 +350,20 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
     {  // step 4
         double record_ms = 0;
         const auto t0 = clock_type::now();
+        const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
         with_weighting(kind, [&](auto w) {
-            fr.new_records = cpu::scan_cache_misses<decltype(w)>(fr.g.view(), cam, sp, o.min_weight > 0.f ? o.min_weight : a,
-                                                                 record_creator(ctx, cam, fr.g, records, record_ms),
-                                                                 records, splat.view(), ctx.order, max_new);
+            using W = decltype(w);
+            if (o.scan == "batched") {
+                const auto stats = cpu::scan_cache_misses_batched<W>(fr.g.view(), cam, sp, min_weight,
+                                                                     record_batch_measurer(ctx, cam, fr.g),
+                                                                     record_committer(ctx, records), records, splat.view(),
+                                                                     ctx.batch, ctx.order, max_new);
+                take_scan_stats(stats, fr, record_ms);
+            } else {
+                fr.new_records = cpu::scan_cache_misses<W>(fr.g.view(), cam, sp, min_weight,
+                                                           record_creator(ctx, cam, fr.g, records, record_ms), records,
+                                                           splat.view(), ctx.order, max_new);
+            }
         });
         timer.add_sample("scan", ms_since(t0) - record_ms);
         timer.add_sample("compute_records", record_ms);
@@ -396,7 +434,6 @@ int run(const options& o) {
     limits.gradient_limit = o.gradient_limit;
     embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     context ctx{o, scene, bvh, integrator, std::ref(embree_sampler)};
-    ctx.pure_sampler = true;  // embree::record_sampler: seeded by the point, thread-safe
     ctx.batch.max_records = o.scan_batch;
     const std::string scan_order = !o.scan_order.empty() ? o.scan_order : (o.progressive > 0 ? "coarse-to-fine" : "linear");
     if (scan_order == "coarse-to-fine") ctx.order = cpu::coarse_to_fine_order(o.width, o.height);
@@ -410,10 +447,14 @@ int run(const options& o) {
     std::optional<gl::raster_record_sampler> raster_sampler;
     if (o.sampler == "raster") {
         // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4).
-        gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, 1});
+        // One atlas per batch of the scan's guesses (16 planes unless --scan-batch says).
+        const std::size_t planes = o.scan_batch > 0 ? o.scan_batch : 16;
+        gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, planes});
         raster_sampler.emplace(*gl_state->raster, limits);
-        ctx.sampler = std::ref(*raster_sampler);
-        ctx.pure_sampler = false;  // one GL context: records one at a time
+        ctx.sampler = [&](glm::vec3 p, glm::vec3 n, double fp) { return (*raster_sampler)(p, n, fp); };
+        ctx.batch_sampler = [&](std::span<const glm::vec3> p, std::span<const glm::vec3> n, std::span<const double> fp,
+                                std::span<std::optional<irradiance_record>> out) { (*raster_sampler)(p, n, fp, out); };
+        ctx.batch.max_records = planes;
     }
     const bool gl_frames = o.interp == "splat-gl";
 #else
@@ -449,7 +490,7 @@ int run(const options& o) {
                          {"max_extrapolation", o.max_extrapolation},
                          {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
                          {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
-                         {"scan", ctx.pure_sampler ? o.scan : std::string("sequential")}, {"scan_order", scan_order}};
+                         {"scan", o.scan}, {"scan_batch", ctx.batch.max_records}, {"scan_order", scan_order}};
 
     auto reference_for = [&](const camera& cam) {
         bool hit = false;
@@ -658,7 +699,7 @@ int main(int argc, char** argv) {
     app.add_option("--scan-order", o.scan_order,
                    "cache-miss scan order: linear | coarse-to-fine (default: linear; coarse-to-fine when progressive)")
         ->check(CLI::IsMember({"linear", "coarse-to-fine"}));
-    app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread)")
+    app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread; 16 planes per atlas for --sampler raster)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
     app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");

@@ -118,6 +118,34 @@ TEST_CASE("the batched scan makes the sequential scan's records and splat buffer
     if (batch_size == 1 || (batch_size == 0 && threads == 1)) REQUIRE(stats.wasted == 0);  // no guesses, no waste
 }
 
+TEST_CASE("a per-batch measure (a GPU atlas) gives the per-pixel scan's records", "[scan][cpu][batched]") {
+    const std::size_t w = 64, h = 48;
+    plane_scene s(w, h);
+    cpu::splat_params sp;
+    sp.a = 0.12f;
+    const std::size_t batch_size = GENERATE(1, 5, 32);
+    std::vector<irradiance_record> seq, bat;
+    image<glm::vec4> seq_splat(w, h, glm::vec4(0.f)), bat_splat(w, h, glm::vec4(0.f));
+    auto create = [&](std::size_t x, std::size_t y) { return pure_record(s.gb, x, y); };
+    cpu::scan_cache_misses<ward_weight>(s.gb.view(), s.cam, sp, sp.a, create, seq, seq_splat.view());
+    std::size_t calls = 0, largest = 0;
+    auto measure_batch = [&](std::span<const cpu::pixel_xy> px, std::span<std::optional<irradiance_record>> out) {
+        ++calls;
+        largest = std::max(largest, px.size());
+        REQUIRE(px.size() == out.size());
+        for (std::size_t k = 0; k < px.size(); ++k) out[k] = pure_record(s.gb, px[k].x, px[k].y);
+    };
+    const auto stats = cpu::scan_cache_misses_batched<ward_weight>(
+        s.gb.view(), s.cam, sp, sp.a, measure_batch, [](irradiance_record&) {}, bat, bat_splat.view(),
+        cpu::scan_batch{batch_size, 0});
+    REQUIRE(bat.size() == seq.size());
+    REQUIRE(std::memcmp(bat.data(), seq.data(), seq.size() * sizeof(irradiance_record)) == 0);
+    REQUIRE(std::memcmp(bat_splat.data(), seq_splat.data(), w * h * sizeof(glm::vec4)) == 0);
+    REQUIRE(largest <= batch_size);
+    REQUIRE(calls <= stats.measured);
+    if (batch_size > 1) REQUIRE(calls < stats.created);  // batches did hold several records
+}
+
 TEST_CASE("the batched scan refuses bad orders by name", "[scan][cpu][batched][bad-input]") {
     plane_scene s(8, 6);
     cpu::splat_params sp;

@@ -9,6 +9,7 @@
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/kernel_map.hpp>
+#include <bounce/gl/raster_record_sampler.hpp>
 #include <bounce/hemisphere.hpp>
 #include <bounce/sampling.hpp>
 
@@ -246,4 +247,45 @@ TEST_CASE("asynchronous read-backs return each batch's planes in order", "[hemis
     bad = options;
     bad.camera.aperture_deg = 180.0;
     CHECK_THROWS_AS(gl::hemisphere_raster(s, mesh, light, bad), parameter_error);
+}
+
+TEST_CASE("the raster record sampler makes the same records one at a time and in atlas batches", "[hemisphere][gl][record]") {
+    gl_test::shared_context();
+    const float H = 1.5f, x_edge = 0.4f, kd = 0.75f, E_perp = 2.f;
+    const io::scene s = half_lit_ceiling_scene(H, x_edge, kd, E_perp);
+    const gl::scene_mesh mesh(s);
+    const gl::direct_light light(s, mesh, 512);
+    gl::hemisphere_raster_options options;
+    options.camera = {32, 126.0};
+    options.batch = 4;
+    options.offset = 1e-3f;
+    gl::hemisphere_raster raster(s, mesh, light, options);
+    radius_limits limits;
+    gl::raster_record_sampler sampler(raster, limits);
+    pcg32 rng(9);
+    std::vector<glm::vec3> p, n;
+    std::vector<double> footprint;
+    for (int k = 0; k < 11; ++k) {  // 11 records: batches of 4, 4 and 3
+        p.emplace_back(float(4 * rng.next_double() - 2), 0.f, float(4 * rng.next_double() - 2));
+        n.emplace_back(0.f, 1.f, 0.f);
+        footprint.push_back(1e-3);
+    }
+    std::vector<std::optional<irradiance_record>> batched(p.size());
+    sampler(p, n, footprint, batched);
+    const float L = kd / float(pi) * E_perp;
+    for (std::size_t k = 0; k < p.size(); ++k) {
+        const auto one = sampler(p[k], n[k], footprint[k]);
+        REQUIRE(one.has_value());
+        REQUIRE(batched[k].has_value());
+        // Same plane in another tile of the atlas: the tile placement's rounding only.
+        for (int c = 0; c < 3; ++c) CHECK(batched[k]->irradiance[c] == Approx(one->irradiance[c]).epsilon(1e-5));
+        CHECK(batched[k]->radius == Approx(one->radius).epsilon(1e-5));
+        // The closed form of the half-lit ceiling, E = (pi L / 2)(1 + x0 / sqrt(x0^2 + H^2)), with
+        // x0 the distance past the edge; a 32^2 plane with border stretching is within a few %.
+        const double x0 = double(p[k].x - x_edge);
+        const double exact = pi * L / 2 * (1 + x0 / std::sqrt(x0 * x0 + double(H) * H));
+        CHECK(batched[k]->irradiance.x == Approx(exact).epsilon(0.05).margin(0.02 * pi * L));
+    }
+    std::vector<std::optional<irradiance_record>> wrong(2);
+    CHECK_THROWS_AS(sampler(p, n, footprint, wrong), parameter_error);
 }

@@ -26,6 +26,7 @@
 #include <map>
 #include <optional>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -44,6 +45,11 @@ struct scan_batch {
     std::size_t lookahead = 0;
 };
 
+/// A pixel of a batch of guesses.
+struct pixel_xy {
+    std::size_t x = 0, y = 0;
+};
+
 /// What a scan did.
 struct scan_stats {
     std::size_t created = 0;   ///< records appended
@@ -54,8 +60,11 @@ struct scan_stats {
 
 /// The generic driver, for any cache that answers "is (x, y) a miss?": visits pixels in
 /// `order` (row by row when empty), and at each pixel where `is_miss(x, y)` measures a
-/// record (std::optional<irradiance_record> measure(x, y), called from several threads at
-/// once, a pure function of the pixel) unless a guess already did, passes it to
+/// record unless a guess already did. `measure` is either per pixel,
+/// std::optional<irradiance_record>(x, y), called from several threads at once, or per
+/// batch, void(std::span<const pixel_xy>, std::span<std::optional<irradiance_record>> out),
+/// called once per batch (a GPU sampler that renders a batch in one atlas); either way a
+/// pure function of the pixel. The driver passes each record it keeps to
 /// `commit(record&)` and then to `accept(const record&) -> float`, which adds it to the
 /// cache and returns its zone of influence's radius in pixels (the spacing of the next
 /// guesses). Stops after `max_new` records.
@@ -104,11 +113,13 @@ scan_stats batched_scan(std::size_t width, std::size_t height, std::span<const s
                 if (ok) guess.push_back(j);
             }
             std::vector<std::optional<irradiance_record>> measured(guess.size());
+            std::vector<pixel_xy> where(guess.size());
+            for (std::size_t k = 0; k < guess.size(); ++k) where[k] = {pixel(guess[k]).first, pixel(guess[k]).second};
             const auto t0 = std::chrono::steady_clock::now();
-            tbb::parallel_for(std::size_t(0), guess.size(), [&](std::size_t k) {
-                const auto [gx, gy] = pixel(guess[k]);
-                measured[k] = measure(gx, gy);
-            });
+            if constexpr (std::is_invocable_v<Measure&, std::span<const pixel_xy>, std::span<std::optional<irradiance_record>>>)
+                measure(std::span<const pixel_xy>(where), std::span<std::optional<irradiance_record>>(measured));
+            else
+                tbb::parallel_for(std::size_t(0), guess.size(), [&](std::size_t k) { measured[k] = measure(where[k].x, where[k].y); });
             stats.measure_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             stats.measured += guess.size();
             for (std::size_t k = 0; k < guess.size(); ++k) ahead.emplace(guess[k], std::move(measured[k]));
@@ -132,7 +143,8 @@ inline float guess_spacing(const pixel_rect& r) noexcept {
 }
 
 /// scan_cache_misses with records measured ahead in parallel (see the file comment):
-/// `measure(x, y)` must be thread-safe and a pure function of the pixel; `commit(record&)`
+/// `measure` (per pixel and thread-safe, or per batch; see batched_scan) must be a pure
+/// function of the pixel; `commit(record&)`
 /// runs in scan order before the record is appended and splatted. Bitwise the same
 /// records and splat buffer as scan_cache_misses<Weight> with create = measure + commit.
 template <class Weight, class Measure, class Commit>

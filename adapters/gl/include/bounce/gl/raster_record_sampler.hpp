@@ -5,17 +5,20 @@
 ///   std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint),
 /// over gl::hemisphere_raster with border-stretching weights and the GPU reduction.
 ///
-/// The irradiance cache's scan asks for one record at a time, so each call renders a batch
-/// of one plane; a renderer that can gather misses first should call hemisphere_raster
-/// with full batches instead.
+/// One record per call renders a batch of one plane; the batch form renders many planes
+/// per atlas, which is what cpu::scan_cache_misses_batched gives it (its guesses). A plane
+/// depends only on its record's point and normal, so both forms make the same records up
+/// to the rounding of the atlas placement.
 
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/hemisphere.hpp>
 #include <bounce/irradiance_record.hpp>
 #include <bounce/sampling.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 #include <span>
 
 namespace bounce::gl {
@@ -31,13 +34,31 @@ public:
     }
 
     std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint) {
-        raster_.render(std::span(&p, 1), std::span(&n, 1));
-        const hemisphere_estimate est = raster_.reduce().at(0);
-        // The planes are rendered in the frame of orthonormal_basis(n) (hemisphere.hpp).
-        const auto tb = orthonormal_basis<float, glm::vec3>(n);
-        const irradiance_record rec = make_record(p, n, tb[0], tb[1], est, limits_, pixel_footprint);
-        if (!std::isfinite(rec.radius) || !(rec.radius > 0.f)) return std::nullopt;
-        return rec;
+        std::optional<irradiance_record> out;
+        (*this)(std::span(&p, 1), std::span(&n, 1), std::span(&pixel_footprint, 1), std::span(&out, 1));
+        return out;
+    }
+
+    /// Records for points[k], normals[k], footprints[k] into out[k], rendered capacity()
+    /// planes per atlas. Throws parameter_error when the spans' sizes differ.
+    void operator()(std::span<const glm::vec3> points, std::span<const glm::vec3> normals,
+                    std::span<const double> footprints, std::span<std::optional<irradiance_record>> out) {
+        require(normals.size() == points.size() && footprints.size() == points.size() && out.size() == points.size(),
+                "points", "points, normals, footprints and out must have one entry per record");
+        for (std::size_t first = 0; first < points.size(); first += raster_.capacity()) {
+            const std::size_t count = std::min(raster_.capacity(), points.size() - first);
+            raster_.render(points.subspan(first, count), normals.subspan(first, count));
+            const std::vector<hemisphere_estimate> est = raster_.reduce();
+            for (std::size_t k = 0; k < count; ++k) {
+                const glm::vec3 n = normals[first + k];
+                // The planes are rendered in the frame of orthonormal_basis(n) (hemisphere.hpp).
+                const auto tb = orthonormal_basis<float, glm::vec3>(n);
+                const irradiance_record rec =
+                    make_record(points[first + k], n, tb[0], tb[1], est.at(k), limits_, footprints[first + k]);
+                if (std::isfinite(rec.radius) && rec.radius > 0.f) out[first + k] = rec;
+                else out[first + k] = std::nullopt;
+            }
+        }
     }
 
 private:
