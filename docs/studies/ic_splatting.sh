@@ -47,6 +47,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
         --indirect-out "docs/figures/$tag-$w-a0.4.png" --out "docs/figures/$tag-$w-final.png"
   done
   run "$tag-octree" "${common[@]}" --a 0.15 --weight ward-smooth --interp octree
+  [[ $tag == cornell ]] && run "$tag-raster" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster
   run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
   run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
   # Every frame of the camera path needs its own reference: smaller images, fewer samples.
