@@ -306,6 +306,8 @@ struct gl_backend {
     gl::splat_pass splats;
     gl::compose_pass compose;
     std::size_t on_gpu = 0;
+    gl::splat_pass wide_splats;  // progressive hole filling: the same records, wider a
+    std::size_t wide_on_gpu = 0;
 
     std::optional<gl::hemisphere_raster> raster;  // the record sampler, for --sampler raster
 
@@ -320,6 +322,7 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
     const cpu::splat_params sp = splat_params_for(o, a);
     const gl::splat_params gsp{sp.a, sp.gradients, sp.max_extrapolation};
     const weighting_kind kind = parse_weight(o.weight);
+    const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
     frame_result fr;
     {  // step 1
         auto t = timer.measure("gbuffer");
@@ -373,15 +376,23 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
         gb.splats.append(std::span(records).subspan(before));
         gb.on_gpu = records.size();
         gb.splats.splat(tex, cam, gsp, kind, before);
+        if (fill_holes) {
+            // A budget left pixels uncovered: every record again with zones fill x wider.
+            if (gb.wide_on_gpu < records.size()) gb.wide_splats.append(std::span(records).subspan(gb.wide_on_gpu));
+            gb.wide_on_gpu = records.size();
+            gb.wide_splats.clear(o.width, o.height);
+            gb.wide_splats.splat(tex, cam, {sp.a * o.fill_holes, sp.gradients, sp.max_extrapolation}, kind);
+        }
         gl::finish();
     }
     {
         auto t = timer.measure("normalize");
         fr.indirect = image<glm::vec3>(o.width, o.height);
         fr.combined = image<glm::vec3>(o.width, o.height);
-        gb.compose.compose(gb.splats.splat_texture());
+        const gl::texture* wide = fill_holes ? &gb.wide_splats.splat_texture() : nullptr;
+        gb.compose.compose(gb.splats.splat_texture(), nullptr, wide, 1e-3f);
         gb.compose.read(fr.indirect.view());
-        gb.compose.compose(gb.splats.splat_texture(), &gb.light.radiance());
+        gb.compose.compose(gb.splats.splat_texture(), &gb.light.radiance(), wide, 1e-3f);
         gb.compose.read(fr.combined->view());
     }
     return fr;
@@ -684,7 +695,7 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree"}))->capture_default_str();
     app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)");
     app.add_option("--fill-holes", o.fill_holes,
-                   "progressive, splat-cpu: fill pixels no zone reaches from a splat with a this many times wider (0: off)")
+                   "progressive: fill pixels no zone reaches from a splat with a this many times wider (0: off)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(CLI::PositiveNumber)->capture_default_str();

@@ -354,6 +354,41 @@ TEST_CASE("normalization and composition on the GPU equal cpu::normalize_splats 
     CHECK(got(0, 0) == direct(0, 0));
 }
 
+TEST_CASE("hole filling on the GPU equals cpu::normalize_splats with a wide splat", "[gl][splat][compose]") {
+    gl_test::shared_context();
+    plane_view v;
+    const auto recs = test_records(v);
+    cpu::splat_params sp, wide_sp;
+    sp.a = 0.1f;  // small zones leave holes
+    wide_sp.a = 0.4f;
+    image<glm::vec4> splat(W, H, glm::vec4(0.f)), wide(W, H, glm::vec4(0.f));
+    cpu::splat_records<ward_smooth_weight>(v.gb.view(), v.cam, std::span(recs).first(recs.size() / 4), sp, splat.view());
+    cpu::splat_records<ward_smooth_weight>(v.gb.view(), v.cam, std::span(recs).first(recs.size() / 4), wide_sp, wide.view());
+    std::size_t holes = 0;
+    for (std::size_t y = 0; y < H; ++y)
+        for (std::size_t x = 0; x < W; ++x) holes += splat(x, y).w == 0.f && wide(x, y).w > 0.f;
+    REQUIRE(holes > 10);  // the case hole filling is for
+    const float lambda = 1e-3f;
+    image<glm::vec3> expected(W, H), got(W, H);
+    cpu::normalize_splats(splat.view(), wide.view(), lambda, expected.view());
+
+    gl::texture splat_tex(gl::texel_format::rgba32f, W, H), wide_tex(gl::texel_format::rgba32f, W, H);
+    gl::write_texture(splat_tex, splat.view());
+    gl::write_texture(wide_tex, wide.view());
+    gl::compose_pass pass;
+    pass.compose(splat_tex, nullptr, &wide_tex, lambda);
+    pass.read(got.view());
+    // Two multiply-adds, one division (GLSL: 2.5 ulp): 8 ulps of the result bound the gap.
+    const double ulp8 = 8.0 * std::ldexp(1.0, -24);
+    for (std::size_t y = 0; y < H; ++y)
+        for (std::size_t x = 0; x < W; ++x)
+            for (int c = 0; c < 3; ++c)
+                REQUIRE(std::abs(double(got(x, y)[c]) - expected(x, y)[c]) <= ulp8 * std::abs(expected(x, y)[c]) + 1e-30);
+    gl::texture small(gl::texel_format::rgba32f, 2, 2);
+    CHECK_THROWS_AS(pass.compose(splat_tex, nullptr, &small, lambda), parameter_error);
+    CHECK_THROWS_AS(pass.compose(splat_tex, nullptr, &wide_tex, 0.f), parameter_error);
+}
+
 TEST_CASE("the splat pass refuses bad records, parameters and sizes, naming them", "[gl][splat][bad-input]") {
     gl_test::shared_context();
     plane_view v;

@@ -411,16 +411,26 @@ const texture& splat_pass::splat_texture() const {
 // ---- compose_pass -----------------------------------------------------------------------
 
 namespace {
-std::string compose_fragment(bool with_direct) {
+constexpr GLint loc_lambda = 0;
+
+// with_wide: hole filling (hole_filled_splat) from a second splat buffer at a wider a.
+std::string compose_fragment(bool with_direct, bool with_wide) {
     glsl::function_set kernels;
     kernels.add("normalized_splat", normalized_splat<glsl::f32, glsl::vec3>, "sum", "weight");
+    if (with_wide)
+        kernels.add("hole_filled_splat", hole_filled_splat<glsl::f32, glsl::vec3>, "sum", "weight", "wide_sum",
+                    "wide_weight", "lambda");
     return std::string("#version 450 core\n") + "layout(binding = 0) uniform sampler2D splat_buffer;\n" +
            (with_direct ? "layout(binding = 1) uniform sampler2D direct_radiance;\n" : "") +
+           (with_wide ? "layout(binding = 2) uniform sampler2D wide_buffer;\nlayout(location = 0) uniform float lambda;\n"
+                      : "") +
            "layout(location = 0) out vec4 radiance;\n\n" + kernels.source() +
            "\nvoid main() {\n"
            "    ivec2 pixel = ivec2(gl_FragCoord.xy);\n"
-           "    vec4 s = texelFetch(splat_buffer, pixel, 0);\n"
-           "    vec3 indirect = normalized_splat(s.rgb, s.a);\n" +
+           "    vec4 s = texelFetch(splat_buffer, pixel, 0);\n" +
+           (with_wide ? "    vec4 w = texelFetch(wide_buffer, pixel, 0);\n"
+                        "    vec3 indirect = hole_filled_splat(s.rgb, s.a, w.rgb, w.a, lambda);\n"
+                      : "    vec3 indirect = normalized_splat(s.rgb, s.a);\n") +
            (with_direct ? "    radiance = vec4(texelFetch(direct_radiance, pixel, 0).rgb + indirect, 1.0);\n"
                         : "    radiance = vec4(indirect, 1.0);\n") +
            "}\n";
@@ -428,14 +438,25 @@ std::string compose_fragment(bool with_direct) {
 }  // namespace
 
 compose_pass::compose_pass()
-    : with_direct_(fullscreen_vertex, compose_fragment(true)), without_direct_(fullscreen_vertex, compose_fragment(false)) {}
+    : with_direct_(fullscreen_vertex, compose_fragment(true, false)),
+      without_direct_(fullscreen_vertex, compose_fragment(false, false)),
+      with_direct_wide_(fullscreen_vertex, compose_fragment(true, true)),
+      without_direct_wide_(fullscreen_vertex, compose_fragment(false, true)) {}
 
-void compose_pass::compose(const texture& splat, const texture* direct) {
+void compose_pass::compose(const texture& splat, const texture* direct) { compose(splat, direct, nullptr, 0.f); }
+
+void compose_pass::compose(const texture& splat, const texture* direct, const texture* wide, float lambda) {
     require_rgba32f(splat, "splat");
     if (direct) {
         require_rgba32f(*direct, "direct");
         require(direct->width() == splat.width() && direct->height() == splat.height(), "direct",
                 "size differs from the splat buffer");
+    }
+    if (wide) {
+        require_rgba32f(*wide, "wide");
+        require(wide->width() == splat.width() && wide->height() == splat.height(), "wide",
+                "size differs from the splat buffer");
+        require(std::isfinite(lambda) && lambda > 0.f, "lambda", "must be a positive number");
     }
     if (!result_ || result_->width() != splat.width() || result_->height() != splat.height()) {
         result_.emplace(texel_format::rgba32f, splat.width(), splat.height());
@@ -443,10 +464,10 @@ void compose_pass::compose(const texture& splat, const texture* direct) {
         fbo_.set_draw_buffers(1);
         fbo_.check_complete();
     }
-    const program& prog = direct ? with_direct_ : without_direct_;
+    const program& prog = wide ? (direct ? with_direct_wide_ : without_direct_wide_) : (direct ? with_direct_ : without_direct_);
     const detail::raster_state raster;
     const detail::program_and_storage_state bindings({});
-    const detail::texture_unit_state units(0, 2);
+    const detail::texture_unit_state units(0, 3);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_.id());
     glViewport(0, 0, GLsizei(splat.width()), GLsizei(splat.height()));
     glDisable(GL_DEPTH_TEST);
@@ -458,6 +479,11 @@ void compose_pass::compose(const texture& splat, const texture* direct) {
     if (direct) {
         glBindTextureUnit(1, direct->id());
         glBindSampler(1, 0);
+    }
+    if (wide) {
+        glBindTextureUnit(2, wide->id());
+        glBindSampler(2, 0);
+        glProgramUniform1f(prog.id(), loc_lambda, lambda);
     }
     glDrawArrays(GL_TRIANGLES, 0, 3);
     check_error("compose_pass::compose");

@@ -174,6 +174,11 @@ public:
     /// radiance, e.g. direct_light::radiance()) may be null for the indirect image alone.
     /// Throws parameter_error when the sizes differ or a texture is not RGBA32F.
     void compose(const texture& splat, const texture* direct = nullptr);
+    /// Progressive hole filling: result = hole_filled_splat(splat, wide, lambda) + direct,
+    /// `wide` holding the same records splatted with a wider a (see cpu::normalize_splats);
+    /// `wide` null is the plain compose. Throws parameter_error on sizes, formats or
+    /// lambda <= 0.
+    void compose(const texture& splat, const texture* direct, const texture* wide, float lambda);
     /// The same with the direct radiance given as a CPU image (row 0 at the top).
     void compose(const texture& splat, image_view<const glm::vec3> direct);
     /// Copies the result's rgb into `out` (row 0 at the top; sizes must match).
@@ -182,7 +187,7 @@ public:
     const texture& result() const;
 
 private:
-    program with_direct_, without_direct_;
+    program with_direct_, without_direct_, with_direct_wide_, without_direct_wide_;
     std::optional<texture> result_, uploaded_direct_;
     framebuffer fbo_;
     vertex_array empty_vao_;
