@@ -1,6 +1,8 @@
 // The batched cache-miss scan against the sequential one: with records that depend only on
 // their pixel, both must give the same records in the same order and the same splat buffer,
 // bit for bit, whatever the batch size, lookahead, order, budget and thread count.
+#include "plane_view.hpp"
+
 #include <bounce/cpu/batched_scan.hpp>
 #include <bounce/cpu/neighbour_index.hpp>
 #include <bounce/sampling.hpp>
@@ -13,29 +15,10 @@
 using namespace bounce;
 
 namespace {
-// A tilted plane seen from above, its exact G-buffer, and a hole (uncovered pixels) in it.
-struct plane_scene {
-    camera cam;
-    gbuffer<float> gb;
-    plane_scene(std::size_t w, std::size_t h) : gb(w, h) {
-        cam.position = {0.3f, -0.2f, 4.f};
-        cam.look_at = {0.f, 0.f, 0.f};
-        cam.up = {0, 1, 0};
-        cam.fov_y_deg = 60.f;
-        const glm::vec3 n = glm::normalize(glm::vec3(0.2f, -0.1f, 1.f));
-        for (std::size_t y = 0; y < h; ++y)
-            for (std::size_t x = 0; x < w; ++x) {
-                if (x > w / 3 && x < w / 2 && y > h / 4 && y < h / 2) continue;  // the hole
-                const glm::vec3 d = cam.direction(float(x) + 0.5f, float(y) + 0.5f, w, h);
-                const float t = -glm::dot(cam.position, n) / glm::dot(d, n);
-                if (!(t > 0.f)) continue;
-                gb.position(x, y) = cam.position + t * d;
-                gb.normal(x, y) = n;
-                gb.albedo(x, y) = {0.5f, 0.25f, 1.f};
-                gb.depth(x, y) = glm::dot(gb.position(x, y) - cam.position, cam.forward());
-            }
-    }
-};
+// A tilted plane seen from above, with a hole (uncovered pixels) in it.
+cpu_test::plane_view plane_scene(std::size_t w, std::size_t h) {
+    return cpu_test::plane_view(w, h, glm::normalize(glm::vec3(0.2f, -0.1f, 1.f)), true);
+}
 
 // A pure record of the pixel: radius and irradiance from a hash of (x, y), some pixels
 // refusing (nullopt), as a sampler that finds no finite estimate would.
@@ -54,7 +37,7 @@ std::optional<irradiance_record> pure_record(const gbuffer<float>& gb, std::size
 
 TEST_CASE("the batched scan makes the sequential scan's records and splat buffer, bitwise", "[scan][cpu][batched]") {
     const std::size_t w = 72, h = 54;
-    plane_scene s(w, h);
+    auto s = plane_scene(w, h);
     const auto variant = GENERATE(range(0, 24));
     const std::size_t batch_size = std::array<std::size_t, 4>{1, 0, 3, 64}[variant % 4];
     const std::size_t lookahead = std::array<std::size_t, 3>{0, 1, 4000}[(variant / 4) % 3];
@@ -120,7 +103,7 @@ TEST_CASE("the batched scan makes the sequential scan's records and splat buffer
 
 TEST_CASE("a per-batch measure (a GPU atlas) gives the per-pixel scan's records", "[scan][cpu][batched]") {
     const std::size_t w = 64, h = 48;
-    plane_scene s(w, h);
+    auto s = plane_scene(w, h);
     cpu::splat_params sp;
     sp.a = 0.12f;
     const std::size_t batch_size = GENERATE(1, 5, 32);
@@ -147,7 +130,7 @@ TEST_CASE("a per-batch measure (a GPU atlas) gives the per-pixel scan's records"
 }
 
 TEST_CASE("the batched scan refuses bad orders by name", "[scan][cpu][batched][bad-input]") {
-    plane_scene s(8, 6);
+    auto s = plane_scene(8, 6);
     cpu::splat_params sp;
     std::vector<irradiance_record> recs;
     image<glm::vec4> splat(8, 6, glm::vec4(0.f));

@@ -1,5 +1,7 @@
 // CPU irradiance splatting on analytic G-buffers: zones of influence land where the math
 // says, the scan leaves no pixel under-covered, and results do not depend on threads.
+#include "plane_view.hpp"
+
 #include <bounce/cpu/splatting.hpp>
 #include <bounce/sampling.hpp>
 
@@ -10,32 +12,9 @@
 #include <numbers>
 
 using namespace bounce;
+using cpu_test::plane_view;
 
 namespace {
-// A camera looking down at the plane z = 0 from height 4, and the exact G-buffer of that plane.
-struct plane_view {
-    camera cam;
-    gbuffer<float> gb;
-    plane_view(std::size_t w, std::size_t h) : gb(w, h) {
-        cam.position = {0.3f, -0.2f, 4.f};
-        cam.look_at = {0.f, 0.f, 0.f};
-        cam.up = {0, 1, 0};
-        cam.fov_y_deg = 60.f;
-        const glm::vec3 f = cam.forward();
-        for (std::size_t y = 0; y < h; ++y)
-            for (std::size_t x = 0; x < w; ++x) {
-                const glm::vec3 d = cam.direction(float(x) + 0.5f, float(y) + 0.5f, w, h);
-                if (d.z >= 0.f) continue;
-                const float t = -cam.position.z / d.z;
-                const glm::vec3 p = cam.position + t * d;
-                gb.position(x, y) = p;
-                gb.normal(x, y) = {0, 0, 1};
-                gb.albedo(x, y) = {0.5f, 0.25f, 1.f};
-                gb.depth(x, y) = glm::dot(p - cam.position, f);
-            }
-    }
-};
-
 irradiance_record record_at(glm::vec3 p, float radius, glm::vec3 e) {
     irradiance_record r;
     r.position = p;
