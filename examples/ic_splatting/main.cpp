@@ -165,10 +165,8 @@ auto record_batch_measurer(const context& ctx, const camera& cam, const gbuffer<
             ctx.batch_sampler(p, n, footprint, out);
             return;
         }
-        tbb::parallel_for(std::size_t(0), px.size(), [&](std::size_t k) {
-            out[k] = ctx.sampler(g.position(px[k].x, px[k].y), g.normal(px[k].x, px[k].y),
-                                 cam.pixel_footprint(g.depth(px[k].x, px[k].y), g.height()));
-        });
+        const auto one = record_measurer(ctx, cam, g);
+        tbb::parallel_for(std::size_t(0), px.size(), [&](std::size_t k) { out[k] = one(px[k].x, px[k].y); });
     };
 }
 
@@ -195,6 +193,24 @@ auto record_creator(const context& ctx, const camera& cam, const gbuffer<float>&
     };
 }
 
+// Step 4 over a splat buffer, for the CPU and GL backends alike: the batched scan (guesses
+// measured together) or the sequential one; sets fr's record counts, adds to record_ms.
+template <class W>
+void scan_splat_buffer(const context& ctx, const camera& cam, gbuffer<float>& g, const cpu::splat_params& sp,
+                       float min_weight, std::vector<irradiance_record>& records, image_view<glm::vec4> splat,
+                       std::size_t max_new, frame_result& fr, double& record_ms) {
+    if (ctx.opt.scan == "batched") {
+        const auto stats = cpu::scan_cache_misses_batched<W>(g.view(), cam, sp, min_weight, record_batch_measurer(ctx, cam, g),
+                                                             record_committer(ctx, records), records, splat, ctx.batch,
+                                                             ctx.order, max_new);
+        take_scan_stats(stats, fr, record_ms);
+    } else {
+        fr.new_records = cpu::scan_cache_misses<W>(g.view(), cam, sp, min_weight,
+                                                   record_creator(ctx, cam, g, records, record_ms), records, splat,
+                                                   ctx.order, max_new);
+    }
+}
+
 // CPU backends: splat-cpu (Algorithm 5 on the CPU) and octree (the classical two passes).
 frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> g_in, float a,
                           std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
@@ -205,13 +221,10 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
     const auto gv = g_in.view();
 
     double record_ms = 0;
-    auto create = record_creator(ctx, cam, g, records, record_ms);
-
     frame_result fr;
     fr.indirect = image<glm::vec3>(g.width(), g.height());
     image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
     const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
-    auto take = [&](const cpu::scan_stats& stats) { take_scan_stats(stats, fr, record_ms); };
     std::optional<image<glm::vec4>> wide;  // hole filling's wide splat
     with_weighting(parse_weight(o.weight), [&](auto w) {
         using W = decltype(w);
@@ -237,8 +250,9 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                         const float zone = W::template influence_radius<float>(rec.radius, a);
                         return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
                     });
-                take(stats);
+                take_scan_stats(stats, fr, record_ms);
             } else {
+                auto create = record_creator(ctx, cam, g, records, record_ms);
                 std::size_t created = 0;
                 for (std::size_t i = 0; i < g.width() * g.height() && created < max_new; ++i) {
                     const std::size_t idx = ctx.order.empty() ? i : ctx.order[i];
@@ -263,14 +277,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 cpu::splat_records<W>(gv, cam, records, sp, splat.view());
             }
             const auto t0 = clock_type::now();
-            if (o.scan == "batched") {
-                const auto stats = cpu::scan_cache_misses_batched<W>(gv, cam, sp, min_weight, record_batch_measurer(ctx, cam, g),
-                                                                     record_committer(ctx, records), records, splat.view(),
-                                                                     ctx.batch, ctx.order, max_new);
-                take(stats);
-            } else {
-                fr.new_records = cpu::scan_cache_misses<W>(gv, cam, sp, min_weight, create, records, splat.view(), ctx.order, max_new);
-            }
+            scan_splat_buffer<W>(ctx, cam, g_in, sp, min_weight, records, splat.view(), max_new, fr, record_ms);
             timer.add_sample("scan", ms_since(t0) - record_ms);
             timer.add_sample("compute_records", record_ms);
             // Step 5: the image comes from splatting every record (on the GPU in the seed).
@@ -355,18 +362,7 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
         const auto t0 = clock_type::now();
         const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
         with_weighting(kind, [&](auto w) {
-            using W = decltype(w);
-            if (o.scan == "batched") {
-                const auto stats = cpu::scan_cache_misses_batched<W>(fr.g.view(), cam, sp, min_weight,
-                                                                     record_batch_measurer(ctx, cam, fr.g),
-                                                                     record_committer(ctx, records), records, splat.view(),
-                                                                     ctx.batch, ctx.order, max_new);
-                take_scan_stats(stats, fr, record_ms);
-            } else {
-                fr.new_records = cpu::scan_cache_misses<W>(fr.g.view(), cam, sp, min_weight,
-                                                           record_creator(ctx, cam, fr.g, records, record_ms), records,
-                                                           splat.view(), ctx.order, max_new);
-            }
+            scan_splat_buffer<decltype(w)>(ctx, cam, fr.g, sp, min_weight, records, splat.view(), max_new, fr, record_ms);
         });
         timer.add_sample("scan", ms_since(t0) - record_ms);
         timer.add_sample("compute_records", record_ms);

@@ -226,6 +226,9 @@ RTCRayHit to_rayhit(const ray& r) {
     return rh;
 }
 
+// rtcOccluded sets tfar to -inf when it finds an occluder.
+bool found_occluder(const RTCRay& r) { return r.tfar < 0.f && std::isinf(r.tfar); }
+
 hit from_rayhit(const RTCRayHit& rh) {
     hit h;
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
@@ -261,8 +264,7 @@ bool accel::occluded(const ray& r) const {
     RTCIntersectContext c = context(false);
     RTCRayHit rh = to_rayhit(r);
     rtcOccluded1(state_->handle, &c, &rh.ray);
-    // Embree sets tfar to -inf when it finds an occluder.
-    return rh.ray.tfar < 0.f && std::isinf(rh.ray.tfar);
+    return found_occluder(rh.ray);
 }
 
 void accel::intersect(std::span<const ray> rays, std::span<hit> hits, bool coherent) const {
@@ -289,7 +291,7 @@ void accel::occluded(std::span<const ray> rays, std::span<std::uint8_t> blocked,
         for (std::size_t i = 0; i < n; ++i) buffer[i] = to_rayhit(rays[base + i]).ray;
         rtcOccluded1M(state_->handle, &c, buffer, unsigned(n), sizeof(RTCRay));
         for (std::size_t i = 0; i < n; ++i)
-            blocked[base + i] = (buffer[i].tfar < 0.f && std::isinf(buffer[i].tfar)) ? 1 : 0;
+            blocked[base + i] = found_occluder(buffer[i]) ? 1 : 0;
     }
 }
 

@@ -114,7 +114,10 @@ scan_stats batched_scan(std::size_t width, std::size_t height, std::span<const s
             }
             std::vector<std::optional<irradiance_record>> measured(guess.size());
             std::vector<pixel_xy> where(guess.size());
-            for (std::size_t k = 0; k < guess.size(); ++k) where[k] = {pixel(guess[k]).first, pixel(guess[k]).second};
+            for (std::size_t k = 0; k < guess.size(); ++k) {
+                const auto [gx, gy] = pixel(guess[k]);
+                where[k] = {gx, gy};
+            }
             const auto t0 = std::chrono::steady_clock::now();
             if constexpr (std::is_invocable_v<Measure&, std::span<const pixel_xy>, std::span<std::optional<irradiance_record>>>)
                 measure(std::span<const pixel_xy>(where), std::span<std::optional<irradiance_record>>(measured));
