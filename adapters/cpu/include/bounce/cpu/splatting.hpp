@@ -214,16 +214,24 @@ std::size_t scan_cache_misses(const gbuffer_view<float>& gb, const camera& cam, 
     return created;
 }
 
+namespace detail {
+/// f(x, y) for every pixel of a width x height image, rows in parallel.
+template <class F>
+void for_each_pixel(std::size_t width, std::size_t height, F&& f) {
+    tbb::parallel_for(std::size_t(0), height, [&](std::size_t y) {
+        for (std::size_t x = 0; x < width; ++x) f(x, y);
+    });
+}
+}  // namespace detail
+
 /// Normalization (seed Algorithm 5, last loop): indirect radiance = sum / weight, 0 where
 /// no record reached the pixel.
 inline void normalize_splats(image_view<const glm::vec4> splat, image_view<glm::vec3> indirect) {
     require(splat.width() == indirect.width() && splat.height() == indirect.height(), "indirect",
             "size differs from the splat buffer");
-    tbb::parallel_for(std::size_t(0), splat.height(), [&](std::size_t y) {
-        for (std::size_t x = 0; x < splat.width(); ++x) {
-            const glm::vec4 s = splat(x, y);
-            indirect(x, y) = normalized_splat<float, glm::vec3>(glm::vec3(s), s.w);
-        }
+    detail::for_each_pixel(splat.width(), splat.height(), [&](std::size_t x, std::size_t y) {
+        const glm::vec4 s = splat(x, y);
+        indirect(x, y) = normalized_splat<float, glm::vec3>(glm::vec3(s), s.w);
     });
 }
 
@@ -235,11 +243,9 @@ inline void normalize_splats(image_view<const glm::vec4> splat, image_view<const
                 wide.height() == splat.height(),
             "indirect", "size differs from the splat buffer");
     require(std::isfinite(lambda) && lambda > 0.f, "lambda", "must be a positive number");
-    tbb::parallel_for(std::size_t(0), splat.height(), [&](std::size_t y) {
-        for (std::size_t x = 0; x < splat.width(); ++x) {
-            const glm::vec4 s = splat(x, y), w = wide(x, y);
-            indirect(x, y) = hole_filled_splat<float, glm::vec3>(glm::vec3(s), s.w, glm::vec3(w), w.w, lambda);
-        }
+    detail::for_each_pixel(splat.width(), splat.height(), [&](std::size_t x, std::size_t y) {
+        const glm::vec4 s = splat(x, y), w = wide(x, y);
+        indirect(x, y) = hole_filled_splat<float, glm::vec3>(glm::vec3(s), s.w, glm::vec3(w), w.w, lambda);
     });
 }
 
@@ -248,9 +254,8 @@ inline void compose(image_view<const glm::vec3> direct, image_view<const glm::ve
     require(direct.width() == out.width() && indirect.width() == out.width() && direct.height() == out.height() &&
                 indirect.height() == out.height(),
             "out", "direct, indirect and output sizes differ");
-    tbb::parallel_for(std::size_t(0), out.height(), [&](std::size_t y) {
-        for (std::size_t x = 0; x < out.width(); ++x) out(x, y) = direct(x, y) + indirect(x, y);
-    });
+    detail::for_each_pixel(out.width(), out.height(),
+                           [&](std::size_t x, std::size_t y) { out(x, y) = direct(x, y) + indirect(x, y); });
 }
 
 }  // namespace bounce::cpu
