@@ -237,36 +237,23 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 for (const auto& r : records) tree.insert(r);
             }
             const auto t0 = clock_type::now();
-            if (o.scan == "batched") {
-                const glm::mat4 view = cam.view_matrix();
-                const auto stats = cpu::batched_scan(
-                    g.width(), g.height(), ctx.order, max_new, ctx.batch,
-                    [&](std::size_t x, std::size_t y) {
-                        return gv.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
-                    },
-                    record_batch_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
-                        records.push_back(rec);
-                        tree.insert(rec);
-                        const float zone = W::template influence_radius<float>(rec.radius, a);
-                        return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
-                    });
-                take_scan_stats(stats, fr, record_ms);
-            } else {
-                auto create = record_creator(ctx, cam, g, records, record_ms);
-                std::size_t created = 0;
-                for (std::size_t i = 0; i < g.width() * g.height() && created < max_new; ++i) {
-                    const std::size_t idx = ctx.order.empty() ? i : ctx.order[i];
-                    const std::size_t x = idx % g.width(), y = idx / g.width();
-                    if (!gv.covered(x, y) || tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w >= min_weight)
-                        continue;
-                    if (auto rec = create(x, y)) {
-                        records.push_back(*rec);
-                        tree.insert(*rec);
-                        ++created;
-                    }
-                }
-                fr.new_records = created;
-            }
+            // The classical fill: the same driver as the splat scan; --scan sequential makes it
+            // one record at a time (a batch of one guesses nothing).
+            cpu::scan_batch batch = ctx.batch;
+            if (o.scan == "sequential") batch.max_records = 1;
+            const glm::mat4 view = cam.view_matrix();
+            const auto stats = cpu::batched_scan(
+                g.width(), g.height(), ctx.order, max_new, batch,
+                [&](std::size_t x, std::size_t y) {
+                    return gv.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
+                },
+                record_batch_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
+                    records.push_back(rec);
+                    tree.insert(rec);
+                    const float zone = W::template influence_radius<float>(rec.radius, a);
+                    return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
+                });
+            take_scan_stats(stats, fr, record_ms);
             timer.add_sample("scan", ms_since(t0) - record_ms);
             timer.add_sample("compute_records", record_ms);
             auto t = timer.measure("interpolate");
