@@ -1,0 +1,141 @@
+#pragma once
+/// \file lanes.hpp
+/// Four floats computed at once: a scalar type and a vector type that satisfy the kernel
+/// contract of concepts.hpp, so a kernel of include/bounce/ runs on four pixels per
+/// instruction with no second copy of its math (the third instantiation, beside plain
+/// numbers and GLSL expressions).
+///
+/// Every lane computes exactly what the scalar float instantiation computes: the same
+/// IEEE operations (+ - * / and sqrt are correctly rounded in both) in the same order as
+/// GLM's (dot is (x + y) + z, cross and clamp as GLM writes them), and no fused
+/// multiply-add (GCC does not contract vector-extension arithmetic into FMA unless the
+/// target has it, and then neither the scalar code nor this may use it: build both with the
+/// same flags). The CPU splat relies on that to stay bitwise equal to the scalar kernel;
+/// tests/cpu/test_lanes.cpp checks it lane by lane.
+///
+/// Built on the GCC/Clang vector extensions, which compile to SSE on x86-64 and to NEON on
+/// AArch64 (and to scalar code elsewhere).
+
+#include <bounce/concepts.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <type_traits>
+
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
+namespace bounce::cpu::lanes {
+
+using f32v = float __attribute__((vector_size(16)));
+using i32v = std::int32_t __attribute__((vector_size(16)));
+
+/// A lane-wise comparison result: all bits set where it holds.
+struct mask4 {
+    i32v bits;
+    friend mask4 operator&&(mask4 a, mask4 b) noexcept { return {a.bits & b.bits}; }
+    friend mask4 operator||(mask4 a, mask4 b) noexcept { return {a.bits | b.bits}; }
+    friend mask4 operator!(mask4 a) noexcept { return {~a.bits}; }
+    bool any() const noexcept { return (bits[0] | bits[1] | bits[2] | bits[3]) != 0; }
+    bool operator[](int i) const noexcept { return bits[i] != 0; }
+};
+
+/// Four floats.
+struct f32x4 {
+    f32v v;
+
+    f32x4() noexcept : v{0.f, 0.f, 0.f, 0.f} {}
+    f32x4(f32v x) noexcept : v(x) {}
+    /// Broadcast; a double rounds to float as `T(x)` does in the scalar kernel.
+    template <class A>
+        requires std::is_arithmetic_v<A>
+    explicit f32x4(A x) noexcept : v{float(x), float(x), float(x), float(x)} {}
+    f32x4(float a, float b, float c, float d) noexcept : v{a, b, c, d} {}
+
+    float operator[](int i) const noexcept { return v[i]; }
+
+    friend f32x4 operator+(f32x4 a, f32x4 b) noexcept { return {a.v + b.v}; }
+    friend f32x4 operator-(f32x4 a, f32x4 b) noexcept { return {a.v - b.v}; }
+    friend f32x4 operator*(f32x4 a, f32x4 b) noexcept { return {a.v * b.v}; }
+    friend f32x4 operator/(f32x4 a, f32x4 b) noexcept { return {a.v / b.v}; }
+    friend f32x4 operator-(f32x4 a) noexcept { return {-a.v}; }
+    friend mask4 operator<(f32x4 a, f32x4 b) noexcept { return {a.v < b.v}; }
+    friend mask4 operator>(f32x4 a, f32x4 b) noexcept { return {a.v > b.v}; }
+    friend mask4 operator<=(f32x4 a, f32x4 b) noexcept { return {a.v <= b.v}; }
+    friend mask4 operator>=(f32x4 a, f32x4 b) noexcept { return {a.v >= b.v}; }
+};
+
+/// `a` where `m` holds, else `b`.
+inline f32x4 select(mask4 m, f32x4 a, f32x4 b) noexcept {
+    i32v ai, bi;
+    std::memcpy(&ai, &a.v, sizeof ai);
+    std::memcpy(&bi, &b.v, sizeof bi);
+    const i32v r = (ai & m.bits) | (bi & ~m.bits);
+    f32v out;
+    std::memcpy(&out, &r, sizeof out);
+    return {out};
+}
+
+inline f32x4 sqrt(f32x4 x) noexcept {
+#if defined(__SSE__)
+    return {_mm_sqrt_ps(x.v)};
+#else
+    return {x[0] >= 0.f ? std::sqrt(x[0]) : NAN, x[1] >= 0.f ? std::sqrt(x[1]) : NAN,
+            x[2] >= 0.f ? std::sqrt(x[2]) : NAN, x[3] >= 0.f ? std::sqrt(x[3]) : NAN};
+#endif
+}
+// The scalar vocabulary's semantics (vocabulary.hpp): min(a, b) = b < a ? b : a.
+inline f32x4 min(f32x4 a, f32x4 b) noexcept { return select(b < a, b, a); }
+inline f32x4 max(f32x4 a, f32x4 b) noexcept { return select(a < b, b, a); }
+inline f32x4 clamp(f32x4 x, f32x4 lo, f32x4 hi) noexcept { return min(max(x, lo), hi); }
+inline f32x4 abs(f32x4 x) noexcept { return select(x < f32x4(0.f), -x, x); }
+
+/// Three components of four lanes each (a structure of arrays).
+struct vec3x4 {
+    f32x4 x, y, z;
+
+    vec3x4() noexcept = default;
+    vec3x4(f32x4 a, f32x4 b, f32x4 c) noexcept : x(a), y(b), z(c) {}
+    /// Four vectors, one per lane.
+    template <class V3>
+    static vec3x4 gather(const V3& a, const V3& b, const V3& c, const V3& d) noexcept {
+        return {{a.x, b.x, c.x, d.x}, {a.y, b.y, c.y, d.y}, {a.z, b.z, c.z, d.z}};
+    }
+    /// One vector in every lane.
+    template <class V3>
+    static vec3x4 broadcast(const V3& a) noexcept {
+        return {f32x4(float(a.x)), f32x4(float(a.y)), f32x4(float(a.z))};
+    }
+
+    friend vec3x4 operator+(const vec3x4& a, const vec3x4& b) noexcept { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+    friend vec3x4 operator-(const vec3x4& a, const vec3x4& b) noexcept { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+    friend vec3x4 operator*(const vec3x4& a, const vec3x4& b) noexcept { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+    friend vec3x4 operator*(const vec3x4& a, f32x4 s) noexcept { return {a.x * s, a.y * s, a.z * s}; }
+    friend vec3x4 operator*(f32x4 s, const vec3x4& a) noexcept { return {s * a.x, s * a.y, s * a.z}; }
+    friend vec3x4 operator/(const vec3x4& a, f32x4 s) noexcept { return {a.x / s, a.y / s, a.z / s}; }
+    friend vec3x4 operator-(const vec3x4& a) noexcept { return {-a.x, -a.y, -a.z}; }
+};
+
+// GLM's order of operations (glm/detail/func_geometric.inl).
+inline f32x4 dot(const vec3x4& a, const vec3x4& b) noexcept {
+    const vec3x4 t = a * b;
+    return t.x + t.y + t.z;
+}
+inline vec3x4 cross(const vec3x4& a, const vec3x4& b) noexcept {
+    return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
+}
+inline f32x4 length(const vec3x4& a) noexcept { return sqrt(dot(a, a)); }
+inline vec3x4 normalize(const vec3x4& a) noexcept { return a * (f32x4(1.f) / sqrt(dot(a, a))); }
+inline vec3x4 clamp(const vec3x4& v, const vec3x4& lo, const vec3x4& hi) noexcept {
+    return {clamp(v.x, lo.x, hi.x), clamp(v.y, lo.y, hi.y), clamp(v.z, lo.z, hi.z)};
+}
+inline vec3x4 select(mask4 m, const vec3x4& a, const vec3x4& b) noexcept {
+    return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
+}
+
+static_assert(real<f32x4>);
+static_assert(vec3_of<vec3x4, f32x4>);
+
+}  // namespace bounce::cpu::lanes
