@@ -3,6 +3,7 @@
 docs/data/*.json (written by the examples' --json option; see docs/studies/)."""
 import glob
 import json
+import math
 import os
 
 import matplotlib
@@ -31,6 +32,30 @@ def row(name, r):
             f"{t.get('compute_records', float('nan')):.0f} | {t.get('total', float('nan')):.0f} | {e:.4f} |")
 
 
+def mc_time_at(sweep, e):
+    """Monte Carlo's time to reach error e, by log-log interpolation in its spp sweep:
+    (ms, False), or (ms of its last point, True) when it never got down to e (a lower bound)."""
+    for a, b in zip(sweep, sweep[1:]):
+        if a["rel_rms"] >= e >= b["rel_rms"]:
+            f = math.log(a["rel_rms"] / e) / math.log(a["rel_rms"] / b["rel_rms"])
+            return a["ms"] * (b["ms"] / a["ms"]) ** f, False
+    if e < sweep[-1]["rel_rms"]:
+        return sweep[-1]["ms"], True
+    return None, False
+
+
+def sweep_table(sweep, mc):
+    """The a sweep's speed against error, each a beside Monte Carlo's time at its error."""
+    lines = ["| a | records | total ms | rel_rms | Monte Carlo ms at that error | speed-up |", "|---|---|---|---|---|---|"]
+    for r in sweep:
+        e, t = r["error"]["rel_rms"], r["timings_ms"]["total"]
+        ms, bound = mc_time_at(mc, e) if mc else (None, False)
+        mc_cell = "" if ms is None else f"{'> ' if bound else ''}{ms:.0f}"
+        up = "" if ms is None else f"{'> ' if bound else ''}{ms / t:.1f}x"
+        lines.append(f"| {r['parameters']['a']:.2g} | {r['records']} | {t:.0f} | {e:.4f} | {mc_cell} | {up} |")
+    return lines
+
+
 def headline(scene, mine):
     """The comparisons of the irradiance-splatting issue, from the runs that exist."""
     def err(name):
@@ -48,14 +73,20 @@ def headline(scene, mine):
                    f"gradients lower the error by {100 * (1 - err('r4096') / err('r4096-nograd')):.0f}%")
     if err("smooth") and err("ward"):
         out.append(f"- smoothed weight {err('smooth'):.4f} against Ward's {err('ward'):.4f} (target: not above)")
+    if err("r4096") and err("ward-r4096"):
+        out.append(f"- with 4096 rays per record: smoothed {err('r4096'):.4f}, Ward's {err('ward-r4096'):.4f}")
     if err("a0.4") and err("ward-a0.4"):
         out.append(f"- at a = 0.4, where Ward's seams show: smoothed {err('a0.4'):.4f}, Ward's {err('ward-a0.4'):.4f}")
+    si, oi = mine.get(f"{scene}-interp-splat"), mine.get(f"{scene}-interp-octree")
+    if si and oi:
+        s_ms, o_ms = si["timings_ms"]["interpolate"], oi["timings_ms"]["interpolate"]
+        out.append(f"- interpolation on one saved cache ({si['records']} records, medians of {si['repeat']} renders): "
+                   f"splatting {s_ms:.1f} ms, octree lookups {o_ms:.1f} ms: {o_ms / s_ms:.2f}x (target >= 2x)")
     s, o = mine.get(f"{scene}-smooth"), mine.get(f"{scene}-octree")
     if s and o:
-        out.append(f"- interpolation: splatting {s['timings_ms']['interpolate']:.1f} ms, octree lookups "
-                   f"{o['timings_ms']['interpolate']:.1f} ms on the same records: "
-                   f"{o['timings_ms']['interpolate'] / s['timings_ms']['interpolate']:.2f}x (target >= 2x); whole frame "
-                   f"{s['timings_ms']['total']:.0f} ms against {o['timings_ms']['total']:.0f} ms")
+        out.append(f"- whole two-pass frame: splatting {s['timings_ms']['total']:.0f} ms at {err('smooth'):.4f}, "
+                   f"octree {o['timings_ms']['total']:.0f} ms at {o['error']['rel_rms']:.4f} (single runs: interpolate "
+                   f"{s['timings_ms']['interpolate']:.1f} and {o['timings_ms']['interpolate']:.1f} ms)")
     g = mine.get(f"{scene}-gl")
     if g:
         out.append(f"- GL splatting (llvmpipe, no GPU): interpolate {g['timings_ms']['interpolate']:.1f} ms, "
@@ -110,9 +141,12 @@ def main():
             lines += [f"| {f['frame']} | {f['records']} | {f['new_records']} | {f['ms']:.0f} | {f['fps']:.2f} | "
                       f"{f['rel_rms']:.4f} |" for f in prog[0]["frames"]]
             lines.append("")
-        # Plot: total time against error for the a sweep, plus the Monte Carlo curve.
+        # The a sweep against Monte Carlo, as a table and as a plot.
         sweep = sorted((v for k, v in mine.items() if "-a0" in k and "ward-" not in k), key=lambda r: r["parameters"]["a"])
         if sweep:
+            lines += ["Speed against error over the a sweep (smoothed Ward, gradients on); Monte Carlo's time at",
+                      "each run's error comes from its spp sweep above (log-log interpolation; '>' where it",
+                      "never got that low):", ""] + sweep_table(sweep, mc[0]["mc_sweep"] if mc else None) + [""]
             fig, ax = plt.subplots(figsize=(5, 3.4), dpi=100)
             ax.plot([r["error"]["rel_rms"] for r in sweep], [r["timings_ms"]["total"] for r in sweep], "o-",
                     label="irradiance splatting (a sweep)")

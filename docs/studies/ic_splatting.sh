@@ -16,10 +16,19 @@ run() {  # run NAME ARGS...: one measured run
   "$bin" "$@" --json "docs/data/$name.json"
 }
 
-rays() {  # rays TAG ARGS...: gradients on/off with 4096 rays per record (less record noise)
+rays() {  # rays TAG ARGS...: gradients on/off and Ward's weight with 4096 rays per record (less record noise)
   local tag=$1; shift
   run "$tag-r4096" "$@" --a 0.15 --weight ward-smooth --record-samples 4096
   run "$tag-r4096-nograd" "$@" --a 0.15 --weight ward-smooth --record-samples 4096 --gradients off
+  run "$tag-ward-r4096" "$@" --a 0.15 --weight ward --record-samples 4096  # Ward's weight, less record noise
+}
+
+interp() {  # interp TAG ARGS...: splat against octree on one saved cache, medians of 15 renders
+  local tag=$1; shift
+  local cache="build/$tag-a0.15.cache"
+  "$bin" "$@" --a 0.15 --weight ward-smooth --cache-out "$cache" > /dev/null
+  run "$tag-interp-splat" "$@" --a 0.15 --weight ward-smooth --cache-in "$cache" --repeat 15
+  run "$tag-interp-octree" "$@" --a 0.15 --weight ward-smooth --cache-in "$cache" --repeat 15 --interp octree
 }
 
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor)
@@ -47,6 +56,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
         --indirect-out "docs/figures/$tag-$w-a0.4.png" --out "docs/figures/$tag-$w-final.png"
   done
   run "$tag-octree" "${common[@]}" --a 0.15 --weight ward-smooth --interp octree
+  interp "$tag" "${common[@]}"
   [[ $tag == cornell ]] && run "$tag-raster" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster
   run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
   run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
