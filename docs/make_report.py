@@ -68,6 +68,15 @@ def headline(scene, mine):
     if err("smooth") and err("nograd"):
         out.append(f"- gradients lower the error by {100 * (1 - err('smooth') / err('nograd')):.0f}% "
                    f"({err('nograd'):.4f} without; target >= 25%)")
+    if err("nolimit-nograd") and err("nolimit"):
+        nl, nn, sm = mine[f"{scene}-nolimit"], mine[f"{scene}-nolimit-nograd"], mine.get(f"{scene}-smooth")
+        line = (f"- without any gradient (Ward 1988, no radius limit either): {err('nolimit-nograd'):.4f} with "
+                f"{nn['records']} records; the same records extrapolated: {err('nolimit'):.4f} "
+                f"(-{100 * (1 - err('nolimit') / err('nolimit-nograd')):.0f}%)")
+        if sm:
+            line += (f"; with the radius limit too ({sm['records']} records): "
+                     f"-{100 * (1 - err('smooth') / err('nolimit-nograd')):.0f}%")
+        out.append(line)
     if err("r4096") and err("r4096-nograd"):
         out.append(f"- with 4096 rays per record: {err('r4096'):.4f}, without gradients {err('r4096-nograd'):.4f}: "
                    f"gradients lower the error by {100 * (1 - err('r4096') / err('r4096-nograd')):.0f}%")
