@@ -7,7 +7,8 @@
 /// float32, the layout of the GL adapter's RGBA32F texture. Records are binned into
 /// screen tiles and each tile adds its records in index order, so every pixel sums the same
 /// terms in the same order whatever the thread count, and the same order as splatting the
-/// records one by one: results are bitwise reproducible.
+/// records one by one: results are bitwise reproducible. Each record is evaluated on four
+/// pixels of a row at once (cpu::lanes), bitwise what the scalar kernel gives each pixel.
 
 #include <bounce/camera.hpp>
 #include <bounce/cpu/lanes.hpp>
@@ -82,9 +83,10 @@ inline float culling_radius2(const irradiance_record& rec, float a) {
     return zone * zone * (1.f + 1e-5f);
 }
 
-/// What record `rec` adds at a point: splat_contribution (the kernel) behind a
-/// squared-distance rejection, which removes most candidates (other surfaces, the corners
-/// of a splat box, the far side of an octree node) before the weight's square roots.
+/// What record `rec` adds at a point, one point at a time (the octree's lookups, and the
+/// reference the four-lane splat is tested against): splat_contribution (the kernel) behind
+/// a squared-distance rejection, which removes most candidates (other surfaces, the
+/// corners of a splat box, the far side of an octree node) before the weight's square roots.
 template <class Weight>
 inline glm::vec4 contribution(const irradiance_record& rec, const glm::vec3& p, const glm::vec3& n,
                               const glm::vec3& albedo, const splat_params& sp, float cull2) {
