@@ -237,7 +237,7 @@ estimates ray_cast(const embree::reference_integrator& ref, const std::vector<st
 struct gl_scene {
     gl::scene_mesh mesh;
     gl::direct_light light;
-    gl_scene(const io::scene& s, int shadow_resolution) : mesh(s), light(s, mesh, shadow_resolution) {}
+    gl_scene(const io::scene& s, const gl::direct_light_options& shadows) : mesh(s), light(s, mesh, shadows) {}
 };
 
 struct raster_result {
@@ -320,6 +320,9 @@ int main(int argc, char** argv) {
     std::size_t points = 10000, sweep_points = 1000, batch = 64;
     std::uint64_t seed = 1;
     int shadow_resolution = 4096;
+#ifdef BOUNCE_STUDY_WITH_GL
+    gl::direct_light_options shadows;  // its resolution comes from shadow_resolution
+#endif
     bool sweep = false, no_raster = false, no_ray_cast = false, no_cache = false;
     fs::path json_path, points_csv, cache_dir = embree::default_cache_dir();
     app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
@@ -346,6 +349,13 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-resolution", shadow_resolution, "texels per side of the raster sampler's shadow maps")
         ->check(CLI::Range(64, 8192))
         ->capture_default_str();
+#ifdef BOUNCE_STUDY_WITH_GL
+    app.add_option("--shadow-normal-offset", shadows.normal_offset_texels,
+                   "raster sampler: shadow lookups moved this many texels along n")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--shadow-slope-bias", shadows.slope_bias, "raster sampler: shadow depth bias in depth slopes per texel")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
+#endif
     app.add_flag("--no-raster", no_raster, "skip the GL raster sampler");
     app.add_flag("--no-ray-cast", no_ray_cast, "skip the Embree ray-cast sampler");
     app.add_option("--cache-dir", cache_dir, "where the reference is cached ($BOUNCE_CACHE)")->capture_default_str();
@@ -398,7 +408,9 @@ int main(int argc, char** argv) {
         if (!no_raster) {
             try {
                 context.emplace();
-                gls.emplace(scene, shadow_resolution);
+                shadows.shadow_resolution = shadow_resolution;
+                shadows.validate();
+                gls.emplace(scene, shadows);
                 fmt::print("  GL: {} ({})\n", context->renderer(), context->platform());
             } catch (const gl::gl_error& e) {
                 fmt::print(stderr, "  no GL raster sampler: {}\n", e.what());
@@ -500,6 +512,10 @@ int main(int argc, char** argv) {
             report.parameters["seed"] = seed;
             report.parameters["batch"] = batch;
             report.parameters["shadow_resolution"] = shadow_resolution;
+#ifdef BOUNCE_STUDY_WITH_GL
+            report.parameters["shadow_normal_offset"] = shadows.normal_offset_texels;
+            report.parameters["shadow_slope_bias"] = shadows.slope_bias;
+#endif
             report.parameters["reference_spp_per_half"] = reference.spp;
             report.set_count("records", points);
             json j = report.to_json();
