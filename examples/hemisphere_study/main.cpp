@@ -307,6 +307,49 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
     }
     return out;
 }
+
+// How far the raster planes are from ray-cast planes of the same points, texel by texel:
+// sqrt(sum w_i (L_raster - L_ray)^2 / sum w_i L_ray^2) over every texel of every point, on
+// luminance, w_i the texel's cosine-weighted solid angle. Unlike the irradiance errors,
+// errors of opposite sign (a shadow-map leak here, acne there) cannot cancel, so this is
+// the measure to set the shadow maps' bias by.
+double plane_texel_difference(const embree::reference_integrator& ref, const io::scene& scene, const gl_scene& g,
+                              const std::vector<study_point>& pts, const plane_camera& cam, std::size_t batch) {
+    const tables t(cam);
+    gl::hemisphere_raster_options o;
+    o.camera = cam;
+    o.batch = batch;
+    gl::hemisphere_raster r(scene, g.mesh, g.light, o);
+    const std::size_t texels = std::size_t(cam.resolution) * cam.resolution;
+    std::vector<double> squared(pts.size(), 0.0), norm(pts.size(), 0.0);  // per point: summed in order below
+    std::vector<glm::vec3> positions, normals;
+    for (std::size_t first = 0; first < pts.size(); first += batch) {
+        positions.clear();
+        normals.clear();
+        for (std::size_t k = first; k < std::min(pts.size(), first + batch); ++k) {
+            positions.push_back(pts[k].p);
+            normals.push_back(pts[k].n);
+        }
+        r.render(positions, normals);
+        r.start_read();
+        const auto planes = r.finish_read();
+        tbb::parallel_for(std::size_t(0), planes.size(), [&](std::size_t k) {
+            image<glm::vec3> radiance(cam.resolution, cam.resolution);
+            image<float> distance(cam.resolution, cam.resolution);
+            embree::sample_plane(ref, cam, pts[first + k].p, pts[first + k].n, radiance.view(), distance.view());
+            const glm::vec3* raster = planes.radiance[k].data();
+            for (std::size_t i = 0; i < texels; ++i) {
+                const double lr = rec709_luminance<double, glm::dvec3>(glm::dvec3(raster[i]));
+                const double lc = rec709_luminance<double, glm::dvec3>(glm::dvec3(radiance.data()[i]));
+                squared[first + k] += t.plane.irradiance[i] * (lr - lc) * (lr - lc);
+                norm[first + k] += t.plane.irradiance[i] * lc * lc;
+            }
+        });
+    }
+    const double total = std::accumulate(squared.begin(), squared.end(), 0.0);
+    const double total_norm = std::accumulate(norm.begin(), norm.end(), 0.0);
+    return total_norm > 0 ? std::sqrt(total / total_norm) : 0.0;
+}
 #endif
 
 }  // namespace
@@ -324,6 +367,7 @@ int main(int argc, char** argv) {
     gl::direct_light_options shadows;  // its resolution comes from shadow_resolution
 #endif
     bool sweep = false, no_raster = false, no_ray_cast = false, no_cache = false;
+    std::size_t texel_points = 0;
     fs::path json_path, points_csv, cache_dir = embree::default_cache_dir();
     app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
         ->capture_default_str();
@@ -356,6 +400,9 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-slope-bias", shadows.slope_bias, "raster sampler: shadow depth bias in depth slopes per texel")
         ->check(CLI::NonNegativeNumber)->capture_default_str();
 #endif
+    app.add_option("--texel-points", texel_points,
+                   "also compare raster and ray-cast planes texel by texel on this many points (the first of --points)")
+        ->capture_default_str();
     app.add_flag("--no-raster", no_raster, "skip the GL raster sampler");
     app.add_flag("--no-ray-cast", no_ray_cast, "skip the Embree ray-cast sampler");
     app.add_option("--cache-dir", cache_dir, "where the reference is cached ($BOUNCE_CACHE)")->capture_default_str();
@@ -436,6 +483,12 @@ int main(int argc, char** argv) {
             print_row("raster (CPU sum)", e, double(main_pts.size()) / r.cpu.seconds);
             fmt::print("  raster (GPU sum)  {:8.1f} records/s; CPU and GPU sums differ by at most {:.2e} (relative)\n",
                        double(main_pts.size()) / r.gpu_seconds, r.cpu_gpu_difference);
+            if (texel_points > 0) {
+                const auto tp = first(pts, std::min(texel_points, pts.size()));
+                const double d = plane_texel_difference(ref, scene, *gls, tp, cam, std::min(batch, tp.size()));
+                report_error["raster_texel_difference"] = d;
+                fmt::print("  raster against ray-cast planes, texel by texel ({} points): {:.2f}%\n", tp.size(), 100 * d);
+            }
 #endif
         }
         if (!no_ray_cast) {
