@@ -500,8 +500,11 @@ int main(int argc, char** argv) {
         }
         // The headline figures: the raster sampler's (the seed's method) where it ran.
         for (const char* sampler : {"ray_cast", "raster"})
-            if (report_error.contains(sampler))
-                for (const auto& [k, v] : report_error[sampler].items()) report_error[k] = v;
+            if (report_error.contains(sampler)) {
+                // A copy: inserting into report_error may move the object being iterated.
+                const json figures = report_error[sampler];
+                for (const auto& [k, v] : figures.items()) report_error[k] = v;
+            }
         if (report_error.contains("rms_stretch")) report_error["rel_rms"] = report_error["rms_stretch"];
 
         json sweep_rows = json::array();
