@@ -240,6 +240,17 @@ struct gl_scene {
     gl_scene(const io::scene& s, const gl::direct_light_options& shadows) : mesh(s), light(s, mesh, shadows) {}
 };
 
+// Points first .. first + batch - 1 (fewer at the end) as the raster sampler takes them.
+void batch_points(const std::vector<study_point>& pts, std::size_t first, std::size_t batch,
+                  std::vector<glm::vec3>& positions, std::vector<glm::vec3>& normals) {
+    positions.clear();
+    normals.clear();
+    for (std::size_t k = first; k < std::min(pts.size(), first + batch); ++k) {
+        positions.push_back(pts[k].p);
+        normals.push_back(pts[k].n);
+    }
+}
+
 struct raster_result {
     estimates cpu;              // PBO read-back + CPU sums (estimate_plane)
     double gpu_seconds = 0;     // render + GPU reduction (stretch table), all records
@@ -262,14 +273,7 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
     out.cpu.coverage_scale = t.coverage_scale();
     radial_profile profile(cam);
     std::vector<glm::vec3> positions, normals;
-    const auto load = [&](std::size_t first) {
-        positions.clear();
-        normals.clear();
-        for (std::size_t k = first; k < std::min(pts.size(), first + batch); ++k) {
-            positions.push_back(pts[k].p);
-            normals.push_back(pts[k].n);
-        }
-    };
+    const auto load = [&](std::size_t first) { batch_points(pts, first, batch, positions, normals); };
     const auto sum = [&](std::size_t first) {
         const auto planes = r.finish_read();
         tbb::parallel_for(std::size_t(0), planes.size(), [&](std::size_t k) {
@@ -324,12 +328,7 @@ double plane_texel_difference(const embree::reference_integrator& ref, const io:
     std::vector<double> squared(pts.size(), 0.0), norm(pts.size(), 0.0);  // per point: summed in order below
     std::vector<glm::vec3> positions, normals;
     for (std::size_t first = 0; first < pts.size(); first += batch) {
-        positions.clear();
-        normals.clear();
-        for (std::size_t k = first; k < std::min(pts.size(), first + batch); ++k) {
-            positions.push_back(pts[k].p);
-            normals.push_back(pts[k].n);
-        }
+        batch_points(pts, first, batch, positions, normals);
         r.render(positions, normals);
         r.start_read();
         const auto planes = r.finish_read();
