@@ -80,6 +80,10 @@ def headline(scene, mine):
     if err("r4096") and err("r4096-nograd"):
         out.append(f"- with 4096 rays per record: {err('r4096'):.4f}, without gradients {err('r4096-nograd'):.4f}: "
                    f"gradients lower the error by {100 * (1 - err('r4096') / err('r4096-nograd')):.0f}%")
+    if err("smooth") and err("front"):
+        f, sm = mine[f"{scene}-front"], mine[f"{scene}-smooth"]
+        out.append(f"- Ward's in-front test (tolerance {f['parameters']['front_tolerance']:.2g}): {err('front'):.4f} with "
+                   f"{f['records']} records, against {err('smooth'):.4f} with {sm['records']} without it")
     if err("smooth") and err("ward"):
         out.append(f"- smoothed weight {err('smooth'):.4f} against Ward's {err('ward'):.4f} (target: not above)")
     if err("r4096") and err("ward-r4096"):

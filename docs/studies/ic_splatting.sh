@@ -43,6 +43,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   # No gradient anywhere (Ward 1988: nor the radius limit), and the same records extrapolated.
   run "$tag-nolimit-nograd" "${common[@]}" --a 0.15 --weight ward-smooth --gradients off --no-gradient-limit
   run "$tag-nolimit" "${common[@]}" --a 0.15 --weight ward-smooth --no-gradient-limit
+  run "$tag-front" "${common[@]}" --a 0.15 --weight ward-smooth --front-tolerance 0.1  # Ward's in-front test
   run "$tag-ward" "${common[@]}" --a 0.15 --weight ward
   run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
   run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show

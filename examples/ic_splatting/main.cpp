@@ -74,6 +74,7 @@ struct options {
     std::size_t scan_batch = 0;
     bool gradient_limit = true;
     float max_extrapolation = 1.f;
+    float front_tolerance = 1.f;
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
     int repeat = 1;
     bool mc_compare = false;
@@ -139,6 +140,7 @@ cpu::splat_params splat_params_for(const options& o, float a) {
     sp.a = a;
     sp.gradients = o.gradients;
     sp.max_extrapolation = o.max_extrapolation;
+    sp.front_tolerance = o.front_tolerance;
     return sp;
 }
 
@@ -314,7 +316,6 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
                              std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
     const options& o = ctx.opt;
     const cpu::splat_params sp = splat_params_for(o, a);
-    const gl::splat_params gsp{sp.a, sp.gradients, sp.max_extrapolation};
     const weighting_kind kind = parse_weight(o.weight);
     const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
     frame_result fr;
@@ -335,7 +336,7 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
         if (gb.on_gpu < records.size()) gb.splats.append(std::span(records).subspan(gb.on_gpu));
         gb.on_gpu = records.size();
         gb.splats.clear(o.width, o.height);
-        gb.splats.splat(tex, cam, gsp, kind);
+        gb.splats.splat(tex, cam, sp, kind);
         gl::finish();
     }
     {  // step 3
@@ -358,13 +359,15 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
         auto t = timer.measure("interpolate");
         gb.splats.append(std::span(records).subspan(before));
         gb.on_gpu = records.size();
-        gb.splats.splat(tex, cam, gsp, kind, before);
+        gb.splats.splat(tex, cam, sp, kind, before);
         if (fill_holes) {
             // A budget left pixels uncovered: every record again with zones fill x wider.
             if (gb.wide_on_gpu < records.size()) gb.wide_splats.append(std::span(records).subspan(gb.wide_on_gpu));
             gb.wide_on_gpu = records.size();
             gb.wide_splats.clear(o.width, o.height);
-            gb.wide_splats.splat(tex, cam, {sp.a * o.fill_holes, sp.gradients, sp.max_extrapolation}, kind);
+            gl::splat_params wide_sp = sp;
+            wide_sp.a *= o.fill_holes;
+            gb.wide_splats.splat(tex, cam, wide_sp, kind);
         }
         gl::finish();
     }
@@ -482,6 +485,7 @@ int run(const options& o) {
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
                          {"max_extrapolation", o.max_extrapolation},
+                         {"front_tolerance", o.front_tolerance},
                          {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
                          {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
                          {"scan", o.scan}, {"scan_batch", ctx.batch.max_records}, {"scan_order", scan_order}};
@@ -699,6 +703,9 @@ int main(int argc, char** argv) {
     app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
     app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
     app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--front-tolerance", o.front_tolerance,
+                   "skip records whose tangent plane the point lies this fraction of the zone behind (Ward's in-front test; 1: off)")
+        ->check(CLI::Range(0.f, 1.f))->capture_default_str();
     app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(CLI::NonNegativeNumber);
     app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
     app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");

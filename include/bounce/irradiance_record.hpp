@@ -4,6 +4,7 @@
 /// gradients (seed Algorithms 1 and 4), what it adds to the splat buffer, and how its
 /// radius R is limited.
 
+#include <bounce/errors.hpp>
 #include <bounce/irradiance_gradients.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/vocabulary.hpp>
@@ -50,21 +51,57 @@ V constant_irradiance(const V&, const V&, const V&, const V&, const V& e, const 
     return e;
 }
 
+/// Ward et al. 1988's test against records in front of the shaded point. With the mean
+/// normal (n + nk) / 2, d = (p - pk) . (n + nk) / 2 is the height of p above record k's
+/// tangent plane: 0 up to rounding for two points of one plane or one sphere, whatever their
+/// distance. d < 0 puts record k in front of p: a record on a step above p, or on the far
+/// side of a crease, measured a hemisphere p does not see. True (record k must not
+/// contribute) where d < -tolerance * a * R_k: the allowance is a fraction of the zone's
+/// radius, so the test does not depend on the scene's scale and ignores the small depths
+/// of tessellated curved surfaces. Inside the zone |d| <= a R_k, so tolerance >= 1 never
+/// rejects (the test is off).
+template <real T, vec3_of<T> V>
+auto record_in_front(const V& p, const V& n, const V& pk, const V& nk, T inv_r, T a, T tolerance) {
+    return dot(p - pk, n + nk) * inv_r < T(-2) * tolerance * a;
+}
+
 /// What record k adds to the splat buffer at a pixel (seed Algorithm 1): the weighted
 /// outgoing radiance w * (rho_d / pi) * E_k(p) in rgb and the weight w in the fourth
 /// component. `Weight` is a policy of weighting.hpp; `Gradients` is true to extrapolate
-/// with the record's gradients. Returns all zeros where the record does not contribute.
+/// with the record's gradients; `front_tolerance` is record_in_front's (1: off). Returns
+/// all zeros where the record does not contribute.
 template <class Weight, bool Gradients, real T, vec3_of<T> V>
 std::array<T, 4> splat_contribution(const V& p, const V& n, const V& albedo, const V& pk, const V& nk, T inv_r,
                                     T a, const V& e, const V& rot_r, const V& rot_g, const V& rot_b,
-                                    const V& tr_r, const V& tr_g, const V& tr_b, T max_extrapolation) {
-    const T w = Weight::template weight<T, V>(p, n, pk, nk, inv_r, a);
+                                    const V& tr_r, const V& tr_g, const V& tr_b, T max_extrapolation,
+                                    T front_tolerance) {
+    const T w = select(record_in_front<T, V>(p, n, pk, nk, inv_r, a, front_tolerance), T(0),
+                       Weight::template weight<T, V>(p, n, pk, nk, inv_r, a));
     V ek = e;
     if constexpr (Gradients)
         ek = extrapolated_irradiance<T, V>(p, n, pk, nk, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation);
     const V lo = albedo * ek * (w * T(1.0 / std::numbers::pi));
     return {lo.x, lo.y, lo.z, w};
 }
+
+/// What every splat of a frame shares, on every backend (cpu::splat_params and
+/// gl::splat_params are this type).
+struct splat_params {
+    float a = 0.2f;                 ///< accuracy a of Eq. 8.3; typical 0.1-0.4 (smaller: more records)
+    bool gradients = true;          ///< extrapolate with the records' gradients
+    float max_extrapolation = 1.f;  ///< gradient term clamped to +-this * E_k per channel; typical 1
+    /// Ward's in-front test (record_in_front): records whose tangent plane p lies more than
+    /// this fraction of the zone's radius behind are skipped. In [0, 1]; 1 turns it off.
+    float front_tolerance = 1.f;
+
+    /// Throws parameter_error naming the first bad field.
+    void validate() const {
+        require(std::isfinite(a) && a > 0.f, "a", "accuracy must be a positive number");
+        require(std::isfinite(max_extrapolation) && max_extrapolation >= 0.f, "max_extrapolation",
+                "must be a non-negative number");
+        require(front_tolerance >= 0.f && front_tolerance <= 1.f, "front_tolerance", "must be in [0, 1] (1: off)");
+    }
+};
 
 /// Normalization of the splat buffer (seed Algorithm 5, last loop): sum / weight, black
 /// where no record reached the pixel.

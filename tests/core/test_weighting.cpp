@@ -182,6 +182,48 @@ TEST_CASE("extrapolation is exact at the record, first order nearby, and bounded
     }
 }
 
+TEST_CASE("Ward's in-front test keeps planes and spheres, cuts steps at the tolerance, and is off at 1",
+          "[record][weighting]") {
+    const auto seed = GENERATE(range(0, 200));
+    pcg32 rng(std::uint64_t(seed) + 4000);
+    const float a = 0.1f + 0.5f * rng.next_float(), r = 0.1f + 2 * rng.next_float(), inv_r = 1.f / r;
+    const glm::vec3 nk = random_unit(rng), pk = random_unit(rng);
+    const auto in_front = [&](glm::vec3 p, glm::vec3 n, glm::vec3 k, glm::vec3 nrm, float tolerance) {
+        return record_in_front<float, glm::vec3>(p, n, k, nrm, inv_r, a, tolerance);
+    };
+    // Two points of one sphere (radius rho, centre c), normals radial, outwards (convex) or
+    // inwards (concave): (p - pk) . (n + nk) = 0 exactly, so a small tolerance keeps them.
+    const float rho = r * (0.2f + 5 * rng.next_float());
+    const float side = seed % 2 ? 1.f : -1.f;
+    const glm::vec3 c = pk - side * rho * nk;
+    const glm::vec3 on_sphere = c + rho * glm::normalize(pk - c + random_unit(rng) * (a * r * rng.next_float()));
+    if (glm::length(on_sphere - pk) <= a * r)
+        CHECK_FALSE(in_front(on_sphere, side * glm::normalize(on_sphere - c), pk, nk, 0.01f));
+    // A step of height h below the record's plane, n = nk: cut exactly where h > tolerance a R.
+    const float tolerance = 0.02f + 0.3f * rng.next_float();
+    const auto tb = orthonormal_basis<float, glm::vec3>(nk);
+    const glm::vec3 along = (tb[0] * (rng.next_float() - 0.5f) + tb[1] * (rng.next_float() - 0.5f)) * (a * r);
+    const float h = tolerance * a * r;
+    CHECK(in_front(pk + along - 1.01f * h * nk, nk, pk, nk, tolerance));
+    CHECK_FALSE(in_front(pk + along - 0.99f * h * nk, nk, pk, nk, tolerance));
+    CHECK_FALSE(in_front(pk + along + h * nk, nk, pk, nk, tolerance));  // above the plane: never
+    // Tolerance 1 is off: no point inside the zone lies a R below the mean plane.
+    const glm::vec3 p = pk + random_unit(rng) * (0.999f * a * r * std::sqrt(rng.next_float()));
+    const glm::vec3 n = random_unit(rng);
+    CHECK_FALSE(in_front(p, n, pk, nk, 1.f));
+    // And splat_contribution is zero where the test cuts, unchanged elsewhere.
+    const glm::vec3 e(1.f, 2.f, 3.f), z(0.f), albedo(0.5f);
+    const auto contribution = [&](glm::vec3 q, float tol) {
+        return splat_contribution<ward_weight, true, float, glm::vec3>(q, nk, albedo, pk, nk, inv_r, a, e, z, z, z, z, z,
+                                                                       z, 1.f, tol);
+    };
+    const glm::vec3 below = pk + 0.5f * along - 1.5f * h * nk;
+    CHECK(contribution(below, 1.f)[3] > 0.f);
+    CHECK(contribution(below, tolerance) == std::array<float, 4>{0.f, 0.f, 0.f, 0.f});
+    const glm::vec3 level = pk + 0.5f * along - 0.5f * h * nk;
+    CHECK(contribution(level, tolerance) == contribution(level, 1.f));
+}
+
 TEST_CASE("radius limits apply the gradient limit, then world and pixel clamps", "[record]") {
     const std::array<glm::dvec3, 3> g{glm::dvec3(2, 0, 0), glm::dvec3(0, 0.5, 0), glm::dvec3(0)};
     const glm::dvec3 e(1, 1, 1);

@@ -51,7 +51,7 @@ lane_input make_input(pcg32& rng, int kind) {
 }
 
 template <class W, bool G>
-void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation) {
+void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation, float front_tolerance) {
     auto gather = [&](auto member) {
         return vec3x4::gather(in[0].*member, in[1].*member, in[2].*member, in[3].*member);
     };
@@ -63,12 +63,13 @@ void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation) {
         gather(&lane_input::p), gather(&lane_input::n), gather(&lane_input::albedo), gather(&lane_input::pk),
         gather(&lane_input::nk), inv_r, f32x4(a), gather(&lane_input::e), gather_g(&lane_input::rot, 0),
         gather_g(&lane_input::rot, 1), gather_g(&lane_input::rot, 2), gather_g(&lane_input::tr, 0),
-        gather_g(&lane_input::tr, 1), gather_g(&lane_input::tr, 2), f32x4(max_extrapolation));
+        gather_g(&lane_input::tr, 1), gather_g(&lane_input::tr, 2), f32x4(max_extrapolation),
+        f32x4(front_tolerance));
     for (int i = 0; i < 4; ++i) {
         const lane_input& s = in[i];
         const auto scalar = splat_contribution<W, G, float, glm::vec3>(s.p, s.n, s.albedo, s.pk, s.nk, s.inv_r, a, s.e,
                                                                       s.rot[0], s.rot[1], s.rot[2], s.tr[0], s.tr[1],
-                                                                      s.tr[2], max_extrapolation);
+                                                                      s.tr[2], max_extrapolation, front_tolerance);
         for (int c = 0; c < 4; ++c) {
             INFO("lane " << i << " component " << c << ": " << lanes[c][i] << " vs " << scalar[c]);
             REQUIRE(std::bit_cast<std::uint32_t>(lanes[c][i]) == std::bit_cast<std::uint32_t>(scalar[c]));
@@ -77,9 +78,9 @@ void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation) {
 }
 
 template <class W>
-void check_policy(const lane_input (&in)[4], float a, float max_extrapolation) {
-    check_lanes<W, true>(in, a, max_extrapolation);
-    check_lanes<W, false>(in, a, max_extrapolation);
+void check_policy(const lane_input (&in)[4], float a, float max_extrapolation, float front_tolerance) {
+    check_lanes<W, true>(in, a, max_extrapolation, front_tolerance);
+    check_lanes<W, false>(in, a, max_extrapolation, front_tolerance);
 }
 
 }  // namespace
@@ -90,11 +91,13 @@ TEST_CASE("each lane of the four-lane splat kernel is bitwise the scalar float k
     lane_input in[4];
     for (int i = 0; i < 4; ++i) in[i] = make_input(rng, int(rng.next_u32() % 6));
     const float a = 0.05f + 0.6f * rng.next_float(), max_extrapolation = 2 * rng.next_float();
-    check_policy<ward_weight>(in, a, max_extrapolation);
-    check_policy<ward_smooth_weight>(in, a, max_extrapolation);
-    check_policy<gpu_ward_weight<>>(in, a, max_extrapolation);
-    check_policy<gpu_ward_shader_weight>(in, a, max_extrapolation);
-    check_policy<tabellion_weight>(in, a, max_extrapolation);
+    // Ward's in-front test off (1), at its edge (0: any depth below the mean plane) or between.
+    const float front = seed % 3 == 0 ? 1.f : seed % 3 == 1 ? 0.f : 0.3f * rng.next_float();
+    check_policy<ward_weight>(in, a, max_extrapolation, front);
+    check_policy<ward_smooth_weight>(in, a, max_extrapolation, front);
+    check_policy<gpu_ward_weight<>>(in, a, max_extrapolation, front);
+    check_policy<gpu_ward_shader_weight>(in, a, max_extrapolation, front);
+    check_policy<tabellion_weight>(in, a, max_extrapolation, front);
 }
 
 TEST_CASE("the lane vocabulary follows the scalar one at its edges", "[lanes][cpu]") {

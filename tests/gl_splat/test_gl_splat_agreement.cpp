@@ -183,6 +183,13 @@ pixel_bounds bounds_for(const gbuffer_view<float>& gb, const std::vector<irradia
                 const glm::dvec3 e = glm::dvec3(r.irradiance) * (1.0 + sp.max_extrapolation) / std::numbers::pi;
                 b.slack(x, y) += glm::vec4(glm::vec3(w_slack * rho * e), float(w_slack));
                 if (jumps && std::abs(reach - a) < 1e-5 * a + d_reach) b.excluded(x, y) = 1;
+                // Ward's in-front test cuts every policy: pixels whose height below the
+                // record's plane is within rounding of the cut may fall either side.
+                if (sp.front_tolerance < 1.f) {
+                    const double height = glm::dot(p - glm::dvec3(r.position), n + glm::dvec3(r.normal)) / r.radius;
+                    const double rounding = 64 * ulp * (glm::length(p) + glm::length(glm::dvec3(r.position)) + 1) / r.radius;
+                    if (std::abs(height + 2 * sp.front_tolerance * a) <= rounding) b.excluded(x, y) = 1;
+                }
             }
         }
     return b;
@@ -222,16 +229,17 @@ TEST_CASE("GL and CPU splat buffers agree for every weighting policy, with and w
                                weighting_kind::ward_gpu_shader, weighting_kind::tabellion);
     const bool gradients = GENERATE(true, false);
     const float a = GENERATE(0.15f, 0.4f);
-    INFO("weighting " << kind_name(kind) << ", gradients " << gradients << ", a = " << a);
+    // Ward's in-front test off, and on: the records sit up to 0.1 off the plane, so it cuts.
+    const float front_tolerance = GENERATE(1.f, 0.05f);
+    INFO("weighting " << kind_name(kind) << ", gradients " << gradients << ", a = " << a << ", front tolerance "
+                      << front_tolerance);
 
-    gl::splat_params gp;
+    splat_params gp;  // gl::splat_params and cpu::splat_params are one type
     gp.a = a;
     gp.gradients = gradients;
     gp.max_extrapolation = 0.8f;
-    cpu::splat_params cp;
-    cp.a = gp.a;
-    cp.gradients = gp.gradients;
-    cp.max_extrapolation = gp.max_extrapolation;
+    gp.front_tolerance = front_tolerance;
+    const splat_params& cp = gp;
 
     image<glm::vec4> cpu_buf(W, H, glm::vec4(0.f));
     with_weighting(kind, [&](auto w) {
@@ -258,6 +266,16 @@ TEST_CASE("GL and CPU splat buffers agree for every weighting policy, with and w
     CHECK(weighted > W * H / 4);
     // The relative bound, not the slack, decides for most weighted pixels.
     CHECK(well_conditioned > weighted / 2);
+    if (front_tolerance < 1.f) {  // and the in-front test removed weight from many pixels
+        splat_params off = cp;
+        off.front_tolerance = 1.f;
+        image<glm::vec4> uncut(W, H, glm::vec4(0.f));
+        with_weighting(kind, [&](auto w) { cpu::splat_records<decltype(w)>(v.gb.view(), v.cam, recs, off, uncut.view()); });
+        std::size_t cut = 0;
+        for (std::size_t y = 0; y < H; ++y)
+            for (std::size_t x = 0; x < W; ++x) cut += cpu_buf(x, y).w < uncut(x, y).w;
+        CHECK(cut > W * H / 10);
+    }
     WARN("worst relative difference where well conditioned " << worst << "; " << well_conditioned << " of " << weighted
                                                             << " weighted pixels well conditioned");
 }

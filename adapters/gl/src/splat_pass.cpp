@@ -51,6 +51,7 @@ enum location : int {
     loc_pixel_ndc = 5,
     loc_first = 6,
     loc_max_extrapolation = 7,
+    loc_front_tolerance = 8,
 };
 
 bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -178,12 +179,6 @@ void read_texture(const texture& t, image_view<glm::vec4> out) { read_texels(t, 
 
 void read_texture(const texture& t, image_view<glm::vec3> out) { read_texels(t, out); }
 
-void splat_params::validate() const {
-    require(std::isfinite(a) && a > 0.f, "a", "accuracy must be a positive number");
-    require(std::isfinite(max_extrapolation) && max_extrapolation >= 0.f, "max_extrapolation",
-            "must be a non-negative number");
-}
-
 // ---- splat_pass -------------------------------------------------------------------------
 
 std::string splat_pass::vertex_source(weighting_kind weighting) {
@@ -233,7 +228,7 @@ std::string splat_pass::fragment_source(weighting_kind weighting, bool gradients
         using W = decltype(policy);
         const auto add = [&](auto kernel) {
             kernels.add("splat_contribution", kernel, "p", "n", "albedo", "pk", "nk", "inv_r", "a", "e", "rot_r", "rot_g",
-                        "rot_b", "tr_r", "tr_g", "tr_b", "max_extrapolation", "c");
+                        "rot_b", "tr_r", "tr_g", "tr_b", "max_extrapolation", "front_tolerance", "c");
         };
         if (gradients) add(splat_contribution<W, true, glsl::f32, glsl::vec3>);
         else add(splat_contribution<W, false, glsl::f32, glsl::vec3>);
@@ -243,6 +238,7 @@ layout(binding = 1) uniform sampler2D gbuffer_normal;
 layout(binding = 2) uniform sampler2D gbuffer_albedo;
 layout(location = 1) uniform float a;
 layout(location = 7) uniform float max_extrapolation;
+layout(location = 8) uniform float front_tolerance;
 flat in uint record_index;
 layout(location = 0) out vec4 splat;
 
@@ -259,7 +255,7 @@ void main() {
                        texelFetch(gbuffer_albedo, pixel, 0).rgb, r.position_inv_r.xyz, r.normal_radius.xyz,
                        r.position_inv_r.w, a, r.irradiance.xyz, r.rotation[0].xyz, r.rotation[1].xyz,
                        r.rotation[2].xyz, r.translation[0].xyz, r.translation[1].xyz, r.translation[2].xyz,
-                       max_extrapolation, c);
+                       max_extrapolation, front_tolerance, c);
     // The record does not reach this pixel (cpu::splat_records adds only w > 0).
     if (!(c[3] > 0.0)) discard;
     splat = vec4(c[0], c[1], c[2], c[3]);
@@ -367,6 +363,7 @@ void splat_pass::splat(const gbuffer_textures& g, const camera& cam, const splat
     prog.set(loc_pixel_ndc, glm::vec2(2.f / float(width_), 2.f / float(height_)));
     prog.set(loc_first, unsigned(first));
     prog.set(loc_max_extrapolation, params.max_extrapolation);
+    prog.set(loc_front_tolerance, params.front_tolerance);
 
     const detail::raster_state raster;
     const detail::blend_offset_state blend;

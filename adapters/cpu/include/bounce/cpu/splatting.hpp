@@ -31,18 +31,8 @@
 
 namespace bounce::cpu {
 
-/// Parameters shared by every splat of a frame.
-struct splat_params {
-    float a = 0.2f;                  ///< accuracy a of Eq. 8.3; typical 0.1-0.4 (smaller: more records)
-    bool gradients = true;           ///< extrapolate with the records' gradients
-    float max_extrapolation = 1.f;   ///< gradient term clamped to +-this * E_k per channel
-
-    void validate() const {
-        require(std::isfinite(a) && a > 0.f, "a", "accuracy must be a positive number");
-        require(std::isfinite(max_extrapolation) && max_extrapolation >= 0.f, "max_extrapolation",
-                "must be a non-negative number");
-    }
-};
+/// Parameters shared by every splat of a frame (irradiance_record.hpp).
+using bounce::splat_params;
 
 /// Inclusive pixel rectangle; empty when x0 > x1 or y0 > y1.
 struct pixel_rect {
@@ -96,11 +86,13 @@ inline glm::vec4 contribution(const irradiance_record& rec, const glm::vec3& p, 
     const auto c = sp.gradients ? splat_contribution<Weight, true, float, glm::vec3>(
                                       p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance,
                                       rec.rotation[0], rec.rotation[1], rec.rotation[2], rec.translation[0],
-                                      rec.translation[1], rec.translation[2], sp.max_extrapolation)
+                                      rec.translation[1], rec.translation[2], sp.max_extrapolation,
+                                      sp.front_tolerance)
                                 : splat_contribution<Weight, false, float, glm::vec3>(
                                       p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance,
                                       rec.rotation[0], rec.rotation[1], rec.rotation[2], rec.translation[0],
-                                      rec.translation[1], rec.translation[2], sp.max_extrapolation);
+                                      rec.translation[1], rec.translation[2], sp.max_extrapolation,
+                                      sp.front_tolerance);
     return c[3] > 0.f ? glm::vec4(c[0], c[1], c[2], c[3]) : glm::vec4(0.f);
 }
 
@@ -113,7 +105,7 @@ inline void splat_into_lanes(const gbuffer_view<float>& gb, const irradiance_rec
                              const pixel_rect& r, image_view<glm::vec4> out) {
     using namespace lanes;
     const f32x4 cull2(culling_radius2<Weight>(rec, sp.a)), inv_r(1.f / rec.radius), a(sp.a),
-        max_extrapolation(sp.max_extrapolation);
+        max_extrapolation(sp.max_extrapolation), front_tolerance(sp.front_tolerance);
     const vec3x4 pk = vec3x4::broadcast(rec.position), nk = vec3x4::broadcast(rec.normal),
                  e = vec3x4::broadcast(rec.irradiance);
     const vec3x4 rot_r = vec3x4::broadcast(rec.rotation[0]), rot_g = vec3x4::broadcast(rec.rotation[1]),
@@ -139,7 +131,8 @@ inline void splat_into_lanes(const gbuffer_view<float>& gb, const irradiance_rec
             const vec3x4 albedo = vec3x4::gather(gb.albedo(xs[0], yy), gb.albedo(xs[1], yy), gb.albedo(xs[2], yy),
                                                  gb.albedo(xs[3], yy));
             const auto c = splat_contribution<Weight, Gradients, f32x4, vec3x4>(
-                p, n, albedo, pk, nk, inv_r, a, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation);
+                p, n, albedo, pk, nk, inv_r, a, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation,
+                front_tolerance);
             const mask4 keep = inside && c[3] > f32x4(0.f);
             for (int i = 0; i < 4; ++i)
                 if (keep[i]) out(xs[i], yy) += glm::vec4(c[0][i], c[1][i], c[2][i], c[3][i]);

@@ -83,15 +83,8 @@ void read_texture(const texture& t, image_view<glm::vec4> out);
 /// Copies the rgb of the RGBA32F texture `t` into `out` (row 0 at the top).
 void read_texture(const texture& t, image_view<glm::vec3> out);
 
-/// Parameters shared by every splat of a frame (the same meaning as cpu::splat_params).
-struct splat_params {
-    float a = 0.2f;                 ///< accuracy a of Eq. 8.3; typical 0.1-0.4 (smaller: more records)
-    bool gradients = true;          ///< extrapolate with the records' gradients
-    float max_extrapolation = 1.f;  ///< gradient term clamped to +-this * E_k per channel; typical 1
-
-    /// Throws parameter_error naming "a" or "max_extrapolation".
-    void validate() const;
-};
+/// Parameters shared by every splat of a frame (irradiance_record.hpp).
+using bounce::splat_params;
 
 /// The GL irradiance splatting pass: a record buffer on the GPU that grows by appending,
 /// and a splat texture (RGBA32F: sum of w rho_d/pi E_k(p) in rgb, sum of w in alpha).
