@@ -95,6 +95,10 @@ def headline(scene, mine):
         s_ms, o_ms = si["timings_ms"]["interpolate"], oi["timings_ms"]["interpolate"]
         out.append(f"- interpolation on one saved cache ({si['records']} records, medians of {si['repeat']} renders): "
                    f"splatting {s_ms:.1f} ms, octree lookups {o_ms:.1f} ms: {o_ms / s_ms:.2f}x (target >= 2x)")
+        ol = mine.get(f"{scene}-interp-octree-lanes")
+        if ol:
+            out.append(f"- the octree evaluating four records at a time (same lanes as the splat): "
+                       f"{ol['timings_ms']['interpolate']:.1f} ms")
     s, o = mine.get(f"{scene}-smooth"), mine.get(f"{scene}-octree")
     if s and o:
         out.append(f"- whole two-pass frame: splatting {s['timings_ms']['total']:.0f} ms at {err('smooth'):.4f}, "

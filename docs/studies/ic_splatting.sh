@@ -23,12 +23,13 @@ rays() {  # rays TAG ARGS...: gradients on/off and Ward's weight with 4096 rays 
   run "$tag-ward-r4096" "$@" --a 0.15 --weight ward --record-samples 4096  # Ward's weight, less record noise
 }
 
-interp() {  # interp TAG ARGS...: splat against octree on one saved cache, medians of 15 renders
+interp() {  # interp TAG ARGS...: splat against octree (scalar, four-lane) on one saved cache, medians of 15 renders
   local tag=$1; shift
   local cache="build/$tag-a0.15.cache"
   "$bin" "$@" --a 0.15 --weight ward-smooth --cache-out "$cache" > /dev/null
   run "$tag-interp-splat" "$@" --a 0.15 --weight ward-smooth --cache-in "$cache" --repeat 15
   run "$tag-interp-octree" "$@" --a 0.15 --weight ward-smooth --cache-in "$cache" --repeat 15 --interp octree
+  run "$tag-interp-octree-lanes" "$@" --a 0.15 --weight ward-smooth --cache-in "$cache" --repeat 15 --interp octree-lanes
 }
 
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor)

@@ -213,7 +213,8 @@ void scan_splat_buffer(const context& ctx, const camera& cam, gbuffer<float>& g,
     }
 }
 
-// CPU backends: splat-cpu (Algorithm 5 on the CPU) and octree (the classical two passes).
+// CPU backends: splat-cpu (Algorithm 5 on the CPU) and octree / octree-lanes (the classical
+// two passes, the records evaluated one or four at a time).
 frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> g_in, float a,
                           std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
     const gbuffer<float>& g = g_in;
@@ -230,7 +231,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
     std::optional<image<glm::vec4>> wide;  // hole filling's wide splat
     with_weighting(parse_weight(o.weight), [&](auto w) {
         using W = decltype(w);
-        if (o.interp == "octree") {
+        if (o.interp.starts_with("octree")) {
             // Classical: the tree depends on a, so it is built for this frame's a.
             const auto [lo, hi] = ctx.scene.bounds();
             cpu::octree_cache<W> tree(lo, hi, sp);
@@ -259,7 +260,8 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
             timer.add_sample("scan", ms_since(t0) - record_ms);
             timer.add_sample("compute_records", record_ms);
             auto t = timer.measure("interpolate");
-            tree.render(gv, splat.view());
+            tree.render(gv, splat.view(), o.interp == "octree-lanes" ? cpu::octree_evaluation::lanes
+                                                                      : cpu::octree_evaluation::scalar);
         } else {
             {
                 auto t = timer.measure("splat_existing");
@@ -479,7 +481,7 @@ int run(const options& o) {
     report.scene = scene.name;
     report.width = o.width;
     report.height = o.height;
-    report.backend = o.interp == "octree" ? "cpu-octree" : o.interp == "splat-gl" ? "gl" : "cpu";
+    report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
@@ -678,8 +680,9 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion"}))->capture_default_str();
     app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
     app.add_option("--sampler", o.sampler, "record sampler: embree | raster")->check(CLI::IsMember({"embree", "raster"}))->capture_default_str();
-    app.add_option("--interp", o.interp, "splat-cpu | splat-gl | octree")
-        ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree"}))->capture_default_str();
+    app.add_option("--interp", o.interp,
+                   "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
+        ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();
     app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)");
     app.add_option("--fill-holes", o.fill_holes,
                    "progressive: fill pixels no zone reaches from a splat with a this many times wider (0: off)")

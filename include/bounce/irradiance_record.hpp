@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <glm/glm.hpp>
 
@@ -68,15 +69,16 @@ auto record_in_front(const V& p, const V& n, const V& pk, const V& nk, T inv_r, 
 /// What record k adds to the splat buffer at a pixel (seed Algorithm 1): the weighted
 /// outgoing radiance w * (rho_d / pi) * E_k(p) in rgb and the weight w in the fourth
 /// component. `Weight` is a policy of weighting.hpp; `Gradients` is true to extrapolate
-/// with the record's gradients; `front_tolerance` is record_in_front's (1: off). Returns
-/// all zeros where the record does not contribute.
-template <class Weight, bool Gradients, real T, vec3_of<T> V>
+/// with the record's gradients; `FrontTest` is true to apply record_in_front with
+/// `front_tolerance` (ignored otherwise). Returns all zeros where the record does not
+/// contribute.
+template <class Weight, bool Gradients, bool FrontTest, real T, vec3_of<T> V>
 std::array<T, 4> splat_contribution(const V& p, const V& n, const V& albedo, const V& pk, const V& nk, T inv_r,
                                     T a, const V& e, const V& rot_r, const V& rot_g, const V& rot_b,
                                     const V& tr_r, const V& tr_g, const V& tr_b, T max_extrapolation,
-                                    T front_tolerance) {
-    const T w = select(record_in_front<T, V>(p, n, pk, nk, inv_r, a, front_tolerance), T(0),
-                       Weight::template weight<T, V>(p, n, pk, nk, inv_r, a));
+                                    [[maybe_unused]] T front_tolerance) {
+    T w = Weight::template weight<T, V>(p, n, pk, nk, inv_r, a);
+    if constexpr (FrontTest) w = select(record_in_front<T, V>(p, n, pk, nk, inv_r, a, front_tolerance), T(0), w);
     V ek = e;
     if constexpr (Gradients)
         ek = extrapolated_irradiance<T, V>(p, n, pk, nk, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation);
@@ -91,8 +93,11 @@ struct splat_params {
     bool gradients = true;          ///< extrapolate with the records' gradients
     float max_extrapolation = 1.f;  ///< gradient term clamped to +-this * E_k per channel; typical 1
     /// Ward's in-front test (record_in_front): records whose tangent plane p lies more than
-    /// this fraction of the zone's radius behind are skipped. In [0, 1]; 1 turns it off.
+    /// this fraction of the zone's radius behind are skipped. In [0, 1]; 1 turns it off, and
+    /// then backends run the kernel without the test (FrontTest = false).
     float front_tolerance = 1.f;
+
+    bool front_test() const noexcept { return front_tolerance < 1.f; }
 
     /// Throws parameter_error naming the first bad field.
     void validate() const {
@@ -102,6 +107,17 @@ struct splat_params {
         require(front_tolerance >= 0.f && front_tolerance <= 1.f, "front_tolerance", "must be in [0, 1] (1: off)");
     }
 };
+
+/// Calls f(std::bool_constant<Gradients>{}, std::bool_constant<FrontTest>{}) with the
+/// compile-time flags of splat_contribution that `sp` asks for, so a run-time setting
+/// reaches a kernel that pays only for what it uses (as with_weighting does for policies).
+template <class F>
+decltype(auto) with_kernel_flags(const splat_params& sp, F&& f) {
+    const auto front = [&](auto gradients) -> decltype(auto) {
+        return sp.front_test() ? f(gradients, std::true_type{}) : f(gradients, std::false_type{});
+    };
+    return sp.gradients ? front(std::true_type{}) : front(std::false_type{});
+}
 
 /// Normalization of the splat buffer (seed Algorithm 5, last loop): sum / weight, black
 /// where no record reached the pixel.

@@ -214,14 +214,19 @@ TEST_CASE("Ward's in-front test keeps planes and spheres, cuts steps at the tole
     // And splat_contribution is zero where the test cuts, unchanged elsewhere.
     const glm::vec3 e(1.f, 2.f, 3.f), z(0.f), albedo(0.5f);
     const auto contribution = [&](glm::vec3 q, float tol) {
-        return splat_contribution<ward_weight, true, float, glm::vec3>(q, nk, albedo, pk, nk, inv_r, a, e, z, z, z, z, z,
-                                                                       z, 1.f, tol);
+        return splat_contribution<ward_weight, true, true, float, glm::vec3>(q, nk, albedo, pk, nk, inv_r, a, e, z, z, z,
+                                                                             z, z, z, 1.f, tol);
+    };
+    const auto without_test = [&](glm::vec3 q) {
+        return splat_contribution<ward_weight, true, false, float, glm::vec3>(q, nk, albedo, pk, nk, inv_r, a, e, z, z, z,
+                                                                              z, z, z, 1.f, 0.f);
     };
     const glm::vec3 below = pk + 0.5f * along - 1.5f * h * nk;
     CHECK(contribution(below, 1.f)[3] > 0.f);
+    CHECK(contribution(below, 1.f) == without_test(below));
     CHECK(contribution(below, tolerance) == std::array<float, 4>{0.f, 0.f, 0.f, 0.f});
     const glm::vec3 level = pk + 0.5f * along - 0.5f * h * nk;
-    CHECK(contribution(level, tolerance) == contribution(level, 1.f));
+    CHECK(contribution(level, tolerance) == without_test(level));
 }
 
 TEST_CASE("radius limits apply the gradient limit, then world and pixel clamps", "[record]") {

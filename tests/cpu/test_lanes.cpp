@@ -50,7 +50,7 @@ lane_input make_input(pcg32& rng, int kind) {
     return in;
 }
 
-template <class W, bool G>
+template <class W, bool G, bool F>
 void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation, float front_tolerance) {
     auto gather = [&](auto member) {
         return vec3x4::gather(in[0].*member, in[1].*member, in[2].*member, in[3].*member);
@@ -59,7 +59,7 @@ void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation, fl
         return vec3x4::gather((in[0].*member)[c], (in[1].*member)[c], (in[2].*member)[c], (in[3].*member)[c]);
     };
     const f32x4 inv_r(in[0].inv_r, in[1].inv_r, in[2].inv_r, in[3].inv_r);
-    const auto lanes = splat_contribution<W, G, f32x4, vec3x4>(
+    const auto lanes = splat_contribution<W, G, F, f32x4, vec3x4>(
         gather(&lane_input::p), gather(&lane_input::n), gather(&lane_input::albedo), gather(&lane_input::pk),
         gather(&lane_input::nk), inv_r, f32x4(a), gather(&lane_input::e), gather_g(&lane_input::rot, 0),
         gather_g(&lane_input::rot, 1), gather_g(&lane_input::rot, 2), gather_g(&lane_input::tr, 0),
@@ -67,7 +67,7 @@ void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation, fl
         f32x4(front_tolerance));
     for (int i = 0; i < 4; ++i) {
         const lane_input& s = in[i];
-        const auto scalar = splat_contribution<W, G, float, glm::vec3>(s.p, s.n, s.albedo, s.pk, s.nk, s.inv_r, a, s.e,
+        const auto scalar = splat_contribution<W, G, F, float, glm::vec3>(s.p, s.n, s.albedo, s.pk, s.nk, s.inv_r, a, s.e,
                                                                       s.rot[0], s.rot[1], s.rot[2], s.tr[0], s.tr[1],
                                                                       s.tr[2], max_extrapolation, front_tolerance);
         for (int c = 0; c < 4; ++c) {
@@ -79,8 +79,10 @@ void check_lanes(const lane_input (&in)[4], float a, float max_extrapolation, fl
 
 template <class W>
 void check_policy(const lane_input (&in)[4], float a, float max_extrapolation, float front_tolerance) {
-    check_lanes<W, true>(in, a, max_extrapolation, front_tolerance);
-    check_lanes<W, false>(in, a, max_extrapolation, front_tolerance);
+    check_lanes<W, true, true>(in, a, max_extrapolation, front_tolerance);
+    check_lanes<W, false, true>(in, a, max_extrapolation, front_tolerance);
+    check_lanes<W, true, false>(in, a, max_extrapolation, front_tolerance);
+    check_lanes<W, false, false>(in, a, max_extrapolation, front_tolerance);
 }
 
 }  // namespace

@@ -229,6 +229,43 @@ TEST_CASE("octree lookups give the splat buffer's values on the same records", "
             for (int c = 0; c < 4; ++c) REQUIRE(looked(x, y)[c] == Approx(splat(x, y)[c]).epsilon(1e-5).margin(1e-30));
 }
 
+TEMPLATE_TEST_CASE("the octree's four-lane lookups equal its scalar lookups bit for bit", "[octree][cpu][lanes]",
+                   ward_weight, ward_smooth_weight, gpu_ward_shader_weight, tabellion_weight) {
+    plane_view v(80, 60);
+    pcg32 rng(std::uint64_t(GENERATE(1, 2, 3)));
+    cpu::splat_params sp;
+    sp.a = GENERATE(0.15f, 0.4f);
+    sp.gradients = GENERATE(true, false);
+    sp.front_tolerance = GENERATE(1.f, 0.05f);
+    cpu::octree_cache<TestType> tree({-3, -3, -1}, {3, 3, 1}, sp);
+    // Records off the plane and tilted (so the in-front test and the normal term both act),
+    // many overlapping (lookups meet more than one group of 64), and one at a pixel's point.
+    for (int i = 0; i < 1500; ++i) {
+        const glm::vec3 pk{4.f * rng.next_float() - 2.f, 4.f * rng.next_float() - 2.f, 0.1f * rng.next_float() - 0.05f};
+        auto r = record_at(pk, 0.05f + 3.f * rng.next_float() * rng.next_float(),
+                           {rng.next_float(), rng.next_float(), rng.next_float()});
+        if (i % 3 == 0)
+            r.normal = glm::normalize(glm::vec3(0.1f * rng.next_float() - 0.05f, 0.1f * rng.next_float() - 0.05f, 1.f));
+        r.rotation[0] = {rng.next_float() - 0.5f, 0.2f, 0.f};
+        r.translation[1] = {0.f, rng.next_float() - 0.5f, 0.3f};
+        tree.insert(r);
+    }
+    tree.insert(record_at(v.gb.position(40, 30), 0.3f, {1.f, 1.f, 1.f}));
+    image<glm::vec4> scalar(80, 60), lanes(80, 60);
+    tree.render(v.gb.view(), scalar.view());
+    tree.render(v.gb.view(), lanes.view(), cpu::octree_evaluation::lanes);
+    std::size_t weighted = 0;
+    for (std::size_t y = 0; y < 60; ++y)
+        for (std::size_t x = 0; x < 80; ++x) {
+            weighted += scalar(x, y).w > 0.f;
+            for (int c = 0; c < 4; ++c) {
+                INFO("pixel (" << x << ", " << y << ") component " << c);
+                REQUIRE(lanes(x, y)[c] == scalar(x, y)[c]);
+            }
+        }
+    CHECK(weighted > 80 * 60 / 2);
+}
+
 TEST_CASE("the classical fill leaves every pixel covered once both passes ran", "[octree][cpu][scan]") {
     plane_view v(64, 48);
     cpu::splat_params sp;

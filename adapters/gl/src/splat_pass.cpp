@@ -222,16 +222,18 @@ void main() {
 )";
 }
 
-std::string splat_pass::fragment_source(weighting_kind weighting, bool gradients) {
+std::string splat_pass::fragment_source(weighting_kind weighting, bool gradients, bool front_test) {
     glsl::function_set kernels;
+    splat_params flags;
+    flags.gradients = gradients;
+    flags.front_tolerance = front_test ? 0.f : 1.f;
     with_weighting(weighting, [&](auto policy) {
-        using W = decltype(policy);
-        const auto add = [&](auto kernel) {
-            kernels.add("splat_contribution", kernel, "p", "n", "albedo", "pk", "nk", "inv_r", "a", "e", "rot_r", "rot_g",
-                        "rot_b", "tr_r", "tr_g", "tr_b", "max_extrapolation", "front_tolerance", "c");
-        };
-        if (gradients) add(splat_contribution<W, true, glsl::f32, glsl::vec3>);
-        else add(splat_contribution<W, false, glsl::f32, glsl::vec3>);
+        with_kernel_flags(flags, [&](auto g, auto f) {
+            kernels.add("splat_contribution",
+                        splat_contribution<decltype(policy), decltype(g)::value, decltype(f)::value, glsl::f32, glsl::vec3>,
+                        "p", "n", "albedo", "pk", "nk", "inv_r", "a", "e", "rot_r", "rot_g", "rot_b", "tr_r", "tr_g",
+                        "tr_b", "max_extrapolation", "front_tolerance", "c");
+        });
     });
     return std::string("#version 450 core\n") + record_block + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
 layout(binding = 1) uniform sampler2D gbuffer_normal;
@@ -277,11 +279,13 @@ splat_pass::splat_pass() {
     check_error("splat_pass vertex array");
 }
 
-const program& splat_pass::variant(weighting_kind weighting, bool gradients) {
-    const auto key = std::make_pair(int(weighting), gradients);
+const program& splat_pass::variant(weighting_kind weighting, bool gradients, bool front_test) {
+    const auto key = std::make_tuple(int(weighting), gradients, front_test);
     auto it = programs_.find(key);
     if (it == programs_.end())
-        it = programs_.emplace(key, program(vertex_source(weighting), fragment_source(weighting, gradients))).first;
+        it = programs_
+                 .emplace(key, program(vertex_source(weighting), fragment_source(weighting, gradients, front_test)))
+                 .first;
     return it->second;
 }
 
@@ -353,7 +357,7 @@ void splat_pass::splat(const gbuffer_textures& g, const camera& cam, const splat
     count = std::min(count, count_ - first);
     if (count == 0) return;
     require(count <= std::size_t(std::numeric_limits<GLsizei>::max()), "count", "too many records for one draw");
-    const program& prog = variant(weighting, params.gradients);
+    const program& prog = variant(weighting, params.gradients, params.front_test());
 
     prog.set(loc_view, cam.view_matrix());
     prog.set(loc_a, params.a);

@@ -8,11 +8,17 @@
 /// depth whose node diagonal is smaller than the zone's (pbrt-v2's rule); a lookup walks
 /// from the root to the leaf containing p and tests the records met on the way. The tree
 /// depends on a (zones are a * R): changing a means rebuilding it, which splatting avoids.
+///
+/// Lookups evaluate the records they meet one at a time (the classical code, and the
+/// baseline the irradiance-splatting issue names) or four at a time on cpu::lanes, the
+/// splat's own instantiation of the kernel (`octree_evaluation::lanes`): the two give the
+/// same sums, bit for bit, so the lane form measures what vectorization alone buys.
 
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/irradiance_record.hpp>
 #include <bounce/weighting.hpp>
+#include <bounce/cpu/lanes.hpp>
 #include <bounce/cpu/splatting.hpp>
 
 #include <array>
@@ -25,6 +31,10 @@
 #include <tbb/parallel_for.h>
 
 namespace bounce::cpu {
+
+/// How an octree lookup evaluates the records it meets: one at a time, or the records whose
+/// zone holds the point four at a time (same sums, bit for bit).
+enum class octree_evaluation { scalar, lanes };
 
 template <class Weight>
 class octree_cache {
@@ -58,19 +68,34 @@ public:
     /// are met root to leaf here, in index order there).
     glm::vec4 lookup(const glm::vec3& p, const glm::vec3& n, const glm::vec3& albedo) const {
         glm::vec4 sum(0.f);
-        const node* nd = root_.get();
-        glm::vec3 lo = lo_, hi = hi_;
-        while (nd) {
-            for (std::uint32_t i : nd->items) {
-                const auto& r = records_[i];
-                sum += detail::contribution<Weight>(r, p, n, albedo, sp_, detail::culling_radius2<Weight>(r, sp_.a));
-            }
-            const glm::vec3 mid = 0.5f * (lo + hi);
-            const int child = (p.x > mid.x) | ((p.y > mid.y) << 1) | ((p.z > mid.z) << 2);
-            if (!nd->children[child]) break;
-            child_box(lo, hi, child, lo, hi);
-            nd = nd->children[child].get();
-        }
+        walk(p, [&](const irradiance_record& r) {
+            sum += detail::contribution<Weight>(r, p, n, albedo, sp_, detail::culling_radius2<Weight>(r, sp_.a));
+        });
+        return sum;
+    }
+
+    /// `lookup` with the kernel on four records at a time: the walk keeps the records whose
+    /// zone holds p (the scalar code's distance test) in the order it meets them, and they
+    /// are evaluated in groups of four, their non-zero terms added in that order: the same
+    /// float additions as `lookup`.
+    glm::vec4 lookup_lanes(const glm::vec3& p, const glm::vec3& n, const glm::vec3& albedo) const {
+        std::array<const irradiance_record*, 64> near;
+        std::size_t count = 0;
+        glm::vec4 sum(0.f);
+        const auto flush = [&] {
+            with_kernel_flags(sp_, [&](auto gradients, auto front_test) {
+                add_lanes<decltype(gradients)::value, decltype(front_test)::value>(std::span(near).first(count), p, n,
+                                                                                   albedo, sum);
+            });
+            count = 0;
+        };
+        walk(p, [&](const irradiance_record& r) {
+            const glm::vec3 d = p - r.position;
+            if (!(glm::dot(d, d) <= detail::culling_radius2<Weight>(r, sp_.a))) return;
+            near[count++] = &r;
+            if (count == near.size()) flush();
+        });
+        if (count) flush();
         return sum;
     }
 
@@ -93,15 +118,67 @@ public:
     }
 
     /// Second pass: the (sum, weight) of every pixel by lookups, in parallel.
-    void render(const gbuffer_view<float>& gb, image_view<glm::vec4> out) const {
+    void render(const gbuffer_view<float>& gb, image_view<glm::vec4> out,
+                octree_evaluation evaluation = octree_evaluation::scalar) const {
         require(out.width() == gb.width() && out.height() == gb.height(), "out", "size differs from the G-buffer");
+        const bool lanes = evaluation == octree_evaluation::lanes;
         tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t y) {
-            for (std::size_t x = 0; x < gb.width(); ++x)
-                out(x, y) = gb.covered(x, y) ? lookup(gb.position(x, y), gb.normal(x, y), gb.albedo(x, y)) : glm::vec4(0.f);
+            for (std::size_t x = 0; x < gb.width(); ++x) {
+                if (!gb.covered(x, y)) {
+                    out(x, y) = glm::vec4(0.f);
+                    continue;
+                }
+                const glm::vec3 p = gb.position(x, y), n = gb.normal(x, y), albedo = gb.albedo(x, y);
+                out(x, y) = lanes ? lookup_lanes(p, n, albedo) : lookup(p, n, albedo);
+            }
         });
     }
 
 private:
+    // Calls f(record) for the records stored on the path from the root to the leaf that
+    // contains p, root first, each node's in insertion order.
+    template <class F>
+    void walk(const glm::vec3& p, F&& f) const {
+        const node* nd = root_.get();
+        glm::vec3 lo = lo_, hi = hi_;
+        while (nd) {
+            for (std::uint32_t i : nd->items) f(records_[i]);
+            const glm::vec3 mid = 0.5f * (lo + hi);
+            const int child = (p.x > mid.x) | ((p.y > mid.y) << 1) | ((p.z > mid.z) << 2);
+            if (!nd->children[child]) break;
+            child_box(lo, hi, child, lo, hi);
+            nd = nd->children[child].get();
+        }
+    }
+
+    // Adds the contributions of records `recs` at one point, four records per kernel call;
+    // a short last group repeats its last record in the spare lanes and ignores them.
+    template <bool Gradients, bool FrontTest>
+    void add_lanes(std::span<const irradiance_record* const> recs, const glm::vec3& p, const glm::vec3& n,
+                   const glm::vec3& albedo, glm::vec4& sum) const {
+        using namespace lanes;
+        const vec3x4 pv = vec3x4::broadcast(p), nv = vec3x4::broadcast(n), av = vec3x4::broadcast(albedo);
+        const f32x4 a(sp_.a), max_extrapolation(sp_.max_extrapolation), front_tolerance(sp_.front_tolerance);
+        for (std::size_t g = 0; g < recs.size(); g += 4) {
+            const std::size_t valid = std::min<std::size_t>(4, recs.size() - g);
+            const irradiance_record* r[4];
+            for (std::size_t i = 0; i < 4; ++i) r[i] = recs[g + std::min(i, valid - 1)];
+            const auto field = [&](auto member) { return vec3x4::gather(r[0]->*member, r[1]->*member, r[2]->*member, r[3]->*member); };
+            const auto gradient = [&](auto member, int c) {
+                return vec3x4::gather((r[0]->*member)[c], (r[1]->*member)[c], (r[2]->*member)[c], (r[3]->*member)[c]);
+            };
+            const f32x4 inv_r(1.f / r[0]->radius, 1.f / r[1]->radius, 1.f / r[2]->radius, 1.f / r[3]->radius);
+            const auto c = splat_contribution<Weight, Gradients, FrontTest, f32x4, vec3x4>(
+                pv, nv, av, field(&irradiance_record::position), field(&irradiance_record::normal), inv_r, a,
+                field(&irradiance_record::irradiance), gradient(&irradiance_record::rotation, 0),
+                gradient(&irradiance_record::rotation, 1), gradient(&irradiance_record::rotation, 2),
+                gradient(&irradiance_record::translation, 0), gradient(&irradiance_record::translation, 1),
+                gradient(&irradiance_record::translation, 2), max_extrapolation, front_tolerance);
+            for (std::size_t i = 0; i < valid; ++i)
+                if (c[3][int(i)] > 0.f) sum += glm::vec4(c[0][int(i)], c[1][int(i)], c[2][int(i)], c[3][int(i)]);
+        }
+    }
+
     struct node {
         std::vector<std::uint32_t> items;
         std::array<std::unique_ptr<node>, 8> children;

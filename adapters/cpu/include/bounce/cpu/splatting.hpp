@@ -83,16 +83,12 @@ inline glm::vec4 contribution(const irradiance_record& rec, const glm::vec3& p, 
     const glm::vec3 d = p - rec.position;
     if (!(glm::dot(d, d) <= cull2)) return glm::vec4(0.f);
     const float inv_r = 1.f / rec.radius;
-    const auto c = sp.gradients ? splat_contribution<Weight, true, float, glm::vec3>(
-                                      p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance,
-                                      rec.rotation[0], rec.rotation[1], rec.rotation[2], rec.translation[0],
-                                      rec.translation[1], rec.translation[2], sp.max_extrapolation,
-                                      sp.front_tolerance)
-                                : splat_contribution<Weight, false, float, glm::vec3>(
-                                      p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance,
-                                      rec.rotation[0], rec.rotation[1], rec.rotation[2], rec.translation[0],
-                                      rec.translation[1], rec.translation[2], sp.max_extrapolation,
-                                      sp.front_tolerance);
+    const auto c = with_kernel_flags(sp, [&](auto gradients, auto front_test) {
+        return splat_contribution<Weight, decltype(gradients)::value, decltype(front_test)::value, float, glm::vec3>(
+            p, n, albedo, rec.position, rec.normal, inv_r, sp.a, rec.irradiance, rec.rotation[0], rec.rotation[1],
+            rec.rotation[2], rec.translation[0], rec.translation[1], rec.translation[2], sp.max_extrapolation,
+            sp.front_tolerance);
+    });
     return c[3] > 0.f ? glm::vec4(c[0], c[1], c[2], c[3]) : glm::vec4(0.f);
 }
 
@@ -100,7 +96,7 @@ inline glm::vec4 contribution(const irradiance_record& rec, const glm::vec3& p, 
 /// the kernel runs on lanes::f32x4, which computes what the scalar float kernel computes,
 /// bit for bit, so each pixel receives exactly the terms `contribution` gives, in the same
 /// order. Lanes past the row's end repeat its last pixel and are masked off.
-template <class Weight, bool Gradients>
+template <class Weight, bool Gradients, bool FrontTest>
 inline void splat_into_lanes(const gbuffer_view<float>& gb, const irradiance_record& rec, const splat_params& sp,
                              const pixel_rect& r, image_view<glm::vec4> out) {
     using namespace lanes;
@@ -130,7 +126,7 @@ inline void splat_into_lanes(const gbuffer_view<float>& gb, const irradiance_rec
                                             gb.normal(xs[3], yy));
             const vec3x4 albedo = vec3x4::gather(gb.albedo(xs[0], yy), gb.albedo(xs[1], yy), gb.albedo(xs[2], yy),
                                                  gb.albedo(xs[3], yy));
-            const auto c = splat_contribution<Weight, Gradients, f32x4, vec3x4>(
+            const auto c = splat_contribution<Weight, Gradients, FrontTest, f32x4, vec3x4>(
                 p, n, albedo, pk, nk, inv_r, a, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation,
                 front_tolerance);
             const mask4 keep = inside && c[3] > f32x4(0.f);
@@ -143,8 +139,9 @@ inline void splat_into_lanes(const gbuffer_view<float>& gb, const irradiance_rec
 template <class Weight>
 inline void splat_into(const gbuffer_view<float>& gb, const irradiance_record& rec, const splat_params& sp,
                        const pixel_rect& r, image_view<glm::vec4> out) {
-    if (sp.gradients) splat_into_lanes<Weight, true>(gb, rec, sp, r, out);
-    else splat_into_lanes<Weight, false>(gb, rec, sp, r, out);
+    with_kernel_flags(sp, [&](auto gradients, auto front_test) {
+        splat_into_lanes<Weight, decltype(gradients)::value, decltype(front_test)::value>(gb, rec, sp, r, out);
+    });
 }
 }  // namespace detail
 

@@ -31,6 +31,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include <glm/vec3.hpp>
@@ -140,10 +141,10 @@ public:
 
     /// The shaders of a variant, with the emitted kernels in them (for inspection).
     static std::string vertex_source(weighting_kind weighting);
-    static std::string fragment_source(weighting_kind weighting, bool gradients);
+    static std::string fragment_source(weighting_kind weighting, bool gradients, bool front_test = false);
 
 private:
-    const program& variant(weighting_kind weighting, bool gradients);
+    const program& variant(weighting_kind weighting, bool gradients, bool front_test);
     void ensure_target(std::size_t width, std::size_t height);
     void write_records(std::size_t at, std::span<const irradiance_record> records);
 
@@ -153,7 +154,7 @@ private:
     framebuffer fbo_;
     vertex_array record_vao_;
     std::size_t width_ = 0, height_ = 0;
-    std::map<std::pair<int, bool>, program> programs_;
+    std::map<std::tuple<int, bool, bool>, program> programs_;  // (weighting, gradients, front test)
 };
 
 /// Normalization and composition (Algorithm 5, last steps) on the GPU: per pixel the
