@@ -199,6 +199,16 @@ TEST_CASE("bad splatting parameters are refused with the parameter named", "[spl
         }
     }
     sp.a = 0.2f;
+    for (float t : {-0.1f, 1.5f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        sp.front_tolerance = t;
+        try {
+            cpu::splat_records<ward_weight>(v.gb.view(), v.cam, std::span(&rec, 1), sp, splat.view());
+            FAIL("accepted front_tolerance = " << t);
+        } catch (const parameter_error& e) {
+            CHECK(e.parameter() == "front_tolerance");
+        }
+    }
+    sp.front_tolerance = 1.f;
     CHECK_THROWS_AS(cpu::splat_records<ward_weight>(v.gb.view(), v.cam, std::span(&rec, 1), sp, small.view()), parameter_error);
 }
 
