@@ -158,21 +158,29 @@ def main():
             lines += [f"| {f['frame']} | {f['records']} | {f['new_records']} | {f['ms']:.0f} | {f['fps']:.2f} | "
                       f"{f['rel_rms']:.4f} |" for f in prog[0]["frames"]]
             lines.append("")
-        # The a sweep against Monte Carlo, as a table and as a plot.
-        sweep = sorted((v for k, v in mine.items() if "-a0" in k and "ward-" not in k), key=lambda r: r["parameters"]["a"])
-        if sweep:
-            lines += ["Speed against error over the a sweep (smoothed Ward, gradients on); Monte Carlo's time at",
-                      "each run's error comes from its spp sweep above (log-log interpolation; '>' where it",
-                      "never got that low):", ""] + sweep_table(sweep, mc[0]["mc_sweep"] if mc else None) + [""]
+        # The a sweep against Monte Carlo, as a table and as a plot: one series per number of
+        # rays per record (runs named SCENE-aA and SCENE-rN-aA).
+        swept = [v for k, v in mine.items() if "-a0" in k and "ward-" not in k]
+        series = {}
+        for r in swept:
+            series.setdefault(r["parameters"]["record_samples"], []).append(r)
+        if series:
+            mc_sweep = mc[0]["mc_sweep"] if mc else None
+            lines += ["Speed against error over the a sweep (smoothed Ward, gradients on), for each number of",
+                      "rays per record; Monte Carlo's time at each run's error comes from its spp sweep above",
+                      "(log-log interpolation; '>' where it never got that low):", ""]
             fig, ax = plt.subplots(figsize=(5, 3.4), dpi=100)
-            ax.plot([r["error"]["rel_rms"] for r in sweep], [r["timings_ms"]["total"] for r in sweep], "o-",
-                    label="irradiance splatting (a sweep)")
-            for r in sweep:
-                ax.annotate(f"a={r['parameters']['a']}", (r["error"]["rel_rms"], r["timings_ms"]["total"]),
-                            fontsize=7)
-            if mc:
-                ms = mc[0]["mc_sweep"]
-                ax.plot([m["rel_rms"] for m in ms], [m["ms"] for m in ms], "s--", label="Monte Carlo (spp sweep)")
+            for rays, group in sorted(series.items()):
+                group.sort(key=lambda r: r["parameters"]["a"])
+                lines += [f"{rays} rays per record:", ""] + sweep_table(group, mc_sweep) + [""]
+                ax.plot([r["error"]["rel_rms"] for r in group], [r["timings_ms"]["total"] for r in group], "o-",
+                        label=f"irradiance splatting, {rays} rays/record (a sweep)")
+                for r in group:
+                    ax.annotate(f"a={r['parameters']['a']:.2g}", (r["error"]["rel_rms"], r["timings_ms"]["total"]),
+                                fontsize=7)
+            if mc_sweep:
+                ax.plot([m["rel_rms"] for m in mc_sweep], [m["ms"] for m in mc_sweep], "s--",
+                        label="Monte Carlo (spp sweep)")
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_xlabel("indirect rel. RMS error")
