@@ -163,7 +163,9 @@ private:
             const std::size_t valid = std::min<std::size_t>(4, recs.size() - g);
             const irradiance_record* r[4];
             for (std::size_t i = 0; i < 4; ++i) r[i] = recs[g + std::min(i, valid - 1)];
-            const auto field = [&](auto member) { return vec3x4::gather(r[0]->*member, r[1]->*member, r[2]->*member, r[3]->*member); };
+            const auto field = [&](auto member) {
+                return vec3x4::gather(r[0]->*member, r[1]->*member, r[2]->*member, r[3]->*member);
+            };
             const auto gradient = [&](auto member, int c) {
                 return vec3x4::gather((r[0]->*member)[c], (r[1]->*member)[c], (r[2]->*member)[c], (r[3]->*member)[c]);
             };
