@@ -28,7 +28,7 @@ def row(name, r):
     p = r["parameters"]
     return (f"| {name} | {r['backend']} | {p.get('weight', '')} | {'on' if p.get('gradients') else 'off'} | "
             f"{'on' if p.get('neighbour_clamp') else 'off'} | "
-            f"{p.get('a', 0):.3g} | {r.get('records', '')} | {t.get('interpolate', float('nan')):.1f} | "
+            f"{p.get('a', 0):.3g} | {p.get('record_samples', '')} | {r.get('records', '')} | {t.get('interpolate', float('nan')):.1f} | "
             f"{t.get('compute_records', float('nan')):.0f} | {t.get('total', float('nan')):.0f} | {e:.4f} |")
 
 
@@ -124,10 +124,13 @@ def main():
              "indirect image's luminance against the reference integrator over covered pixels.",
              "Machine: 2 cores, no GPU (OpenGL on Mesa llvmpipe).", ""]
     for scene in sorted({r["scene"] for r in runs.values()}):
-        lines += [f"## {scene}", "",
-                  "| run | backend | weight | gradients | clamp | a | records | interpolate ms | records ms | total ms | rel_rms |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|"]
         mine = {k: v for k, v in runs.items() if v["scene"] == scene}
+        refs = sorted({(r["width"], r["parameters"]["reference_spp"]) for r in mine.values()
+                       if "reference_spp" in r.get("parameters", {})}, reverse=True)
+        lines += [f"## {scene}", "",
+                  "References: " + ", ".join(f"{spp} spp at {w}x{w}" for w, spp in refs) + ".", "",
+                  "| run | backend | weight | gradients | clamp | a | rays | records | interpolate ms | records ms | total ms | rel_rms |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for name, r in mine.items():
             lines.append(row(name, r))
         lines.append("")
