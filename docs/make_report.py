@@ -77,6 +77,11 @@ def headline(scene, mine):
             line += (f"; with the radius limit too ({sm['records']} records): "
                      f"-{100 * (1 - err('smooth') / err('nolimit-nograd')):.0f}%")
         out.append(line)
+    for rays in (1024, 2048):  # the same pair with the ray count the scene's main runs do not use
+        on = err(f"r{rays}") or err(f"r{rays}-a0.15")
+        if on and err(f"r{rays}-nograd"):
+            out.append(f"- with {rays} rays per record: {on:.4f}, without gradients {err(f'r{rays}-nograd'):.4f}: "
+                       f"gradients lower the error by {100 * (1 - on / err(f'r{rays}-nograd')):.0f}%")
     if err("r4096") and err("r4096-nograd"):
         out.append(f"- with 4096 rays per record: {err('r4096'):.4f}, without gradients {err('r4096-nograd'):.4f}: "
                    f"gradients lower the error by {100 * (1 - err('r4096') / err('r4096-nograd')):.0f}%")

@@ -45,6 +45,13 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
     if [[ $rays != 1024 ]]; then run "$tag-r1024-a$a" "${base[@]}" --record-samples 1024 --a "$a" --weight ward-smooth; fi
   done
   run "$tag-nograd" "${common[@]}" --a 0.15 --weight ward-smooth --gradients off
+  # The gradients' gain on the same records with the other number of rays per record.
+  if [[ $rays == 1024 ]]; then
+    run "$tag-r2048" "${base[@]}" --record-samples 2048 --a 0.15 --weight ward-smooth
+    run "$tag-r2048-nograd" "${base[@]}" --record-samples 2048 --a 0.15 --weight ward-smooth --gradients off
+  else
+    run "$tag-r1024-nograd" "${base[@]}" --record-samples 1024 --a 0.15 --weight ward-smooth --gradients off
+  fi
   # No gradient anywhere (Ward 1988: nor the radius limit), and the same records extrapolated.
   run "$tag-nolimit-nograd" "${common[@]}" --a 0.15 --weight ward-smooth --gradients off --no-gradient-limit
   run "$tag-nolimit" "${common[@]}" --a 0.15 --weight ward-smooth --no-gradient-limit
