@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 #include <glm/glm.hpp>
 
@@ -109,14 +110,20 @@ struct splat_params {
 };
 
 /// Calls f(std::bool_constant<Gradients>{}, std::bool_constant<FrontTest>{}) with the
-/// compile-time flags of splat_contribution that `sp` asks for, so a run-time setting
-/// reaches a kernel that pays only for what it uses (as with_weighting does for policies).
+/// compile-time flags of splat_contribution, so a run-time setting reaches a kernel that
+/// pays only for what it uses (as with_weighting does for policies).
+template <class F>
+decltype(auto) with_kernel_flags(bool gradients, bool front_test, F&& f) {
+    const auto front = [&](auto g) -> decltype(auto) {
+        return front_test ? f(g, std::true_type{}) : f(g, std::false_type{});
+    };
+    return gradients ? front(std::true_type{}) : front(std::false_type{});
+}
+
+/// The flags `sp` asks for.
 template <class F>
 decltype(auto) with_kernel_flags(const splat_params& sp, F&& f) {
-    const auto front = [&](auto gradients) -> decltype(auto) {
-        return sp.front_test() ? f(gradients, std::true_type{}) : f(gradients, std::false_type{});
-    };
-    return sp.gradients ? front(std::true_type{}) : front(std::false_type{});
+    return with_kernel_flags(sp.gradients, sp.front_test(), std::forward<F>(f));
 }
 
 /// Normalization of the splat buffer (seed Algorithm 5, last loop): sum / weight, black

@@ -185,7 +185,7 @@ pixel_bounds bounds_for(const gbuffer_view<float>& gb, const std::vector<irradia
                 if (jumps && std::abs(reach - a) < 1e-5 * a + d_reach) b.excluded(x, y) = 1;
                 // Ward's in-front test cuts every policy: pixels whose height below the
                 // record's plane is within rounding of the cut may fall either side.
-                if (sp.front_tolerance < 1.f) {
+                if (sp.front_test()) {
                     const double height = glm::dot(p - glm::dvec3(r.position), n + glm::dvec3(r.normal)) / r.radius;
                     const double rounding = 64 * ulp * (glm::length(p) + glm::length(glm::dvec3(r.position)) + 1) / r.radius;
                     if (std::abs(height + 2 * sp.front_tolerance * a) <= rounding) b.excluded(x, y) = 1;
@@ -266,7 +266,7 @@ TEST_CASE("GL and CPU splat buffers agree for every weighting policy, with and w
     CHECK(weighted > W * H / 4);
     // The relative bound, not the slack, decides for most weighted pixels.
     CHECK(well_conditioned > weighted / 2);
-    if (front_tolerance < 1.f) {  // and the in-front test removed weight from many pixels
+    if (cp.front_test()) {  // and the in-front test removed weight from many pixels
         splat_params off = cp;
         off.front_tolerance = 1.f;
         image<glm::vec4> uncut(W, H, glm::vec4(0.f));

@@ -224,11 +224,8 @@ void main() {
 
 std::string splat_pass::fragment_source(weighting_kind weighting, bool gradients, bool front_test) {
     glsl::function_set kernels;
-    splat_params flags;
-    flags.gradients = gradients;
-    flags.front_tolerance = front_test ? 0.f : 1.f;
     with_weighting(weighting, [&](auto policy) {
-        with_kernel_flags(flags, [&](auto g, auto f) {
+        with_kernel_flags(gradients, front_test, [&](auto g, auto f) {
             kernels.add("splat_contribution",
                         splat_contribution<decltype(policy), decltype(g)::value, decltype(f)::value, glsl::f32, glsl::vec3>,
                         "p", "n", "albedo", "pk", "nk", "inv_r", "a", "e", "rot_r", "rot_g", "rot_b", "tr_r", "tr_g",
