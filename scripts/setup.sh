@@ -6,11 +6,13 @@ set -euo pipefail
 preset="${1:-default}"
 cd "$(dirname "$0")/.."
 
+# openimageio-tools: Debian's OpenImageIOTargets.cmake names /usr/bin/iconvert and friends, so
+# find_package(OpenImageIO) fails without them (libopenimageio-dev does not depend on it).
 packages=(
   build-essential cmake ninja-build pkg-config git
   libglm-dev libembree-dev libtbb-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
-  catch2 libopenimageio-dev libtinyobjloader-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+  catch2 libopenimageio-dev openimageio-tools libtinyobjloader-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   python3 python3-matplotlib
 )
 missing=()
