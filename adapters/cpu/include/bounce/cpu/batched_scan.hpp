@@ -106,7 +106,10 @@ scan_stats batched_scan(std::size_t width, std::size_t height, std::span<const s
             };
             for (std::size_t j = i + 1; j < std::min(n, i + lookahead) && guess.size() < max_records; ++j) {
                 if (ahead.count(j)) continue;
-                const auto [qx, qy] = pixel(j);
+                // Named members, not a structured binding: the lambdas below capture them,
+                // which C++20 allows but Clang before 16 refuses.
+                const auto q = pixel(j);
+                const std::size_t qx = q.first, qy = q.second;
                 if (!is_miss(qx, qy)) continue;
                 const bool ok = std::all_of(guess.begin(), guess.end(), [&](std::size_t g) { return far_enough(qx, qy, g); }) &&
                                 std::all_of(ahead.begin(), ahead.end(), [&](const auto& a) { return far_enough(qx, qy, a.first); });
