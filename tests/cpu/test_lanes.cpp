@@ -11,6 +11,8 @@
 
 #include <bit>
 #include <cstdint>
+#include <limits>
+#include <vector>
 
 using namespace bounce;
 using cpu::lanes::f32x4;
@@ -117,6 +119,36 @@ TEST_CASE("the lane vocabulary follows the scalar one at its edges", "[lanes][cp
     const auto s = select(x < y, f32x4(1.f), f32x4(2.f));
     CHECK((s[0] == 2.f && s[1] == 2.f && s[2] == 2.f && s[3] == 2.f));
     CHECK(select(x <= y, f32x4(1.f), f32x4(2.f))[3] == 1.f);
+}
+
+TEST_CASE("packed loads and the transpose move the same floats as the scalar gathers", "[lanes][cpu]") {
+    // 16 packed vec3s with every float distinct (NaN and signed zeros included: bits move,
+    // nothing is computed), read from each of the first four offsets.
+    std::vector<glm::vec3> row(16);
+    for (std::size_t i = 0; i < row.size(); ++i) row[i] = {float(3 * i) + 0.25f, -float(3 * i + 1), float(3 * i + 2) * 1e-3f};
+    row[5].y = -0.f;
+    row[6].z = std::numeric_limits<float>::quiet_NaN();
+    const auto same = [](float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); };
+    for (std::size_t o = 0; o < 4; ++o) {
+        const vec3x4 packed = vec3x4::load_packed(&row[o].x);
+        const vec3x4 gathered = vec3x4::gather(row[o], row[o + 1], row[o + 2], row[o + 3]);
+        for (int i = 0; i < 4; ++i) {
+            CHECK(same(packed.x[i], gathered.x[i]));
+            CHECK(same(packed.y[i], gathered.y[i]));
+            CHECK(same(packed.z[i], gathered.z[i]));
+        }
+    }
+    const f32x4 r(1.f, 2.f, 3.f, 4.f), g(5.f, 6.f, 7.f, 8.f), b(9.f, 10.f, 11.f, 12.f), w(13.f, 14.f, 15.f, 16.f);
+    const auto t = cpu::lanes::transpose(r, g, b, w);
+    for (int i = 0; i < 4; ++i) {
+        CHECK(t[std::size_t(i)][0] == r[i]);
+        CHECK(t[std::size_t(i)][1] == g[i]);
+        CHECK(t[std::size_t(i)][2] == b[i]);
+        CHECK(t[std::size_t(i)][3] == w[i]);
+    }
+    float out[4];
+    t[2].store(out);
+    CHECK((out[0] == 3.f && out[1] == 7.f && out[2] == 11.f && out[3] == 15.f));
 }
 
 TEST_CASE("the CPU splat is the scalar kernel summed over every pixel, bit for bit", "[lanes][splat][cpu]") {

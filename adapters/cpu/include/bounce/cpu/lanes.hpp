@@ -21,6 +21,7 @@
 
 #include <bounce/concepts.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -57,6 +58,16 @@ struct f32x4 {
     explicit f32x4(A x) noexcept : v{float(x), float(x), float(x), float(x)} {}
     f32x4(float a, float b, float c, float d) noexcept : v{a, b, c, d} {}
 
+    /// Four consecutive floats (any alignment).
+    static f32x4 load(const float* p) noexcept {
+        f32v x;
+        std::memcpy(&x, p, sizeof x);
+        return {x};
+    }
+
+    /// Stores the four floats at `p` (any alignment).
+    void store(float* p) const noexcept { std::memcpy(p, &v, sizeof v); }
+
     float operator[](int i) const noexcept { return v[i]; }
 
     friend f32x4 operator+(f32x4 a, f32x4 b) noexcept { return {a.v + b.v}; }
@@ -69,6 +80,18 @@ struct f32x4 {
     friend mask4 operator<=(f32x4 a, f32x4 b) noexcept { return {a.v <= b.v}; }
     friend mask4 operator>=(f32x4 a, f32x4 b) noexcept { return {a.v >= b.v}; }
 };
+
+/// The 4x4 transpose: lane i of the result holds (a[i], b[i], c[i], d[i]).
+inline std::array<f32x4, 4> transpose(f32x4 a, f32x4 b, f32x4 c, f32x4 d) noexcept {
+#if defined(__SSE__)
+    __m128 r0 = a.v, r1 = b.v, r2 = c.v, r3 = d.v;
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    return {f32x4{r0}, f32x4{r1}, f32x4{r2}, f32x4{r3}};
+#else
+    return {f32x4(a[0], b[0], c[0], d[0]), f32x4(a[1], b[1], c[1], d[1]), f32x4(a[2], b[2], c[2], d[2]),
+            f32x4(a[3], b[3], c[3], d[3])};
+#endif
+}
 
 /// `a` where `m` holds, else `b`.
 inline f32x4 select(mask4 m, f32x4 a, f32x4 b) noexcept {
@@ -105,6 +128,25 @@ struct vec3x4 {
     template <class V3>
     static vec3x4 gather(const V3& a, const V3& b, const V3& c, const V3& d) noexcept {
         return {{a.x, b.x, c.x, d.x}, {a.y, b.y, c.y, d.y}, {a.z, b.z, c.z, d.z}};
+    }
+    /// Four consecutive vectors of three packed floats (a G-buffer row: x0 y0 z0 x1 ...),
+    /// one per lane: three unaligned loads and six shuffles instead of twelve scalar loads.
+    /// The lanes hold the same floats `gather` would give them.
+    static vec3x4 load_packed(const float* p) noexcept {
+        const f32v a = f32x4::load(p).v, b = f32x4::load(p + 4).v, c = f32x4::load(p + 8).v;
+        // a = x0 y0 z0 x1, b = y1 z1 x2 y2, c = z2 x3 y3 z3
+#if defined(__SSE__)
+        const __m128 bc_x = _mm_shuffle_ps(b, c, _MM_SHUFFLE(0, 1, 0, 2));  // x2 . x3 .
+        const __m128 ab_y = _mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 0, 1));  // y0 . y1 .
+        const __m128 bc_y = _mm_shuffle_ps(b, c, _MM_SHUFFLE(0, 2, 0, 3));  // y2 . y3 .
+        const __m128 ab_z = _mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 1, 0, 2));  // z0 . z1 .
+        const f32v x = _mm_shuffle_ps(a, bc_x, _MM_SHUFFLE(2, 0, 3, 0));
+        const f32v y = _mm_shuffle_ps(ab_y, bc_y, _MM_SHUFFLE(2, 0, 2, 0));
+        const f32v z = _mm_shuffle_ps(ab_z, c, _MM_SHUFFLE(3, 0, 2, 0));
+#else
+        const f32v x{a[0], a[3], b[2], c[1]}, y{a[1], b[0], b[3], c[2]}, z{a[2], b[1], c[0], c[3]};
+#endif
+        return {{x}, {y}, {z}};
     }
     /// One vector in every lane.
     template <class V3>

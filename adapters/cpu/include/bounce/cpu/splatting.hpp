@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -65,6 +66,9 @@ inline pixel_rect splat_rect(const camera& cam, const glm::mat4& view, const glm
 }
 
 namespace detail {
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "G-buffer rows are read as packed floats");
+static_assert(sizeof(glm::vec4) == 4 * sizeof(float), "splat buffer pixels are read as four packed floats");
+
 /// Squared radius beyond which `Weight` gives a record no weight, widened by a relative
 /// 1e-5 so that rounding in |p - pk|^2 never culls a point the weight itself would keep.
 template <class Weight>
@@ -110,28 +114,42 @@ inline void splat_into_lanes(const gbuffer_view<float>& gb, const irradiance_rec
     for (int y = r.y0; y <= r.y1; ++y) {
         const std::size_t yy = std::size_t(y);
         for (int x = r.x0; x <= r.x1; x += 4) {
+            // Four pixels of the row are contiguous in every G-buffer plane: load them
+            // packed; the row's last group repeats its last pixel in the spare lanes.
+            const bool full = x + 3 <= r.x1;
             std::size_t xs[4];
             mask4 valid{};
-            for (int i = 0; i < 4; ++i) {
-                xs[i] = std::size_t(std::min(x + i, r.x1));
-                valid.bits[i] = x + i <= r.x1 && gb.covered(xs[i], yy) ? -1 : 0;
+            if (full) {
+                for (int i = 0; i < 4; ++i) xs[i] = std::size_t(x + i);
+                valid = f32x4::load(&gb.depth(xs[0], yy)) < f32x4(std::numeric_limits<float>::infinity());
+            } else {
+                for (int i = 0; i < 4; ++i) {
+                    xs[i] = std::size_t(std::min(x + i, r.x1));
+                    valid.bits[i] = x + i <= r.x1 && gb.covered(xs[i], yy) ? -1 : 0;
+                }
             }
             if (!valid.any()) continue;
-            const vec3x4 p = vec3x4::gather(gb.position(xs[0], yy), gb.position(xs[1], yy), gb.position(xs[2], yy),
-                                            gb.position(xs[3], yy));
+            const auto load = [&](const image_view<glm::vec3>& plane) {
+                return full ? vec3x4::load_packed(&plane(xs[0], yy).x)
+                            : vec3x4::gather(plane(xs[0], yy), plane(xs[1], yy), plane(xs[2], yy), plane(xs[3], yy));
+            };
+            const vec3x4 p = load(gb.position);
             const vec3x4 d = p - pk;
             const mask4 inside = valid && dot(d, d) <= cull2;
             if (!inside.any()) continue;
-            const vec3x4 n = vec3x4::gather(gb.normal(xs[0], yy), gb.normal(xs[1], yy), gb.normal(xs[2], yy),
-                                            gb.normal(xs[3], yy));
-            const vec3x4 albedo = vec3x4::gather(gb.albedo(xs[0], yy), gb.albedo(xs[1], yy), gb.albedo(xs[2], yy),
-                                                 gb.albedo(xs[3], yy));
+            const vec3x4 n = load(gb.normal);
+            const vec3x4 albedo = load(gb.albedo);
             const auto c = splat_contribution<Weight, Gradients, FrontTest, f32x4, vec3x4>(
                 p, n, albedo, pk, nk, inv_r, a, e, rot_r, rot_g, rot_b, tr_r, tr_g, tr_b, max_extrapolation,
                 front_tolerance);
             const mask4 keep = inside && c[3] > f32x4(0.f);
+            if (!keep.any()) continue;
+            const auto pixels = transpose(c[0], c[1], c[2], c[3]);  // (r, g, b, w) of each lane
             for (int i = 0; i < 4; ++i)
-                if (keep[i]) out(xs[i], yy) += glm::vec4(c[0][i], c[1][i], c[2][i], c[3][i]);
+                if (keep[i]) {
+                    glm::vec4& o = out(xs[i], yy);
+                    (f32x4::load(&o.x) + pixels[i]).store(&o.x);
+                }
         }
     }
 }
