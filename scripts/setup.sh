@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages bounce needs when they are missing, then configures and
-# builds with a CMake preset.  Usage: scripts/setup.sh [default|sanitize]
+# builds with a CMake preset.  Usage: scripts/setup.sh [default|clang|sanitize]
 # Runs as root (apt-get) or as a user with sudo; does nothing to packages already present.
 set -euo pipefail
 preset="${1:-default}"
@@ -15,6 +15,7 @@ packages=(
   catch2 libopenimageio-dev openimageio-tools libtinyobjloader-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   python3 python3-matplotlib
 )
+[ "$preset" = clang ] && packages+=(clang)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
