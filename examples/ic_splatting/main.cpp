@@ -197,20 +197,31 @@ auto record_creator(const context& ctx, const camera& cam, const gbuffer<float>&
 
 // Step 4 over a splat buffer, for the CPU and GL backends alike: the batched scan (guesses
 // measured together) or the sequential one; sets fr's record counts, adds to record_ms.
+// `record_g`: where the records of missed pixels are measured (the scanned G-buffer `g`
+// itself, or for GL frames the sampler's own view of the same pixels, record_points_for).
 template <class W>
-void scan_splat_buffer(const context& ctx, const camera& cam, gbuffer<float>& g, const cpu::splat_params& sp,
-                       float min_weight, std::vector<irradiance_record>& records, image_view<glm::vec4> splat,
-                       std::size_t max_new, frame_result& fr, double& record_ms) {
+void scan_splat_buffer(const context& ctx, const camera& cam, gbuffer<float>& g, const gbuffer<float>& record_g,
+                       const cpu::splat_params& sp, float min_weight, std::vector<irradiance_record>& records,
+                       image_view<glm::vec4> splat, std::size_t max_new, frame_result& fr, double& record_ms) {
     if (ctx.opt.scan == "batched") {
-        const auto stats = cpu::scan_cache_misses_batched<W>(g.view(), cam, sp, min_weight, record_batch_measurer(ctx, cam, g),
+        const auto stats = cpu::scan_cache_misses_batched<W>(g.view(), cam, sp, min_weight,
+                                                             record_batch_measurer(ctx, cam, record_g),
                                                              record_committer(ctx, records), records, splat, ctx.batch,
                                                              ctx.order, max_new);
         take_scan_stats(stats, fr, record_ms);
     } else {
         fr.new_records = cpu::scan_cache_misses<W>(g.view(), cam, sp, min_weight,
-                                                   record_creator(ctx, cam, g, records, record_ms), records, splat,
-                                                   ctx.order, max_new);
+                                                   record_creator(ctx, cam, record_g, records, record_ms), records,
+                                                   splat, ctx.order, max_new);
     }
+}
+
+// Whether two G-buffers see the same surface at a pixel: points within 1e-4 of the scene's
+// size and normals within 2.6 degrees (the error mask of GL frames uses the same test).
+bool same_surface(const gbuffer<float>& g, const gbuffer<float>& h, std::size_t x, std::size_t y, float scene_size) {
+    return std::isfinite(g.depth(x, y)) && std::isfinite(h.depth(x, y)) &&
+           glm::length(g.position(x, y) - h.position(x, y)) <= 1e-4f * scene_size &&
+           glm::dot(g.normal(x, y), h.normal(x, y)) >= 0.999f;
 }
 
 // CPU backends: splat-cpu (Algorithm 5 on the CPU) and octree / octree-lanes (the classical
@@ -268,7 +279,7 @@ frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> 
                 cpu::splat_records<W>(gv, cam, records, sp, splat.view());
             }
             const auto t0 = clock_type::now();
-            scan_splat_buffer<W>(ctx, cam, g_in, sp, min_weight, records, splat.view(), max_new, fr, record_ms);
+            scan_splat_buffer<W>(ctx, cam, g_in, g_in, sp, min_weight, records, splat.view(), max_new, fr, record_ms);
             timer.add_sample("scan", ms_since(t0) - record_ms);
             timer.add_sample("compute_records", record_ms);
             // Step 5: the image comes from splatting every record (on the GPU in the seed).
@@ -314,6 +325,27 @@ struct gl_backend {
 
 // Algorithm 5 as the seed runs it: G-buffer, direct light and splatting on the GPU, the
 // cache-miss scan on the CPU over the read-back splat buffer.
+// Where a GL frame's records are measured. The Embree sampler starts its rays at its own
+// hit of the pixel's camera ray, where that is the surface the raster saw: the rasterized
+// point is only within about 1e-6 of the triangle, and at a contact line (a gallery's
+// underside meeting a wall) that is enough to put the ray origin inside the touching solid,
+// whose record then sees a closed hemisphere. Elsewhere (silhouettes, where the two see
+// different surfaces), and for the raster sampler, the raster's own point is kept.
+gbuffer<float> record_points_for(const context& ctx, const camera& cam, const gbuffer<float>& g) {
+    gbuffer<float> out = g;
+    if (ctx.opt.sampler != "embree") return out;
+    const gbuffer<float> ray = embree::ray_cast_gbuffer(ctx.bvh, ctx.scene, cam, g.width(), g.height());
+    const float scene_size = glm::length(ctx.scene.bounds().second - ctx.scene.bounds().first);
+    for (std::size_t y = 0; y < g.height(); ++y)
+        for (std::size_t x = 0; x < g.width(); ++x)
+            if (same_surface(g, ray, x, y, scene_size)) {
+                out.position(x, y) = ray.position(x, y);
+                out.normal(x, y) = ray.normal(x, y);
+                out.depth(x, y) = ray.depth(x, y);
+            }
+    return out;
+}
+
 frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& cam, float a,
                              std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
     const options& o = ctx.opt;
@@ -351,8 +383,12 @@ frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& c
         double record_ms = 0;
         const auto t0 = clock_type::now();
         const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
+        const auto t_points = clock_type::now();
+        const gbuffer<float> record_g = record_points_for(ctx, cam, fr.g);
+        record_ms += ms_since(t_points);
         with_weighting(kind, [&](auto w) {
-            scan_splat_buffer<decltype(w)>(ctx, cam, fr.g, sp, min_weight, records, splat.view(), max_new, fr, record_ms);
+            scan_splat_buffer<decltype(w)>(ctx, cam, fr.g, record_g, sp, min_weight, records, splat.view(), max_new, fr,
+                                           record_ms);
         });
         timer.add_sample("scan", ms_since(t0) - record_ms);
         timer.add_sample("compute_records", record_ms);
@@ -402,10 +438,7 @@ image<float> comparable_mask(const gbuffer<float>& g, const gbuffer<float>& ref_
     image<float> m = coverage_mask(g);
     for (std::size_t y = 0; y < g.height(); ++y)
         for (std::size_t x = 0; x < g.width(); ++x)
-            if (m(x, y) > 0.f && !(std::isfinite(ref_g.depth(x, y)) &&
-                                   glm::length(g.position(x, y) - ref_g.position(x, y)) <= 1e-4f * scene_size &&
-                                   glm::dot(g.normal(x, y), ref_g.normal(x, y)) >= 0.999f))
-                m(x, y) = 0.f;
+            if (m(x, y) > 0.f && !same_surface(g, ref_g, x, y, scene_size)) m(x, y) = 0.f;
     return m;
 }
 
