@@ -323,8 +323,6 @@ struct gl_backend {
     explicit gl_backend(const io::scene& s) : mesh(s), light(s, mesh, 2048) {}
 };
 
-// Algorithm 5 as the seed runs it: G-buffer, direct light and splatting on the GPU, the
-// cache-miss scan on the CPU over the read-back splat buffer.
 // Where a GL frame's records are measured. The Embree sampler starts its rays at its own
 // hit of the pixel's camera ray, where that is the surface the raster saw: the rasterized
 // point is only within about 1e-6 of the triangle, and at a contact line (a gallery's
@@ -346,6 +344,8 @@ gbuffer<float> record_points_for(const context& ctx, const camera& cam, const gb
     return out;
 }
 
+// Algorithm 5 as the seed runs it: G-buffer, direct light and splatting on the GPU, the
+// cache-miss scan on the CPU over the read-back splat buffer.
 frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& cam, float a,
                              std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
     const options& o = ctx.opt;

@@ -130,7 +130,7 @@ struct vec3x4 {
         return {{a.x, b.x, c.x, d.x}, {a.y, b.y, c.y, d.y}, {a.z, b.z, c.z, d.z}};
     }
     /// Four consecutive vectors of three packed floats (a G-buffer row: x0 y0 z0 x1 ...),
-    /// one per lane: three unaligned loads and six shuffles instead of twelve scalar loads.
+    /// one per lane: three unaligned loads and seven shuffles instead of twelve scalar loads.
     /// The lanes hold the same floats `gather` would give them.
     static vec3x4 load_packed(const float* p) noexcept {
         const f32v a = f32x4::load(p).v, b = f32x4::load(p + 4).v, c = f32x4::load(p + 8).v;
