@@ -32,6 +32,7 @@
 #endif
 
 #include <CLI/CLI.hpp>
+#include "../common/cli_number_checks.hpp"
 #include <fmt/core.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -395,9 +396,9 @@ int main(int argc, char** argv) {
 #ifdef BOUNCE_STUDY_WITH_GL
     app.add_option("--shadow-normal-offset", shadows.normal_offset_texels,
                    "raster sampler: shadow lookups moved this many texels along n")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
+        ->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--shadow-slope-bias", shadows.slope_bias, "raster sampler: shadow depth bias in depth slopes per texel")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
+        ->check(examples::finite_non_negative)->capture_default_str();
 #endif
     app.add_option("--texel-points", texel_points,
                    "also compare raster and ray-cast planes texel by texel on this many points (the first of --points)")

@@ -31,6 +31,7 @@
 #endif
 
 #include <CLI/CLI.hpp>
+#include "../common/cli_number_checks.hpp"
 #include <fmt/core.h>
 
 #include <chrono>
@@ -708,7 +709,7 @@ int main(int argc, char** argv) {
     app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, or an .obj")->capture_default_str();
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
-    app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(examples::finite_positive)->capture_default_str();
     app.add_option("--weight", o.weight, "ward | ward-smooth | ward-gpu | ward-gpu-shader | tabellion")
         ->check(CLI::IsMember({"ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion"}))->capture_default_str();
     app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
@@ -719,14 +720,16 @@ int main(int argc, char** argv) {
     app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)");
     app.add_option("--fill-holes", o.fill_holes,
                    "progressive: fill pixels no zone reaches from a splat with a this many times wider (0: off)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(examples::finite_non_negative)
         ->capture_default_str();
-    app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("--a-sweep", o.a_sweep, "comma-separated a values rendered from one growing cache")->delimiter(',');
+    app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--a-sweep", o.a_sweep, "comma-separated a values rendered from one growing cache")
+        ->delimiter(',')
+        ->check(examples::finite_positive);
     app.add_option("--record-samples", o.record_samples, "hemisphere rays per record")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
     app.add_option("--ref-spp", o.ref_spp, "reference integrator samples per pixel")->check(CLI::Range(1u, 1u << 20))->capture_default_str();
-    app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(CLI::NonNegativeNumber)->capture_default_str();
-    app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(examples::finite_non_negative)->capture_default_str();
+    app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(examples::finite_positive)->capture_default_str();
     app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
         ->check(CLI::IsMember({"batched", "sequential"}))
         ->capture_default_str();
@@ -738,11 +741,11 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
     app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
-    app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--front-tolerance", o.front_tolerance,
                    "skip records whose tangent plane the point lies this fraction of the zone behind (Ward's in-front test; 1: off)")
         ->check(CLI::Range(0.f, 1.f))->capture_default_str();
-    app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(CLI::NonNegativeNumber);
+    app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(examples::finite_non_negative);
     app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
     app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");
     app.add_option("--json", o.json, "write the run report here");

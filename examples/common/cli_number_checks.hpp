@@ -1,0 +1,46 @@
+#pragma once
+/// \file cli_number_checks.hpp
+/// CLI11 validators for the examples' numeric options. CLI::PositiveNumber and
+/// CLI::NonNegativeNumber let "nan" through (every comparison with NaN is false), so a run
+/// would go on to fail, or quietly give NaN figures, after minutes of reference rendering,
+/// and their messages print the range up to DBL_MAX in full. These refuse NaN and
+/// infinities at parse time and say what they want.
+
+#include <CLI/CLI.hpp>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace bounce::examples {
+
+namespace detail {
+/// The number `s` spells (the whole of it), or NaN when it spells none.
+inline double parse_number(const std::string& s) {
+    const char* begin = s.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(begin, &end);
+    if (end == begin || *end != '\0' || errno == ERANGE) return std::nan("");
+    return v;
+}
+
+inline CLI::Validator finite_number_at_least_zero(bool zero_allowed) {
+    const std::string want = zero_allowed ? "a finite number >= 0" : "a finite number > 0";
+    return CLI::Validator(
+        [zero_allowed, want](std::string& s) -> std::string {
+            const double v = parse_number(s);
+            if (std::isfinite(v) && (v > 0 || (zero_allowed && v == 0))) return {};
+            return "'" + s + "' is not " + want;
+        },
+        zero_allowed ? "FINITE >= 0" : "FINITE > 0");
+}
+}  // namespace detail
+
+/// A finite number above zero.
+inline const CLI::Validator finite_positive = detail::finite_number_at_least_zero(false);
+/// A finite number, zero or above.
+inline const CLI::Validator finite_non_negative = detail::finite_number_at_least_zero(true);
+
+}  // namespace bounce::examples

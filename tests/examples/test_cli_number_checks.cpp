@@ -1,0 +1,58 @@
+// The examples' numeric option checks: what CLI11's own PositiveNumber lets through.
+#include <common/cli_number_checks.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+namespace {
+
+// Parses `--x VALUE` against an option checked by `check`; returns whether CLI11 accepted it
+// (and the value it stored), rethrowing anything but a validation failure.
+bool accepts(const CLI::Validator& check, const std::string& value, double* stored = nullptr) {
+    CLI::App app;
+    double x = -7;
+    app.add_option("--x", x)->check(check);
+    std::vector<std::string> args{value, "--x"};  // CLI11 takes them in reverse order
+    try {
+        app.parse(args);
+    } catch (const CLI::ValidationError&) {
+        return false;
+    }
+    if (stored) *stored = x;
+    return true;
+}
+
+}  // namespace
+
+TEST_CASE("finite_positive refuses what is not a finite number above zero", "[examples][cli]") {
+    const std::string bad = GENERATE("0", "-0", "-1", "-1e-30", "nan", "NaN", "-nan", "inf", "-inf", "infinity",
+                                     "1e400", "abc", "0.15x", "", " ");
+    CAPTURE(bad);
+    CHECK_FALSE(bounce::examples::finite_positive(std::string(bad)).empty());
+    CHECK_FALSE(accepts(bounce::examples::finite_positive, bad));
+}
+
+TEST_CASE("finite_positive keeps every finite number above zero as written", "[examples][cli]") {
+    const std::string good = GENERATE("0.15", "1", "4e-45", "1e-300", "3.4e38", "1e308", "0x1p-3", "+2");
+    double stored = 0;
+    CAPTURE(good);
+    REQUIRE(accepts(bounce::examples::finite_positive, good, &stored));
+    CHECK(stored == std::stod(good));
+}
+
+TEST_CASE("finite_non_negative takes zero and refuses the rest of what finite_positive refuses", "[examples][cli]") {
+    CHECK(accepts(bounce::examples::finite_non_negative, "0"));
+    CHECK(accepts(bounce::examples::finite_non_negative, "-0"));
+    CHECK(accepts(bounce::examples::finite_non_negative, "2.5"));
+    const std::string bad = GENERATE("-1e-30", "nan", "inf", "-inf", "abc", "");
+    CAPTURE(bad);
+    CHECK_FALSE(accepts(bounce::examples::finite_non_negative, bad));
+}
+
+TEST_CASE("the refusal says what the option wants", "[examples][cli]") {
+    const std::string message = bounce::examples::finite_positive(std::string("nan"));
+    CHECK(message.find("'nan'") != std::string::npos);
+    CHECK(message.find("finite number > 0") != std::string::npos);
+}
