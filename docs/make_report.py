@@ -161,7 +161,7 @@ def main():
             lines.append("")
         prog = [r for r in mine.values() if "frames" in r]
         if prog:
-            lines += ["Progressive mode (at most N new records per frame over a camera path):", "",
+            lines += ["Progressive mode (at most N new records per frame; the camera walks forward and pans from -10 to +10 degrees):", "",
                       "| frame | records | new | ms | fps | rel_rms |", "|---|---|---|---|---|---|"]
             lines += [f"| {f['frame']} | {f['records']} | {f['new_records']} | {f['ms']:.0f} | {f['fps']:.2f} | "
                       f"{f['rel_rms']:.4f} |" for f in prog[0]["frames"]]
