@@ -60,6 +60,12 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
   run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show
   rays "$tag" "${base[@]}"
+  # Nearly noise-free records (Cornell only: Sponza's would take half an hour each): does the
+  # smoothed weight's excess over Ward's at a = 0.15 come from record noise?
+  if [[ $tag == cornell ]]; then
+    run "$tag-r16384" "${base[@]}" --a 0.15 --weight ward-smooth --record-samples 16384
+    run "$tag-ward-r16384" "${base[@]}" --a 0.15 --weight ward --record-samples 16384
+  fi
   if [[ $clamp == on ]]; then
     run "$tag-$other" --scene "$scene" --width 512 --height 512 --ref-spp "$spp" --record-samples "$rays" --a 0.15 \
         --weight ward-smooth
