@@ -93,6 +93,11 @@ def headline(scene, mine):
         out.append(f"- smoothed weight {err('smooth'):.4f} against Ward's {err('ward'):.4f} (target: not above)")
     if err("r4096") and err("ward-r4096"):
         out.append(f"- with 4096 rays per record: smoothed {err('r4096'):.4f}, Ward's {err('ward-r4096'):.4f}")
+    for tag, label in (("r16384", "with 16384 rays per record (nearly noise-free records)"),
+                       ("256-r1024", "at 256x256 against a 16384-spp reference, 1024 rays per record"),
+                       ("256-r16384", "at 256x256 against a 16384-spp reference, 16384 rays per record")):
+        if err(tag) and err(f"ward-{tag}"):
+            out.append(f"- {label}: smoothed {err(tag):.4f}, Ward's {err(f'ward-{tag}'):.4f}")
     if err("a0.4") and err("ward-a0.4"):
         out.append(f"- at a = 0.4, where Ward's seams show: smoothed {err('a0.4'):.4f}, Ward's {err('ward-a0.4'):.4f}")
     si, oi = mine.get(f"{scene}-interp-splat"), mine.get(f"{scene}-interp-octree")

@@ -60,11 +60,18 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
   run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show
   rays "$tag" "${base[@]}"
-  # Nearly noise-free records (Cornell only: Sponza's would take half an hour each): does the
-  # smoothed weight's excess over Ward's at a = 0.15 come from record noise?
+  # Nearly noise-free records: does the smoothed weight's excess over Ward's at a = 0.15 come
+  # from record noise? Sponza's at 256x256 (at 512x512 a run would take half an hour), against
+  # a 16384-spp reference of that size, with 1024 rays beside them.
   if [[ $tag == cornell ]]; then
     run "$tag-r16384" "${base[@]}" --a 0.15 --weight ward-smooth --record-samples 16384
     run "$tag-ward-r16384" "${base[@]}" --a 0.15 --weight ward --record-samples 16384
+  else
+    local small=(--scene "$scene" --width 256 --height 256 --ref-spp 16384 "${flags[@]}" --a 0.15)
+    for r in 1024 16384; do
+      run "$tag-256-r$r" "${small[@]}" --weight ward-smooth --record-samples "$r"
+      run "$tag-ward-256-r$r" "${small[@]}" --weight ward --record-samples "$r"
+    done
   fi
   if [[ $clamp == on ]]; then
     run "$tag-$other" --scene "$scene" --width 512 --height 512 --ref-spp "$spp" --record-samples "$rays" --a 0.15 \
