@@ -72,6 +72,8 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
       run "$tag-256-r$r" "${small[@]}" --weight ward-smooth --record-samples "$r"
       run "$tag-ward-256-r$r" "${small[@]}" --weight ward --record-samples "$r"
     done
+    # and the gradients' gain on those accurate records
+    run "$tag-256-r16384-nograd" "${small[@]}" --weight ward-smooth --record-samples 16384 --gradients off
   fi
   if [[ $clamp == on ]]; then
     run "$tag-$other" --scene "$scene" --width 512 --height 512 --ref-spp "$spp" --record-samples "$rays" --a 0.15 \
