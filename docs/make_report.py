@@ -82,13 +82,11 @@ def headline(scene, mine):
         if on and err(f"r{rays}-nograd"):
             out.append(f"- with {rays} rays per record: {on:.4f}, without gradients {err(f'r{rays}-nograd'):.4f}: "
                        f"gradients lower the error by {100 * (1 - on / err(f'r{rays}-nograd')):.0f}%")
-    if err("256-r16384") and err("256-r16384-nograd"):
-        out.append(f"- at 256x256 against a 16384-spp reference, 16384 rays per record: {err('256-r16384'):.4f}, "
-                   f"without gradients {err('256-r16384-nograd'):.4f}: gradients lower the error by "
-                   f"{100 * (1 - err('256-r16384') / err('256-r16384-nograd')):.0f}%")
-    if err("r4096") and err("r4096-nograd"):
-        out.append(f"- with 4096 rays per record: {err('r4096'):.4f}, without gradients {err('r4096-nograd'):.4f}: "
-                   f"gradients lower the error by {100 * (1 - err('r4096') / err('r4096-nograd')):.0f}%")
+    for tag, label in (("256-r16384", "at 256x256 against a 16384-spp reference, 16384 rays per record"),
+                       ("r4096", "with 4096 rays per record")):
+        if err(tag) and err(f"{tag}-nograd"):
+            out.append(f"- {label}: {err(tag):.4f}, without gradients {err(f'{tag}-nograd'):.4f}: "
+                       f"gradients lower the error by {100 * (1 - err(tag) / err(f'{tag}-nograd')):.0f}%")
     if err("smooth") and err("front"):
         f, sm = mine[f"{scene}-front"], mine[f"{scene}-smooth"]
         out.append(f"- Ward's in-front test (tolerance {f['parameters']['front_tolerance']:.2g}): {err('front'):.4f} with "

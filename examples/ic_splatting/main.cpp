@@ -444,23 +444,33 @@ image<float> comparable_mask(const gbuffer<float>& g, const gbuffer<float>& ref_
     return m;
 }
 
-// Frame f of the progressive mode's camera path: from the scene's camera, a walk forward
-// along the view axis (a tenth of the way to the target, and never more than half the way to
-// the first surface on the axis) while the view pans from -10 to +10 degrees about the up
-// axis, so the eye stays in the open space it starts in. (An orbit about the target, the
-// first path, swung Sponza's eye 3 m sideways through the colonnade: frames saw one column
-// face from centimetres away, and their errors told nothing about the cache.)
-camera camera_on_path(const embree::accel& bvh, const camera& base, std::size_t f, std::size_t frames) {
-    const glm::vec3 axis = base.look_at - base.position;
-    const embree::hit first = bvh.intersect({base.position, glm::normalize(axis)});  // t = inf on a miss
-    const float walk = std::min(0.1f * glm::length(axis), 0.5f * first.t);
-    const float t = float(f) / float(std::max<std::size_t>(1, frames - 1));
-    camera cam = base;
-    cam.position = base.position + t * walk * glm::normalize(axis);
-    const glm::quat pan = glm::angleAxis(glm::radians(20.f) * (t - 0.5f), glm::normalize(base.up));
-    cam.look_at = cam.position + pan * (base.look_at - cam.position);
-    return cam;
-}
+// The progressive mode's camera path: from the scene's camera, a walk forward along the
+// view axis (a tenth of the way to the target, and never more than half the way to the first
+// surface on the axis) while the view pans from -10 to +10 degrees about the up axis, so the
+// eye stays in the open space it starts in. (An orbit about the target, the first path, swung
+// Sponza's eye 3 m sideways through the colonnade: frames saw one column face from
+// centimetres away, and their errors told nothing about the cache.)
+struct camera_path {
+    camera base;
+    glm::vec3 forward;
+    float walk;  // world units the eye moves over the whole path
+    std::size_t frames;
+
+    camera_path(const embree::accel& bvh, const camera& start, std::size_t frame_count)
+        : base(start), forward(start.forward()), frames(frame_count) {
+        const embree::hit first = bvh.intersect({base.position, forward});  // t = inf on a miss
+        walk = std::min(0.1f * glm::length(base.look_at - base.position), 0.5f * first.t);
+    }
+
+    camera at(std::size_t f) const {
+        const float t = float(f) / float(std::max<std::size_t>(1, frames - 1));
+        camera cam = base;
+        cam.position = base.position + t * walk * forward;
+        const glm::quat pan = glm::angleAxis(glm::radians(20.f) * (t - 0.5f), glm::normalize(base.up));
+        cam.look_at = cam.position + pan * (base.look_at - cam.position);
+        return cam;
+    }
+};
 
 nlohmann::ordered_json error_json(const io::error_figures& e) {
     return {{"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}, {"sum_sq", e.sum_sq}, {"pixels", e.pixels}};
@@ -567,8 +577,9 @@ int run(const options& o) {
         // Progressive mode: records are view-independent, so each frame of the camera path
         // reuses the cache and adds at most N records.
         nlohmann::ordered_json frames = nlohmann::ordered_json::array();
+        const camera_path path(bvh, scene.camera, o.frames);
         for (std::size_t f = 0; f < o.frames; ++f) {
-            const camera cam = camera_on_path(bvh, scene.camera, f, o.frames);
+            const camera cam = path.at(f);
             io::stage_timer ft;
             const auto t0 = clock_type::now();
             const auto fr = frame(cam, o.a, ft, o.progressive);
