@@ -44,6 +44,7 @@
 #include <fstream>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -175,9 +176,12 @@ reference_set compute_reference(const embree::reference_integrator& ref, const i
 
 // Irradiance per point for the four weightings, from the plane and stretch sums of each
 // record (coverage and fall-off are linear in them: E_cov = pi / sum(w_plane) E_plane,
-// E_falloff = E_plane + kappa (E_stretch - E_plane)), and the records' kappa.
+// E_falloff = E_plane + kappa (E_stretch - E_plane)), and the records' kappa: pooled over
+// the whole run, and running (what a renderer can know: the profile of the batches made so
+// far, the record's own batch included).
 struct estimates {
     std::vector<glm::dvec3> plane, stretch;
+    std::vector<double> running_kappa;  // per point
     double coverage_scale = 1, kappa = 1;
     double seconds = 0;  // wall time of sampling and summing all records
 
@@ -186,9 +190,10 @@ struct estimates {
         for (const auto& e : plane) c.push_back(e * coverage_scale);
         return c;
     }
-    std::vector<glm::dvec3> falloff() const {
+    std::vector<glm::dvec3> falloff(std::span<const double> kappas = {}) const {
         std::vector<glm::dvec3> f;
-        for (std::size_t k = 0; k < plane.size(); ++k) f.push_back(plane[k] + kappa * (stretch[k] - plane[k]));
+        for (std::size_t k = 0; k < plane.size(); ++k)
+            f.push_back(plane[k] + (kappas.empty() ? kappa : kappas[k]) * (stretch[k] - plane[k]));
         return f;
     }
     json errors(const std::vector<glm::dvec3>& ref) const {
@@ -196,7 +201,9 @@ struct estimates {
                 {"rms_coverage", rel_rms(coverage(), ref)},
                 {"rms_stretch", rel_rms(stretch, ref)},
                 {"rms_falloff", rel_rms(falloff(), ref)},
-                {"falloff_kappa", kappa}};
+                {"falloff_kappa", kappa},
+                {"rms_falloff_running", rel_rms(falloff(running_kappa), ref)},
+                {"falloff_kappa_first_batch", running_kappa.empty() ? 1.0 : running_kappa.front()}};
     }
 };
 
@@ -209,28 +216,36 @@ struct tables {
 
 // The ray-cast sampler: each pixel's ray from p + eps n through the plane, shaded with the
 // reference integrator's incoming radiance (Kd / pi * E_direct at the hit, shadow rays).
-estimates ray_cast(const embree::reference_integrator& ref, const std::vector<study_point>& pts, const plane_camera& cam) {
+// Batches of `batch` points in order, as a renderer makes them (parallel within a batch).
+estimates ray_cast(const embree::reference_integrator& ref, const std::vector<study_point>& pts, const plane_camera& cam,
+                   std::size_t batch) {
     const tables t(cam);
     estimates out;
     out.plane.resize(pts.size());
     out.stretch.resize(pts.size());
+    out.running_kappa.resize(pts.size());
     out.coverage_scale = t.coverage_scale();
-    tbb::enumerable_thread_specific<radial_profile> profiles([&] { return radial_profile(cam); });
+    radial_profile running(cam);
     const auto t0 = clock_type::now();
-    tbb::parallel_for(std::size_t(0), pts.size(), [&](std::size_t k) {
-        const auto [p, n] = pts[k];
-        image<glm::vec3> radiance(cam.resolution, cam.resolution);
-        image<float> distance(cam.resolution, cam.resolution);
-        embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
-        const plane_view v{radiance.view(), distance.view()};
-        out.stretch[k] = estimate_plane(t.stretch, v).irradiance;
-        out.plane[k] = estimate_plane(t.plane, v).irradiance;
-        profiles.local().add(radiance.view());
-    });
+    for (std::size_t first = 0; first < pts.size(); first += batch) {
+        const std::size_t last = std::min(pts.size(), first + batch);
+        tbb::enumerable_thread_specific<radial_profile> profiles([&] { return radial_profile(cam); });
+        tbb::parallel_for(first, last, [&](std::size_t k) {
+            const auto [p, n] = pts[k];
+            image<glm::vec3> radiance(cam.resolution, cam.resolution);
+            image<float> distance(cam.resolution, cam.resolution);
+            embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
+            const plane_view v{radiance.view(), distance.view()};
+            out.stretch[k] = estimate_plane(t.stretch, v).irradiance;
+            out.plane[k] = estimate_plane(t.plane, v).irradiance;
+            profiles.local().add(radiance.view());
+        });
+        for (const auto& p : profiles) running.merge(p);
+        std::fill(out.running_kappa.begin() + std::ptrdiff_t(first), out.running_kappa.begin() + std::ptrdiff_t(last),
+                  running.falloff_factor());
+    }
     out.seconds = seconds_since(t0);
-    radial_profile all(cam);
-    for (const auto& p : profiles) all.merge(p);
-    out.kappa = all.falloff_factor();
+    out.kappa = running.falloff_factor();
     return out;
 }
 
@@ -271,6 +286,7 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
     raster_result out;
     out.cpu.plane.resize(pts.size());
     out.cpu.stretch.resize(pts.size());
+    out.cpu.running_kappa.resize(pts.size());
     out.cpu.coverage_scale = t.coverage_scale();
     radial_profile profile(cam);
     std::vector<glm::vec3> positions, normals;
@@ -282,6 +298,7 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
             out.cpu.plane[first + k] = estimate_plane(t.plane, planes.view(k)).irradiance;
         });
         for (std::size_t k = 0; k < planes.size(); ++k) profile.add(planes.radiance[k].view());
+        std::fill_n(out.cpu.running_kappa.begin() + std::ptrdiff_t(first), planes.size(), profile.falloff_factor());
     };
     const auto t0 = clock_type::now();
     std::optional<std::size_t> previous;
@@ -389,7 +406,9 @@ int main(int argc, char** argv) {
     app.add_option("--sweep-points", sweep_points, "points per setting of the sweep (the first of --points)")
         ->check(CLI::Range(1, 200000))
         ->capture_default_str();
-    app.add_option("--batch", batch, "records per raster atlas")->check(CLI::Range(1, 1024))->capture_default_str();
+    app.add_option("--batch", batch, "records per raster atlas, and per step of the running fall-off profile")
+        ->check(CLI::Range(1, 1024))
+        ->capture_default_str();
     app.add_option("--shadow-resolution", shadow_resolution, "texels per side of the raster sampler's shadow maps")
         ->check(CLI::Range(64, 8192))
         ->capture_default_str();
@@ -442,11 +461,11 @@ int main(int argc, char** argv) {
 
         json report_error = json::object(), records_per_s = json::object(), extra = json::object();
         const auto print_row = [](const char* sampler, const json& e, double rps) {
-            fmt::print("  {:<16} plane {:6.2f}%  coverage {:6.2f}%  stretch {:6.2f}%  falloff {:6.2f}% (kappa {:.3f})  "
-                       "{:8.1f} records/s\n",
+            fmt::print("  {:<16} plane {:6.2f}%  coverage {:6.2f}%  stretch {:6.2f}%  falloff {:6.2f}% (kappa {:.3f}; "
+                       "running {:6.2f}%)  {:8.1f} records/s\n",
                        sampler, 100 * e["rms_plane"].get<double>(), 100 * e["rms_coverage"].get<double>(),
                        100 * e["rms_stretch"].get<double>(), 100 * e["rms_falloff"].get<double>(),
-                       e["falloff_kappa"].get<double>(), rps);
+                       e["falloff_kappa"].get<double>(), 100 * e["rms_falloff_running"].get<double>(), rps);
         };
 
 #ifdef BOUNCE_STUDY_WITH_GL
@@ -492,7 +511,7 @@ int main(int argc, char** argv) {
 #endif
         }
         if (!no_ray_cast) {
-            ray_main = ray_cast(ref, main_pts, cam);
+            ray_main = ray_cast(ref, main_pts, cam, batch);
             const json e = ray_main->errors(main_ref);
             report_error["ray_cast"] = e;
             records_per_s["ray_cast"] = double(main_pts.size()) / ray_main->seconds;
@@ -522,7 +541,7 @@ int main(int argc, char** argv) {
                         sweep_rows.push_back(row);
                         print_row(fmt::format("{} {}^2 {}", sampler, n, ap).c_str(), row, row["records_per_s"].get<double>());
                     };
-                    if (!no_ray_cast) add_row("ray_cast", ray_cast(ref, sp, c));
+                    if (!no_ray_cast) add_row("ray_cast", ray_cast(ref, sp, c, batch));
 #ifdef BOUNCE_STUDY_WITH_GL
                     if (!no_raster) add_row("raster", run_raster(sp, c).cpu);
 #endif
