@@ -309,3 +309,36 @@ TEST_CASE("the raster record sampler makes the same records one at a time and in
     std::vector<std::optional<irradiance_record>> wrong(2);
     CHECK_THROWS_AS(sampler(p, n, footprint, wrong), parameter_error);
 }
+
+TEST_CASE("the raster record sampler's fall-off kappa moves the band between plane and stretching", "[hemisphere][gl][record]") {
+    gl_test::shared_context();
+    const io::scene s = half_lit_ceiling_scene(1.5f, 0.4f, 0.75f, 2.f);
+    const gl::scene_mesh mesh(s);
+    const gl::direct_light light(s, mesh, 512);
+    gl::hemisphere_raster_options options;
+    options.camera = {16, 126.0};
+    options.batch = 2;
+    options.offset = 1e-3f;
+    gl::hemisphere_raster raster(s, mesh, light, options);
+    const radius_limits limits;
+    // Four samplers on one raster, called in turn: each must sum with its own weights.
+    gl::raster_record_sampler stretch(raster, limits), none(raster, limits, plane_weighting::falloff, 0.0),
+        half(raster, limits, plane_weighting::falloff, 0.5), full(raster, limits, plane_weighting::falloff, 1.0);
+    pcg32 rng(4);
+    for (int k = 0; k < 20; ++k) {
+        const float x = float(4 * rng.next_double() - 2);
+        const glm::vec3 p(x, 0.f, float(4 * rng.next_double() - 2)), n(0.f, 1.f, 0.f);
+        const auto e1 = stretch(p, n, 1e-3), e0 = none(p, n, 1e-3), eh = half(p, n, 1e-3), ef = full(p, n, 1e-3);
+        REQUIRE((e1 && e0 && eh && ef));
+        CAPTURE(k, x);
+        // E is linear in kappa; kappa = 1 is stretching. Float sums on the GPU: 1e-5 relative.
+        CHECK(ef->irradiance.x == Approx(e1->irradiance.x).epsilon(1e-5));
+        CHECK(eh->irradiance.x == Approx(0.5f * (e0->irradiance.x + e1->irradiance.x)).epsilon(1e-5).margin(1e-6));
+        // The lit half of the ceiling reaches the horizon on one side, so the band always
+        // sees light (at least 2% of E here): less kappa, less irradiance.
+        CHECK(e0->irradiance.x < 0.98f * e1->irradiance.x);
+    }
+    CHECK_THROWS_AS(gl::raster_record_sampler(raster, limits, plane_weighting::stretch, 0.5), parameter_error);
+    CHECK_THROWS_AS(gl::raster_record_sampler(raster, limits, plane_weighting::falloff, 1.5), parameter_error);
+    CHECK_THROWS_AS(gl::raster_record_sampler(raster, limits, plane_weighting::falloff, std::nan("")), parameter_error);
+}

@@ -26,11 +26,15 @@ namespace bounce::gl {
 class raster_record_sampler {
 public:
     /// `raster` must outlive the sampler (and its context be current when it is called);
-    /// `kind`: the plane weighting (typical: stretch); `limits`: radius clamps.
+    /// `kind`: the plane weighting (typical: stretch); `limits`: radius clamps; `kappa`:
+    /// fall-off stretching's band factor, fixed for the sampler's life (for instance
+    /// radial_profile::falloff_factor of an earlier run's planes; the reduction does not
+    /// keep a profile). Throws parameter_error for a kappa outside [0, 1], or a kappa other
+    /// than 1 with another weighting.
     raster_record_sampler(hemisphere_raster& raster, radius_limits limits,
-                          plane_weighting kind = plane_weighting::stretch)
-        : raster_(raster), limits_(limits) {
-        raster_.set_weights(make_plane_weights(raster_.options().camera, kind));
+                          plane_weighting kind = plane_weighting::stretch, double kappa = 1.0)
+        : raster_(raster), limits_(limits), weights_(make_plane_weights(raster.options().camera, kind, kappa)) {
+        require(kind == plane_weighting::falloff || kappa == 1.0, "kappa", "applies to fall-off stretching only");
     }
 
     std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint) {
@@ -45,6 +49,7 @@ public:
                     std::span<const double> footprints, std::span<std::optional<irradiance_record>> out) {
         require(normals.size() == points.size() && footprints.size() == points.size() && out.size() == points.size(),
                 "points", "points, normals, footprints and out must have one entry per record");
+        raster_.set_weights(weights_);  // the raster may be shared with other samplers or studies
         for (std::size_t first = 0; first < points.size(); first += raster_.capacity()) {
             const std::size_t count = std::min(raster_.capacity(), points.size() - first);
             raster_.render(points.subspan(first, count), normals.subspan(first, count));
@@ -64,6 +69,7 @@ public:
 private:
     hemisphere_raster& raster_;
     radius_limits limits_;
+    plane_weights weights_;
 };
 
 }  // namespace bounce::gl
