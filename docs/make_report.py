@@ -128,6 +128,32 @@ def headline(scene, mine):
     return out
 
 
+WEIGHTS = ("ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion")
+
+
+def weights_table(scene, mine):
+    """Every weighting policy on its own cache at a = 0.15 and 0.4 (runs SCENE-w-WEIGHT-aA)."""
+    cells = {}
+    for w in WEIGHTS:
+        for a in ("0.15", "0.4"):
+            r = mine.get(f"{scene}-w-{w}-a{a}")
+            if r:
+                cells[w, a] = f"{r['records']} | {r['timings_ms']['total']:.0f} | {r['error']['rel_rms']:.4f}"
+    if not cells:
+        return []
+    lines = ["Weighting functions, each on the cache it builds (runs back to back on one machine):", "",
+             "| weight | a = 0.15: records | ms | rel_rms | a = 0.4: records | ms | rel_rms |", "|---|---|---|---|---|---|---|"]
+    for w in WEIGHTS:
+        lines.append(f"| {w} | {cells.get((w, '0.15'), ' | | ')} | {cells.get((w, '0.4'), ' | | ')} |")
+    m = mine.get(f"{scene}-tabellion-mc")
+    if m and "mc_equal_error" in m:
+        bound = "at least " if m["mc_equal_error"].get("lower_bound") else ""
+        lines += ["", f"Tabellion's weight at a = {m['parameters']['a']:.2g} ({m['records']} records, "
+                      f"{m['timings_ms']['total']:.0f} ms, rel_rms {m['error']['rel_rms']:.4f}): brute-force Monte Carlo "
+                      f"takes {bound}{m['mc_equal_error']['speedup']:.1f}x the cache's time at that error."]
+    return lines + [""]
+
+
 def main():
     runs = load()
     lines = ["# Speed against error", "",
@@ -149,6 +175,7 @@ def main():
         head = headline(scene, mine)
         if head:
             lines += ["Figures the irradiance-splatting issue asks for (a = 0.15):", ""] + head + [""]
+        lines += weights_table(scene, mine)
         mc = [r for r in mine.values() if "mc_sweep" in r]
         if mc:
             r = mc[0]
@@ -175,7 +202,7 @@ def main():
             lines.append("")
         # The a sweep against Monte Carlo, as a table and as a plot: one series per number of
         # rays per record (runs named SCENE-aA and SCENE-rN-aA).
-        swept = [v for k, v in mine.items() if "-a0" in k and "ward-" not in k]
+        swept = [v for k, v in mine.items() if "-a0" in k and "ward-" not in k and "-w-" not in k]
         series = {}
         for r in swept:
             series.setdefault(r["parameters"]["record_samples"], []).append(r)

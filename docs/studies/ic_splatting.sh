@@ -32,6 +32,16 @@ interp() {  # interp TAG ARGS...: splat against octree (scalar, four-lane) on on
   run "$tag-interp-octree-lanes" "$@" --a 0.15 --weight ward-smooth --cache-in "$cache" --repeat 15 --interp octree-lanes
 }
 
+weights() {  # weights TAG ARGS...: every weighting policy at a = 0.15 and 0.4, run back to back (one machine's times)
+  local tag=$1; shift
+  for a in 0.15 0.4; do
+    for w in ward ward-smooth ward-gpu ward-gpu-shader tabellion; do
+      run "$tag-w-$w-a$a" "$@" --a "$a" --weight "$w"
+    done
+  done
+  run "$tag-tabellion-mc" "$@" --a 0.4 --weight tabellion --mc-compare  # its best error per record, against Monte Carlo
+}
+
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor) RAYS(per record)
   local tag=$1 scene=$2 spp=$3 clamp=$4 fill=$5 rays=$6
   local flags=() other=clamp  # other: the cross-check run with the other clamping setting
@@ -60,6 +70,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-smooth" "${common[@]}" --a 0.15 --weight ward-smooth
   run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show
   rays "$tag" "${base[@]}"
+  weights "$tag" "${common[@]}"
   # Nearly noise-free records: does the smoothed weight's excess over Ward's at a = 0.15 come
   # from record noise? Sponza's at 256x256 (at 512x512 a run would take half an hour), against
   # a 16384-spp reference of that size, with 1024 rays beside them.
