@@ -71,6 +71,27 @@ bool edge_crosses_pixel(const plane_camera& cam, const analytic_ceiling& c, std:
     return s00 != side(b[2], b[1]) || s00 != side(b[0], b[3]) || s00 != side(b[2], b[3]);
 }
 
+// A half-lit ceiling (half_lit_ceiling_scene's parameters) on GL: its mesh, its light with
+// shadow maps of `shadow_resolution`, and a hemisphere raster with `options`.
+struct gl_ceiling {
+    io::scene scene;
+    gl::scene_mesh mesh;
+    gl::direct_light light;
+    gl::hemisphere_raster raster;
+    gl_ceiling(float H, float x_edge, float kd, float E_perp, int shadow_resolution,
+               const gl::hemisphere_raster_options& options)
+        : scene(half_lit_ceiling_scene(H, x_edge, kd, E_perp)), mesh(scene), light(scene, mesh, shadow_resolution),
+          raster(scene, mesh, light, options) {}
+};
+
+gl::hemisphere_raster_options raster_options(std::uint32_t N, double aperture, std::size_t batch, float offset) {
+    gl::hemisphere_raster_options o;
+    o.camera = {N, aperture};
+    o.batch = batch;
+    o.offset = offset;
+    return o;
+}
+
 }  // namespace
 
 TEST_CASE("plane kernels print to GLSL and agree with the CPU", "[hemisphere][gl][agreement]") {
@@ -153,16 +174,11 @@ TEST_CASE("rasterized planes of a half-lit ceiling match the analytic plane, and
     gl_test::shared_context();
     const float H = 1.5f, x_edge = 0.4f, kd = 0.75f, E_perp = 2.f;
     const float L = kd / float(pi) * E_perp;
-    const io::scene s = half_lit_ceiling_scene(H, x_edge, kd, E_perp);
-    const gl::scene_mesh mesh(s);
-    const gl::direct_light light(s, mesh, 512);
     const auto N = GENERATE(16u, 64u);
     const auto aperture = GENERATE(90.0, 126.0, 150.0);
-    gl::hemisphere_raster_options options;
-    options.camera = {N, aperture};
-    options.batch = 7;  // 3 x 3 atlas, two tiles unused
-    options.offset = 1e-3f;
-    gl::hemisphere_raster raster(s, mesh, light, options);
+    const auto options = raster_options(N, aperture, 7, 1e-3f);  // 3 x 3 atlas, two tiles unused
+    gl_ceiling g(H, x_edge, kd, E_perp, 512, options);
+    gl::hemisphere_raster& raster = g.raster;
     pcg32 rng(N + unsigned(aperture));
     std::vector<glm::vec3> positions, normals;
     for (std::size_t k = 0; k < options.batch; ++k) {
@@ -213,13 +229,9 @@ TEST_CASE("rasterized planes of a half-lit ceiling match the analytic plane, and
 
 TEST_CASE("asynchronous read-backs return each batch's planes in order", "[hemisphere][gl]") {
     gl_test::shared_context();
-    const io::scene s = half_lit_ceiling_scene(2.f, 0.f, 0.5f, 1.f);
-    const gl::scene_mesh mesh(s);
-    const gl::direct_light light(s, mesh, 256);
-    gl::hemisphere_raster_options options;
-    options.camera = {8, 120.0};
-    options.batch = 3;
-    gl::hemisphere_raster raster(s, mesh, light, options);
+    const auto options = raster_options(8, 120.0, 3, 0.f);
+    gl_ceiling g(2.f, 0.f, 0.5f, 1.f, 256, options);
+    gl::hemisphere_raster& raster = g.raster;
     CHECK_THROWS_AS(raster.start_read(), parameter_error);  // nothing rendered
     CHECK_THROWS_AS(raster.finish_read(), parameter_error);  // nothing pending
     const std::vector<glm::vec3> up(3, glm::vec3(0, 1, 0));
@@ -247,25 +259,19 @@ TEST_CASE("asynchronous read-backs return each batch's planes in order", "[hemis
                     parameter_error);
     gl::hemisphere_raster_options bad = options;
     bad.batch = 0;
-    CHECK_THROWS_AS(gl::hemisphere_raster(s, mesh, light, bad), parameter_error);
+    CHECK_THROWS_AS(gl::hemisphere_raster(g.scene, g.mesh, g.light, bad), parameter_error);
     bad = options;
     bad.camera.aperture_deg = 180.0;
-    CHECK_THROWS_AS(gl::hemisphere_raster(s, mesh, light, bad), parameter_error);
+    CHECK_THROWS_AS(gl::hemisphere_raster(g.scene, g.mesh, g.light, bad), parameter_error);
 }
 
 TEST_CASE("the raster record sampler makes the same records one at a time and in atlas batches", "[hemisphere][gl][record]") {
     gl_test::shared_context();
     const float H = 1.5f, x_edge = 0.4f, kd = 0.75f, E_perp = 2.f;
-    const io::scene s = half_lit_ceiling_scene(H, x_edge, kd, E_perp);
-    const gl::scene_mesh mesh(s);
-    const gl::direct_light light(s, mesh, 512);
-    gl::hemisphere_raster_options options;
-    options.camera = {32, 126.0};
-    options.batch = 4;
-    options.offset = 1e-3f;
-    gl::hemisphere_raster raster(s, mesh, light, options);
+    const auto options = raster_options(32, 126.0, 4, 1e-3f);
+    gl_ceiling g(H, x_edge, kd, E_perp, 512, options);
     radius_limits limits;
-    gl::raster_record_sampler sampler(raster, limits);
+    gl::raster_record_sampler sampler(g.raster, limits);
     pcg32 rng(9);
     std::vector<glm::vec3> p, n;
     std::vector<double> footprint;
@@ -312,14 +318,8 @@ TEST_CASE("the raster record sampler makes the same records one at a time and in
 
 TEST_CASE("the raster record sampler's fall-off kappa moves the band between plane and stretching", "[hemisphere][gl][record]") {
     gl_test::shared_context();
-    const io::scene s = half_lit_ceiling_scene(1.5f, 0.4f, 0.75f, 2.f);
-    const gl::scene_mesh mesh(s);
-    const gl::direct_light light(s, mesh, 512);
-    gl::hemisphere_raster_options options;
-    options.camera = {16, 126.0};
-    options.batch = 2;
-    options.offset = 1e-3f;
-    gl::hemisphere_raster raster(s, mesh, light, options);
+    gl_ceiling g(1.5f, 0.4f, 0.75f, 2.f, 512, raster_options(16, 126.0, 2, 1e-3f));
+    gl::hemisphere_raster& raster = g.raster;
     const radius_limits limits;
     // Four samplers on one raster, called in turn: each must sum with its own weights.
     gl::raster_record_sampler stretch(raster, limits), none(raster, limits, plane_weighting::falloff, 0.0),
