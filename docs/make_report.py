@@ -145,6 +145,11 @@ def weights_table(scene, mine):
              "| weight | a = 0.15: records | ms | rel_rms | a = 0.4: records | ms | rel_rms |", "|---|---|---|---|---|---|---|"]
     for w in WEIGHTS:
         lines.append(f"| {w} | {cells.get((w, '0.15'), ' | | ')} | {cells.get((w, '0.4'), ' | | ')} |")
+    on, off = mine.get(f"{scene}-w-tabellion-a0.15"), mine.get(f"{scene}-tabellion-nograd")
+    if on and off:
+        e_on, e_off = on["error"]["rel_rms"], off["error"]["rel_rms"]
+        lines += ["", f"Tabellion's weight at a = 0.15 without gradients (same records): {e_off:.4f}; gradients lower "
+                      f"its error by {100 * (1 - e_on / e_off):.0f}%."]
     m = mine.get(f"{scene}-tabellion-mc")
     if m and "mc_equal_error" in m:
         bound = "at least " if m["mc_equal_error"].get("lower_bound") else ""

@@ -40,6 +40,7 @@ weights() {  # weights TAG ARGS...: every weighting policy at a = 0.15 and 0.4, 
     done
   done
   run "$tag-tabellion-mc" "$@" --a 0.4 --weight tabellion --mc-compare  # its best error per record, against Monte Carlo
+  run "$tag-tabellion-nograd" "$@" --a 0.15 --weight tabellion --gradients off  # beside $tag-w-tabellion-a0.15
 }
 
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor) RAYS(per record)
