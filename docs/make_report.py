@@ -181,7 +181,8 @@ def main():
         if head:
             lines += ["Figures the irradiance-splatting issue asks for (a = 0.15):", ""] + head + [""]
         lines += weights_table(scene, mine)
-        mc = [r for r in mine.values() if "mc_sweep" in r]
+        # The main Monte Carlo run (others, such as SCENE-tabellion-mc, have their own lines).
+        mc = [r for k, r in mine.items() if "mc_sweep" in r and k == f"{scene}-mc"]
         if mc:
             r = mc[0]
             lines += ["Brute-force Monte Carlo (reference integrator, independent seed) on the same G-buffer:", "",
