@@ -39,6 +39,7 @@ weights() {  # weights TAG ARGS...: every weighting policy at a = 0.15 and 0.4, 
       run "$tag-w-$w-a$a" "$@" --a "$a" --weight "$w"
     done
   done
+  for a in 0.3 0.2 0.1; do run "$tag-w-tabellion-a$a" "$@" --a "$a" --weight tabellion; done  # its whole sweep
   run "$tag-tabellion-mc" "$@" --a 0.4 --weight tabellion --mc-compare  # its best error per record, against Monte Carlo
   run "$tag-tabellion-nograd" "$@" --a 0.15 --weight tabellion --gradients off  # beside $tag-w-tabellion-a0.15
 }
@@ -102,6 +103,9 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-octree" "${common[@]}" --a 0.15 --weight ward-smooth --interp octree
   interp "$tag" "${common[@]}"
   [[ $tag == cornell ]] && run "$tag-raster" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster
+  # Fall-off stretching with the kappa hemisphere_study measures for the box (0.881).
+  [[ $tag == cornell ]] && run "$tag-raster-falloff" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster \
+      --falloff-kappa 0.881
   run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
   run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
   # Every frame of the camera path needs its own reference: smaller images, fewer samples.

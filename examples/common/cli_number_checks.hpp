@@ -42,5 +42,13 @@ inline CLI::Validator finite_number_at_least_zero(bool zero_allowed) {
 inline const CLI::Validator finite_positive = detail::finite_number_at_least_zero(false);
 /// A finite number, zero or above.
 inline const CLI::Validator finite_non_negative = detail::finite_number_at_least_zero(true);
+/// A number in [0, 1] (CLI::Range lets NaN through as well).
+inline const CLI::Validator unit_interval = CLI::Validator(
+    [](std::string& s) -> std::string {
+        const double v = detail::parse_number(s);
+        if (v >= 0 && v <= 1) return {};
+        return "'" + s + "' is not a number in [0, 1]";
+    },
+    "IN [0, 1]");
 
 }  // namespace bounce::examples

@@ -63,6 +63,7 @@ struct options {
     std::string weight = "ward-smooth";
     bool gradients = true;
     std::string sampler = "embree";
+    float falloff_kappa = 1.f;  // raster sampler: fall-off stretching's band factor (1: border stretching)
     std::string interp = "splat-cpu";
     std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
     float fill_holes = 4.f;       // progressive: wide splat's a / a (0: leave holes black)
@@ -115,6 +116,7 @@ struct context {
 // The parameters records depend on (not a: records are valid for every a).
 nlohmann::json cache_parameters(const options& o, const io::scene& s) {
     return {{"scene", s.name},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
+            {"falloff_kappa", o.sampler == "raster" ? o.falloff_kappa : 1.f},
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
             {"gradient_limit", o.gradient_limit}, {"height", o.height}};
 }
@@ -508,11 +510,15 @@ int run(const options& o) {
     if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene); });
     std::optional<gl::raster_record_sampler> raster_sampler;
     if (o.sampler == "raster") {
-        // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4).
+        // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4), or
+        // fall-off stretching with a fixed kappa (docs/hemisphere-sampling.md).
         // One atlas per batch of the scan's guesses (16 planes unless --scan-batch says).
         const std::size_t planes = o.scan_batch > 0 ? o.scan_batch : 16;
         gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, planes});
-        raster_sampler.emplace(*gl_state->raster, limits);
+        if (o.falloff_kappa < 1.f)
+            raster_sampler.emplace(*gl_state->raster, limits, plane_weighting::falloff, double(o.falloff_kappa));
+        else
+            raster_sampler.emplace(*gl_state->raster, limits);
         ctx.sampler = [&](glm::vec3 p, glm::vec3 n, double fp) { return (*raster_sampler)(p, n, fp); };
         ctx.batch_sampler = [&](std::span<const glm::vec3> p, std::span<const glm::vec3> n, std::span<const double> fp,
                                 std::span<std::optional<irradiance_record>> out) { (*raster_sampler)(p, n, fp, out); };
@@ -546,6 +552,7 @@ int run(const options& o) {
     report.height = o.height;
     report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
+                         {"falloff_kappa", o.sampler == "raster" ? o.falloff_kappa : 1.f},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
@@ -739,6 +746,11 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion"}))->capture_default_str();
     app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
     app.add_option("--sampler", o.sampler, "record sampler: embree | raster")->check(CLI::IsMember({"embree", "raster"}))->capture_default_str();
+    app.add_option("--falloff-kappa", o.falloff_kappa,
+                   "raster sampler: fall-off stretching with this band factor (hemisphere_study's falloff_kappa for the "
+                   "scene); 1: border stretching")
+        ->check(examples::unit_interval)
+        ->capture_default_str();
     app.add_option("--interp", o.interp,
                    "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
         ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();

@@ -51,6 +51,18 @@ TEST_CASE("finite_non_negative takes zero and refuses the rest of what finite_po
     CHECK_FALSE(accepts(bounce::examples::finite_non_negative, bad));
 }
 
+TEST_CASE("unit_interval takes [0, 1] and nothing else", "[examples][cli]") {
+    for (const char* good : {"0", "-0", "1", "0.881", "1e-300", "0x1p-1"}) {
+        double stored = -1;
+        CAPTURE(good);
+        CHECK(accepts(bounce::examples::unit_interval, good, &stored));
+        CHECK(stored == std::stod(good));
+    }
+    const std::string bad = GENERATE("-1e-30", "1.0000001", "2", "nan", "inf", "-inf", "abc", "0.5x", "");
+    CAPTURE(bad);
+    CHECK_FALSE(accepts(bounce::examples::unit_interval, bad));
+}
+
 TEST_CASE("the refusal says what the option wants", "[examples][cli]") {
     const std::string message = bounce::examples::finite_positive(std::string("nan"));
     CHECK(message.find("'nan'") != std::string::npos);
