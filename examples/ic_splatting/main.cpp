@@ -486,6 +486,8 @@ embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64
 }
 
 int run(const options& o) {
+    if (o.falloff_kappa != 1.f && o.sampler != "raster")
+        throw parameter_error("--falloff-kappa", "applies to --sampler raster only");
     io::stage_timer setup;
     const io::scene scene = io::load_scene_arg(o.scene);
     std::optional<embree::accel> bvh_storage;
