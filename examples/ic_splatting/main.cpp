@@ -113,10 +113,11 @@ struct context {
     std::vector<std::uint32_t> order{};  // the cache-miss scan's pixel order; empty: row by row
 };
 
-// The parameters records depend on (not a: records are valid for every a).
+// The parameters records depend on (not a: records are valid for every a). falloff_kappa
+// is 1 unless the raster sampler takes it (run() refuses it with the Embree sampler).
 nlohmann::json cache_parameters(const options& o, const io::scene& s) {
     return {{"scene", s.name},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
-            {"falloff_kappa", o.sampler == "raster" ? o.falloff_kappa : 1.f},
+            {"falloff_kappa", o.falloff_kappa},
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
             {"gradient_limit", o.gradient_limit}, {"height", o.height}};
 }
@@ -517,10 +518,9 @@ int run(const options& o) {
         // One atlas per batch of the scan's guesses (16 planes unless --scan-batch says).
         const std::size_t planes = o.scan_batch > 0 ? o.scan_batch : 16;
         gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, planes});
-        if (o.falloff_kappa < 1.f)
-            raster_sampler.emplace(*gl_state->raster, limits, plane_weighting::falloff, double(o.falloff_kappa));
-        else
-            raster_sampler.emplace(*gl_state->raster, limits);
+        raster_sampler.emplace(*gl_state->raster, limits,
+                               o.falloff_kappa < 1.f ? plane_weighting::falloff : plane_weighting::stretch,
+                               double(o.falloff_kappa));
         ctx.sampler = [&](glm::vec3 p, glm::vec3 n, double fp) { return (*raster_sampler)(p, n, fp); };
         ctx.batch_sampler = [&](std::span<const glm::vec3> p, std::span<const glm::vec3> n, std::span<const double> fp,
                                 std::span<std::optional<irradiance_record>> out) { (*raster_sampler)(p, n, fp, out); };
@@ -554,7 +554,7 @@ int run(const options& o) {
     report.height = o.height;
     report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
-                         {"falloff_kappa", o.sampler == "raster" ? o.falloff_kappa : 1.f},
+                         {"falloff_kappa", o.falloff_kappa},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
@@ -783,7 +783,7 @@ int main(int argc, char** argv) {
     app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--front-tolerance", o.front_tolerance,
                    "skip records whose tangent plane the point lies this fraction of the zone behind (Ward's in-front test; 1: off)")
-        ->check(CLI::Range(0.f, 1.f))->capture_default_str();
+        ->check(examples::unit_interval)->capture_default_str();
     app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(examples::finite_non_negative);
     app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
     app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");
