@@ -42,6 +42,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numeric>
 #include <optional>
 #include <span>
@@ -225,11 +226,16 @@ estimates ray_cast(const embree::reference_integrator& ref, const std::vector<st
     out.stretch.resize(pts.size());
     out.running_kappa.resize(pts.size());
     out.coverage_scale = t.coverage_scale();
-    radial_profile running(cam);
+    tbb::enumerable_thread_specific<radial_profile> profiles([&] { return radial_profile(cam); });
+    // Every plane so far: the threads' profiles pooled (each holds what its thread added).
+    const auto pooled = [&] {
+        radial_profile all = *profiles.begin();
+        for (auto it = std::next(profiles.begin()); it != profiles.end(); ++it) all.merge(*it);
+        return all;
+    };
     const auto t0 = clock_type::now();
     for (std::size_t first = 0; first < pts.size(); first += batch) {
         const std::size_t last = std::min(pts.size(), first + batch);
-        tbb::enumerable_thread_specific<radial_profile> profiles([&] { return radial_profile(cam); });
         tbb::parallel_for(first, last, [&](std::size_t k) {
             const auto [p, n] = pts[k];
             image<glm::vec3> radiance(cam.resolution, cam.resolution);
@@ -240,12 +246,11 @@ estimates ray_cast(const embree::reference_integrator& ref, const std::vector<st
             out.plane[k] = estimate_plane(t.plane, v).irradiance;
             profiles.local().add(radiance.view());
         });
-        for (const auto& p : profiles) running.merge(p);
         std::fill(out.running_kappa.begin() + std::ptrdiff_t(first), out.running_kappa.begin() + std::ptrdiff_t(last),
-                  running.falloff_factor());
+                  pooled().falloff_factor());
     }
     out.seconds = seconds_since(t0);
-    out.kappa = running.falloff_factor();
+    out.kappa = out.running_kappa.empty() ? 1.0 : out.running_kappa.back();
     return out;
 }
 
