@@ -50,5 +50,13 @@ inline const CLI::Validator unit_interval = CLI::Validator(
         return "'" + s + "' is not a number in [0, 1]";
     },
     "IN [0, 1]");
+/// An angle in [0, 90) degrees: a turn of a square, which repeats every 90.
+inline const CLI::Validator quarter_turn_deg = CLI::Validator(
+    [](std::string& s) -> std::string {
+        const double v = detail::parse_number(s);
+        if (v >= 0 && v < 90) return {};
+        return "'" + s + "' is not an angle in [0, 90) degrees";
+    },
+    "IN [0, 90)");
 
 }  // namespace bounce::examples

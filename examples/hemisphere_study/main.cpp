@@ -381,7 +381,8 @@ int main(int argc, char** argv) {
                  "Monte Carlo reference"};
     std::string scene_arg = "sponza";
     std::uint32_t resolution = 64, reference_spp = 16384;
-    double aperture = 126.0, reference_target = 0.005;
+    double aperture = 126.0, reference_target = 0.005, turn = 0.0;
+    bool hashed_turn = false;
     std::size_t points = 10000, sweep_points = 1000, batch = 64;
     std::uint64_t seed = 1;
     int shadow_resolution = 4096;
@@ -399,6 +400,10 @@ int main(int argc, char** argv) {
     app.add_option("--aperture", aperture, "full angle of the plane's square field of view, degrees")
         ->check(CLI::Range(1.0, 179.0))
         ->capture_default_str();
+    app.add_option("--plane-turn", turn, "turn of every plane about its normal from orthonormal_basis(n), degrees in [0, 90)")
+        ->check(examples::quarter_turn_deg)
+        ->capture_default_str();
+    app.add_flag("--hashed-turn", hashed_turn, "also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
     app.add_option("--points", points, "random visible points (fixed seed)")->check(CLI::Range(1, 200000))->capture_default_str();
     app.add_option("--seed", seed, "seed of the points and of the reference")->capture_default_str();
     app.add_option("--reference-spp", reference_spp, "reference rays per point and half (doubled until the error target)")
@@ -439,14 +444,14 @@ int main(int argc, char** argv) {
         fs::path scene_path = scene_arg;
         if (!fs::exists(scene_path) && scene_arg != "cornell") scene_path = io::scenes_dir() / scene_arg;
         const io::scene scene = io::load_scene_arg(scene_path.string() == "cornell" ? "cornell" : scene_path.string());
-        const plane_camera cam{resolution, aperture};
+        const plane_camera cam{resolution, aperture, turn, hashed_turn};
         cam.validate();
         const embree::accel bvh(scene);
         const embree::reference_integrator ref(bvh, scene);
         const std::size_t K = std::max(points, sweep ? sweep_points : std::size_t(0));
         const auto pts = pick_points(bvh, scene, K, seed);
-        fmt::print("hemisphere_study: {} ({} triangles), {} points, plane {}^2 at {} deg\n", scene.name,
-                   scene.triangles.size(), K, resolution, aperture);
+        fmt::print("hemisphere_study: {} ({} triangles), {} points, plane {}^2 at {} deg, turned {} deg{}\n", scene.name,
+                   scene.triangles.size(), K, resolution, aperture, turn, hashed_turn ? " + hashed" : "");
 
         const auto t_ref = clock_type::now();
         const reference_set reference =
@@ -537,7 +542,7 @@ int main(int argc, char** argv) {
             const auto sref = first_ref(sweep_points);
             for (std::uint32_t n : {16u, 32u, 48u, 64u, 96u, 128u})
                 for (double ap : {90.0, 105.0, 120.0, 126.0, 135.0, 140.0, 150.0}) {
-                    const plane_camera c{n, ap};
+                    const plane_camera c{n, ap, turn, hashed_turn};
                     const auto add_row = [&](const char* sampler, const estimates& e) {
                         json row = {{"sampler", sampler}, {"resolution", n}, {"aperture", ap}};
                         const json errors = e.errors(sref);
@@ -588,6 +593,8 @@ int main(int argc, char** argv) {
             report.backend = no_raster ? "embree" : (no_ray_cast ? "gl" : "gl+embree");
             report.parameters["resolution"] = resolution;
             report.parameters["aperture_deg"] = aperture;
+            report.parameters["plane_turn_deg"] = turn;
+            report.parameters["hashed_turn"] = hashed_turn;
             report.parameters["points"] = points;
             report.parameters["seed"] = seed;
             report.parameters["batch"] = batch;

@@ -64,6 +64,8 @@ struct options {
     bool gradients = true;
     std::string sampler = "embree";
     float falloff_kappa = 1.f;  // raster sampler: fall-off stretching's band factor (1: border stretching)
+    double plane_turn = 0.0;    // raster sampler: plane_camera::turn_deg
+    bool hashed_turn = false;   // raster sampler: plane_camera::hashed_turn
     std::string interp = "splat-cpu";
     std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
     float fill_holes = 4.f;       // progressive: wide splat's a / a (0: leave holes black)
@@ -114,10 +116,11 @@ struct context {
 };
 
 // The parameters records depend on (not a: records are valid for every a). falloff_kappa
-// is 1 unless the raster sampler takes it (run() refuses it with the Embree sampler).
+// and the plane's turn keep their defaults unless the raster sampler takes them (run()
+// refuses them with the Embree sampler).
 nlohmann::json cache_parameters(const options& o, const io::scene& s) {
     return {{"scene", s.name},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
-            {"falloff_kappa", o.falloff_kappa},
+            {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
             {"gradient_limit", o.gradient_limit}, {"height", o.height}};
 }
@@ -489,6 +492,8 @@ embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64
 int run(const options& o) {
     if (o.falloff_kappa != 1.f && o.sampler != "raster")
         throw parameter_error("--falloff-kappa", "applies to --sampler raster only");
+    if ((o.plane_turn != 0.0 || o.hashed_turn) && o.sampler != "raster")
+        throw parameter_error("--plane-turn/--hashed-turn", "apply to --sampler raster only");
     io::stage_timer setup;
     const io::scene scene = io::load_scene_arg(o.scene);
     std::optional<embree::accel> bvh_storage;
@@ -517,7 +522,8 @@ int run(const options& o) {
         // fall-off stretching with a fixed kappa (docs/hemisphere-sampling.md).
         // One atlas per batch of the scan's guesses (16 planes unless --scan-batch says).
         const std::size_t planes = o.scan_batch > 0 ? o.scan_batch : 16;
-        gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light, gl::hemisphere_raster_options{{64, 126.0}, planes});
+        gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light,
+                                 gl::hemisphere_raster_options{{64, 126.0, o.plane_turn, o.hashed_turn}, planes});
         raster_sampler.emplace(*gl_state->raster, limits,
                                o.falloff_kappa < 1.f ? plane_weighting::falloff : plane_weighting::stretch,
                                double(o.falloff_kappa));
@@ -554,7 +560,7 @@ int run(const options& o) {
     report.height = o.height;
     report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
-                         {"falloff_kappa", o.falloff_kappa},
+                         {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
@@ -753,6 +759,12 @@ int main(int argc, char** argv) {
                    "scene); 1: border stretching")
         ->check(examples::unit_interval)
         ->capture_default_str();
+    app.add_option("--plane-turn", o.plane_turn,
+                   "raster sampler: turn of every plane about its normal from orthonormal_basis(n), degrees in [0, 90)")
+        ->check(examples::quarter_turn_deg)
+        ->capture_default_str();
+    app.add_flag("--hashed-turn", o.hashed_turn,
+                 "raster sampler: also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
     app.add_option("--interp", o.interp,
                    "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
         ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();

@@ -34,10 +34,12 @@
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
 #include <bounce/irradiance_gradients.hpp>
+#include <bounce/sampling.hpp>
 #include <bounce/vocabulary.hpp>
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -169,16 +171,54 @@ T rec709_luminance(const V& c) {
 // ---------------------------------------------------------------------------------------
 // The plane camera and its weight tables
 
+/// A turn in [0, 1) of the unit interval, hashed from the bits of a position (+0 and -0
+/// alike): SplitMix64's finalizer (Steele, Lea and Flood 2014) over the three floats, so
+/// points an ulp apart get unrelated turns and the same point always the same one.
+inline double plane_turn_hash(glm::vec3 p) noexcept {
+    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (const float f : {p.x, p.y, p.z}) {
+        h ^= std::bit_cast<std::uint32_t>(f == 0.f ? 0.f : f);
+        h += 0x9e3779b97f4a7c15ULL;
+        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
+        h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
+        h ^= h >> 31;
+    }
+    return double(h >> 11) * 0x1p-53;
+}
+
 /// The camera of single-plane hemisphere sampling: an N x N square plane above the record.
 struct plane_camera {
     std::uint32_t resolution = 64;  ///< N: pixels per side; typical 32-128 (seed: 64)
     double aperture_deg = 126.0;    ///< full angle of the square field of view, degrees, in (0, 180); typical 126
+    /// Turn of every plane about its normal from the frame of orthonormal_basis(n), degrees
+    /// in [0, 90) (the square repeats every 90). The seed leaves the turn open; that frame
+    /// lays the plane's edges along the walls of an axis-aligned scene.
+    double turn_deg = 0.0;
+    /// Also turn each record's plane by its own angle, 90 plane_turn_hash(p) degrees: no
+    /// edge keeps to the scene's axes, and neighbouring records miss different directions.
+    /// docs/hemisphere-sampling.md measures both turns.
+    bool hashed_turn = false;
 
-    /// Throws parameter_error unless 1 <= resolution <= 8192 and 0 < aperture < 180.
+    /// Throws parameter_error unless 1 <= resolution <= 8192, 0 < aperture < 180 and
+    /// 0 <= turn < 90.
     void validate() const {
         require(resolution >= 1 && resolution <= 8192, "resolution", "must lie in [1, 8192]");
         require(std::isfinite(aperture_deg) && aperture_deg > 0.0 && aperture_deg < 180.0, "aperture_deg",
                 "must lie in (0, 180) degrees");
+        require(turn_deg >= 0.0 && turn_deg < 90.0, "turn_deg", "must lie in [0, 90) degrees");
+    }
+    /// The turn of the plane of a record at p, degrees in [0, 180).
+    double turn_at(glm::vec3 p) const { return turn_deg + (hashed_turn ? 90.0 * plane_turn_hash(p) : 0.0); }
+    /// The plane's frame {x, y} (z = n) of a record at p with unit normal n: the frame of
+    /// orthonormal_basis(n) turned by turn_at(p) about n, exactly that frame at turn 0. The
+    /// planes are rendered, and their estimates' gradients expressed, in it.
+    std::array<glm::vec3, 2> frame(glm::vec3 p, glm::vec3 n) const {
+        const auto tb = orthonormal_basis<float, glm::vec3>(n);
+        const double turn = turn_at(p);
+        if (turn == 0.0) return tb;
+        const double r = turn * std::numbers::pi / 180.0;
+        const float c = float(std::cos(r)), s = float(std::sin(r));
+        return {c * tb[0] + s * tb[1], c * tb[1] - s * tb[0]};
     }
     /// a = tan(aperture / 2): the plane spans [-a, a]^2 at unit distance.
     double half_extent() const { return std::tan(aperture_deg * std::numbers::pi / 360.0); }

@@ -11,7 +11,9 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 using namespace bounce;
@@ -388,6 +390,76 @@ TEST_CASE("the radial profile recovers a radiance linear in cos(theta) exactly",
     CHECK_THROWS_AS(radial_profile(cam).add(wrong.view()), parameter_error);
 }
 
+TEST_CASE("a plane's frame is orthonormal, right-handed about n, and turned by the camera's angle", "[hemisphere][frame]") {
+    pcg32 rng(90);
+    std::vector<glm::vec3> normals = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
+                                      glm::normalize(glm::vec3(1e-4f, 0, -1)), glm::normalize(glm::vec3(0, -3e-4f, -1)),
+                                      glm::normalize(glm::vec3(1, 1, 1e-7f))};
+    for (int k = 0; k < 300; ++k) {  // uniform on the sphere
+        const double z = 2 * rng.next_double() - 1, phi = 2 * pi * rng.next_double(), r = std::sqrt(1 - z * z);
+        normals.push_back(glm::normalize(glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(z))));
+    }
+    const auto [turn, hashed] = GENERATE(std::pair{0.0, false}, std::pair{30.0, false}, std::pair{89.999, false},
+                                         std::pair{0.0, true}, std::pair{45.0, true});
+    const plane_camera cam{16, 126.0, turn, hashed};
+    REQUIRE_NOTHROW(cam.validate());
+    // orthonormal_basis is orthonormal to a few float ulps; turning it rounds each
+    // component of c t + s b twice more: 8 ulps of 1 bound every product below.
+    const double tol = 8 * 0x1p-24;
+    for (std::size_t k = 0; k < normals.size(); ++k) {
+        const glm::vec3 n = normals[k];
+        const glm::vec3 p(float(rng.next_double()), float(rng.next_double() - 7), float(1e3 * rng.next_double()));
+        const auto f = cam.frame(p, n);
+        const auto tb = orthonormal_basis<float, glm::vec3>(n);
+        const glm::dvec3 x(f[0]), y(f[1]), nd(n);
+        CAPTURE(turn, hashed, k, n.x, n.y, n.z);
+        CHECK(std::abs(glm::length(x) - 1) < tol);
+        CHECK(std::abs(glm::length(y) - 1) < tol);
+        CHECK(std::abs(glm::dot(x, y)) < tol);
+        CHECK(std::abs(glm::dot(x, nd)) < tol);
+        CHECK(std::abs(glm::dot(y, nd)) < tol);
+        CHECK(glm::length(glm::cross(x, y) - nd) < 2 * tol);
+        // The turn: the angle from the basis's tangent to x, measured about n.
+        const double want = cam.turn_at(p);
+        CHECK(want >= turn);
+        CHECK(want < turn + (hashed ? 90 : 1e-12));
+        const double got = std::atan2(glm::dot(x, glm::dvec3(tb[1])), glm::dot(x, glm::dvec3(tb[0]))) * 180 / pi;
+        CHECK(std::remainder(got - want, 360.0) == Approx(0).margin(1e-4));
+        if (want == 0) CHECK((f[0] == tb[0] && f[1] == tb[1]));  // no turn: the basis itself, bit for bit
+    }
+}
+
+TEST_CASE("the hashed turn is the same for the same point and uniform over neighbouring points", "[hemisphere][frame]") {
+    const glm::vec3 p(1.25f, -3.5f, 1e4f);
+    CHECK(plane_turn_hash(p) == plane_turn_hash(p));
+    CHECK(plane_turn_hash(glm::vec3(0.f, 2.f, -0.f)) == plane_turn_hash(glm::vec3(-0.f, 2.f, 0.f)));
+    // The hardest inputs: points one float ulp apart, along each axis in turn. 16 bins of
+    // 6000 hashes: chi-square with 15 degrees of freedom, whose 0.999 quantile is 37.7.
+    // Consecutive hashes must not be correlated: |r| below 4 standard errors, 4 / sqrt(n).
+    const int axis = GENERATE(0, 1, 2);
+    const int count = 6000, bins = 16;
+    std::vector<int> histogram(bins, 0);
+    std::vector<double> h;
+    glm::vec3 q(0.75f, 12.f, -2.f);
+    for (int k = 0; k < count; ++k) {
+        h.push_back(plane_turn_hash(q));
+        q[axis] = std::nextafter(q[axis], 1e30f);
+        REQUIRE(h.back() >= 0);
+        REQUIRE(h.back() < 1);
+        ++histogram[std::size_t(h.back() * bins)];
+    }
+    double chi2 = 0;
+    for (int c : histogram) chi2 += (c - double(count) / bins) * (c - double(count) / bins) / (double(count) / bins);
+    double mean = 0, var = 0, cov = 0;
+    for (double v : h) mean += v / count;
+    for (int k = 0; k < count; ++k) var += (h[k] - mean) * (h[k] - mean);
+    for (int k = 0; k + 1 < count; ++k) cov += (h[k] - mean) * (h[k + 1] - mean);
+    const double r = cov / var;
+    CAPTURE(axis, chi2, r);
+    CHECK(chi2 < 37.7);
+    CHECK(std::abs(r) < 4 / std::sqrt(double(count)));
+}
+
 TEST_CASE("a hit at the eye keeps a positive distance", "[hemisphere][bad-input]") {
     const glm::vec3 eye(10.f, 5.f, -3.f);
     CHECK(plane_hit_distance<float, glm::vec3>(eye, eye) > 0.f);
@@ -399,6 +471,8 @@ TEST_CASE("bad cameras and planes are refused", "[hemisphere][bad-input]") {
     CHECK_THROWS_AS(make_plane_weights(plane_camera{64, 180.0}, plane_weighting::stretch), parameter_error);
     CHECK_THROWS_AS(make_plane_weights(plane_camera{64, 0.0}, plane_weighting::plane), parameter_error);
     CHECK_THROWS_AS(make_plane_weights(plane_camera{64, std::nan("")}, plane_weighting::plane), parameter_error);
+    for (const double turn : {-1e-9, 90.0, 135.0, std::nan(""), std::numeric_limits<double>::infinity()})
+        CHECK_THROWS_AS(make_plane_weights(plane_camera{64, 126.0, turn}, plane_weighting::plane), parameter_error);
     const plane_camera cam{4, 90.0};
     const auto t = make_plane_weights(cam, plane_weighting::stretch);
     auto p = render(cam, [](const glm::dvec3&) { return std::pair{glm::vec3(1.f), 1.f}; });

@@ -63,6 +63,18 @@ TEST_CASE("unit_interval takes [0, 1] and nothing else", "[examples][cli]") {
     CHECK_FALSE(accepts(bounce::examples::unit_interval, bad));
 }
 
+TEST_CASE("quarter_turn_deg takes [0, 90) and nothing else", "[examples][cli]") {
+    for (const char* good : {"0", "-0", "30", "89.999", "1e-300", "0x1p+6"}) {
+        double stored = -1;
+        CAPTURE(good);
+        CHECK(accepts(bounce::examples::quarter_turn_deg, good, &stored));
+        CHECK(stored == std::stod(good));
+    }
+    const std::string bad = GENERATE("-1e-30", "90", "90.0000001", "180", "nan", "inf", "-inf", "abc", "");
+    CAPTURE(bad);
+    CHECK_FALSE(accepts(bounce::examples::quarter_turn_deg, bad));
+}
+
 TEST_CASE("the refusal says what the option wants", "[examples][cli]") {
     const std::string message = bounce::examples::finite_positive(std::string("nan"));
     CHECK(message.find("'nan'") != std::string::npos);

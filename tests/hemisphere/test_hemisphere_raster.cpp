@@ -2,6 +2,7 @@
 // emitted kernels agree with their CPU instantiation; planes of a half-lit ceiling match the
 // analytic plane texel by texel away from the edge; the GPU reduction agrees with the CPU
 // sum; tiles of an atlas do not bleed; asynchronous read-backs come back in order.
+#include "../core/half_lit_ceiling.hpp"
 #include "../gl/shared_context.hpp"
 #include "half_lit_ceiling_scene.hpp"
 
@@ -15,6 +16,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -32,14 +34,19 @@ T atan_kernel(T y, T x) {
     return atan(y, x);
 }
 
-// The analytic plane of that ceiling for a record at (px, 0, pz) with n = +y, in the frame
-// the sampler uses (orthonormal_basis of n), eye offset by `offset` along n.
+// The analytic plane of that ceiling for a record at p = (px, 0, pz) with n = +y, in the
+// frame the sampler uses (the camera's frame at p), eye offset by `offset` along n.
 struct analytic_ceiling {
     float H, x_edge, L;  // L: radiance of the lit part
     glm::vec3 eye;
+    std::array<glm::dvec3, 2> tb;  // the plane's x and y in world space
+    analytic_ceiling(float H_, float x_edge_, float L_, const plane_camera& cam, glm::vec3 p, float offset)
+        : H(H_), x_edge(x_edge_), L(L_), eye(p + glm::vec3(0, offset, 0)) {
+        const auto f = cam.frame(p, glm::vec3(0, 1, 0));
+        tb = {glm::dvec3(f[0]), glm::dvec3(f[1])};
+    }
     std::pair<glm::vec3, float> trace(const glm::dvec3& d_local) const {
         const glm::dvec3 n(0, 1, 0);
-        const auto tb = orthonormal_basis<double, glm::dvec3>(n);
         const glm::dvec3 d = tb[0] * d_local.x + tb[1] * d_local.y + n * d_local.z;
         const double t = (double(H) - eye.y) / d.y;
         const double x = eye.x + t * d.x;
@@ -63,9 +70,8 @@ rendered analytic_plane(const plane_camera& cam, const analytic_ceiling& c) {
 // `eye` (n = +y): the ceiling point seen through plane point (u, v) is
 // eye + h (t u + b v + n), so the edge is the line t.x u + b.x v = (x_edge - eye.x) / h.
 bool edge_crosses_pixel(const plane_camera& cam, const analytic_ceiling& c, std::uint32_t i, std::uint32_t j) {
-    const auto tb = orthonormal_basis<double, glm::dvec3>(glm::dvec3(0, 1, 0));
     const double k_edge = (c.x_edge - c.eye.x) / (c.H - c.eye.y);
-    const auto side = [&](double u, double v) { return tb[0].x * u + tb[1].x * v > k_edge; };
+    const auto side = [&](double u, double v) { return c.tb[0].x * u + c.tb[1].x * v > k_edge; };
     const auto b = plane_pixel_bounds<double>(i, j, cam.resolution, cam.half_extent());
     const bool s00 = side(b[0], b[1]);
     return s00 != side(b[2], b[1]) || s00 != side(b[0], b[3]) || s00 != side(b[2], b[3]);
@@ -84,9 +90,10 @@ struct gl_ceiling {
           raster(scene, mesh, light, options) {}
 };
 
-gl::hemisphere_raster_options raster_options(std::uint32_t N, double aperture, std::size_t batch, float offset) {
+gl::hemisphere_raster_options raster_options(std::uint32_t N, double aperture, std::size_t batch, float offset,
+                                              double turn = 0, bool hashed_turn = false) {
     gl::hemisphere_raster_options o;
-    o.camera = {N, aperture};
+    o.camera = {N, aperture, turn, hashed_turn};
     o.batch = batch;
     o.offset = offset;
     return o;
@@ -176,7 +183,8 @@ TEST_CASE("rasterized planes of a half-lit ceiling match the analytic plane, and
     const float L = kd / float(pi) * E_perp;
     const auto N = GENERATE(16u, 64u);
     const auto aperture = GENERATE(90.0, 126.0, 150.0);
-    const auto options = raster_options(N, aperture, 7, 1e-3f);  // 3 x 3 atlas, two tiles unused
+    const bool hashed = GENERATE(false, true);  // planes in orthonormal_basis(n), or each turned its own way
+    const auto options = raster_options(N, aperture, 7, 1e-3f, hashed ? 10.0 : 0.0, hashed);  // 3 x 3 atlas, two tiles unused
     gl_ceiling g(H, x_edge, kd, E_perp, 512, options);
     gl::hemisphere_raster& raster = g.raster;
     pcg32 rng(N + unsigned(aperture));
@@ -195,7 +203,7 @@ TEST_CASE("rasterized planes of a half-lit ceiling match the analytic plane, and
     REQUIRE(batch.size() == options.batch);
     const auto stretch = make_plane_weights(options.camera, plane_weighting::stretch);
     for (std::size_t k = 0; k < batch.size(); ++k) {
-        const analytic_ceiling c{H, x_edge, L, positions[k] + options.offset * normals[k]};
+        const analytic_ceiling c(H, x_edge, L, options.camera, positions[k], options.offset);
         const auto expected = analytic_plane(options.camera, c);
         // Texel by texel: radiance equal except in texels the edge crosses (the rasterizer and
         // the analytic test may put a texel centre on different sides of it); distances to
@@ -210,7 +218,7 @@ TEST_CASE("rasterized planes of a half-lit ceiling match the analytic plane, and
                 worst_distance = std::max(
                     worst_distance, std::abs(double(batch.distance[k](i, j)) / double(expected.distance(i, j)) - 1));
             }
-        CAPTURE(k, N, aperture, mismatched_away_from_edge, worst_distance);
+        CAPTURE(k, N, aperture, hashed, mismatched_away_from_edge, worst_distance);
         CHECK(mismatched_away_from_edge == 0);
         CHECK(worst_distance < 1e-4);
         // CPU sum (double, from the read-back) and GPU reduction (float): sums of N^2 float
@@ -295,7 +303,7 @@ TEST_CASE("the raster record sampler makes the same records one at a time and in
         CHECK(batched[k]->radius == Approx(one->radius).epsilon(1e-5));
         // The estimate from the analytic plane: the raster plane differs only in texels the
         // edge crosses (test above), each by at most L, so by at most L times their weights.
-        const analytic_ceiling c{H, x_edge, L, p[k] + options.offset * n[k]};
+        const analytic_ceiling c(H, x_edge, L, options.camera, p[k], options.offset);
         const auto analytic = estimate_plane(stretch, analytic_plane(options.camera, c).view());
         double crossed = 0;
         for (std::uint32_t j = 0; j < options.camera.resolution; ++j)
@@ -341,4 +349,37 @@ TEST_CASE("the raster record sampler's fall-off kappa moves the band between pla
     CHECK_THROWS_AS(gl::raster_record_sampler(raster, limits, plane_weighting::stretch, 0.5), parameter_error);
     CHECK_THROWS_AS(gl::raster_record_sampler(raster, limits, plane_weighting::falloff, 1.5), parameter_error);
     CHECK_THROWS_AS(gl::raster_record_sampler(raster, limits, plane_weighting::falloff, std::nan("")), parameter_error);
+}
+
+TEST_CASE("turned raster planes give world-space records of the half-lit ceiling's closed forms", "[hemisphere][gl][record]") {
+    gl_test::shared_context();
+    const float H = 1.5f, x_edge = 0.4f, kd = 0.75f, E_perp = 2.f;
+    const double L = double(kd / float(pi) * E_perp);
+    const double turn = GENERATE(0.0, 30.0, 45.0);
+    const bool hashed = GENERATE(false, true);
+    const auto options = raster_options(64, 126.0, 4, 1e-3f, turn, hashed);
+    gl_ceiling g(H, x_edge, kd, E_perp, 512, options);
+    gl::raster_record_sampler sampler(g.raster, radius_limits{});
+    pcg32 rng(17);
+    for (int k = 0; k < 12; ++k) {
+        const float x = float(4 * rng.next_double() - 2);
+        const glm::vec3 p(x, 0.f, float(4 * rng.next_double() - 2)), n(0.f, 1.f, 0.f);
+        const auto rec = sampler(p, n, 1e-3);
+        REQUIRE(rec.has_value());
+        // The plane sees the core test's ceiling with h = H - offset, x0 = p.x - x_edge and
+        // rot the angle of world +x in the plane's frame. Its closed forms do not depend on
+        // the frame: the rotation gradient is rot_y (n x world x) = rot_y (0, 0, -1). An
+        // estimate from the analytic plane is within L times the mixed cells' weights of
+        // them; the raster plane differs from the analytic one in those cells only, by at
+        // most L each: twice the bound. A record expressed in the wrong frame would be off
+        // by 2 sin(turn / 2) |rot_y| (52% at 30 deg).
+        const auto tb = options.camera.frame(p, n);
+        const double h = double(H) - double(options.offset);
+        const ceiling_test::half_lit_ceiling hc{h, double(x - x_edge), L, std::atan2(double(tb[1].x), double(tb[0].x))};
+        const auto bound = ceiling_test::mixed_cells(options.camera, hc, true);
+        CAPTURE(k, x, turn, hashed, options.camera.turn_at(p), rec->irradiance.x, hc.E(), bound.E, bound.rotation);
+        CHECK(std::abs(double(rec->irradiance.x) - hc.E()) <= 2 * L * bound.E + 1e-5 * hc.E());
+        CHECK(glm::length(glm::dvec3(rec->rotation[0]) - hc.rot_y() * glm::dvec3(0, 0, -1)) <=
+              2 * L * bound.rotation + 1e-5 * hc.E());
+    }
 }

@@ -245,7 +245,7 @@ void hemisphere_raster::render(std::span<const glm::vec3> positions, std::span<c
         const glm::vec3 p = positions[k], n = normals[k];
         require(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "positions", "non-finite position");
         require(std::abs(glm::length(n) - 1.f) <= 1e-3f, "normals", "normal is not unit length");
-        const auto tb = orthonormal_basis<float, glm::vec3>(n);
+        const auto tb = options_.camera.frame(p, n);
         const glm::vec3 eye = p + offset_ * n;
         const glm::mat4 vp = projection * plane_view(eye, tb[0], tb[1], n);
         std::memcpy(&packed[k * 24], &vp[0][0], 16 * sizeof(float));

@@ -6,7 +6,6 @@
 
 #include <bounce/embree/reference.hpp>
 #include <bounce/hemisphere.hpp>
-#include <bounce/sampling.hpp>
 
 #include <algorithm>
 #include <utility>
@@ -14,13 +13,14 @@
 namespace bounce::embree {
 
 /// Fills `radiance` and `distance` (resolution x resolution) with the plane of `camera` at
-/// the record (p, n), in the frame of orthonormal_basis(n), rays leaving p + ray_epsilon n.
+/// the record (p, n), in the camera's frame (plane_camera::frame), rays leaving
+/// p + ray_epsilon n.
 /// Distances are floored at 1e-30: an origin lying on another surface (a record in a
 /// corner) can hit it at t = 0, and plane distances must be positive, as
 /// plane_hit_distance keeps them in the raster sampler.
 inline void sample_plane(const reference_integrator& ref, const plane_camera& camera, glm::vec3 p, glm::vec3 n,
                          image_view<glm::vec3> radiance, image_view<float> distance) {
-    const auto tb = orthonormal_basis<float, glm::vec3>(n);
+    const auto tb = camera.frame(p, n);
     const glm::vec3 origin = p + ref.ray_epsilon() * n;
     bounce::sample_plane(
         camera,

@@ -14,8 +14,8 @@
 /// shadow-mapped `direct_irradiance` through the emitted lambertian_radiance and stores
 /// (radiance rgb, hit distance) in RGBA32F; texels that see nothing keep (environment, +inf).
 ///
-/// A record's plane is its local frame of hemisphere.hpp: x = tangent, y = bitangent of
-/// orthonormal_basis(n), z = n; pixel (i, j) of tile k is texel (i, j) of the tile in
+/// A record's plane is its local frame of hemisphere.hpp: x, y = the camera's
+/// plane_camera::frame(p, n), z = n; pixel (i, j) of tile k is texel (i, j) of the tile in
 /// memory order (the projection flips y so that row 0, the first in memory, is +y). The
 /// record's eye is p + offset n, as a ray caster offsets its origins.
 

@@ -13,7 +13,6 @@
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/hemisphere.hpp>
 #include <bounce/irradiance_record.hpp>
-#include <bounce/sampling.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -56,8 +55,8 @@ public:
             const std::vector<hemisphere_estimate> est = raster_.reduce();
             for (std::size_t k = 0; k < count; ++k) {
                 const glm::vec3 n = normals[first + k];
-                // The planes are rendered in the frame of orthonormal_basis(n) (hemisphere.hpp).
-                const auto tb = orthonormal_basis<float, glm::vec3>(n);
+                // The planes are rendered, and estimated, in the camera's frame.
+                const auto tb = raster_.options().camera.frame(points[first + k], n);
                 const irradiance_record rec =
                     make_record(points[first + k], n, tb[0], tb[1], est.at(k), limits_, footprints[first + k]);
                 if (std::isfinite(rec.radius) && rec.radius > 0.f) out[first + k] = rec;
