@@ -106,6 +106,16 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   # Fall-off stretching with the kappa hemisphere_study measures for the box (0.881).
   [[ $tag == cornell ]] && run "$tag-raster-falloff" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster \
       --falloff-kappa 0.881
+  # The planes turned about their normals (docs/hemisphere-sampling.md, "The plane's turn").
+  [[ $tag == cornell ]] && run "$tag-raster-hashed" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster --hashed-turn
+  [[ $tag == cornell ]] && run "$tag-raster-turn30" "${common[@]}" --a 0.15 --weight ward-smooth --sampler raster --plane-turn 30
+  # Sponza's raster records at 256x256 and a = 0.3 (ten minutes a run on llvmpipe).
+  if [[ $tag == sponza ]]; then
+    local small_raster=(--scene "$scene" --width 256 --height 256 --ref-spp 16384 "${flags[@]}" --a 0.3 --weight ward-smooth --sampler raster)
+    run "$tag-256-embree-a0.3" --scene "$scene" --width 256 --height 256 --ref-spp 16384 "${flags[@]}" --a 0.3 --weight ward-smooth
+    run "$tag-256-raster" "${small_raster[@]}"
+    run "$tag-256-raster-turn30" "${small_raster[@]}" --plane-turn 30
+  fi
   run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
   run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
   # Every frame of the camera path needs its own reference: smaller images, fewer samples.

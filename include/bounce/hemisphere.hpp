@@ -171,9 +171,10 @@ T rec709_luminance(const V& c) {
 // ---------------------------------------------------------------------------------------
 // The plane camera and its weight tables
 
-/// A turn in [0, 1) of the unit interval, hashed from the bits of a position (+0 and -0
-/// alike): SplitMix64's finalizer (Steele, Lea and Flood 2014) over the three floats, so
-/// points an ulp apart get unrelated turns and the same point always the same one.
+/// A number in [0, 1) hashed from the bits of a position (+0 and -0 alike), the fraction of
+/// a quarter turn that plane_camera::hashed_turn gives a record's plane: SplitMix64's
+/// finalizer (Steele, Lea and Flood 2014) over the three floats, so points an ulp apart get
+/// unrelated turns and the same point always the same one.
 inline double plane_turn_hash(glm::vec3 p) noexcept {
     std::uint64_t h = 0x9e3779b97f4a7c15ULL;
     for (const float f : {p.x, p.y, p.z}) {
