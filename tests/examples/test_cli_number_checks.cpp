@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,21 @@ bool accepts(const CLI::Validator& check, const std::string& value, double* stor
     }
     if (stored) *stored = x;
     return true;
+}
+
+// `check` takes each of `good`, storing it as written, and refuses each of `bad`.
+void takes_exactly(const CLI::Validator& check, std::initializer_list<const char*> good,
+                   std::initializer_list<const char*> bad) {
+    for (const char* g : good) {
+        double stored = -1;
+        CAPTURE(g);
+        CHECK(accepts(check, g, &stored));
+        CHECK(stored == std::stod(g));
+    }
+    for (const char* b : bad) {
+        CAPTURE(b);
+        CHECK_FALSE(accepts(check, b));
+    }
 }
 
 }  // namespace
@@ -52,27 +68,13 @@ TEST_CASE("finite_non_negative takes zero and refuses the rest of what finite_po
 }
 
 TEST_CASE("unit_interval takes [0, 1] and nothing else", "[examples][cli]") {
-    for (const char* good : {"0", "-0", "1", "0.881", "1e-300", "0x1p-1"}) {
-        double stored = -1;
-        CAPTURE(good);
-        CHECK(accepts(bounce::examples::unit_interval, good, &stored));
-        CHECK(stored == std::stod(good));
-    }
-    const std::string bad = GENERATE("-1e-30", "1.0000001", "2", "nan", "inf", "-inf", "abc", "0.5x", "");
-    CAPTURE(bad);
-    CHECK_FALSE(accepts(bounce::examples::unit_interval, bad));
+    takes_exactly(bounce::examples::unit_interval, {"0", "-0", "1", "0.881", "1e-300", "0x1p-1"},
+                  {"-1e-30", "1.0000001", "2", "nan", "inf", "-inf", "abc", "0.5x", ""});
 }
 
 TEST_CASE("quarter_turn_deg takes [0, 90) and nothing else", "[examples][cli]") {
-    for (const char* good : {"0", "-0", "30", "89.999", "1e-300", "0x1p+6"}) {
-        double stored = -1;
-        CAPTURE(good);
-        CHECK(accepts(bounce::examples::quarter_turn_deg, good, &stored));
-        CHECK(stored == std::stod(good));
-    }
-    const std::string bad = GENERATE("-1e-30", "90", "90.0000001", "180", "nan", "inf", "-inf", "abc", "");
-    CAPTURE(bad);
-    CHECK_FALSE(accepts(bounce::examples::quarter_turn_deg, bad));
+    takes_exactly(bounce::examples::quarter_turn_deg, {"0", "-0", "30", "89.999", "1e-300", "0x1p+6"},
+                  {"-1e-30", "90", "90.0000001", "180", "nan", "inf", "-inf", "abc", ""});
 }
 
 TEST_CASE("the refusal says what the option wants", "[examples][cli]") {
