@@ -8,6 +8,7 @@ import pathlib
 import sys
 
 KEYS = ("rms_plane", "rms_coverage", "rms_stretch", "rms_falloff")
+SCENES = {"sponza": "Sponza", "cornell": "Cornell box"}
 
 
 def rows(folder, scene):
@@ -26,7 +27,7 @@ def main(folder):
         runs = rows(folder, scene)
         if not runs:
             continue
-        print(f"\n{scene}, ray-cast, 64^2 at 126 deg, {runs[0][3]} points\n")
+        print(f"\n**{SCENES[scene]}**, ray-cast, 64^2 at 126 deg, {runs[0][3]} points:\n")
         print("| turn (deg) | plane | coverage | stretching | fall-off (kappa) | stretching / plane |")
         print("|---|---|---|---|---|---|")
         for _, label, e, _ in runs:
