@@ -115,6 +115,13 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
     run "$tag-256-embree-a0.3" --scene "$scene" --width 256 --height 256 --ref-spp 16384 "${flags[@]}" --a 0.3 --weight ward-smooth
     run "$tag-256-raster" "${small_raster[@]}"
     run "$tag-256-raster-turn30" "${small_raster[@]}" --plane-turn 30
+    # Where the raster records' error sits (128x128, against the same cached reference).
+    local tiny=(--scene "$scene" --width 128 --height 128 --ref-spp 1024 "${flags[@]}" --a 0.3 --weight ward-smooth)
+    run "$tag-128-embree-a0.3" "${tiny[@]}" --indirect-exr build/sponza-128-embree.exr
+    run "$tag-128-raster-a0.3" "${tiny[@]}" --sampler raster --indirect-exr build/sponza-128-raster.exr
+    build/bin/reference --scene "$scene" --width 128 --height 128 --spp 1024 --out build/sponza-128-reference.exr --quiet
+    /usr/bin/python3 docs/studies/error_concentration.py build/sponza-128-reference.indirect.exr \
+        build/sponza-128-raster.exr build/sponza-128-embree.exr
   fi
   run "$tag-gl" "${common[@]}" --a 0.15 --weight ward-smooth --interp splat-gl
   run "$tag-mc" "${common[@]}" --a 0.15 --weight ward-smooth --mc-compare
