@@ -7,6 +7,7 @@
 Left: RMS error of the four weightings against the plane resolution at the aperture of the
 main run (126 degrees by default), ray-cast sampler solid, raster sampler dashed.
 Right: border stretching's error against resolution, one line per aperture (ray-cast).
+The title names the planes' turn when the study ran with --plane-turn or --hashed-turn.
 Needs matplotlib (Debian: python3-matplotlib; run with /usr/bin/python3).
 """
 import json
@@ -42,7 +43,10 @@ def main(argv):
     left.set_xscale("log", base=2)
     left.set_xlabel("plane resolution N (N x N pixels)")
     left.set_ylabel("RMS error of irradiance (%)")
-    left.set_title(f"{study['scene']}, aperture {aperture:g} deg, {study.get('sweep_points', '?')} points")
+    params = study["parameters"]
+    turn = params.get("plane_turn_deg", 0) or 0
+    turned = (f", turned {turn:g} deg" if turn else "") + (", hashed turn" if params.get("hashed_turn") else "")
+    left.set_title(f"{study['scene']}, aperture {aperture:g} deg{turned}, {study.get('sweep_points', '?')} points")
     left.grid(True, alpha=0.3)
     left.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
 
