@@ -39,7 +39,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -172,19 +171,11 @@ T rec709_luminance(const V& c) {
 // The plane camera and its weight tables
 
 /// A number in [0, 1) hashed from the bits of a position (+0 and -0 alike), the fraction of
-/// a quarter turn that plane_camera::hashed_turn gives a record's plane: SplitMix64's
-/// finalizer (Steele, Lea and Flood 2014) over the three floats, so points an ulp apart get
-/// unrelated turns and the same point always the same one.
+/// a quarter turn that plane_camera::hashed_turn gives a record's plane (hash_floats): points
+/// an ulp apart get unrelated turns and the same point always the same one.
 inline double plane_turn_hash(glm::vec3 p) noexcept {
-    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (const float f : {p.x, p.y, p.z}) {
-        h ^= std::bit_cast<std::uint32_t>(f == 0.f ? 0.f : f);
-        h += 0x9e3779b97f4a7c15ULL;
-        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
-        h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
-        h ^= h >> 31;
-    }
-    return double(h >> 11) * 0x1p-53;
+    const auto bits = [](float f) { return f == 0.f ? 0.f : f; };
+    return double(hash_floats({bits(p.x), bits(p.y), bits(p.z)}) >> 11) * 0x1p-53;
 }
 
 /// The camera of single-plane hemisphere sampling: an N x N square plane above the record.

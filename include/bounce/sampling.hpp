@@ -10,7 +10,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
+#include <initializer_list>
 #include <numbers>
 #include <vector>
 
@@ -85,6 +87,23 @@ template <real T, vec3_of<T> V>
 V to_world(const V& d, const V& n) {
     const auto tb = orthonormal_basis<T, V>(n);
     return tb[0] * d.x + tb[1] * d.y + n * d.z;
+}
+
+/// SplitMix64's step (Steele, Lea and Flood 2014): a bijective mix of 64 bits, for
+/// deriving seeds and keys (not a generator by itself).
+constexpr std::uint64_t splitmix64(std::uint64_t x) noexcept {
+    x += 0x9e3779b97f4a7c15ULL;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+    return x ^ (x >> 31);
+}
+
+/// 64 bits from the bit patterns of `values`, one splitmix64 step each: different inputs
+/// (-0 and +0 included) get unrelated keys, the same inputs always the same key.
+inline std::uint64_t hash_floats(std::initializer_list<float> values) noexcept {
+    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (const float f : values) h = splitmix64(h ^ std::bit_cast<std::uint32_t>(f));
+    return h;
 }
 
 /// PCG32 (O'Neill 2014): a small, fast generator with the same stream on every platform,

@@ -25,13 +25,6 @@ constexpr double pi = std::numbers::pi;
 // Stage tags for derive_seed: the direct and indirect images use unrelated streams.
 constexpr std::uint64_t stage_direct = 1, stage_indirect = 2, stage_secondary = 3;
 
-std::uint64_t splitmix64(std::uint64_t x) noexcept {
-    x += 0x9e3779b97f4a7c15ULL;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-    return x ^ (x >> 31);
-}
-
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool non_negative3(glm::vec3 v) { return finite3(v) && v.x >= 0.f && v.y >= 0.f && v.z >= 0.f; }
 

@@ -11,9 +11,9 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/irradiance_gradients.hpp>
 #include <bounce/irradiance_record.hpp>
+#include <bounce/sampling.hpp>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -65,18 +65,9 @@ private:
     translation_gradient_kind kind_;
     std::uint64_t seed_;
 
-    // 64 bits from the six floats' bit patterns (splitmix64 steps): distinct points get
-    // independent streams, the same point the same stream.
+    // Distinct points get independent streams, the same point the same stream.
     static std::uint64_t point_key(const glm::vec3& p, const glm::vec3& n) noexcept {
-        std::uint64_t h = 0x9e3779b97f4a7c15ull;
-        for (float f : {p.x, p.y, p.z, n.x, n.y, n.z}) {
-            h ^= std::bit_cast<std::uint32_t>(f);
-            h += 0x9e3779b97f4a7c15ull;
-            h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
-            h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
-            h ^= h >> 31;
-        }
-        return h;
+        return hash_floats({p.x, p.y, p.z, n.x, n.y, n.z});
     }
 };
 
