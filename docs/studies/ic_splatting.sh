@@ -119,6 +119,10 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
     local tiny=(--scene "$scene" --width 128 --height 128 --ref-spp 1024 "${flags[@]}" --a 0.3 --weight ward-smooth)
     run "$tag-128-embree-a0.3" "${tiny[@]}" --indirect-exr build/sponza-128-embree.exr
     run "$tag-128-raster-a0.3" "${tiny[@]}" --sampler raster --indirect-exr build/sponza-128-raster.exr
+    for r in 4096 8192; do  # the renderer's shadow maps are 2048^2 unless told
+      run "$tag-128-raster-shadow$r-a0.3" "${tiny[@]}" --sampler raster --shadow-resolution "$r"
+    done
+    run "$tag-128-raster-shadow8192-turn30-a0.3" "${tiny[@]}" --sampler raster --shadow-resolution 8192 --plane-turn 30
     build/bin/reference --scene "$scene" --width 128 --height 128 --spp 1024 --out build/sponza-128-reference.exr --quiet
     /usr/bin/python3 docs/studies/error_concentration.py build/sponza-128-reference.indirect.exr \
         build/sponza-128-raster.exr build/sponza-128-embree.exr

@@ -66,6 +66,7 @@ struct options {
     float falloff_kappa = 1.f;  // raster sampler: fall-off stretching's band factor (1: border stretching)
     double plane_turn = 0.0;    // raster sampler: plane_camera::turn_deg
     bool hashed_turn = false;   // raster sampler: plane_camera::hashed_turn
+    int shadow_resolution = 2048;  // GL: texels per side of the shadow maps (raster records, GL frames' direct light)
     std::string interp = "splat-cpu";
     std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
     float fill_holes = 4.f;       // progressive: wide splat's a / a (0: leave holes black)
@@ -121,6 +122,7 @@ struct context {
 nlohmann::json cache_parameters(const options& o, const io::scene& s) {
     return {{"scene", s.name},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
             {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
+            {"shadow_resolution", o.sampler == "raster" ? o.shadow_resolution : 0},  // the raster's records see the maps
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
             {"gradient_limit", o.gradient_limit}, {"height", o.height}};
 }
@@ -328,7 +330,7 @@ struct gl_backend {
 
     std::optional<gl::hemisphere_raster> raster;  // the record sampler, for --sampler raster
 
-    explicit gl_backend(const io::scene& s) : mesh(s), light(s, mesh, 2048) {}
+    gl_backend(const io::scene& s, int shadow_resolution) : mesh(s), light(s, mesh, shadow_resolution) {}
 };
 
 // Where a GL frame's records are measured. The Embree sampler starts its rays at its own
@@ -515,7 +517,7 @@ int run(const options& o) {
 
 #ifdef BOUNCE_IC_WITH_GL
     std::optional<gl_backend> gl_state;
-    if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene); });
+    if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene, o.shadow_resolution); });
     std::optional<gl::raster_record_sampler> raster_sampler;
     if (o.sampler == "raster") {
         // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4), or
@@ -561,6 +563,7 @@ int run(const options& o) {
     report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
                          {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
+                         {"shadow_resolution", o.shadow_resolution},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
@@ -762,6 +765,10 @@ int main(int argc, char** argv) {
     app.add_option("--plane-turn", o.plane_turn,
                    "raster sampler: turn of every plane about its normal from orthonormal_basis(n), degrees in [0, 90)")
         ->check(examples::quarter_turn_deg)
+        ->capture_default_str();
+    app.add_option("--shadow-resolution", o.shadow_resolution,
+                   "GL: texels per side of the shadow maps (raster sampler's records, splat-gl's direct light)")
+        ->check(CLI::Range(64, 8192))
         ->capture_default_str();
     app.add_flag("--hashed-turn", o.hashed_turn,
                  "raster sampler: also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
