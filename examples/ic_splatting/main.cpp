@@ -517,7 +517,8 @@ int run(const options& o) {
 
 #ifdef BOUNCE_IC_WITH_GL
     std::optional<gl_backend> gl_state;
-    if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene, o.shadow_resolution); });
+    if (o.interp == "splat-gl" || o.sampler == "raster")
+        setup.time("gl_setup", [&] { gl_state.emplace(scene, o.shadow_resolution); });
     std::optional<gl::raster_record_sampler> raster_sampler;
     if (o.sampler == "raster") {
         // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4), or

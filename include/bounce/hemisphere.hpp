@@ -174,8 +174,8 @@ T rec709_luminance(const V& c) {
 /// a quarter turn that plane_camera::hashed_turn gives a record's plane (hash_floats): points
 /// an ulp apart get unrelated turns and the same point always the same one.
 inline double plane_turn_hash(glm::vec3 p) noexcept {
-    const auto bits = [](float f) { return f == 0.f ? 0.f : f; };
-    return double(hash_floats({bits(p.x), bits(p.y), bits(p.z)}) >> 11) * 0x1p-53;
+    const auto plus_zero = [](float f) { return f == 0.f ? 0.f : f; };
+    return double(hash_floats({plus_zero(p.x), plus_zero(p.y), plus_zero(p.z)}) >> 11) * 0x1p-53;
 }
 
 /// The camera of single-plane hemisphere sampling: an N x N square plane above the record.
