@@ -3,8 +3,12 @@
 // facing down, Kd = kd_lit for x > x_edge and 0 elsewhere, 2 * extent wide, lit from
 // below by a directional light travelling +y that delivers E_perp, so the lit part has
 // radiance kd / pi * E_perp. Records sit at y = 0 looking up (n = +y).
+#include "../core/half_lit_ceiling.hpp"
+
+#include <bounce/hemisphere.hpp>
 #include <bounce/io/scene.hpp>
 
+#include <cmath>
 #include <cstdint>
 
 namespace bounce::hemisphere_test {
@@ -34,6 +38,16 @@ inline io::scene half_lit_ceiling_scene(float H, float x_edge, float kd_lit, flo
     quad(-extent, x_edge, 1);
     s.lights.push_back(io::directional_light{glm::vec3(0, 1, 0), glm::vec3(E_perp)});
     return s;
+}
+
+// That ceiling as a record at p (n = +y), whose rays or eye leave at height `offset`, sees
+// it in its plane's frame (cam.frame): the core tests' half_lit_ceiling with
+// h = H - offset, x0 = p.x - x_edge and rot = atan2(b.x, t.x), the angle of world +x (the
+// edge's normal) in that frame ((t.x, b.x) is a unit vector, n being +y).
+inline ceiling_test::half_lit_ceiling ceiling_seen_from(const plane_camera& cam, glm::vec3 p, float H, double offset,
+                                                        float x_edge, double L) {
+    const auto tb = cam.frame(p, glm::vec3(0, 1, 0));
+    return {double(H) - offset, double(p.x) - double(x_edge), L, std::atan2(double(tb[1].x), double(tb[0].x))};
 }
 
 }  // namespace bounce::hemisphere_test

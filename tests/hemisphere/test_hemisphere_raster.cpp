@@ -366,16 +366,13 @@ TEST_CASE("turned raster planes give world-space records of the half-lit ceiling
         const glm::vec3 p(x, 0.f, float(4 * rng.next_double() - 2)), n(0.f, 1.f, 0.f);
         const auto rec = sampler(p, n, 1e-3);
         REQUIRE(rec.has_value());
-        // The plane sees the core test's ceiling with h = H - offset, x0 = p.x - x_edge and
-        // rot the angle of world +x in the plane's frame. Its closed forms do not depend on
-        // the frame: the rotation gradient is rot_y (n x world x) = rot_y (0, 0, -1). An
+        // The plane sees the core test's ceiling (ceiling_seen_from). Its closed forms do not
+        // depend on the frame: the rotation gradient is rot_y (n x world x) = rot_y (0, 0, -1). An
         // estimate from the analytic plane is within L times the mixed cells' weights of
         // them; the raster plane differs from the analytic one in those cells only, by at
         // most L each: twice the bound. A record expressed in the wrong frame would be off
         // by 2 sin(turn / 2) |rot_y| (52% at 30 deg).
-        const auto tb = options.camera.frame(p, n);
-        const double h = double(H) - double(options.offset);
-        const ceiling_test::half_lit_ceiling hc{h, double(x - x_edge), L, std::atan2(double(tb[1].x), double(tb[0].x))};
+        const auto hc = hemisphere_test::ceiling_seen_from(options.camera, p, H, options.offset, x_edge, L);
         const auto bound = ceiling_test::mixed_cells(options.camera, hc, true);
         CAPTURE(k, x, turn, hashed, options.camera.turn_at(p), rec->irradiance.x, hc.E(), bound.E, bound.rotation);
         CHECK(std::abs(double(rec->irradiance.x) - hc.E()) <= 2 * L * bound.E + 1e-5 * hc.E());

@@ -38,23 +38,20 @@ TEST_CASE("ray-cast planes of a half-lit ceiling give the closed-form irradiance
     pcg32 rng(8);
     for (int c = 0; c < 12; ++c) {
         const glm::vec3 p(float(2 * rng.next_double() - 1), 0.f, float(2 * rng.next_double() - 1));
-        const auto tb = cam.frame(p, n);
         image<glm::vec3> radiance(cam.resolution, cam.resolution);
         image<float> distance(cam.resolution, cam.resolution);
         embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
         const auto e = estimate_plane(stretch, {radiance.view(), distance.view()});
-        // The record at p sees the lit side where world x > x_edge. In the plane's frame the
-        // edge direction is (t.x, b.x) (a unit vector, n being +y), so this is the core
-        // test's ceiling with h = H - offset, x0 = p.x - x_edge and rot = atan2(b.x, t.x):
-        // its rigorous bound on E (mixed cells) and its translation budget for N = 64.
-        const double h = double(H) - ref.ray_epsilon();
-        const ceiling_test::half_lit_ceiling hc{h, double(p.x) - x_edge, L, std::atan2(double(tb[1].x), double(tb[0].x))};
+        // The record at p sees the lit side where world x > x_edge: the core test's ceiling
+        // (ceiling_seen_from), its rigorous bound on E (mixed cells) and its translation
+        // budget for N = 64.
+        const auto hc = hemisphere_test::ceiling_seen_from(cam, p, H, ref.ray_epsilon(), x_edge, L);
         const auto bound = ceiling_test::mixed_cells(cam, hc, true);
         CAPTURE(turn, hashed, p.x, p.z, e.irradiance.x, hc.E(), bound.E);
         // Float radiance (relative 1e-7 of E) on top of the bound.
         CHECK(std::abs(e.irradiance.x - hc.E()) <= L * bound.E + 1e-6 * hc.E());
         CHECK(glm::length(e.rotation[0] - hc.rot_y() * hc.across()) <= L * bound.rotation + 1e-6 * hc.E());
-        CHECK(glm::length(e.translation[0] - hc.dE_dx() * hc.along()) < 0.044 * pi * L / (2 * h));
+        CHECK(glm::length(e.translation[0] - hc.dE_dx() * hc.along()) < 0.044 * pi * L / (2 * hc.h));
         const double E = hc.E();
         // And the full-hemisphere reference integrator agrees with the same closed form
         // (its stratified estimate of a step: ~1/M of the scale with M = 18 at 1024 rays).
