@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 
 namespace bounce::examples {
@@ -36,6 +37,20 @@ inline CLI::Validator finite_number_at_least_zero(bool zero_allowed) {
         },
         zero_allowed ? "FINITE >= 0" : "FINITE > 0");
 }
+
+/// A number in [lo, hi] (or [lo, hi) when `hi` is excluded), called `what` in refusals.
+inline CLI::Validator number_in(double lo, double hi, bool hi_included, const std::string& what) {
+    std::ostringstream text;
+    text << '[' << lo << ", " << hi << (hi_included ? ']' : ')');
+    const std::string range = text.str();
+    return CLI::Validator(
+        [=](std::string& s) -> std::string {
+            const double v = parse_number(s);
+            if (v >= lo && (v < hi || (hi_included && v == hi))) return {};
+            return "'" + s + "' is not " + what + " in " + range;
+        },
+        "IN " + range);
+}
 }  // namespace detail
 
 /// A finite number above zero.
@@ -43,20 +58,8 @@ inline const CLI::Validator finite_positive = detail::finite_number_at_least_zer
 /// A finite number, zero or above.
 inline const CLI::Validator finite_non_negative = detail::finite_number_at_least_zero(true);
 /// A number in [0, 1] (CLI::Range lets NaN through as well).
-inline const CLI::Validator unit_interval = CLI::Validator(
-    [](std::string& s) -> std::string {
-        const double v = detail::parse_number(s);
-        if (v >= 0 && v <= 1) return {};
-        return "'" + s + "' is not a number in [0, 1]";
-    },
-    "IN [0, 1]");
+inline const CLI::Validator unit_interval = detail::number_in(0, 1, true, "a number");
 /// An angle in [0, 90) degrees: a turn of a square, which repeats every 90.
-inline const CLI::Validator quarter_turn_deg = CLI::Validator(
-    [](std::string& s) -> std::string {
-        const double v = detail::parse_number(s);
-        if (v >= 0 && v < 90) return {};
-        return "'" + s + "' is not an angle in [0, 90) degrees";
-    },
-    "IN [0, 90)");
+inline const CLI::Validator quarter_turn_deg = detail::number_in(0, 90, false, "an angle");
 
 }  // namespace bounce::examples

@@ -767,12 +767,12 @@ int main(int argc, char** argv) {
                    "raster sampler: turn of every plane about its normal from orthonormal_basis(n), degrees in [0, 90)")
         ->check(examples::quarter_turn_deg)
         ->capture_default_str();
+    app.add_flag("--hashed-turn", o.hashed_turn,
+                 "raster sampler: also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
     app.add_option("--shadow-resolution", o.shadow_resolution,
                    "GL: texels per side of the shadow maps (raster sampler's records, splat-gl's direct light)")
         ->check(CLI::Range(64, 8192))
         ->capture_default_str();
-    app.add_flag("--hashed-turn", o.hashed_turn,
-                 "raster sampler: also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
     app.add_option("--interp", o.interp,
                    "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
         ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();
