@@ -598,6 +598,7 @@ int main(int argc, char** argv) {
             report.parameters["points"] = points;
             report.parameters["seed"] = seed;
             report.parameters["batch"] = batch;
+            report.parameters["embree_config"] = bvh.owner().config();
             report.parameters["shadow_resolution"] = shadow_resolution;
 #ifdef BOUNCE_STUDY_WITH_GL
             report.parameters["shadow_normal_offset"] = shadows.normal_offset_texels;

@@ -572,7 +572,8 @@ int run(const options& o) {
                          {"front_tolerance", o.front_tolerance},
                          {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
                          {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
-                         {"scan", o.scan}, {"scan_batch", ctx.batch.max_records}, {"scan_order", scan_order}};
+                         {"scan", o.scan}, {"scan_batch", ctx.batch.max_records}, {"scan_order", scan_order},
+                         {"embree_config", bvh.owner().config()}};
 
     auto reference_for = [&](const camera& cam) {
         bool hit = false;

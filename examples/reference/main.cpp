@@ -99,16 +99,18 @@ int main(int argc, char** argv) {
         settings.seed = seed;
 
         io::stage_timer timer;
+        const embree::device dev;  // BOUNCE_EMBREE_CONFIG, when set, pins its kernels (and keys the cache)
         std::optional<embree::accel> bvh;
         gbuffer<float> g;
         embree::reference_images images;
-        const std::string key = embree::reference_cache_key(scene, scene.camera, width, height, settings);
+        const std::string key =
+            embree::reference_cache_key(scene, scene.camera, width, height, settings, dev.config());
         std::string cache_state = no_cache ? "off" : "miss";
 
         for (int r = 0; r < repeat; ++r) {
             auto total = timer.measure("total");
             bvh.reset();
-            timer.time("bvh", [&] { bvh.emplace(scene); });
+            timer.time("bvh", [&] { bvh.emplace(dev, scene); });
             g = timer.time("gbuffer", [&] { return embree::ray_cast_gbuffer(*bvh, scene, scene.camera, width, height); });
             if (!no_cache && repeat == 1) {
                 auto cached = timer.time("cache_load", [&] {
@@ -130,7 +132,7 @@ int main(int argc, char** argv) {
                     images.combined(x, y) = images.direct(x, y) + images.indirect(x, y);
             images.grid = embree::hemisphere_grid_for(spp);
         }
-        if (!no_cache && cache_state == "miss") embree::store_cached_reference(cache_dir, key, images, scene, scene.camera, settings);
+        if (!no_cache && cache_state == "miss") embree::store_cached_reference(cache_dir, key, images, scene, scene.camera, settings, dev.config());
 
         io::write_exr(out, images.combined.view());
         io::write_exr(sibling(out, "direct"), images.direct.view());
@@ -162,6 +164,7 @@ int main(int argc, char** argv) {
             report.parameters["environment"] = environment;
             report.parameters["cache"] = cache_state;
             report.parameters["cache_key"] = key;
+            report.parameters["embree_config"] = dev.config();
             report.set_timings(timer);
             report.set_count("samples_per_pixel", images.grid.count());
             report.set_count("pixels_covered", covered);

@@ -11,7 +11,9 @@
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <string>
 
 using namespace bounce;
 using namespace bounce::embree;
@@ -52,6 +54,72 @@ TEST_CASE("an Embree error surfaces as embree_error with the callback's message"
     rtcReleaseScene(scene);
     // It is a bounce::error, so callers can catch the library's errors in one place.
     CHECK(std::is_base_of_v<bounce::error, embree_error>);
+}
+
+TEST_CASE("a device's configuration pins Embree's kernels and is checked before Embree sees it",
+          "[embree][device]") {
+    // Two parallel squares z = 1 and z = 2 (as below): every kernel set must find the lower
+    // one at t = 1 / d.z, to the few ulps its float intersection allows.
+    io::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
+    hand_built::add_square_z(s, 1.f, 4.f, false, m);
+    hand_built::add_square_z(s, 2.f, 4.f, false, m);
+    const std::string config = GENERATE(as<std::string>{}, "", "max_isa=sse2", "max_isa=sse4.2,threads=1",
+                                        "max_isa=avx,verbose=0", "start_threads=1,set_affinity=0,hugepages=0");
+    CAPTURE(config);
+    const device dev(config);
+    CHECK(dev.config() == config);
+    const accel bvh(dev, s);
+    pcg32 rng(5);
+    for (int i = 0; i < 200; ++i) {
+        const glm::vec3 o(float(rng.next_double() - 0.5), float(rng.next_double() - 0.5), 0.f);
+        const double cz = 0.5 + 0.5 * rng.next_double(), r = std::sqrt(1 - cz * cz), phi = 6.283185307 * rng.next_double();
+        const ray q{o, glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(cz))};
+        const hit h = bvh.intersect(q);
+        REQUIRE(h.found());
+        CHECK(h.t == Approx(1.0 / q.direction.z).epsilon(1e-5));
+        CHECK(h.triangle < 2u);
+    }
+}
+
+TEST_CASE("a device configuration Embree would silently ignore is refused, naming the option",
+          "[embree][device][bad-input]") {
+    // rtcNewDevice skips unknown keys and values (checked: it returns a device for each of
+    // these), so a misspelt max_isa would quietly leave the kernels unpinned.
+    // {configuration, the option the message must quote}
+    const auto [bad, option] = GENERATE(table<std::string, std::string>({
+        {"bogus=1", "bogus=1"}, {"max_isa=nonsense", "max_isa=nonsense"}, {"max_isa=AVX2", "max_isa=AVX2"},
+        {"threads=-3", "threads=-3"}, {"threads=", "threads="}, {"verbose", "verbose"}, {"=1", "=1"},
+        {"verbose=4", "verbose=4"}, {"max_isa=sse4.2,", ""}, {"threads=1,,verbose=1", ""},
+        {" max_isa=sse4.2", " max_isa=sse4.2"}, {"threads=1,hugepages=yes", "hugepages=yes"},
+        {"frequency_level=simd64", "frequency_level=simd64"}}));
+    CAPTURE(bad);
+    CHECK_THROWS_AS(device(bad), parameter_error);
+    CHECK_THROWS_WITH(device(bad), Catch::Contains("embree::device config") && Catch::Contains("option '" + option + "'"));
+}
+
+TEST_CASE("BOUNCE_EMBREE_CONFIG configures default devices and is checked under its name",
+          "[embree][device][bad-input]") {
+    const char* saved = std::getenv("BOUNCE_EMBREE_CONFIG");
+    const std::string restore = saved ? saved : "";
+    struct restore_env {
+        std::string value;
+        bool was_set;
+        ~restore_env() {
+            if (was_set) setenv("BOUNCE_EMBREE_CONFIG", value.c_str(), 1);
+            else unsetenv("BOUNCE_EMBREE_CONFIG");
+        }
+    } guard{restore, saved != nullptr};
+
+    setenv("BOUNCE_EMBREE_CONFIG", "max_isa=sse4.2", 1);
+    CHECK(device().config() == "max_isa=sse4.2");
+    CHECK(accel(io::scene{}).owner().config() == "max_isa=sse4.2");
+    setenv("BOUNCE_EMBREE_CONFIG", "max_isa=sse4", 1);
+    CHECK_THROWS_WITH(device(), Catch::Contains("BOUNCE_EMBREE_CONFIG") && Catch::Contains("'max_isa=sse4'"));
+    setenv("BOUNCE_EMBREE_CONFIG", "", 1);
+    CHECK(device().config().empty());
+    unsetenv("BOUNCE_EMBREE_CONFIG");
+    CHECK(device().config().empty());
 }
 
 TEST_CASE("building from an invalid scene names the faulty field", "[embree][bad-input]") {

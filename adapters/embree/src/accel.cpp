@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <initializer_list>
 #include <mutex>
 #include <vector>
 
@@ -48,6 +50,7 @@ namespace detail {
 // (per thread in Embree) and this message.
 struct device_state {
     RTCDevice handle = nullptr;
+    std::string config;  // rtcNewDevice's configuration string; empty for the default
     std::mutex mutex;
     std::string last_message;
 
@@ -74,12 +77,66 @@ struct scene_state {
 
 }  // namespace detail
 
-device::device() : state_(std::make_shared<detail::device_state>()) {
-    state_->handle = rtcNewDevice(nullptr);
+namespace {
+
+// Throws parameter_error unless `config` is a list of options rtcNewDevice documents, each
+// with a value of its documented form (Embree itself skips what it does not know).
+void check_device_config(std::string_view config, std::string_view source) {
+    auto is_count = [](std::string_view v) {
+        return !v.empty() && v.size() <= 6 && std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    auto one_of = [](std::string_view v, std::initializer_list<std::string_view> allowed) {
+        return std::find(allowed.begin(), allowed.end(), v) != allowed.end();
+    };
+    std::size_t start = 0;
+    while (start <= config.size()) {
+        const std::size_t end = std::min(config.find(',', start), config.size());
+        const std::string_view option = config.substr(start, end - start);
+        const std::size_t eq = option.find('=');
+        const std::string_view key = option.substr(0, eq);
+        const std::string_view value = eq == std::string_view::npos ? std::string_view() : option.substr(eq + 1);
+        const std::string name(source), quoted = "option '" + std::string(option) + "' ";
+        if (eq == std::string_view::npos || key.empty() || value.empty())
+            throw parameter_error(name, quoted + "is not key=value (options are separated by commas)");
+        const char* expected = nullptr;  // the documented values of `key`, when `value` is not one
+        if (one_of(key, {"threads", "user_threads"})) {
+            if (!is_count(value)) expected = "a count";
+        } else if (one_of(key, {"set_affinity", "start_threads", "hugepages", "enable_selockmemoryprivilege"})) {
+            if (!one_of(value, {"0", "1"})) expected = "0 or 1";
+        } else if (one_of(key, {"isa", "max_isa"})) {
+            if (!one_of(value, {"sse2", "sse4.2", "avx", "avx2", "avx512"})) expected = "sse2, sse4.2, avx, avx2 or avx512";
+        } else if (key == "verbose") {
+            if (!one_of(value, {"0", "1", "2", "3"})) expected = "0 to 3";
+        } else if (key == "frequency_level") {
+            if (!one_of(value, {"simd128", "simd256", "simd512"})) expected = "simd128, simd256 or simd512";
+        } else {
+            throw parameter_error(name, quoted + "is not one rtcNewDevice documents");
+        }
+        if (expected) throw parameter_error(name, quoted + "needs " + expected);
+        start = end + 1;
+    }
+}
+
+// $BOUNCE_EMBREE_CONFIG, checked under its own name (so a bad value says where it came from).
+std::string config_from_environment() {
+    const char* env = std::getenv("BOUNCE_EMBREE_CONFIG");
+    std::string config = env ? env : "";
+    if (!config.empty()) check_device_config(config, "BOUNCE_EMBREE_CONFIG");
+    return config;
+}
+
+}  // namespace
+
+device::device() : device(config_from_environment()) {}
+
+device::device(std::string_view config) : state_(std::make_shared<detail::device_state>()) {
+    if (!config.empty()) check_device_config(config, "embree::device config");
+    state_->config = std::string(config);
+    state_->handle = rtcNewDevice(config.empty() ? nullptr : state_->config.c_str());
     if (!state_->handle) {
         // Creation errors are reported through rtcGetDeviceError(NULL) only; there is no
         // device yet to carry a callback.
-        throw embree_error(int(rtcGetDeviceError(nullptr)), "", "rtcNewDevice");
+        throw embree_error(int(rtcGetDeviceError(nullptr)), "", "rtcNewDevice(\"" + state_->config + "\")");
     }
     rtcSetDeviceErrorFunction(state_->handle, &detail::device_state::on_error, state_.get());
 }
@@ -96,6 +153,8 @@ void device::check(std::string_view during) const {
 }
 
 RTCDeviceTy* device::native() const noexcept { return state_->handle; }
+
+const std::string& device::config() const noexcept { return state_->config; }
 
 void validate(const io::scene& s) {
     const std::size_t nv = s.positions.size(), nt = s.triangles.size();

@@ -39,7 +39,7 @@ public:
         value(v.y);
         value(v.z);
     }
-    void text(const std::string& s) {
+    void text(std::string_view s) {
         value(s.size());
         bytes(s.data(), s.size());
     }
@@ -86,7 +86,8 @@ std::filesystem::path default_cache_dir() {
 }
 
 std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
-                                std::size_t height, const reference_settings& settings) {
+                                std::size_t height, const reference_settings& settings,
+                                std::string_view device_config) {
     fnv1a h;
     h.text(integrator_version);
     h.value(scene.positions.size());
@@ -138,6 +139,7 @@ std::string reference_cache_key(const io::scene& scene, const bounce::camera& ca
     h.vec(settings.environment);
     h.value(settings.ray_epsilon);
     h.value(settings.seed);
+    if (!device_config.empty()) h.text(device_config);  // Embree's default: the keys of earlier versions
 
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
@@ -169,7 +171,8 @@ std::optional<reference_images> load_cached_reference(const std::filesystem::pat
 }
 
 void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
-                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings) {
+                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings,
+                            std::string_view device_config) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) throw bounce::error("bounce::embree: cannot create the cache directory " + dir.string() + ": " + ec.message());
@@ -178,7 +181,7 @@ void store_cached_reference(const std::filesystem::path& dir, const std::string&
     write_atomically(entry(dir, key, ".indirect.exr"), ".exr",
                      [&](const std::filesystem::path& p) { io::write_exr(p, images.indirect.view()); });
 
-    const nlohmann::json description = {
+    nlohmann::json description = {
         {"key", key},
         {"integrator", integrator_version},
         {"scene", scene.name},
@@ -199,6 +202,7 @@ void store_cached_reference(const std::filesystem::path& dir, const std::string&
         {"ray_epsilon", settings.ray_epsilon},
         {"seed", settings.seed},
     };
+    if (!device_config.empty()) description["embree_config"] = std::string(device_config);
     write_atomically(entry(dir, key, ".json"), ".json", [&](const std::filesystem::path& p) {
         std::ofstream f(p);
         f << description.dump(2) << '\n';
@@ -209,14 +213,15 @@ void store_cached_reference(const std::filesystem::path& dir, const std::string&
 reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
                                   std::size_t width, std::size_t height, const reference_settings& settings,
                                   const std::filesystem::path& dir, bool* from_cache) {
-    const std::string key = reference_cache_key(scene, cam, width, height, settings);
+    const std::string& config = bvh.owner().config();
+    const std::string key = reference_cache_key(scene, cam, width, height, settings, config);
     if (auto cached = load_cached_reference(dir, key, width, height, settings)) {
         if (from_cache) *from_cache = true;
         return std::move(*cached);
     }
     auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
     reference_images r = render_reference(bvh, scene, g.view(), settings);
-    store_cached_reference(dir, key, r, scene, cam, settings);
+    store_cached_reference(dir, key, r, scene, cam, settings, config);
     if (from_cache) *from_cache = false;
     return r;
 }

@@ -43,10 +43,29 @@ struct scene_state;
 /// An Embree device (RTCDevice) with an error callback that records Embree's message.
 /// Cheap to copy: copies share the device, which lives while any copy or any `accel` built
 /// on it does. Embree uses the process's TBB scheduler, so tbb::global_control limits it.
+///
+/// Embree picks its SIMD kernels (SSE2 ... AVX-512) by CPU, and the kernels round hit
+/// distances differently in the last bits. bounce's records and references are bitwise
+/// reproducible on one machine, not across CPUs: the Cornell box at a = 0.4 makes 3663
+/// records with AVX2 kernels and 3675 with SSE4.2 ones, at the same error. Pin the kernels
+/// ("max_isa=sse4.2") to compare runs bit for bit across machines.
 class device {
 public:
-    /// Creates a device with Embree's default configuration. Throws embree_error.
+    /// The configuration in the environment variable BOUNCE_EMBREE_CONFIG when it is set and
+    /// not empty (checked as below), else Embree's default. Throws embree_error or
+    /// parameter_error.
     device();
+    /// A device with rtcNewDevice's configuration string `config`: comma-separated
+    /// `key=value` options from Embree's documented set (threads, user_threads,
+    /// set_affinity, start_threads, isa, max_isa, hugepages, enable_selockmemoryprivilege,
+    /// verbose, frequency_level), e.g. "max_isa=sse4.2,threads=2"; empty for the default.
+    /// Embree ignores options it does not know, so bounce checks keys and values and throws
+    /// parameter_error naming the option. Throws embree_error when Embree refuses (an `isa`
+    /// this CPU lacks).
+    explicit device(std::string_view config);
+
+    /// The configuration the device was created with ("" for Embree's default).
+    const std::string& config() const noexcept;
 
     /// Throws embree_error if Embree recorded an error on this thread since the last check;
     /// `during` names the operation for the message (e.g. "rtcCommitScene").

@@ -7,7 +7,9 @@
 /// size and the sample count for people, and ends in a 64-bit FNV-1a hash of everything
 /// the images depend on: the scene's geometry, normals, materials, lights and
 /// use_emission, the camera, the size, the integrator settings (samples, environment,
-/// ray offset, seed) and the integrator's version. Change any of them and the key changes.
+/// ray offset, seed), the integrator's version and, when one was given, the Embree device's
+/// configuration (pinned kernels round hits differently; Embree's default leaves the key as
+/// it was). Change any of them and the key changes.
 
 #include <bounce/camera.hpp>
 #include <bounce/embree/accel.hpp>
@@ -17,6 +19,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace bounce::embree {
 
@@ -25,9 +28,11 @@ namespace bounce::embree {
 std::filesystem::path default_cache_dir();
 
 /// The cache key of a reference render of `scene` seen by `cam` at `width` x `height` with
-/// `settings`: "<scene name>-<W>x<H>-<spp>spp-<16 hex digits>" (file-name safe).
+/// `settings` on a device configured with `device_config` (device::config()):
+/// "<scene name>-<W>x<H>-<spp>spp-<16 hex digits>" (file-name safe).
 std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
-                                std::size_t height, const reference_settings& settings);
+                                std::size_t height, const reference_settings& settings,
+                                std::string_view device_config = {});
 
 /// The cached images under `key` in `dir`, or nothing when an entry is missing, unreadable
 /// or of another size than `width` x `height` (the caller then recomputes). The combined
@@ -36,11 +41,13 @@ std::optional<reference_images> load_cached_reference(const std::filesystem::pat
                                                       std::size_t width, std::size_t height,
                                                       const reference_settings& settings);
 
-/// Writes `images` under `key` in `dir` (created when missing). Each file is written to a
+/// Writes `images` under `key` in `dir` (created when missing), with a JSON description
+/// (including `device_config` when not empty). Each file is written to a
 /// temporary name and renamed, so a reader never sees half an entry. Throws bounce::error
 /// (from the image writer) when the directory or a file cannot be written.
 void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
-                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings);
+                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings,
+                            std::string_view device_config = {});
 
 /// The reference images of `scene` through `cam`: from the cache when present, else ray
 /// cast G-buffer + render_reference, stored for next time. `from_cache` (optional)
