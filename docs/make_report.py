@@ -5,6 +5,7 @@ import glob
 import json
 import math
 import os
+import re
 
 import matplotlib
 
@@ -158,6 +159,24 @@ def weights_table(scene, mine):
     return lines + [""]
 
 
+def seams_table(scene, mine):
+    """Ward's weight against the smoothed one over the a sweep, both run back to back on one
+    machine (runs SCENE-seams-WEIGHT-aA)."""
+    rows = []
+    for a in ("0.4", "0.3", "0.2", "0.15", "0.1"):
+        ward, smooth = mine.get(f"{scene}-seams-ward-a{a}"), mine.get(f"{scene}-seams-ward-smooth-a{a}")
+        if ward and smooth:
+            e_w, e_s = ward["error"]["rel_rms"], smooth["error"]["rel_rms"]
+            rows.append(f"| {a} | {ward['records']} | {e_w:.4f} | {smooth['records']} | {e_s:.4f} | "
+                        f"{100 * (e_s / e_w - 1):+.1f}% |")
+    if not rows:
+        return []
+    return ["Ward's weight against the smoothed one, each on the cache it builds (run back to back on one "
+            "machine):", "",
+            "| a | Ward: records | rel_rms | smoothed: records | rel_rms | smoothed vs Ward |",
+            "|---|---|---|---|---|---|"] + rows + [""]
+
+
 def main():
     runs = load()
     lines = ["# Speed against error", "",
@@ -180,6 +199,7 @@ def main():
         if head:
             lines += ["Figures the irradiance-splatting issue asks for (a = 0.15):", ""] + head + [""]
         lines += weights_table(scene, mine)
+        lines += seams_table(scene, mine)
         # The main Monte Carlo run (others, such as SCENE-tabellion-mc, have their own lines).
         mc = [r for r in [mine.get(f"{scene}-mc")] if r and "mc_sweep" in r]
         if mc:
@@ -207,7 +227,7 @@ def main():
             lines.append("")
         # The a sweep against Monte Carlo, as a table and as a plot: one series per number of
         # rays per record (runs named SCENE-aA and SCENE-rN-aA).
-        swept = [v for k, v in mine.items() if "-a0" in k and "ward-" not in k and "-w-" not in k]
+        swept = [v for k, v in mine.items() if re.fullmatch(rf"{re.escape(scene)}-(r\d+-)?a[0-9.]+", k)]
         series = {}
         for r in swept:
             series.setdefault(r["parameters"]["record_samples"], []).append(r)

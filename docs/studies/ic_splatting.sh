@@ -44,6 +44,13 @@ weights() {  # weights TAG ARGS...: every weighting policy at a = 0.15 and 0.4, 
   run "$tag-tabellion-nograd" "$@" --a 0.15 --weight tabellion --gradients off  # beside $tag-w-tabellion-a0.15
 }
 
+seams() {  # seams TAG ARGS...: Ward's and the smoothed weight over the whole a sweep, back to back on one machine
+  local tag=$1; shift
+  for a in 0.4 0.3 0.2 0.15 0.1; do
+    for w in ward ward-smooth; do run "$tag-seams-$w-a$a" "$@" --a "$a" --weight "$w"; done
+  done
+}
+
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor) RAYS(per record)
   local tag=$1 scene=$2 spp=$3 clamp=$4 fill=$5 rays=$6
   local flags=() other=clamp  # other: the cross-check run with the other clamping setting
@@ -73,6 +80,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   run "$tag-ward-a0.4" "${common[@]}" --a 0.4 --weight ward  # beside $tag-a0.4: where seams show
   rays "$tag" "${base[@]}"
   weights "$tag" "${common[@]}"
+  seams "$tag" "${common[@]}"
   # Nearly noise-free records: does the smoothed weight's excess over Ward's at a = 0.15 come
   # from record noise? Sponza's at 256x256 (at 512x512 a run would take half an hour), against
   # a 16384-spp reference of that size, with 1024 rays beside them.
