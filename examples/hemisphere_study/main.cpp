@@ -441,9 +441,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
 
     try {
-        fs::path scene_path = scene_arg;
-        if (!fs::exists(scene_path) && scene_arg != "cornell") scene_path = io::scenes_dir() / scene_arg;
-        const io::scene scene = io::load_scene_arg(scene_path.string() == "cornell" ? "cornell" : scene_path.string());
+        const io::scene scene = io::load_scene_arg(scene_arg);
         const plane_camera cam{resolution, aperture, turn, hashed_turn};
         cam.validate();
         const embree::accel bvh(scene);

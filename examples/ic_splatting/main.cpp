@@ -751,7 +751,7 @@ int main(int argc, char** argv) {
     CLI::App app{"bounce: irradiance caching by splatting (Gautron, SIGGRAPH 2008 course, ch. 8)"};
     options o;
     std::string gradients = "on";
-    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, or an .obj")->capture_default_str();
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")->capture_default_str();
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(examples::finite_positive)->capture_default_str();

@@ -31,6 +31,7 @@ public:
     /// Writes `content` byte for byte to `name` inside the folder and returns its path.
     std::filesystem::path write(const std::string& name, std::string_view content) const {
         const auto p = path_ / name;
+        std::filesystem::create_directories(p.parent_path());  // "sub/file" writes into sub/
         std::ofstream out(p, std::ios::binary);
         out.write(content.data(), std::streamsize(content.size()));
         return p;

@@ -262,6 +262,28 @@ TEST_CASE("a minimal scene.json loads with its lights, and load_scene_arg finds 
     }
 }
 
+TEST_CASE("load_scene_arg finds a bare name under scenes_dir, and only where nothing here has it", "[io][scene]") {
+    scratch_folder dir;
+    dir.write("tri/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    dir.write("tri/scene.json", R"({"obj": "tri.obj",
+      "camera": { "position": [0, 0, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40 },
+      "lights": [{ "type": "point", "position": [0, 0, 1], "intensity": [1, 1, 1] }]})");
+    const char* old = std::getenv("BOUNCE_SCENES");
+    const std::string saved = old ? old : "";
+    ::setenv("BOUNCE_SCENES", dir.path().string().c_str(), 1);
+    const io::scene s = io::load_scene_arg("tri");
+    CHECK(s.source == dir.path() / "tri" / "scene.json");
+    CHECK(s.triangles.size() == 1);
+    CHECK(io::load_scene_arg("cornell").name == io::cornell_box().name);  // the built-in box still wins
+    // A name with no folder there stays a missing file, named as given.
+    CHECK_THROWS_AS(io::load_scene_arg("no-such-scene"), io::scene_error);
+    CHECK_THROWS_WITH(io::load_scene_arg("no-such-scene"), Catch::Contains("no-such-scene"));
+    // A path (not a bare name) is never looked up there.
+    CHECK_THROWS_AS(io::load_scene_arg("./tri"), io::scene_error);
+    if (old) ::setenv("BOUNCE_SCENES", saved.c_str(), 1);
+    else ::unsetenv("BOUNCE_SCENES");
+}
+
 TEST_CASE("scenes_dir follows BOUNCE_SCENES", "[io][scene]") {
     const char* old = std::getenv("BOUNCE_SCENES");
     const std::string saved = old ? old : "";

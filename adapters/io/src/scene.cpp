@@ -111,6 +111,9 @@ scene load_scene_arg(std::string_view arg) {
     if (arg.empty()) throw scene_error("", 0, "--scene: empty argument (expected cornell or a path)");
     fs::path p{std::string(arg)};
     std::error_code ec;
+    // A bare name that is nothing here is a scene folder under scenes_dir() ("sponza").
+    if (!fs::exists(p, ec) && p.has_filename() && p == p.filename() && fs::is_directory(scenes_dir() / p, ec))
+        p = scenes_dir() / p;
     if (fs::is_directory(p, ec)) p /= "scene.json";
     std::string ext = p.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });

@@ -105,7 +105,8 @@ scene load_obj(const std::filesystem::path& obj, const material& default_materia
 /// power just below it. 38 triangles, all facing into the box (see docs/scenes.md).
 scene cornell_box();
 /// What every program's `--scene` accepts: `cornell` for the built-in box, a path to a
-/// scene.json, a folder holding a scene.json, or an .obj (loaded with load_obj).
+/// scene.json, a folder holding a scene.json, an .obj (loaded with load_obj), or the name
+/// of a scene folder under scenes_dir() (`sponza`) when no file or folder here has it.
 /// \throws scene_error
 scene load_scene_arg(std::string_view arg);
 /// Where the shared scenes live: $BOUNCE_SCENES when set and non-empty, else
