@@ -72,7 +72,9 @@ struct expectation {
     int visibility = 0;
 };
 
-expectation expect(const io::light& light, const glm::dvec3& p, const glm::dvec3& n) {
+// `ortho_texel`: the world size of the orthographic map's texel (direct_light::texel_of),
+// used for directional lights only.
+expectation expect(const io::light& light, const glm::dvec3& p, const glm::dvec3& n, double ortho_texel) {
     expectation x;
     glm::dvec3 to_light;  // unit, towards the light
     double texel = 0, scale = 1;  // shadow texel at p; ground distance per blocker-plane distance
@@ -104,8 +106,7 @@ expectation expect(const io::light& light, const glm::dvec3& p, const glm::dvec3
         const glm::dvec3 dir = glm::normalize(glm::dvec3(dl.direction));
         x.e = glm::dvec3(dl.irradiance) * std::max(0.0, -glm::dot(n, dir));
         to_light = -dir;
-        // The map spans the scene's bounding sphere: the ground quad's half diagonal dominates.
-        texel = 2.0 * 0.505 * glm::length(glm::dvec3(8.0, 8.0, 1.0)) / resolution;
+        texel = ortho_texel;
         scale = 1.0;
     }
     const double cos_theta = std::max(0.2, glm::dot(n, to_light));
@@ -177,7 +178,7 @@ TEST_CASE("shadow-mapped direct light: the closed form where lit, zero in the bl
                 ++uncovered;
                 continue;
             }
-            const auto ex = expect(lc.light, gb.position(x, y), gb.normal(x, y));
+            const auto ex = expect(lc.light, gb.position(x, y), gb.normal(x, y), dl.texel_of(0));
             const glm::dvec3 l = glm::dvec3(gb.albedo(x, y)) * ex.e / std::numbers::pi;
             INFO("pixel (" << x << ", " << y << ") p = (" << gb.position(x, y).x << ", " << gb.position(x, y).y << ", "
                            << gb.position(x, y).z << ")");
@@ -192,6 +193,53 @@ TEST_CASE("shadow-mapped direct light: the closed form where lit, zero in the bl
     CHECK(umbra >= 20);
     // The ground quad ends inside the view: the background was exercised.
     CHECK(uncovered > 0);
+}
+
+TEST_CASE("a directional light's map spans the rectangle the scene's box projects to across the light",
+          "[gl][direct]") {
+    gl_test::shared_context();
+    // A long, flat box (30 x 2 x 6), seen from 200 directions including the axes and the
+    // diagonals. The map's longer side must hold every corner's projection (so it is at
+    // least the projected set's diameter over sqrt 2) and be no longer than that diameter.
+    io::scene s;
+    s.materials.push_back({"m", glm::vec3(0.5f), glm::vec3(0.f)});
+    const glm::dvec3 lo(-15, -1, -3), hi(15, 1, 3);
+    add_quad(s, glm::vec3(0, 0, -3), 1.f, 0);  // only the box matters: a quad and a triangle spanning it
+    s.positions.push_back(glm::vec3(lo));
+    s.positions.push_back(glm::vec3(hi));
+    s.positions.push_back(glm::vec3(float(hi.x), float(lo.y), float(hi.z)));
+    s.normals.resize(s.positions.size(), glm::vec3(0, 0, 1));
+    s.triangles.push_back({std::uint32_t(s.positions.size() - 3), std::uint32_t(s.positions.size() - 2),
+                           std::uint32_t(s.positions.size() - 1)});
+    s.material_of.push_back(0);
+    const int res = 512;
+    pcg32 rng(77);
+    std::vector<glm::dvec3> dirs = {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}, {1, -1, 1}, {-1, -1, 0}, {0.2, -1, 0.35}};
+    while (dirs.size() < 200) {  // uniform on the sphere: z uniform in [-1, 1], phi uniform
+        const double z = 2 * rng.next_double() - 1, phi = 2 * std::numbers::pi * rng.next_double();
+        dirs.push_back({std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z});
+    }
+    for (const glm::dvec3& d : dirs) {
+        CAPTURE(d);
+        s.lights = {io::directional_light{glm::vec3(glm::normalize(d)), {1.f, 1.f, 1.f}}};
+        const gl::scene_mesh mesh(s);
+        const gl::direct_light dl(s, mesh, res);
+        const glm::dvec3 u = glm::normalize(glm::abs(d.x) < 0.9 ? glm::cross(d, glm::dvec3(1, 0, 0))
+                                                                : glm::cross(d, glm::dvec3(0, 1, 0)));
+        const glm::dvec3 v = glm::cross(glm::normalize(d), u);
+        double diameter = 0;  // of the corners' projections across the light
+        for (int a = 0; a < 8; ++a)
+            for (int b = 0; b < 8; ++b) {
+                const glm::dvec3 ca((a & 1) ? hi.x : lo.x, (a & 2) ? hi.y : lo.y, (a & 4) ? hi.z : lo.z);
+                const glm::dvec3 cb((b & 1) ? hi.x : lo.x, (b & 2) ? hi.y : lo.y, (b & 4) ? hi.z : lo.z);
+                diameter = std::max(diameter, glm::length(glm::dvec2(glm::dot(ca - cb, u), glm::dot(ca - cb, v))));
+            }
+        const double side = double(dl.texel_of(0)) * res;
+        CHECK(side >= diameter / std::sqrt(2.0) * (1 - 1e-5));
+        // and no wider than the set along any direction (plus its 1% and PCF margin):
+        // the bounding sphere's map (diameter 30.7) would fail this for most directions.
+        CHECK(side <= diameter * 1.01 / (1.0 - 6.0 / res) * (1 + 1e-5));
+    }
 }
 
 TEST_CASE("direct_irradiance pasted into another shader gives the closed form and the shadow", "[gl][direct][glsl]") {
@@ -242,8 +290,8 @@ TEST_CASE("direct_irradiance pasted into another shader gives the closed form an
     std::size_t judged_lit = 0, judged_umbra = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const glm::dvec3 n = glm::dvec3(pn[2 * i + 1]);
-        const auto a = expect(scene.lights[0], points[i], n);
-        const auto b = expect(scene.lights[1], points[i], n);
+        const auto a = expect(scene.lights[0], points[i], n, dl.texel_of(0));
+        const auto b = expect(scene.lights[1], points[i], n, dl.texel_of(1));
         if (a.visibility == 0 || b.visibility == 0) continue;
         const glm::dvec3 want = (a.visibility > 0 ? a.e : glm::dvec3(0.0)) + (b.visibility > 0 ? b.e : glm::dvec3(0.0));
         INFO("point " << i << " (" << points[i].x << ", " << points[i].y << ")");

@@ -6,7 +6,8 @@
 /// Each light gets one depth map rendered from it:
 /// - spot light with a cone up to `max_spot_map_cone_deg`: a perspective 2D map whose field
 ///   of view is the cone (plus the PCF footprint);
-/// - directional light: an orthographic 2D map fitted to the scene's bounding sphere;
+/// - directional light: an orthographic 2D map spanning the rectangle the scene's box
+///   projects to across the light;
 /// - point light, and spot light with a wider cone: a cube map (six 90-degree faces) of
 ///   radial distance to the light, which compares and filters alike across face seams.
 /// The unshadowed irradiance is the emitted kernel of lights.hpp (the same the reference
@@ -98,6 +99,9 @@ public:
     /// The light's shadow-map kind, for tests and tools.
     enum class map_kind { perspective, orthographic, cube };
     map_kind map_of(std::size_t light) const { return lights_.at(light).map; }
+    /// World size of a texel of the light's orthographic map (the longer side of the
+    /// rectangle it spans; normal offsets are measured in it); 0 for other maps.
+    float texel_of(std::size_t light) const { return lights_.at(light).texel_world; }
 
 private:
     struct light_entry {
