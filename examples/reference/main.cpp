@@ -132,7 +132,8 @@ int main(int argc, char** argv) {
                     images.combined(x, y) = images.direct(x, y) + images.indirect(x, y);
             images.grid = embree::hemisphere_grid_for(spp);
         }
-        if (!no_cache && cache_state == "miss") embree::store_cached_reference(cache_dir, key, images, scene, scene.camera, settings, dev.config());
+        if (!no_cache && cache_state == "miss")
+            embree::store_cached_reference(cache_dir, key, images, scene, scene.camera, settings, dev.config());
 
         io::write_exr(out, images.combined.view());
         io::write_exr(sibling(out, "direct"), images.direct.view());

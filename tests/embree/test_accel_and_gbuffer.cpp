@@ -95,7 +95,8 @@ TEST_CASE("a device configuration Embree would silently ignore is refused, namin
         {"frequency_level=simd64", "frequency_level=simd64"}}));
     CAPTURE(bad);
     CHECK_THROWS_AS(device(bad), parameter_error);
-    CHECK_THROWS_WITH(device(bad), Catch::Contains("embree::device config") && Catch::Contains("option '" + option + "'"));
+    CHECK_THROWS_WITH(device(bad),
+                      Catch::Contains("embree::device config") && Catch::Contains("option '" + option + "'"));
 }
 
 TEST_CASE("BOUNCE_EMBREE_CONFIG configures default devices and is checked under its name",

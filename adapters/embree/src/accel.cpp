@@ -83,7 +83,8 @@ namespace {
 // with a value of its documented form (Embree itself skips what it does not know).
 void check_device_config(std::string_view config, std::string_view source) {
     auto is_count = [](std::string_view v) {
-        return !v.empty() && v.size() <= 6 && std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
+        return !v.empty() && v.size() <= 6 &&
+               std::all_of(v.begin(), v.end(), [](char c) { return c >= '0' && c <= '9'; });
     };
     auto one_of = [](std::string_view v, std::initializer_list<std::string_view> allowed) {
         return std::find(allowed.begin(), allowed.end(), v) != allowed.end();
@@ -104,7 +105,8 @@ void check_device_config(std::string_view config, std::string_view source) {
         } else if (one_of(key, {"set_affinity", "start_threads", "hugepages", "enable_selockmemoryprivilege"})) {
             if (!one_of(value, {"0", "1"})) expected = "0 or 1";
         } else if (one_of(key, {"isa", "max_isa"})) {
-            if (!one_of(value, {"sse2", "sse4.2", "avx", "avx2", "avx512"})) expected = "sse2, sse4.2, avx, avx2 or avx512";
+            if (!one_of(value, {"sse2", "sse4.2", "avx", "avx2", "avx512"}))
+                expected = "sse2, sse4.2, avx, avx2 or avx512";
         } else if (key == "verbose") {
             if (!one_of(value, {"0", "1", "2", "3"})) expected = "0 to 3";
         } else if (key == "frequency_level") {
