@@ -118,14 +118,17 @@ std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 0xcbf
 // Two independent halves of `spp` stratified rays each per point (derive_seed streams 1 and
 // 2): their difference measures the error of their mean, rms(E_a - E_b) / 2 relative to
 // rms(E). If that exceeds `target`, the sample count doubles (up to 8 times the start).
-// Cached in `cache_dir` under a hash of the points, the sample count and the seed.
+// Cached in `cache_dir` under a hash of the points, the sample count, the seed and, when
+// one pins Embree's kernels, the device's configuration (as the image references are).
 reference_set compute_reference(const embree::reference_integrator& ref, const io::scene& scene,
                                 const std::vector<study_point>& pts, std::uint32_t spp, std::uint64_t seed,
-                                double target, const fs::path& cache_dir, bool use_cache) {
+                                double target, const fs::path& cache_dir, bool use_cache,
+                                const std::string& device_config) {
     for (std::uint32_t attempt = 0;; ++attempt) {
         std::uint64_t h = fnv1a(pts.data(), pts.size() * sizeof(study_point));
         h = fnv1a(&spp, sizeof spp, h);
         h = fnv1a(&seed, sizeof seed, h);
+        if (!device_config.empty()) h = fnv1a(device_config.data(), device_config.size(), h);
         const fs::path file = cache_dir / fmt::format("hemisphere-reference-{}-{}pts-{}spp-{:016x}.bin", scene.name,
                                                       pts.size(), spp, h);
         std::vector<glm::vec3> a(pts.size()), b(pts.size());
@@ -453,7 +456,8 @@ int main(int argc, char** argv) {
 
         const auto t_ref = clock_type::now();
         const reference_set reference =
-            compute_reference(ref, scene, pts, reference_spp, seed, reference_target, cache_dir, !no_cache);
+            compute_reference(ref, scene, pts, reference_spp, seed, reference_target, cache_dir, !no_cache,
+                              bvh.owner().config());
         const double reference_seconds = seconds_since(t_ref);
         fmt::print("  reference: 2 x {} rays per point, own error {:.3f}% ({}, {:.1f} s)\n", reference.spp,
                    100 * reference.own_error, reference.from_cache ? "cache" : "computed", reference_seconds);
