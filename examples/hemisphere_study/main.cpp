@@ -12,6 +12,7 @@
 // Embree, shaded with the reference integrator's direct light), which separates the
 // estimator's error from rasterization's. Error: relative RMS of luminance,
 // sqrt(mean((E - E_ref)^2)) / sqrt(mean(E_ref^2)), as in the seed's Table 8.1.
+#include <bounce/content_hash.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/plane_sampler.hpp>
@@ -109,12 +110,6 @@ struct reference_set {
     bool from_cache = false;
 };
 
-std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t h = 0xcbf29ce484222325ull) {
-    const auto* b = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
-    return h;
-}
-
 // Two independent halves of `spp` stratified rays each per point (derive_seed streams 1 and
 // 2): their difference measures the error of their mean, rms(E_a - E_b) / 2 relative to
 // rms(E). If that exceeds `target`, the sample count doubles (up to 8 times the start).
@@ -125,10 +120,12 @@ reference_set compute_reference(const embree::reference_integrator& ref, const i
                                 double target, const fs::path& cache_dir, bool use_cache,
                                 const std::string& device_config) {
     for (std::uint32_t attempt = 0;; ++attempt) {
-        std::uint64_t h = fnv1a(pts.data(), pts.size() * sizeof(study_point));
-        h = fnv1a(&spp, sizeof spp, h);
-        h = fnv1a(&seed, sizeof seed, h);
-        if (!device_config.empty()) h = fnv1a(device_config.data(), device_config.size(), h);
+        fnv1a_hash key;
+        key.bytes(pts.data(), pts.size() * sizeof(study_point));
+        key.value(spp);
+        key.value(seed);
+        if (!device_config.empty()) key.bytes(device_config.data(), device_config.size());
+        const std::uint64_t h = key.digest();
         const fs::path file = cache_dir / fmt::format("hemisphere-reference-{}-{}pts-{}spp-{:016x}.bin", scene.name,
                                                       pts.size(), spp, h);
         std::vector<glm::vec3> a(pts.size()), b(pts.size());

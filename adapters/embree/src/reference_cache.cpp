@@ -1,6 +1,7 @@
 // Reference images cached as EXR under a content hash of everything they depend on.
 #include <bounce/embree/reference_cache.hpp>
 
+#include <bounce/content_hash.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/image_io.hpp>
 
@@ -9,7 +10,6 @@
 #include <cctype>
 #include <fstream>
 #include <system_error>
-#include <type_traits>
 
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -20,34 +20,6 @@ namespace {
 
 // Bump when the estimator changes in a way that changes its images.
 constexpr const char* integrator_version = "bounce-reference-1";
-
-// FNV-1a, 64 bit: a stable, dependency-free hash (the key only has to change when the
-// inputs do; it is not a security boundary).
-class fnv1a {
-public:
-    void bytes(const void* data, std::size_t n) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < n; ++i) h_ = (h_ ^ p[i]) * 0x100000001b3ULL;
-    }
-    template <class T>
-        requires std::is_trivially_copyable_v<T>
-    void value(const T& v) {
-        bytes(&v, sizeof(T));
-    }
-    void vec(const glm::vec3& v) {
-        value(v.x);
-        value(v.y);
-        value(v.z);
-    }
-    void text(std::string_view s) {
-        value(s.size());
-        bytes(s.data(), s.size());
-    }
-    std::uint64_t digest() const { return h_; }
-
-private:
-    std::uint64_t h_ = 0xcbf29ce484222325ULL;
-};
 
 std::string safe_name(const std::string& name) {
     std::string s;
@@ -88,12 +60,12 @@ std::filesystem::path default_cache_dir() {
 std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
                                 std::size_t height, const reference_settings& settings,
                                 std::string_view device_config) {
-    fnv1a h;
+    fnv1a_hash h;
     h.text(integrator_version);
     h.value(scene.positions.size());
-    for (const auto& p : scene.positions) h.vec(p);
+    for (const auto& p : scene.positions) h.value(p);
     h.value(scene.normals.size());
-    for (const auto& n : scene.normals) h.vec(n);
+    for (const auto& n : scene.normals) h.value(n);
     h.value(scene.triangles.size());
     for (const auto& t : scene.triangles) {
         h.value(t.x);
@@ -103,31 +75,31 @@ std::string reference_cache_key(const io::scene& scene, const bounce::camera& ca
     for (auto m : scene.material_of) h.value(m);
     h.value(scene.materials.size());
     for (const auto& m : scene.materials) {
-        h.vec(m.kd);
-        h.vec(m.ke);
+        h.value(m.kd);
+        h.value(m.ke);
     }
     h.value(scene.lights.size());
     for (const auto& l : scene.lights) {
         h.value(l.index());
         if (const auto* p = std::get_if<io::point_light>(&l)) {
-            h.vec(p->position);
-            h.vec(p->intensity);
+            h.value(p->position);
+            h.value(p->intensity);
         } else if (const auto* s = std::get_if<io::spot_light>(&l)) {
-            h.vec(s->position);
-            h.vec(s->direction);
-            h.vec(s->intensity);
+            h.value(s->position);
+            h.value(s->direction);
+            h.value(s->intensity);
             h.value(s->cone_deg);
             h.value(int(s->falloff));
         } else {
             const auto& d = std::get<io::directional_light>(l);
-            h.vec(d.direction);
-            h.vec(d.irradiance);
+            h.value(d.direction);
+            h.value(d.irradiance);
         }
     }
     h.value(scene.use_emission);
-    h.vec(cam.position);
-    h.vec(cam.look_at);
-    h.vec(cam.up);
+    h.value(cam.position);
+    h.value(cam.look_at);
+    h.value(cam.up);
     h.value(cam.fov_y_deg);
     h.value(cam.near_plane);
     h.value(cam.far_plane);
@@ -136,7 +108,7 @@ std::string reference_cache_key(const io::scene& scene, const bounce::camera& ca
     h.value(settings.hemisphere_samples);
     h.value(settings.area_samples);
     h.value(settings.secondary_area_samples);
-    h.vec(settings.environment);
+    h.value(settings.environment);
     h.value(settings.ray_epsilon);
     h.value(settings.seed);
     if (!device_config.empty()) h.text(device_config);  // Embree's default: the keys of earlier versions
