@@ -21,6 +21,9 @@ namespace {
 // Bump when the estimator changes in a way that changes its images.
 constexpr const char* integrator_version = "bounce-reference-1";
 
+// The key hashes vectors' bytes: three floats and no padding, as the keys always did.
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "a padded glm::vec3 would change every cache key");
+
 std::string safe_name(const std::string& name) {
     std::string s;
     for (char c : name) s += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') ? c : '_';
