@@ -124,7 +124,7 @@ reference_set compute_reference(const embree::reference_integrator& ref, const i
         key.bytes(pts.data(), pts.size() * sizeof(study_point));
         key.value(spp);
         key.value(seed);
-        if (!device_config.empty()) key.bytes(device_config.data(), device_config.size());
+        if (!device_config.empty()) key.text(device_config);
         const std::uint64_t h = key.digest();
         const fs::path file = cache_dir / fmt::format("hemisphere-reference-{}-{}pts-{}spp-{:016x}.bin", scene.name,
                                                       pts.size(), spp, h);

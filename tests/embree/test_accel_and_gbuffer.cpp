@@ -5,15 +5,16 @@
 #include <bounce/sampling.hpp>
 
 #include "hand_built_scenes.hpp"
+#include "../scoped_environment.hpp"
 
 #include <catch2/catch.hpp>
 #include <embree3/rtcore.h>
 #include <glm/glm.hpp>
 
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <string>
+#include <vector>
 
 using namespace bounce;
 using namespace bounce::embree;
@@ -30,6 +31,28 @@ io::scene tilted_square(double tilt) {
     auto corner = [&](double a, double b) { return glm::vec3(a * u + b * v); };
     hand_built::add_quad(s, corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1), glm::vec3(-n), m);
     return s;
+}
+
+// Two parallel squares z = 1 and z = 2, 4 wide: rays from below hit z = 1 first.
+io::scene two_parallel_squares() {
+    io::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
+    hand_built::add_square_z(s, 1.f, 4.f, false, m);
+    hand_built::add_square_z(s, 2.f, 4.f, false, m);
+    return s;
+}
+
+// `count` rays from the unit square around the origin in z = 0, within 60 degrees of +z, so
+// they stay inside two_parallel_squares (tan 60 * 2 < 4 - 0.5).
+std::vector<ray> rays_up_into_the_squares(std::uint64_t seed, int count) {
+    pcg32 rng(seed);
+    std::vector<ray> rays;
+    for (int i = 0; i < count; ++i) {
+        const glm::vec3 o(float(rng.next_double() - 0.5), float(rng.next_double() - 0.5), 0.f);
+        const double cz = 0.5 + 0.5 * rng.next_double(), r = std::sqrt(1 - cz * cz), phi = 6.283185307 * rng.next_double();
+        rays.push_back({o, glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(cz))});
+    }
+    return rays;
 }
 
 }  // namespace
@@ -58,23 +81,16 @@ TEST_CASE("an Embree error surfaces as embree_error with the callback's message"
 
 TEST_CASE("a device's configuration pins Embree's kernels and is checked before Embree sees it",
           "[embree][device]") {
-    // Two parallel squares z = 1 and z = 2 (as below): every kernel set must find the lower
-    // one at t = 1 / d.z, to the few ulps its float intersection allows.
-    io::scene s;
-    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
-    hand_built::add_square_z(s, 1.f, 4.f, false, m);
-    hand_built::add_square_z(s, 2.f, 4.f, false, m);
+    // Every kernel set must find the lower square at t = 1 / d.z, to the few ulps its float
+    // intersection allows.
+    const io::scene s = two_parallel_squares();
     const std::string config = GENERATE(as<std::string>{}, "", "max_isa=sse2", "max_isa=sse4.2,threads=1",
                                         "max_isa=avx,verbose=0", "start_threads=1,set_affinity=0,hugepages=0");
     CAPTURE(config);
     const device dev(config);
     CHECK(dev.config() == config);
     const accel bvh(dev, s);
-    pcg32 rng(5);
-    for (int i = 0; i < 200; ++i) {
-        const glm::vec3 o(float(rng.next_double() - 0.5), float(rng.next_double() - 0.5), 0.f);
-        const double cz = 0.5 + 0.5 * rng.next_double(), r = std::sqrt(1 - cz * cz), phi = 6.283185307 * rng.next_double();
-        const ray q{o, glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(cz))};
+    for (const ray& q : rays_up_into_the_squares(5, 200)) {
         const hit h = bvh.intersect(q);
         REQUIRE(h.found());
         CHECK(h.t == Approx(1.0 / q.direction.z).epsilon(1e-5));
@@ -101,25 +117,15 @@ TEST_CASE("a device configuration Embree would silently ignore is refused, namin
 
 TEST_CASE("BOUNCE_EMBREE_CONFIG configures default devices and is checked under its name",
           "[embree][device][bad-input]") {
-    const char* saved = std::getenv("BOUNCE_EMBREE_CONFIG");
-    const std::string restore = saved ? saved : "";
-    struct restore_env {
-        std::string value;
-        bool was_set;
-        ~restore_env() {
-            if (was_set) setenv("BOUNCE_EMBREE_CONFIG", value.c_str(), 1);
-            else unsetenv("BOUNCE_EMBREE_CONFIG");
-        }
-    } guard{restore, saved != nullptr};
-
-    setenv("BOUNCE_EMBREE_CONFIG", "max_isa=sse4.2", 1);
+    const bounce::test::scoped_environment config("BOUNCE_EMBREE_CONFIG");
+    config.set("max_isa=sse4.2");
     CHECK(device().config() == "max_isa=sse4.2");
     CHECK(accel(io::scene{}).owner().config() == "max_isa=sse4.2");
-    setenv("BOUNCE_EMBREE_CONFIG", "max_isa=sse4", 1);
+    config.set("max_isa=sse4");
     CHECK_THROWS_WITH(device(), Catch::Contains("BOUNCE_EMBREE_CONFIG") && Catch::Contains("'max_isa=sse4'"));
-    setenv("BOUNCE_EMBREE_CONFIG", "", 1);
+    config.set("");
     CHECK(device().config().empty());
-    unsetenv("BOUNCE_EMBREE_CONFIG");
+    config.unset();
     CHECK(device().config().empty());
 }
 
@@ -170,21 +176,8 @@ TEST_CASE("an empty scene builds and every ray misses", "[embree]") {
 }
 
 TEST_CASE("closest hits and occlusion agree with the plane equation", "[embree][queries]") {
-    // Two parallel squares z = 1 and z = 2: rays from below hit z = 1 first.
-    io::scene s;
-    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
-    hand_built::add_square_z(s, 1.f, 4.f, false, m);
-    hand_built::add_square_z(s, 2.f, 4.f, false, m);
-    const accel bvh(s);
-
-    pcg32 rng(21);
-    std::vector<ray> rays;
-    for (int i = 0; i < 500; ++i) {
-        const glm::vec3 o(float(rng.next_double() - 0.5), float(rng.next_double() - 0.5), 0.f);
-        // Directions within 60 degrees of +z stay inside the squares (tan 60 * 2 < 4 - 0.5).
-        const double cz = 0.5 + 0.5 * rng.next_double(), r = std::sqrt(1 - cz * cz), phi = 6.283185307 * rng.next_double();
-        rays.push_back({o, glm::vec3(float(r * std::cos(phi)), float(r * std::sin(phi)), float(cz))});
-    }
+    const accel bvh(two_parallel_squares());
+    const std::vector<ray> rays = rays_up_into_the_squares(21, 500);
     std::vector<hit> stream(rays.size());
     bvh.intersect(rays, stream);
     std::vector<std::uint8_t> blocked(rays.size());

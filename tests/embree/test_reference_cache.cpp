@@ -3,6 +3,7 @@
 #include <bounce/embree/reference_cache.hpp>
 
 #include "hand_built_scenes.hpp"
+#include "../scoped_environment.hpp"
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -138,13 +139,11 @@ TEST_CASE("cached references come back bitwise and are recomputed when damaged",
 }
 
 TEST_CASE("the default cache folder follows BOUNCE_CACHE", "[reference][cache]") {
-    const char* before = std::getenv("BOUNCE_CACHE");
-    const std::string saved = before ? before : "";
-    ::setenv("BOUNCE_CACHE", "/tmp/bounce-cache-from-env", 1);
+    const bounce::test::scoped_environment cache("BOUNCE_CACHE");
+    cache.set("/tmp/bounce-cache-from-env");
     CHECK(default_cache_dir() == fs::path("/tmp/bounce-cache-from-env"));
-    ::unsetenv("BOUNCE_CACHE");
+    cache.unset();
     // Test programs live in build/bin: the default is build/cache beside it.
     const fs::path d = default_cache_dir();
     CHECK(d.filename() == "cache");
-    if (before) ::setenv("BOUNCE_CACHE", saved.c_str(), 1);
 }

@@ -4,6 +4,7 @@
 // change the mesh.
 #include "mesh_invariants.hpp"
 #include "scratch_folder.hpp"
+#include "../scoped_environment.hpp"
 
 #include <bounce/io/scene.hpp>
 #include <bounce/sampling.hpp>
@@ -268,9 +269,8 @@ TEST_CASE("load_scene_arg finds a bare name under scenes_dir, and only where not
     dir.write("tri/scene.json", R"({"obj": "tri.obj",
       "camera": { "position": [0, 0, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40 },
       "lights": [{ "type": "point", "position": [0, 0, 1], "intensity": [1, 1, 1] }]})");
-    const char* old = std::getenv("BOUNCE_SCENES");
-    const std::string saved = old ? old : "";
-    ::setenv("BOUNCE_SCENES", dir.path().string().c_str(), 1);
+    const bounce::test::scoped_environment scenes("BOUNCE_SCENES");
+    scenes.set(dir.path().string());
     const io::scene s = io::load_scene_arg("tri");
     CHECK(s.source == dir.path() / "tri" / "scene.json");
     CHECK(s.triangles.size() == 1);
@@ -280,16 +280,12 @@ TEST_CASE("load_scene_arg finds a bare name under scenes_dir, and only where not
     CHECK_THROWS_WITH(io::load_scene_arg("no-such-scene"), Catch::Contains("no-such-scene"));
     // A path (not a bare name) is never looked up there.
     CHECK_THROWS_AS(io::load_scene_arg("./tri"), io::scene_error);
-    if (old) ::setenv("BOUNCE_SCENES", saved.c_str(), 1);
-    else ::unsetenv("BOUNCE_SCENES");
 }
 
 TEST_CASE("scenes_dir follows BOUNCE_SCENES", "[io][scene]") {
-    const char* old = std::getenv("BOUNCE_SCENES");
-    const std::string saved = old ? old : "";
-    ::setenv("BOUNCE_SCENES", "/some/where", 1);
+    const bounce::test::scoped_environment scenes("BOUNCE_SCENES");
+    scenes.set("/some/where");
     CHECK(io::scenes_dir() == std::filesystem::path("/some/where"));
-    ::unsetenv("BOUNCE_SCENES");
+    scenes.unset();
     CHECK(io::scenes_dir() == std::filesystem::path("../shared/scenes"));
-    if (old) ::setenv("BOUNCE_SCENES", saved.c_str(), 1);
 }

@@ -119,20 +119,22 @@ void check_device_config(std::string_view config, std::string_view source) {
     }
 }
 
-// $BOUNCE_EMBREE_CONFIG, checked under its own name (so a bad value says where it came from).
-std::string config_from_environment() {
+const char* environment_config() {
     const char* env = std::getenv("BOUNCE_EMBREE_CONFIG");
-    std::string config = env ? env : "";
-    if (!config.empty()) check_device_config(config, "BOUNCE_EMBREE_CONFIG");
-    return config;
+    return env ? env : "";
 }
 
 }  // namespace
 
-device::device() : device(config_from_environment()) {}
+// A bad $BOUNCE_EMBREE_CONFIG is refused under its own name, so the message says where it
+// came from.
+device::device() : device(environment_config(), "BOUNCE_EMBREE_CONFIG") {}
 
-device::device(std::string_view config) : state_(std::make_shared<detail::device_state>()) {
-    if (!config.empty()) check_device_config(config, "embree::device config");
+device::device(std::string_view config) : device(config, "embree::device config") {}
+
+device::device(std::string_view config, std::string_view source)
+    : state_(std::make_shared<detail::device_state>()) {
+    if (!config.empty()) check_device_config(config, source);
     state_->config = std::string(config);
     state_->handle = rtcNewDevice(config.empty() ? nullptr : state_->config.c_str());
     if (!state_->handle) {

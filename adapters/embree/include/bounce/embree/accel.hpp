@@ -76,6 +76,8 @@ public:
 
 private:
     friend class accel;
+    // `source` names the configuration's origin in a refusal.
+    device(std::string_view config, std::string_view source);
     std::shared_ptr<detail::device_state> state_;
 };
 
