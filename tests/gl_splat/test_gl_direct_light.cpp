@@ -27,6 +27,7 @@
 #include <catch2/catch.hpp>
 #include <glm/glm.hpp>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <variant>
@@ -219,6 +220,8 @@ TEST_CASE("a directional light's map spans the rectangle the scene's box project
         const double z = 2 * rng.next_double() - 1, phi = 2 * std::numbers::pi * rng.next_double();
         dirs.push_back({std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z});
     }
+    std::array<glm::dvec3, 8> corners;
+    for (int c = 0; c < 8; ++c) corners[c] = {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
     for (const glm::dvec3& d : dirs) {
         CAPTURE(d);
         s.lights = {io::directional_light{glm::vec3(glm::normalize(d)), {1.f, 1.f, 1.f}}};
@@ -228,12 +231,9 @@ TEST_CASE("a directional light's map spans the rectangle the scene's box project
                                                                 : glm::cross(d, glm::dvec3(0, 1, 0)));
         const glm::dvec3 v = glm::cross(glm::normalize(d), u);
         double diameter = 0;  // of the corners' projections across the light
-        for (int a = 0; a < 8; ++a)
-            for (int b = 0; b < 8; ++b) {
-                const glm::dvec3 ca((a & 1) ? hi.x : lo.x, (a & 2) ? hi.y : lo.y, (a & 4) ? hi.z : lo.z);
-                const glm::dvec3 cb((b & 1) ? hi.x : lo.x, (b & 2) ? hi.y : lo.y, (b & 4) ? hi.z : lo.z);
+        for (const glm::dvec3& ca : corners)
+            for (const glm::dvec3& cb : corners)
                 diameter = std::max(diameter, glm::length(glm::dvec2(glm::dot(ca - cb, u), glm::dot(ca - cb, v))));
-            }
         const double side = double(dl.texel_of(0)) * res;
         CHECK(side >= diameter / std::sqrt(2.0) * (1 - 1e-5));
         // and no wider than the set along any direction (plus its 1% and PCF margin):

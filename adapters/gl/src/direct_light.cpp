@@ -66,15 +66,17 @@ void main() {
 // An up vector not parallel to the unit view direction `d`.
 glm::vec3 up_for(const glm::vec3& d) { return std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0); }
 
+// Corner `c` (0..7, one bit per axis) of the box [lo, hi].
+glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
+    return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
+}
+
 // Near and far planes of a map centred at `eye` that holds everything in the bounds: far is
 // the farthest corner (with 1% to spare), near 1/1000 of it (float depth keeps about
 // 6e-5 far of resolution at the far plane with that ratio).
 std::pair<float, float> depth_range(const glm::vec3& eye, const glm::vec3& lo, const glm::vec3& hi) {
     float far_depth = 0.f;
-    for (int c = 0; c < 8; ++c) {
-        const glm::vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-        far_depth = std::max(far_depth, glm::length(corner - eye));
-    }
+    for (int c = 0; c < 8; ++c) far_depth = std::max(far_depth, glm::length(box_corner(lo, hi, c) - eye));
     far_depth = std::max(far_depth * 1.01f, 1e-3f);
     return {far_depth * 1e-3f, far_depth};
 }
@@ -176,10 +178,9 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
             const glm::mat4 view = glm::lookAt(centre - 2.f * r * l.vector, centre, up_for(l.vector));
             glm::vec2 half_extent(0.f);  // of the corners in the view's x and y, around the centre's
             const glm::vec2 middle(view * glm::vec4(centre, 1.f));
-            for (int c = 0; c < 8; ++c) {
-                const glm::vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-                half_extent = glm::max(half_extent, glm::abs(glm::vec2(view * glm::vec4(corner, 1.f)) - middle));
-            }
+            for (int c = 0; c < 8; ++c)
+                half_extent = glm::max(half_extent,
+                                       glm::abs(glm::vec2(view * glm::vec4(box_corner(lo, hi, c), 1.f)) - middle));
             half_extent = glm::max(1.01f * half_extent, glm::vec2(1e-3f)) / (1.f - 6.f / float(res));
             l.near_depth = 0.5f * r;
             l.far_depth = 3.5f * r;
