@@ -36,6 +36,8 @@ template <floating T> T pow(T x, T y) noexcept { return std::pow(x, y); }
 template <floating T> T sin(T x) noexcept { return std::sin(x); }
 template <floating T> T cos(T x) noexcept { return std::cos(x); }
 template <floating T> T atan(T y, T x) noexcept { return std::atan2(y, x); }
+/// GLSL `floor`: the largest integer not above x (index arithmetic of interleave maps).
+template <floating T> T floor(T x) noexcept { return std::floor(x); }
 
 /// `select(c, a, b)`: `a` where `c` holds, else `b`, with no data-dependent branch in the
 /// generated code (GLSL prints it as a ternary). For plain booleans it is the obvious
