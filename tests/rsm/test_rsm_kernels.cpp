@@ -1,0 +1,1 @@
+#include <bounce/rsm.hpp>
