@@ -1,16 +1,25 @@
 #pragma once
 /// \file sh_basis.hpp
-/// The real spherical-harmonics basis Y_lm, bands l < L, at a unit direction, as a kernel:
-/// polynomial in (x, y, z), no trigonometry, loops with compile-time bounds.
+/// The real spherical-harmonics basis Y_lm at a unit direction, as a kernel: polynomial in
+/// (x, y, z), no trigonometry, loops with compile-time bounds. Every `sh_*.hpp` header uses
+/// the convention stated here, once:
 ///
-/// Convention (Sloan, "Stupid Spherical Harmonics Tricks", GDC 2008, and "Efficient
-/// Spherical Harmonic Evaluation", JCGT 2013): coefficient index l (l + 1) + m,
-///   Y_l0  = K_l0 P_l^0(z),
-///   Y_lm  = sqrt(2) K_lm cos(m phi) P_l^m(z),   m > 0,
-///   Y_l-m = sqrt(2) K_lm sin(m phi) P_l^m(z),   m > 0,
-///   K_lm  = sqrt((2l + 1) / (4 pi) (l - m)! / (l + m)!),
-/// with the Condon-Shortley phase (-1)^m in P_l^m, so Y_1-1 = -0.4886 y, Y_10 = 0.4886 z,
-/// Y_11 = -0.4886 x. The basis is orthonormal on the unit sphere.
+/// - A *band* l is the 2l + 1 functions Y_l,-l .. Y_l,l of degree l.
+/// - The template parameter `L` of every SH function counts *bands*: bands 0 .. L - 1,
+///   L^2 coefficients. The *order* of such a set is its highest band, L - 1: "order 2" is
+///   L = 3, 9 coefficients, the set irradiance needs (Ramamoorthi and Hanrahan 2001).
+/// - Coefficient index l (l + 1) + m for -l <= m <= l (`sh_index`): band-major, m rising.
+/// - Normalization and phase (Sloan, "Stupid Spherical Harmonics Tricks", GDC 2008, and
+///   "Efficient Spherical Harmonic Evaluation", JCGT 2013):
+///     Y_l0  = K_l0 P_l^0(z),
+///     Y_lm  = sqrt(2) K_lm cos(m phi) P_l^m(z),   m > 0,
+///     Y_l-m = sqrt(2) K_lm sin(m phi) P_l^m(z),   m > 0,
+///     K_lm  = sqrt((2l + 1) / (4 pi) (l - m)! / (l + m)!),
+///   with the Condon-Shortley phase (-1)^m included in P_l^m, so Y_1-1 = -0.4886 y,
+///   Y_10 = 0.4886 z, Y_11 = -0.4886 x. The basis is orthonormal on the unit sphere, so a
+///   function's coefficients are c_lm = int f Y_lm dw and int f^2 dw = sum c_lm^2 (Parseval).
+/// - z is the polar axis, phi is measured from +x towards +y. sh_layouts.hpp converts to
+///   the layouts other engines use (no phase, channel-major).
 
 #include <bounce/concepts.hpp>
 #include <bounce/vocabulary.hpp>
@@ -78,6 +87,21 @@ inline constexpr sh_recurrence<L> sh_recurrence_v = make_sh_recurrence<L>();
 /// Index of Y_lm in the array `sh_basis` returns: l (l + 1) + m, for -l <= m <= l.
 constexpr std::size_t sh_index(int l, int m) noexcept { return std::size_t(l * (l + 1) + m); }
 
+/// Number of coefficients of bands 0 .. bands - 1: bands^2.
+constexpr std::size_t sh_count(int bands) noexcept { return std::size_t(bands) * std::size_t(bands); }
+
+/// The band l of coefficient index i (the l with l^2 <= i < (l + 1)^2).
+constexpr int sh_band(std::size_t i) noexcept {
+    int l = 0;
+    while (sh_count(l + 1) <= i) ++l;
+    return l;
+}
+
+/// Coefficients of bands 0 .. L - 1, index `sh_index(l, m)`; `C` is a number (one channel)
+/// or a vector (RGB: glm::vec3, glm::dvec3, glsl::vec3).
+template <int L, class C>
+using sh_coefficients = std::array<C, sh_count(L)>;
+
 /// Real spherical harmonics Y_lm(d) for the bands l < L (L*L values, index
 /// `sh_index(l, m)`) at the unit direction `d`; see the file comment for the convention.
 /// cos(m phi) sin^m(theta) and sin(m phi) sin^m(theta) are the real and imaginary parts of
@@ -113,6 +137,16 @@ std::array<T, std::size_t(L) * std::size_t(L)> sh_basis(const V& d) {
         }
     }
     return y;
+}
+
+/// The function with coefficients `c` at the unit direction `d`: sum_i c_i Y_i(d).
+/// `C` is the coefficient type (T for one channel, V for RGB).
+template <int L, real T, vec3_of<T> V, class C>
+C sh_evaluate(const std::array<C, sh_count(L)>& c, const V& d) {
+    const auto y = sh_basis<L, T, V>(d);
+    C sum = c[0] * y[0];
+    for (std::size_t i = 1; i < sh_count(L); ++i) sum = sum + c[i] * y[i];
+    return sum;
 }
 
 }  // namespace bounce
