@@ -12,12 +12,12 @@
 // Embree, shaded with the reference integrator's direct light), which separates the
 // estimator's error from rasterization's. Error: relative RMS of luminance,
 // sqrt(mean((E - E_ref)^2)) / sqrt(mean(E_ref^2)), as in the seed's Table 8.1.
-#include <bounce/content_hash.hpp>
+#include <bounce/study/content_hash.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/embree/reference_cache.hpp>
+#include <bounce/study/reference_cache.hpp>
 #include <bounce/hemisphere.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/report.hpp>
@@ -120,7 +120,7 @@ reference_set compute_reference(const embree::reference_integrator& ref, const i
                                 double target, const fs::path& cache_dir, bool use_cache,
                                 const std::string& device_config) {
     for (std::uint32_t attempt = 0;; ++attempt) {
-        fnv1a_hash key;
+        study::fnv1a_hash key;
         key.bytes(pts.data(), pts.size() * sizeof(study_point));
         key.value(spp);
         key.value(seed);
@@ -391,7 +391,7 @@ int main(int argc, char** argv) {
 #endif
     bool sweep = false, no_raster = false, no_ray_cast = false, no_cache = false;
     std::size_t texel_points = 0;
-    fs::path json_path, points_csv, cache_dir = embree::default_cache_dir();
+    fs::path json_path, points_csv, cache_dir = study::default_cache_dir();
     app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--resolution", resolution, "plane resolution N (N x N pixels)")

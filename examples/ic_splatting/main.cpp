@@ -15,7 +15,7 @@
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/embree/reference_cache.hpp>
+#include <bounce/study/reference_cache.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/record_cache.hpp>
 #include <bounce/io/report.hpp>
@@ -577,8 +577,8 @@ int run(const options& o) {
 
     auto reference_for = [&](const camera& cam) {
         bool hit = false;
-        auto ref = embree::cached_reference(bvh, scene, cam, o.width, o.height, reference_settings_for(o.ref_spp, 1),
-                                            embree::default_cache_dir(), &hit);
+        auto ref = study::cached_reference(bvh, scene, cam, o.width, o.height, reference_settings_for(o.ref_spp, 1),
+                                            study::default_cache_dir(), &hit);
         fmt::print(stderr, "reference {}x{} at {} spp: {}\n", o.width, o.height, o.ref_spp, hit ? "from cache" : "computed");
         return ref;
     };

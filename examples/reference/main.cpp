@@ -6,7 +6,7 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/embree/reference_cache.hpp>
+#include <bounce/study/reference_cache.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/report.hpp>
 #include <bounce/io/scene.hpp>
@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
     std::uint32_t spp = 1024, area_samples = 16, secondary_area_samples = 1;
     std::uint64_t seed = 1;
     std::vector<float> environment = {0.f, 0.f, 0.f};
-    fs::path out = "reference.exr", png, json, cache_dir = embree::default_cache_dir();
+    fs::path out = "reference.exr", png, json, cache_dir = study::default_cache_dir();
     float exposure = 0.f;
     int repeat = 1;
     bool no_cache = false, quiet = false;
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
         gbuffer<float> g;
         embree::reference_images images;
         const std::string key =
-            embree::reference_cache_key(scene, scene.camera, width, height, settings, dev.config());
+            study::reference_cache_key(scene, scene.camera, width, height, settings, dev.config());
         std::string cache_state = no_cache ? "off" : "miss";
 
         for (int r = 0; r < repeat; ++r) {
@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
             g = timer.time("gbuffer", [&] { return embree::ray_cast_gbuffer(*bvh, scene, scene.camera, width, height); });
             if (!no_cache && repeat == 1) {
                 auto cached = timer.time("cache_load", [&] {
-                    return embree::load_cached_reference(cache_dir, key, width, height, settings);
+                    return study::load_cached_reference(cache_dir, key, width, height, settings);
                 });
                 if (cached) {
                     images = std::move(*cached);
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
             images.grid = embree::hemisphere_grid_for(spp);
         }
         if (!no_cache && cache_state == "miss")
-            embree::store_cached_reference(cache_dir, key, images, scene, scene.camera, settings, dev.config());
+            study::store_cached_reference(cache_dir, key, images, scene, scene.camera, settings, dev.config());
 
         io::write_exr(out, images.combined.view());
         io::write_exr(sibling(out, "direct"), images.direct.view());

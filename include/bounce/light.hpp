@@ -11,12 +11,12 @@
 
 #include <cmath>
 #include <cstdint>
-#include <numbers>
 #include <span>
 #include <string>
 #include <variant>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -104,9 +104,8 @@ inline packed_light pack(const light& l) {
         p.position_kind = glm::vec4(pl->position, float(light_kind::point));
         p.intensity_falloff = glm::vec4(pl->intensity, 0.f);
     } else if (const auto* sl = std::get_if<spot_light>(&l)) {
-        const double cone_rad = double(sl->cone_deg) * std::numbers::pi / 180.0;
         p.position_kind = glm::vec4(sl->position, float(light_kind::spot));
-        p.direction_cos_cone = glm::vec4(glm::normalize(sl->direction), float(std::cos(cone_rad)));
+        p.direction_cos_cone = glm::vec4(glm::normalize(sl->direction), float(std::cos(glm::radians(double(sl->cone_deg)))));
         p.intensity_falloff =
             glm::vec4(sl->intensity, sl->falloff == spot_light::falloff_kind::cosine ? 1.f : 0.f);
     } else {

@@ -38,12 +38,12 @@ struct scene_view {
     bool use_emission = false;  ///< triangles whose material has emission > 0 are area lights too
 
     /// Throws parameter_error naming the span at fault ("scene.positions", "scene.triangles"
-    /// ...) unless the view is consistent and finite: finite positions and normals, normals
+    /// ...) unless the mesh is consistent and finite: finite positions and normals, normals
     /// empty or one per position, indices in range, one material index per triangle and each
-    /// in range, albedo and emission finite and non-negative, lights as validate_lights asks,
-    /// and fewer than 2^32 - 1 vertices and triangles (32-bit indices on every backend).
-    /// Degenerate (zero-area) triangles are allowed: backends give them no hits and no light.
-    void validate() const {
+    /// in range, albedo and emission finite and non-negative, and fewer than 2^32 - 1
+    /// vertices and triangles (32-bit indices on every backend). Degenerate (zero-area)
+    /// triangles are allowed: backends give them no hits and no light.
+    void validate_mesh() const {
         const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
         const std::size_t nv = positions.size(), nt = triangles.size();
         for (std::size_t i = 0; i < nv; ++i)
@@ -81,6 +81,11 @@ struct scene_view {
                 throw parameter_error("scene.materials", "material " + std::to_string(m) +
                                                              " has a negative or non-finite emission");
         }
+    }
+
+    /// validate_mesh(), then the lights as validate_lights asks ("scene.lights[i]").
+    void validate() const {
+        validate_mesh();
         validate_lights(lights);
     }
 

@@ -1,6 +1,5 @@
 // Properties of the sampling helpers: bases stay orthonormal for every normal, the
 // hemisphere maps have the densities they claim, point sets are stratified and seeded.
-#include <bounce/content_hash.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -165,32 +164,3 @@ TEST_CASE("stratified points lie one per cell, fixed by their seed", "[sampling]
     CHECK_THROWS_AS(stratified2(0, 4, 1), parameter_error);
 }
 
-TEST_CASE("fnv1a_hash gives FNV-1a's published 64-bit values, and text() keeps its pieces apart", "[core][hash]") {
-    // Vectors of the FNV reference (Fowler, Noll, Vo): "", "a", "foobar".
-    const auto of = [](std::string_view s) {
-        bounce::fnv1a_hash h;
-        h.bytes(s.data(), s.size());
-        return h.digest();
-    };
-    CHECK(of("") == 0xcbf29ce484222325ULL);
-    CHECK(of("a") == 0xaf63dc4c8601ec8cULL);
-    CHECK(of("foobar") == 0x85944171f73967e8ULL);
-    // Hashing in pieces is hashing the concatenation; value() reads the object's bytes.
-    bounce::fnv1a_hash pieces;
-    pieces.bytes("foo", 3);
-    pieces.bytes("bar", 3);
-    CHECK(pieces.digest() == of("foobar"));
-    const std::uint32_t word = 0x61626364u;  // "dcba" in little-endian memory
-    bounce::fnv1a_hash w;
-    w.value(word);
-    bounce::fnv1a_hash raw;
-    raw.bytes(&word, sizeof word);
-    CHECK(w.digest() == raw.digest());
-    // text() prefixes the length: ("ab", "c") and ("a", "bc") differ though their bytes agree.
-    bounce::fnv1a_hash ab_c, a_bc;
-    ab_c.text("ab");
-    ab_c.text("c");
-    a_bc.text("a");
-    a_bc.text("bc");
-    CHECK(ab_c.digest() != a_bc.digest());
-}

@@ -1,7 +1,7 @@
 #pragma once
 // Scenes built by hand for the closed-form tests: quads, boxes and a subdivided icosahedron,
 // and Lambert's exact irradiance from a uniformly bright polygon.
-#include <bounce/io/scene.hpp>
+#include "../owned_scene.hpp"
 
 #include <glm/glm.hpp>
 
@@ -17,18 +17,16 @@
 
 namespace hand_built {
 
-using bounce::io::scene;
+using scene = bounce::test::owned_scene;
 
-inline std::uint32_t add_material(scene& s, glm::vec3 kd, glm::vec3 ke = glm::vec3(0.f)) {
-    bounce::io::material m;
-    m.name = std::to_string(s.materials.size());  // (not "m" + ...: GCC 12 -Wrestrict false positive)
-    m.kd = kd;
-    m.ke = ke;
-    s.materials.push_back(m);
+template <class Scene>
+std::uint32_t add_material(Scene& s, glm::vec3 kd, glm::vec3 ke = glm::vec3(0.f)) {
+    s.materials.push_back({kd, ke});
     return std::uint32_t(s.materials.size() - 1);
 }
 
-inline void add_triangle(scene& s, std::array<glm::vec3, 3> p, std::array<glm::vec3, 3> n, std::uint32_t material) {
+template <class Scene>
+void add_triangle(Scene& s, std::array<glm::vec3, 3> p, std::array<glm::vec3, 3> n, std::uint32_t material) {
     const auto base = std::uint32_t(s.positions.size());
     for (int i = 0; i < 3; ++i) {
         s.positions.push_back(p[i]);
@@ -40,14 +38,16 @@ inline void add_triangle(scene& s, std::array<glm::vec3, 3> p, std::array<glm::v
 
 // Quad a b c d (counter-clockwise seen from the side `normal` points to), two triangles
 // sharing the diagonal a-c, every vertex normal equal to `normal`.
-inline void add_quad(scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 normal,
+template <class Scene>
+void add_quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 normal,
                      std::uint32_t material) {
     add_triangle(s, {a, b, c}, {normal, normal, normal}, material);
     add_triangle(s, {a, c, d}, {normal, normal, normal}, material);
 }
 
 // Axis-aligned square of half-size h in the plane z = z0, normal +z or -z.
-inline void add_square_z(scene& s, float z0, float h, bool faces_up, std::uint32_t material, glm::vec2 centre = {0, 0}) {
+template <class Scene>
+void add_square_z(Scene& s, float z0, float h, bool faces_up, std::uint32_t material, glm::vec2 centre = {0, 0}) {
     const glm::vec3 a(centre.x - h, centre.y - h, z0), b(centre.x + h, centre.y - h, z0), c(centre.x + h, centre.y + h, z0),
         d(centre.x - h, centre.y + h, z0);
     if (faces_up) add_quad(s, a, b, c, d, {0, 0, 1}, material);
@@ -56,7 +56,8 @@ inline void add_square_z(scene& s, float z0, float h, bool faces_up, std::uint32
 
 // An icosahedron subdivided `levels` times and projected onto the sphere of radius r around
 // `centre`: shared vertices (watertight), unit radial vertex normals, 20 * 4^levels triangles.
-inline void add_icosphere(scene& s, glm::dvec3 centre, double r, int levels, std::uint32_t material) {
+template <class Scene>
+void add_icosphere(Scene& s, glm::dvec3 centre, double r, int levels, std::uint32_t material) {
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
     std::vector<glm::dvec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
                                  {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};

@@ -23,8 +23,8 @@ namespace {
 
 // A unit square [-1,1]^2 in the plane through the origin with normal (sin a, 0, cos a),
 // its vertex normals pointing *away* from a camera on +z (the G-buffer must flip them).
-io::scene tilted_square(double tilt) {
-    io::scene s;
+test::owned_scene tilted_square(double tilt) {
+    test::owned_scene s;
     s.name = "tilted-square";
     const auto m = hand_built::add_material(s, {0.25f, 0.5f, 0.75f});
     const glm::dvec3 n(std::sin(tilt), 0, std::cos(tilt)), u(std::cos(tilt), 0, -std::sin(tilt)), v(0, 1, 0);
@@ -34,8 +34,8 @@ io::scene tilted_square(double tilt) {
 }
 
 // Two parallel squares z = 1 and z = 2, 4 wide: rays from below hit z = 1 first.
-io::scene two_parallel_squares() {
-    io::scene s;
+test::owned_scene two_parallel_squares() {
+    test::owned_scene s;
     const auto m = hand_built::add_material(s, glm::vec3(0.5f));
     hand_built::add_square_z(s, 1.f, 4.f, false, m);
     hand_built::add_square_z(s, 2.f, 4.f, false, m);
@@ -83,7 +83,7 @@ TEST_CASE("a device's configuration pins Embree's kernels and is checked before 
           "[embree][device]") {
     // Every kernel set must find the lower square at t = 1 / d.z, to the few ulps its float
     // intersection allows.
-    const io::scene s = two_parallel_squares();
+    const test::owned_scene s = two_parallel_squares();
     const std::string config = GENERATE(as<std::string>{}, "", "max_isa=sse2", "max_isa=sse4.2,threads=1",
                                         "max_isa=avx,verbose=0", "start_threads=1,set_affinity=0,hugepages=0");
     CAPTURE(config);
@@ -120,7 +120,8 @@ TEST_CASE("BOUNCE_EMBREE_CONFIG configures default devices and is checked under 
     const bounce::test::scoped_environment config("BOUNCE_EMBREE_CONFIG");
     config.set("max_isa=sse4.2");
     CHECK(device().config() == "max_isa=sse4.2");
-    CHECK(accel(io::scene{}).owner().config() == "max_isa=sse4.2");
+    const test::owned_scene empty;
+    CHECK(accel(empty).owner().config() == "max_isa=sse4.2");
     config.set("max_isa=sse4");
     CHECK_THROWS_WITH(device(), Catch::Contains("BOUNCE_EMBREE_CONFIG") && Catch::Contains("'max_isa=sse4'"));
     config.set("");
@@ -130,7 +131,7 @@ TEST_CASE("BOUNCE_EMBREE_CONFIG configures default devices and is checked under 
 }
 
 TEST_CASE("building from an invalid scene names the faulty field", "[embree][bad-input]") {
-    io::scene s;
+    test::owned_scene s;
     const auto m = hand_built::add_material(s, glm::vec3(0.5f));
     hand_built::add_square_z(s, 0.f, 1.f, true, m);
 
@@ -156,19 +157,19 @@ TEST_CASE("building from an invalid scene names the faulty field", "[embree][bad
         CHECK_THROWS_WITH(accel(s), Catch::Contains("scene.normals"));
     }
     SECTION("negative reflectance") {
-        s.materials[0].kd.y = -0.1f;
+        s.materials[0].albedo.y = -0.1f;
         CHECK_THROWS_WITH(accel(s), Catch::Contains("scene.materials"));
     }
     SECTION("a scene other than the one the accel was built from") {
         const accel bvh(s);
-        io::scene other = s;
+        test::owned_scene other = s;
         hand_built::add_square_z(other, 1.f, 1.f, true, m);
         CHECK_THROWS_AS(ray_cast_gbuffer(bvh, other, other.camera, 8, 8), parameter_error);
     }
 }
 
 TEST_CASE("an empty scene builds and every ray misses", "[embree]") {
-    io::scene s;
+    test::owned_scene s;
     const accel bvh(s);
     CHECK(bvh.triangle_count() == 0);
     CHECK_FALSE(bvh.intersect({{0, 0, 0}, {0, 0, 1}}).found());
@@ -176,7 +177,8 @@ TEST_CASE("an empty scene builds and every ray misses", "[embree]") {
 }
 
 TEST_CASE("closest hits and occlusion agree with the plane equation", "[embree][queries]") {
-    const accel bvh(two_parallel_squares());
+    const test::owned_scene squares = two_parallel_squares();
+    const accel bvh(squares);
     const std::vector<ray> rays = rays_up_into_the_squares(21, 500);
     std::vector<hit> stream(rays.size());
     bvh.intersect(rays, stream);
@@ -203,7 +205,7 @@ TEST_CASE("closest hits and occlusion agree with the plane equation", "[embree][
 
 TEST_CASE("the ray-cast G-buffer of a quad matches the closed-form hit at every pixel", "[embree][gbuffer]") {
     const double tilt = GENERATE(0.0, 0.5, -1.0);
-    const io::scene s = tilted_square(tilt);
+    const test::owned_scene s = tilted_square(tilt);
     const accel bvh(s);
     camera cam;
     cam.position = {0.2f, -0.1f, 4.f};
@@ -251,7 +253,7 @@ TEST_CASE("the ray-cast G-buffer of a quad matches the closed-form hit at every 
 }
 
 TEST_CASE("the G-buffer normal is the normalized barycentric blend of the vertex normals", "[embree][gbuffer]") {
-    io::scene s;
+    test::owned_scene s;
     const auto m = hand_built::add_material(s, glm::vec3(0.5f));
     const std::array<glm::vec3, 3> p = {glm::vec3(-1, -1, 0), glm::vec3(1.5f, -1, 0), glm::vec3(0, 1.5f, 0)};
     const std::array<glm::vec3, 3> nv = {glm::normalize(glm::vec3(0.5f, 0, 1)), glm::normalize(glm::vec3(-0.3f, 0.4f, 1)),
@@ -281,7 +283,7 @@ TEST_CASE("the G-buffer normal is the normalized barycentric blend of the vertex
 }
 
 TEST_CASE("the G-buffer refuses mismatched views and invalid cameras", "[embree][gbuffer][bad-input]") {
-    io::scene s;
+    test::owned_scene s;
     const auto m = hand_built::add_material(s, glm::vec3(0.5f));
     hand_built::add_square_z(s, 0.f, 1.f, true, m);
     const accel bvh(s);

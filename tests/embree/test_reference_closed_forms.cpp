@@ -52,8 +52,8 @@ bool within(glm::dvec3 got, glm::dvec3 expected, glm::dvec3 sigma) {
 }
 
 // A floor z = 0 of half-size `half`, facing up.
-io::scene floor_scene(float half = 10.f, glm::vec3 kd = glm::vec3(0.5f)) {
-    io::scene s;
+test::owned_scene floor_scene(float half = 10.f, glm::vec3 kd = glm::vec3(0.5f)) {
+    test::owned_scene s;
     s.name = "floor";
     const auto m = hand_built::add_material(s, kd);
     hand_built::add_square_z(s, 0.f, half, true, m);
@@ -71,7 +71,7 @@ std::vector<glm::dvec3> square_corners(double z, double half, glm::dvec2 c = {0,
 }  // namespace
 
 TEST_CASE("a plane under a uniform sky receives E = pi L", "[reference][closed-form][sky]") {
-    const io::scene s = floor_scene();
+    const test::owned_scene s = floor_scene();
     const accel bvh(s);
     reference_settings settings;
     settings.environment = {1.f, 0.5f, 0.25f};
@@ -88,7 +88,7 @@ TEST_CASE("a plane under a uniform sky receives E = pi L", "[reference][closed-f
 
 TEST_CASE("a black square under a uniform sky removes L times its projected solid angle", "[reference][closed-form][sky]") {
     // E = pi L - L * Lambert(square): exact for a polygon, so only Monte Carlo error remains.
-    io::scene s = floor_scene();
+    test::owned_scene s = floor_scene();
     const auto black = hand_built::add_material(s, glm::vec3(0.f));
     const float h = 0.5f, half = 0.4f;
     hand_built::add_square_z(s, h, half, false, black, {0.1f, -0.2f});
@@ -107,12 +107,12 @@ TEST_CASE("a black square under a uniform sky removes L times its projected soli
 }
 
 TEST_CASE("a point light above a plane gives E = I cos(theta) / d^2 exactly", "[reference][closed-form][point]") {
-    io::scene s = floor_scene();
+    test::owned_scene s = floor_scene();
     const auto i = GENERATE(range(0, 100));
     pcg32 rng(500 + std::uint64_t(i));
     const glm::vec3 light(float(4 * rng.next_double() - 2), float(4 * rng.next_double() - 2), float(0.2 + 3 * rng.next_double()));
     const glm::vec3 intensity(3.f, 2.f, 1.f);
-    s.lights.push_back(io::point_light{light, intensity});
+    s.lights.push_back(bounce::point_light{light, intensity});
     const accel bvh(s);
     const reference_integrator ri(bvh, s);
     const glm::vec3 p = random_floor_point(rng, 3.f);
@@ -126,10 +126,10 @@ TEST_CASE("a point light above a plane gives E = I cos(theta) / d^2 exactly", "[
 }
 
 TEST_CASE("a spot light lights its cone with the chosen falloff and nothing outside", "[reference][closed-form][spot]") {
-    const auto falloff = GENERATE(io::spot_light::falloff_kind::none, io::spot_light::falloff_kind::cosine);
-    io::scene s = floor_scene();
+    const auto falloff = GENERATE(bounce::spot_light::falloff_kind::none, bounce::spot_light::falloff_kind::cosine);
+    test::owned_scene s = floor_scene();
     const float height = 1.5f, cone_deg = 30.f;
-    s.lights.push_back(io::spot_light{{0.f, 0.f, height}, {0.f, 0.f, -1.f}, {2.f, 2.f, 2.f}, cone_deg, falloff});
+    s.lights.push_back(bounce::spot_light{{0.f, 0.f, height}, {0.f, 0.f, -1.f}, {2.f, 2.f, 2.f}, cone_deg, falloff});
     const accel bvh(s);
     const reference_integrator ri(bvh, s);
     pcg32 rng(600);
@@ -141,7 +141,7 @@ TEST_CASE("a spot light lights its cone with the chosen falloff and nothing outs
         const double dist = glm::length(d), cos_axis = d.z / dist, cos_theta = d.z / dist;
         if (std::abs(cos_axis - cos_cone) < 1e-4) continue;  // float rounding decides the edge
         const double profile =
-            cos_axis >= cos_cone ? (falloff == io::spot_light::falloff_kind::cosine ? cos_axis : 1.0) : 0.0;
+            cos_axis >= cos_cone ? (falloff == bounce::spot_light::falloff_kind::cosine ? cos_axis : 1.0) : 0.0;
         const double expected = 2.0 * profile * cos_theta / (dist * dist);
         const double got = ri.direct_irradiance(p, {0, 0, 1}, 1).x;
         CHECK(std::abs(got - expected) <= float_slack * expected + 1e-12);
@@ -154,10 +154,10 @@ TEST_CASE("a spot light lights its cone with the chosen falloff and nothing outs
 TEST_CASE("an occluder casts an exact shadow of a point light", "[reference][closed-form][shadow]") {
     // Light at height 2 over a square of half-size 0.25 at height 1: its umbra on the floor
     // is the square of half-size 0.5 (similar triangles).
-    io::scene s = floor_scene();
+    test::owned_scene s = floor_scene();
     const auto m = hand_built::add_material(s, glm::vec3(0.7f));
     hand_built::add_square_z(s, 1.f, 0.25f, false, m);
-    s.lights.push_back(io::point_light{{0.f, 0.f, 2.f}, glm::vec3(4.f)});
+    s.lights.push_back(bounce::point_light{{0.f, 0.f, 2.f}, glm::vec3(4.f)});
     const accel bvh(s);
     const reference_integrator ri(bvh, s);
     pcg32 rng(700);
@@ -183,7 +183,7 @@ TEST_CASE("an occluder casts an exact shadow of a point light", "[reference][clo
 TEST_CASE("an emissive square lights the floor with L times Lambert's polygon irradiance", "[reference][closed-form][area]") {
     // The area estimate is compared with the exact polygon irradiance; its standard error
     // comes from 32 independent estimates (different seeds) at each point.
-    io::scene s = floor_scene();
+    test::owned_scene s = floor_scene();
     const glm::vec3 le(2.f, 4.f, 1.f);
     const auto emitter = hand_built::add_material(s, glm::vec3(0.f), le);
     const float h = 0.6f, half = 0.3f;
@@ -216,12 +216,12 @@ TEST_CASE("furnace: inside a closed sphere lit from its centre, E_indirect = rho
     // E_direct(q) = I / |q - c|^2 with h_min <= |q - c| <= R (h_min: the smallest distance
     // from the centre to a face plane); every hemisphere ray hits (closed surface), hence
     // rho I / R^2 <= E_indirect <= rho I / h_min^2.
-    io::scene s;
+    test::owned_scene s;
     const glm::vec3 rho(0.3f, 0.6f, 0.9f), intensity(2.f, 1.f, 0.5f);
     const glm::dvec3 centre(0.1, -0.2, 0.3);
     const double radius = 1.5;
     hand_built::add_icosphere(s, centre, radius, 4, hand_built::add_material(s, rho));
-    s.lights.push_back(io::point_light{glm::vec3(centre), intensity});
+    s.lights.push_back(bounce::point_light{glm::vec3(centre), intensity});
     const accel bvh(s);
     const reference_integrator ri(bvh, s);
 
@@ -261,11 +261,11 @@ TEST_CASE("hemisphere samples under a lit ceiling see h / cos(theta) and the cei
     // L = rho E0 / pi down; rays that miss it bring the environment L_env. So
     // E = rho E0 / pi * Lambert(ceiling) + L_env (pi - Lambert(ceiling)), and each hit lies
     // at distance h / cos(theta).
-    io::scene s;
+    test::owned_scene s;
     const float h = 0.7f, half = 2.f;
     const glm::vec3 rho(0.5f, 0.25f, 1.f);
     hand_built::add_square_z(s, h, half, false, hand_built::add_material(s, rho));
-    s.lights.push_back(io::directional_light{{0.f, 0.f, 1.f}, {3.f, 3.f, 3.f}});
+    s.lights.push_back(bounce::directional_light{{0.f, 0.f, 1.f}, {3.f, 3.f, 3.f}});
     const accel bvh(s);
     reference_settings settings;
     settings.environment = {0.1f, 0.2f, 0.3f};
@@ -292,7 +292,7 @@ TEST_CASE("hemisphere samples under a lit ceiling see h / cos(theta) and the cei
 }
 
 TEST_CASE("hemisphere samples lie one per Ward-Heckbert stratum", "[reference][hemisphere]") {
-    const io::scene s = floor_scene();
+    const test::owned_scene s = floor_scene();
     const accel bvh(s);
     const reference_integrator ri(bvh, s);
     const glm::vec3 n = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
@@ -320,8 +320,8 @@ TEST_CASE("hemisphere samples lie one per Ward-Heckbert stratum", "[reference][h
 }
 
 TEST_CASE("per-pixel images are rho / pi times the irradiance and sum to the combined image", "[reference][images]") {
-    io::scene s = floor_scene(3.f, glm::vec3(0.2f, 0.4f, 0.6f));
-    s.lights.push_back(io::point_light{{0.3f, 0.2f, 1.5f}, glm::vec3(2.f)});
+    test::owned_scene s = floor_scene(3.f, glm::vec3(0.2f, 0.4f, 0.6f));
+    s.lights.push_back(bounce::point_light{{0.3f, 0.2f, 1.5f}, glm::vec3(2.f)});
     s.camera.position = {0.f, -2.f, 2.f};
     s.camera.look_at = {0.f, 0.f, 0.f};
     s.camera.up = {0.f, 0.f, 1.f};
@@ -351,7 +351,7 @@ TEST_CASE("per-pixel images are rho / pi times the irradiance and sum to the com
 
 TEST_CASE("reference images are bitwise the same with 1 and 2 threads", "[reference][determinism]") {
     // A closed box with a point light and an emissive patch: every random stream is used.
-    io::scene s;
+    test::owned_scene s;
     const auto white = hand_built::add_material(s, glm::vec3(0.7f)), red = hand_built::add_material(s, {0.6f, 0.1f, 0.1f});
     const auto lamp = hand_built::add_material(s, glm::vec3(0.f), glm::vec3(5.f));
     hand_built::add_square_z(s, 0.f, 1.f, true, white);
@@ -361,7 +361,7 @@ TEST_CASE("reference images are bitwise the same with 1 and 2 threads", "[refere
     hand_built::add_quad(s, {1, -1, 0}, {1, -1, 2}, {1, 1, 2}, {1, 1, 0}, {-1, 0, 0}, white);
     hand_built::add_quad(s, {-1, 1, 0}, {1, 1, 0}, {1, 1, 2}, {-1, 1, 2}, {0, -1, 0}, white);
     s.use_emission = true;
-    s.lights.push_back(io::point_light{{0.3f, 0.f, 1.5f}, glm::vec3(1.f)});
+    s.lights.push_back(bounce::point_light{{0.3f, 0.f, 1.5f}, glm::vec3(1.f)});
     s.camera.position = {0.f, -3.f, 1.f};
     s.camera.look_at = {0.f, 0.f, 1.f};
     s.camera.up = {0.f, 0.f, 1.f};
@@ -402,22 +402,22 @@ TEST_CASE("reference images are bitwise the same with 1 and 2 threads", "[refere
 }
 
 TEST_CASE("the integrator refuses bad lights, settings and points", "[reference][bad-input]") {
-    io::scene s = floor_scene();
+    test::owned_scene s = floor_scene();
     const accel bvh(s);
     SECTION("zero spot direction") {
-        s.lights.push_back(io::spot_light{{0, 0, 1}, {0, 0, 0}, glm::vec3(1.f), 30.f});
+        s.lights.push_back(bounce::spot_light{{0, 0, 1}, {0, 0, 0}, glm::vec3(1.f), 30.f});
         CHECK_THROWS_WITH(reference_integrator(bvh, s), Catch::Contains("scene.lights[0]"));
     }
     SECTION("zero cone") {
-        s.lights.push_back(io::spot_light{{0, 0, 1}, {0, 0, -1}, glm::vec3(1.f), 0.f});
+        s.lights.push_back(bounce::spot_light{{0, 0, 1}, {0, 0, -1}, glm::vec3(1.f), 0.f});
         CHECK_THROWS_AS(reference_integrator(bvh, s), parameter_error);
     }
     SECTION("negative intensity") {
-        s.lights.push_back(io::point_light{{0, 0, 1}, {1.f, -1.f, 1.f}});
+        s.lights.push_back(bounce::point_light{{0, 0, 1}, {1.f, -1.f, 1.f}});
         CHECK_THROWS_AS(reference_integrator(bvh, s), parameter_error);
     }
     SECTION("NaN directional light") {
-        s.lights.push_back(io::directional_light{{0, 0, std::numeric_limits<float>::quiet_NaN()}, glm::vec3(1.f)});
+        s.lights.push_back(bounce::directional_light{{0, 0, std::numeric_limits<float>::quiet_NaN()}, glm::vec3(1.f)});
         CHECK_THROWS_AS(reference_integrator(bvh, s), parameter_error);
     }
     SECTION("settings") {

@@ -4,6 +4,8 @@
 // the caller's GL state survives; bad scenes are refused.
 #include "shared_context.hpp"
 
+#include "../owned_scene.hpp"
+
 #include <bounce/gl/gbuffer_pass.hpp>
 
 #define GL_GLEXT_PROTOTYPES
@@ -20,7 +22,7 @@ using namespace bounce;
 namespace {
 
 // A square [c - h, c + h]^2 in the plane z = z0 with vertex normals `normal`, material m.
-void add_quad(io::scene& s, float z0, float h, glm::vec3 normal, std::uint32_t m, bool reverse_winding = false) {
+void add_quad(test::owned_scene& s, float z0, float h, glm::vec3 normal, std::uint32_t m, bool reverse_winding = false) {
     const auto base = std::uint32_t(s.positions.size());
     for (const glm::vec2 c : {glm::vec2(-h, -h), glm::vec2(h, -h), glm::vec2(h, h), glm::vec2(-h, h)}) {
         s.positions.emplace_back(c.x, c.y, z0);
@@ -36,9 +38,9 @@ void add_quad(io::scene& s, float z0, float h, glm::vec3 normal, std::uint32_t m
     s.material_of.insert(s.material_of.end(), 2, m);
 }
 
-io::scene quad_scene(glm::vec3 normal, bool reverse_winding = false) {
-    io::scene s;
-    s.materials.push_back({"blue-ish", glm::vec3(0.2f, 0.4f, 0.6f), glm::vec3(0.f)});
+test::owned_scene quad_scene(glm::vec3 normal, bool reverse_winding = false) {
+    test::owned_scene s;
+    s.materials.push_back({glm::vec3(0.2f, 0.4f, 0.6f), glm::vec3(0.f)});
     add_quad(s, 0.f, 1.f, normal, 0, reverse_winding);
     return s;
 }
@@ -140,9 +142,9 @@ TEST_CASE("an oblique view puts every covered pixel on its centre ray, at its vi
 
 TEST_CASE("the nearer of two surfaces wins, with its own material", "[gl][gbuffer]") {
     gl_test::shared_context();
-    io::scene s;
-    s.materials.push_back({"far", glm::vec3(0.f, 1.f, 0.f), glm::vec3(0.f)});
-    s.materials.push_back({"near", glm::vec3(1.f, 0.f, 0.f), glm::vec3(0.f)});
+    test::owned_scene s;
+    s.materials.push_back({glm::vec3(0.f, 1.f, 0.f), glm::vec3(0.f)});
+    s.materials.push_back({glm::vec3(1.f, 0.f, 0.f), glm::vec3(0.f)});
     add_quad(s, 1.f, 0.25f, {0, 0, 1}, 1);  // drawn first, nearer
     add_quad(s, 0.f, 1.f, {0, 0, 1}, 0);
     const gl::scene_mesh mesh(s);
@@ -159,9 +161,9 @@ TEST_CASE("the nearer of two surfaces wins, with its own material", "[gl][gbuffe
 
 TEST_CASE("rows are read back top first: the upper half of the image sees +y", "[gl][gbuffer]") {
     gl_test::shared_context();
-    io::scene s;
-    s.materials.push_back({"bottom", glm::vec3(0.f, 0.f, 1.f), glm::vec3(0.f)});
-    s.materials.push_back({"top", glm::vec3(1.f, 1.f, 0.f), glm::vec3(0.f)});
+    test::owned_scene s;
+    s.materials.push_back({glm::vec3(0.f, 0.f, 1.f), glm::vec3(0.f)});
+    s.materials.push_back({glm::vec3(1.f, 1.f, 0.f), glm::vec3(0.f)});
     // Two strips: y in [-1, 0] (material 0) and y in [0, 1] (material 1).
     s.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 0, 0}, {-1, 0, 0}, {1, 1, 0}, {-1, 1, 0}};
     s.normals.assign(6, glm::vec3(0, 0, 1));
@@ -222,7 +224,7 @@ TEST_CASE("the pass leaves the caller's GL state as it found it", "[gl][gbuffer]
 
 TEST_CASE("an empty scene renders background everywhere", "[gl][gbuffer]") {
     gl_test::shared_context();
-    const gl::scene_mesh mesh(io::scene{});
+    const gl::scene_mesh mesh(test::owned_scene{});
     gl::gbuffer_pass pass;
     pass.render(mesh, front_camera(), 8, 4);
     auto g = pass.read();

@@ -16,6 +16,8 @@
 // result is 0; it is allowed 1e-6 of the unshadowed value.
 #include "../gl/shared_context.hpp"
 
+#include "../owned_scene.hpp"
+
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/splat_pass.hpp>
@@ -41,7 +43,7 @@ constexpr int resolution = 1024;
 constexpr double blocker_z = 1.0, blocker_half = 0.5;
 const glm::dvec2 blocker_centre(0.2, 0.1);
 
-void add_quad(io::scene& s, glm::vec3 centre, float half, std::uint32_t m) {
+void add_quad(test::owned_scene& s, glm::vec3 centre, float half, std::uint32_t m) {
     const auto base = std::uint32_t(s.positions.size());
     for (const glm::vec2 c : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(1, 1), glm::vec2(-1, 1)}) {
         s.positions.push_back(centre + half * glm::vec3(c, 0.f));
@@ -52,10 +54,10 @@ void add_quad(io::scene& s, glm::vec3 centre, float half, std::uint32_t m) {
     s.material_of.insert(s.material_of.end(), 2, m);
 }
 
-io::scene ground_and_blocker(io::light light) {
-    io::scene s;
-    s.materials.push_back({"ground", glm::vec3(0.5f, 0.6f, 0.7f), glm::vec3(0.f)});
-    s.materials.push_back({"blocker", glm::vec3(0.9f, 0.3f, 0.2f), glm::vec3(0.f)});
+test::owned_scene ground_and_blocker(bounce::light light) {
+    test::owned_scene s;
+    s.materials.push_back({glm::vec3(0.5f, 0.6f, 0.7f), glm::vec3(0.f)});
+    s.materials.push_back({glm::vec3(0.9f, 0.3f, 0.2f), glm::vec3(0.f)});
     add_quad(s, {0, 0, 0}, 4.f, 0);
     add_quad(s, glm::vec3(glm::dvec3(blocker_centre, blocker_z)), float(blocker_half), 1);
     s.lights.push_back(light);
@@ -75,23 +77,23 @@ struct expectation {
 
 // `ortho_texel`: the world size of the orthographic map's texel (direct_light::texel_of),
 // used for directional lights only.
-expectation expect(const io::light& light, const glm::dvec3& p, const glm::dvec3& n, double ortho_texel) {
+expectation expect(const bounce::light& light, const glm::dvec3& p, const glm::dvec3& n, double ortho_texel) {
     expectation x;
     glm::dvec3 to_light;  // unit, towards the light
     double texel = 0, scale = 1;  // shadow texel at p; ground distance per blocker-plane distance
-    if (const auto* pl = std::get_if<io::point_light>(&light)) {
+    if (const auto* pl = std::get_if<bounce::point_light>(&light)) {
         const glm::dvec3 d = glm::dvec3(pl->position) - p;
         x.e = glm::dvec3(pl->intensity) * std::max(0.0, glm::dot(n, d)) / std::pow(glm::length(d), 3.0);
         to_light = glm::normalize(d);
         const glm::dvec3 ad = glm::abs(d);
         texel = 2.0 * std::max({ad.x, ad.y, ad.z}) / resolution;
         scale = (pl->position.z - p.z) / (pl->position.z - blocker_z);
-    } else if (const auto* sl = std::get_if<io::spot_light>(&light)) {
+    } else if (const auto* sl = std::get_if<bounce::spot_light>(&light)) {
         const glm::dvec3 d = glm::dvec3(sl->position) - p, axis = glm::normalize(glm::dvec3(sl->direction));
         const double dist = glm::length(d), cos_axis = -glm::dot(axis, d) / dist;
         const double cos_cone = std::cos(sl->cone_deg * std::numbers::pi / 180.0);
         const double profile =
-            cos_axis >= cos_cone ? (sl->falloff == io::spot_light::falloff_kind::cosine ? cos_axis : 1.0) : 0.0;
+            cos_axis >= cos_cone ? (sl->falloff == bounce::spot_light::falloff_kind::cosine ? cos_axis : 1.0) : 0.0;
         x.e = glm::dvec3(sl->intensity) * profile * std::max(0.0, glm::dot(n, d)) / std::pow(dist, 3.0);
         to_light = d / dist;
         if (sl->cone_deg <= 60.f) {
@@ -103,7 +105,7 @@ expectation expect(const io::light& light, const glm::dvec3& p, const glm::dvec3
         scale = (sl->position.z - p.z) / (sl->position.z - blocker_z);
         if (std::abs(cos_axis - cos_cone) < 1e-4) return x;  // the profile jumps here
     } else {
-        const auto& dl = std::get<io::directional_light>(light);
+        const auto& dl = std::get<bounce::directional_light>(light);
         const glm::dvec3 dir = glm::normalize(glm::dvec3(dl.direction));
         x.e = glm::dvec3(dl.irradiance) * std::max(0.0, -glm::dot(n, dir));
         to_light = -dir;
@@ -125,30 +127,30 @@ expectation expect(const io::light& light, const glm::dvec3& p, const glm::dvec3
 
 struct light_case {
     const char* name;
-    io::light light;
+    bounce::light light;
     gl::direct_light::map_kind map;
 };
 
 // Lights off to one side, so that the blocker's shadow falls where the camera sees it
 // (not behind the blocker itself).
 std::vector<light_case> light_cases() {
-    io::spot_light narrow;
+    bounce::spot_light narrow;
     narrow.position = {-1.8f, 1.2f, 3.2f};
     narrow.direction = glm::vec3(0.4f, -0.3f, 0.f) - narrow.position;
     narrow.intensity = {4.f, 3.f, 2.f};
     narrow.cone_deg = 40.f;
-    narrow.falloff = io::spot_light::falloff_kind::cosine;
-    io::spot_light wide = narrow;
+    narrow.falloff = bounce::spot_light::falloff_kind::cosine;
+    bounce::spot_light wide = narrow;
     wide.cone_deg = 75.f;
-    wide.falloff = io::spot_light::falloff_kind::none;
+    wide.falloff = bounce::spot_light::falloff_kind::none;
     using kind = gl::direct_light::map_kind;
-    return {{"point", io::point_light{{-2.f, 1.5f, 3.f}, {3.f, 2.f, 1.f}}, kind::cube},
+    return {{"point", bounce::point_light{{-2.f, 1.5f, 3.f}, {3.f, 2.f, 1.f}}, kind::cube},
             {"narrow spot", narrow, kind::perspective},
             {"wide spot", wide, kind::cube},
-            {"directional", io::directional_light{glm::normalize(glm::vec3(0.8f, -0.5f, -1.f)), {1.5f, 1.f, 0.5f}},
+            {"directional", bounce::directional_light{glm::normalize(glm::vec3(0.8f, -0.5f, -1.f)), {1.5f, 1.f, 0.5f}},
              kind::orthographic},
             // 70 degrees from the ground's normal: the slope-scaled bias at work.
-            {"grazing directional", io::directional_light{glm::normalize(glm::vec3(2.6f, 0.8f, -1.f)), {1.f, 1.f, 1.f}},
+            {"grazing directional", bounce::directional_light{glm::normalize(glm::vec3(2.6f, 0.8f, -1.f)), {1.f, 1.f, 1.f}},
              kind::orthographic}};
 }
 
@@ -159,7 +161,7 @@ TEST_CASE("shadow-mapped direct light: the closed form where lit, zero in the bl
     const auto cases = light_cases();
     const auto& lc = cases[std::size_t(GENERATE(0, 1, 2, 3, 4))];
     INFO(lc.name);
-    const io::scene scene = ground_and_blocker(lc.light);
+    const test::owned_scene scene = ground_and_blocker(lc.light);
     const gl::scene_mesh mesh(scene);
     gl::gbuffer_pass gpass;
     gpass.render(mesh, scene.camera, W, H);
@@ -202,8 +204,8 @@ TEST_CASE("a directional light's map spans the rectangle the scene's box project
     // A long, flat box (30 x 2 x 6), seen from 200 directions including the axes and the
     // diagonals. The map's longer side must hold every corner's projection (so it is at
     // least the projected set's diameter over sqrt 2) and be no longer than that diameter.
-    io::scene s;
-    s.materials.push_back({"m", glm::vec3(0.5f), glm::vec3(0.f)});
+    test::owned_scene s;
+    s.materials.push_back({glm::vec3(0.5f), glm::vec3(0.f)});
     const glm::dvec3 lo(-15, -1, -3), hi(15, 1, 3);
     add_quad(s, glm::vec3(0, 0, -3), 1.f, 0);  // only the box matters: a quad and a triangle spanning it
     s.positions.push_back(glm::vec3(lo));
@@ -224,7 +226,7 @@ TEST_CASE("a directional light's map spans the rectangle the scene's box project
     for (int c = 0; c < 8; ++c) corners[c] = {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
     for (const glm::dvec3& d : dirs) {
         CAPTURE(d);
-        s.lights = {io::directional_light{glm::vec3(glm::normalize(d)), {1.f, 1.f, 1.f}}};
+        s.lights = {bounce::directional_light{glm::vec3(glm::normalize(d)), {1.f, 1.f, 1.f}}};
         const gl::scene_mesh mesh(s);
         const gl::direct_light dl(s, mesh, res);
         const glm::dvec3 u = glm::normalize(glm::abs(d.x) < 0.9 ? glm::cross(d, glm::dvec3(1, 0, 0))
@@ -247,9 +249,9 @@ TEST_CASE("direct_irradiance pasted into another shader gives the closed form an
     const auto cases = light_cases();
     const auto& lc = cases[std::size_t(GENERATE(0, 1, 3))];
     INFO(lc.name);
-    io::scene scene = ground_and_blocker(lc.light);
+    test::owned_scene scene = ground_and_blocker(lc.light);
     // Two lights at once: the sum of both, each with its own map.
-    scene.lights.push_back(io::point_light{{-1.f, -1.f, 2.5f}, {1.f, 1.f, 1.f}});
+    scene.lights.push_back(bounce::point_light{{-1.f, -1.f, 2.5f}, {1.f, 1.f, 1.f}});
     const gl::scene_mesh mesh(scene);
     const gl::direct_light dl(scene, mesh, resolution);
     REQUIRE(dl.texture_units() == 2);
@@ -306,9 +308,9 @@ TEST_CASE("direct_irradiance pasted into another shader gives the closed form an
 
 TEST_CASE("direct_light refuses bad lights and settings, naming them", "[gl][direct][bad-input]") {
     gl_test::shared_context();
-    io::spot_light bad_spot;
+    bounce::spot_light bad_spot;
     bad_spot.direction = {0, 0, 0};
-    io::scene scene = ground_and_blocker(bad_spot);
+    test::owned_scene scene = ground_and_blocker(bad_spot);
     const gl::scene_mesh mesh(scene);
     try {
         gl::direct_light dl(scene, mesh, 64);
@@ -316,9 +318,9 @@ TEST_CASE("direct_light refuses bad lights and settings, naming them", "[gl][dir
     } catch (const parameter_error& e) {
         CHECK(e.parameter() == "scene.lights[0]");
     }
-    scene.lights[0] = io::point_light{{0, 0, 2}, {-1.f, 1.f, 1.f}};
+    scene.lights[0] = bounce::point_light{{0, 0, 2}, {-1.f, 1.f, 1.f}};
     CHECK_THROWS_AS(gl::direct_light(scene, mesh, 64), parameter_error);
-    scene.lights[0] = io::point_light{{0, 0, 2}, {1.f, 1.f, 1.f}};
+    scene.lights[0] = bounce::point_light{{0, 0, 2}, {1.f, 1.f, 1.f}};
     try {
         gl::direct_light dl(scene, mesh, 8);
         FAIL("accepted an 8-texel shadow map");

@@ -34,6 +34,8 @@
 // Tabellion weights are continuous and exclude nothing.
 #include "../gl/shared_context.hpp"
 
+#include "../owned_scene.hpp"
+
 #include <bounce/cpu/splatting.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/splat_pass.hpp>
@@ -500,9 +502,9 @@ TEST_CASE("splatting from the raster G-buffer's textures equals splatting its re
     gl_test::shared_context();
     // A floor and a tilted panel, rendered by gbuffer_pass: normals and reflectances change
     // across the image and some pixels see nothing.
-    io::scene s;
-    s.materials.push_back({"floor", glm::vec3(0.6f, 0.5f, 0.4f), glm::vec3(0.f)});
-    s.materials.push_back({"panel", glm::vec3(0.2f, 0.7f, 0.3f), glm::vec3(0.f)});
+    test::owned_scene s;
+    s.materials.push_back({glm::vec3(0.6f, 0.5f, 0.4f), glm::vec3(0.f)});
+    s.materials.push_back({glm::vec3(0.2f, 0.7f, 0.3f), glm::vec3(0.f)});
     const glm::vec3 floor_n(0, 0, 1), panel_n = glm::normalize(glm::vec3(-1, 0, 1));
     for (const glm::vec3 c : {glm::vec3(-1.5f, -1.5f, 0), glm::vec3(1.5f, -1.5f, 0), glm::vec3(1.5f, 1.5f, 0), glm::vec3(-1.5f, 1.5f, 0)}) {
         s.positions.push_back(c);

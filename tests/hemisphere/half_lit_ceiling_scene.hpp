@@ -6,21 +6,19 @@
 #include "../core/half_lit_ceiling.hpp"
 
 #include <bounce/hemisphere.hpp>
-#include <bounce/io/scene.hpp>
+#include "../owned_scene.hpp"
 
 #include <cmath>
 #include <cstdint>
 
 namespace bounce::hemisphere_test {
 
-inline io::scene half_lit_ceiling_scene(float H, float x_edge, float kd_lit, float E_perp, float extent = 2000.f) {
-    io::scene s;
+inline test::owned_scene half_lit_ceiling_scene(float H, float x_edge, float kd_lit, float E_perp, float extent = 2000.f) {
+    test::owned_scene s;
     s.name = "half-lit-ceiling";
-    io::material lit, dark;
-    lit.name = "lit";
-    lit.kd = glm::vec3(kd_lit);
-    dark.name = "dark";
-    dark.kd = glm::vec3(0.f);
+    bounce::material lit, dark;
+    lit.albedo = glm::vec3(kd_lit);
+    dark.albedo = glm::vec3(0.f);
     s.materials = {lit, dark};
     const glm::vec3 down(0, -1, 0);
     const auto quad = [&](float x0, float x1, std::uint32_t m) {
@@ -36,7 +34,7 @@ inline io::scene half_lit_ceiling_scene(float H, float x_edge, float kd_lit, flo
     };
     quad(x_edge, extent, 0);
     quad(-extent, x_edge, 1);
-    s.lights.push_back(io::directional_light{glm::vec3(0, 1, 0), glm::vec3(E_perp)});
+    s.lights.push_back(bounce::directional_light{glm::vec3(0, 1, 0), glm::vec3(E_perp)});
     return s;
 }
 

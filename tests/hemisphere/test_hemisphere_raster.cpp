@@ -80,7 +80,7 @@ bool edge_crosses_pixel(const plane_camera& cam, const analytic_ceiling& c, std:
 // A half-lit ceiling (half_lit_ceiling_scene's parameters) on GL: its mesh, its light with
 // shadow maps of `shadow_resolution`, and a hemisphere raster with `options`.
 struct gl_ceiling {
-    io::scene scene;
+    test::owned_scene scene;
     gl::scene_mesh mesh;
     gl::direct_light light;
     gl::hemisphere_raster raster;

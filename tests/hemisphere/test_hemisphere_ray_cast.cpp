@@ -27,7 +27,7 @@ constexpr double pi = std::numbers::pi;
 TEST_CASE("ray-cast planes of a half-lit ceiling give the closed-form irradiance and gradient", "[hemisphere][embree]") {
     const float H = 1.5f, x_edge = 0.25f, kd = 0.6f, E_perp = 3.f;
     const double L = double(kd) * E_perp / pi;
-    const io::scene s = hemisphere_test::half_lit_ceiling_scene(H, x_edge, kd, E_perp);
+    const test::owned_scene s = hemisphere_test::half_lit_ceiling_scene(H, x_edge, kd, E_perp);
     const embree::accel bvh(s);
     const embree::reference_integrator ref(bvh, s);
     // Planes in orthonormal_basis(n), turned by a fixed angle, or each by its own.

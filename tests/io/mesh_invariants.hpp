@@ -39,9 +39,9 @@ inline void check_mesh_invariants(const io::scene& s) {
     CHECK(degenerate == 0);
     for (const auto& m : s.materials) {
         for (int c = 0; c < 3; ++c) {
-            CHECK(m.kd[c] >= 0.f);
-            CHECK(m.kd[c] <= 1.f);
-            CHECK(m.ke[c] >= 0.f);
+            CHECK(m.albedo[c] >= 0.f);
+            CHECK(m.albedo[c] <= 1.f);
+            CHECK(m.emission[c] >= 0.f);
         }
     }
     CHECK_NOTHROW(s.camera.validate());

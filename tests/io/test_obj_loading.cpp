@@ -191,15 +191,15 @@ TEST_CASE("materials: Kd is the reflectance, Ke the emission, faces without usem
     const auto obj = dir.write("m.obj",
                                "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
                                "f 1 2 3\nusemtl wall\nf 2 4 3\nusemtl lamp\nf 1 3 4\n");
-    io::material fallback;
-    fallback.kd = glm::vec3(0.1f, 0.2f, 0.3f);
+    bounce::material fallback;
+    fallback.albedo = glm::vec3(0.1f, 0.2f, 0.3f);
     io::scene s = io::load_obj(obj, fallback);
     bounce::test::check_mesh_invariants(s);
     REQUIRE(s.triangles.size() == 3);
-    CHECK(s.materials[s.material_of[0]].kd == fallback.kd);
-    CHECK(s.materials[s.material_of[1]].name == "wall");
-    CHECK(s.materials[s.material_of[1]].kd == glm::vec3(0.5f, 0.25f, 0.125f));
-    CHECK(s.materials[s.material_of[2]].ke == glm::vec3(17, 12, 4));
+    CHECK(s.materials[s.material_of[0]].albedo == fallback.albedo);
+    CHECK(s.material_names.at(s.material_of[1]) == "wall");
+    CHECK(s.materials[s.material_of[1]].albedo == glm::vec3(0.5f, 0.25f, 0.125f));
+    CHECK(s.materials[s.material_of[2]].emission == glm::vec3(17, 12, 4));
     // load_obj turns emission on when a face emits, and adds no other light.
     CHECK(s.use_emission);
     CHECK(s.lights.empty());
@@ -215,7 +215,7 @@ TEST_CASE("usemtl without any mtllib falls back to the default material with a w
     CHECK(has_warning(s, "without mtllib"));
     // No emission: a head light at the camera, E = I / d^2 = 1 at the centre of the bounds.
     REQUIRE(s.lights.size() == 1);
-    const auto& l = std::get<io::point_light>(s.lights[0]);
+    const auto& l = std::get<bounce::point_light>(s.lights[0]);
     const auto [lo, hi] = s.bounds();
     const float d = glm::length(l.position - 0.5f * (lo + hi));
     CHECK(l.intensity.r / (d * d) == Approx(1.f).epsilon(1e-5));
@@ -249,15 +249,15 @@ TEST_CASE("a minimal scene.json loads with its lights, and load_scene_arg finds 
         const io::scene s = io::load_scene_arg(arg);
         bounce::test::check_mesh_invariants(s);
         CHECK(s.source == dir.path() / "scene.json");
-        CHECK(s.materials.at(0).kd == glm::vec3(0.2f, 0.4f, 0.6f));
+        CHECK(s.materials.at(0).albedo == glm::vec3(0.2f, 0.4f, 0.6f));
         CHECK(s.camera.fov_y_deg == 50.f);
         REQUIRE(s.lights.size() == 3);
-        CHECK(std::get<io::point_light>(s.lights[0]).intensity == glm::vec3(1, 2, 3));
-        const auto& spot = std::get<io::spot_light>(s.lights[1]);
+        CHECK(std::get<bounce::point_light>(s.lights[0]).intensity == glm::vec3(1, 2, 3));
+        const auto& spot = std::get<bounce::spot_light>(s.lights[1]);
         CHECK(spot.direction == glm::vec3(0, -1, 0));
-        CHECK(spot.falloff == io::spot_light::falloff_kind::none);
+        CHECK(spot.falloff == bounce::spot_light::falloff_kind::none);
         CHECK(spot.cone_deg == 30.f);
-        CHECK(std::get<io::directional_light>(s.lights[2]).direction == glm::vec3(0, 0, -1));
+        CHECK(std::get<bounce::directional_light>(s.lights[2]).direction == glm::vec3(0, 0, -1));
         // The clip planes enclose the scene: far reaches past its farthest corner.
         CHECK(s.camera.far_plane > glm::length(s.camera.position - glm::vec3(1, 0, 0)));
     }

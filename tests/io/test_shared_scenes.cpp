@@ -54,20 +54,21 @@ TEST_CASE("the shared Cornell box loads: CRLF, relative indices, no normals, use
     CHECK(s.triangles.size() == 36);
     CHECK(has_warning(s, "4 triangles repeat"));
     CHECK(s.lights.size() == 1);
-    CHECK(count_lights<io::spot_light>(s) == 1);
+    CHECK(count_lights<bounce::spot_light>(s) == 1);
     CHECK_FALSE(s.use_emission);
     CHECK(s.emissive_triangles().empty());
-    const auto& spot = std::get<io::spot_light>(s.lights[0]);
-    CHECK(spot.falloff == io::spot_light::falloff_kind::cosine);
+    const auto& spot = std::get<bounce::spot_light>(s.lights[0]);
+    CHECK(spot.falloff == bounce::spot_light::falloff_kind::cosine);
     CHECK(spot.cone_deg == 89.f);
     CHECK(spot.direction == glm::vec3(0, -1, 0));
     // Kd per face from the MTL: the left wall is red, the right one green.
     bool red = false, green = false, light = false;
     for (std::size_t t = 0; t < s.triangles.size(); ++t) {
         const auto& m = s.materials[s.material_of[t]];
-        red = red || (m.name == "leftWall" && m.kd == glm::vec3(0.63f, 0.065f, 0.05f));
-        green = green || (m.name == "rightWall" && m.kd == glm::vec3(0.14f, 0.45f, 0.091f));
-        light = light || (m.name == "light" && m.ke == glm::vec3(17, 12, 4));
+        const std::string& name = s.material_names.at(s.material_of[t]);
+        red = red || (name == "leftWall" && m.albedo == glm::vec3(0.63f, 0.065f, 0.05f));
+        green = green || (name == "rightWall" && m.albedo == glm::vec3(0.14f, 0.45f, 0.091f));
+        light = light || (name == "light" && m.emission == glm::vec3(17, 12, 4));
     }
     CHECK(red);
     CHECK(green);
@@ -97,11 +98,11 @@ TEST_CASE("Sponza loads with its default material and drops its degenerate trian
     CHECK(has_warning(s, "dropped 1 degenerate"));
     CHECK(has_warning(s, "zero or not finite"));
     REQUIRE(s.materials.size() == 1);
-    CHECK(s.materials[0].kd == glm::vec3(0.627f, 0.573f, 0.561f));
-    CHECK(count_lights<io::directional_light>(s) == 1);
-    CHECK(count_lights<io::point_light>(s) == 1);
+    CHECK(s.materials[0].albedo == glm::vec3(0.627f, 0.573f, 0.561f));
+    CHECK(count_lights<bounce::directional_light>(s) == 1);
+    CHECK(count_lights<bounce::point_light>(s) == 1);
     // Directions are stored unit length.
-    const auto& sun = std::get<io::directional_light>(s.lights[0]);
+    const auto& sun = std::get<bounce::directional_light>(s.lights[0]);
     CHECK(glm::length(sun.direction) == Approx(1.f).epsilon(1e-6));
 }
 
@@ -112,7 +113,7 @@ TEST_CASE("the bunny loads with smooth normals computed from its faces", "[io][s
     bounce::test::check_mesh_invariants(s);
     CHECK(s.triangles.size() == 69451);
     CHECK(s.lights.size() == 1);
-    CHECK(count_lights<io::directional_light>(s) == 1);
+    CHECK(count_lights<bounce::directional_light>(s) == 1);
     // No vn in the file: the positions are shared, so each appears once.
     CHECK(s.positions.size() < s.triangles.size());
     // Each normal is the area-weighted mean of its faces' normals, sum(e1 x e2) normalized

@@ -160,62 +160,17 @@ RTCDeviceTy* device::native() const noexcept { return state_->handle; }
 
 const std::string& device::config() const noexcept { return state_->config; }
 
-void validate(const io::scene& s) {
-    const std::size_t nv = s.positions.size(), nt = s.triangles.size();
-    for (std::size_t i = 0; i < nv; ++i) {
-        const glm::vec3& p = s.positions[i];
-        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)))
-            throw parameter_error("scene.positions", "vertex " + std::to_string(i) + " is not finite");
-    }
-    if (!s.normals.empty() && s.normals.size() != nv)
-        throw parameter_error("scene.normals", "has " + std::to_string(s.normals.size()) +
-                                                   " entries for " + std::to_string(nv) + " positions");
-    for (std::size_t i = 0; i < s.normals.size(); ++i) {
-        const glm::vec3& n = s.normals[i];
-        if (!(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z)))
-            throw parameter_error("scene.normals", "normal " + std::to_string(i) + " is not finite");
-    }
-    for (std::size_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 3; ++k)
-            if (s.triangles[t][k] >= nv)
-                throw parameter_error("scene.triangles", "triangle " + std::to_string(t) + " refers to vertex " +
-                                                             std::to_string(s.triangles[t][k]) + " of " +
-                                                             std::to_string(nv));
-    if (s.material_of.size() != nt)
-        throw parameter_error("scene.material_of", "has " + std::to_string(s.material_of.size()) +
-                                                       " entries for " + std::to_string(nt) + " triangles");
-    for (std::size_t t = 0; t < nt; ++t)
-        if (s.material_of[t] >= s.materials.size())
-            throw parameter_error("scene.material_of", "triangle " + std::to_string(t) + " uses material " +
-                                                           std::to_string(s.material_of[t]) + " of " +
-                                                           std::to_string(s.materials.size()));
-    for (std::size_t m = 0; m < s.materials.size(); ++m) {
-        const auto& mat = s.materials[m];
-        for (int c = 0; c < 3; ++c) {
-            if (!(std::isfinite(mat.kd[c]) && mat.kd[c] >= 0.f))
-                throw parameter_error("scene.materials", "material " + std::to_string(m) + " ('" + mat.name +
-                                                             "') has a negative or non-finite kd");
-            if (!(std::isfinite(mat.ke[c]) && mat.ke[c] >= 0.f))
-                throw parameter_error("scene.materials", "material " + std::to_string(m) + " ('" + mat.name +
-                                                             "') has a negative or non-finite ke");
-        }
-    }
-    // Embree indexes with 32-bit unsigned integers.
-    if (nt >= no_triangle || nv >= std::size_t(no_triangle))
-        throw parameter_error("scene.triangles", "more than 2^32 - 1 triangles or vertices");
-}
-
-void require_match(const accel& bvh, const io::scene& scene) {
+void require_match(const accel& bvh, const scene_view& scene) {
     if (bvh.triangle_count() != scene.triangles.size() || scene.material_of.size() != scene.triangles.size())
         throw parameter_error("scene", "does not match the accel: it was built from " +
                                            std::to_string(bvh.triangle_count()) + " triangles, the scene has " +
                                            std::to_string(scene.triangles.size()));
 }
 
-accel::accel(const io::scene& scene) : accel(device(), scene) {}
+accel::accel(const scene_view& scene) : accel(device(), scene) {}
 
-accel::accel(const device& dev, const io::scene& scene) : device_(dev), state_(std::make_shared<detail::scene_state>()) {
-    validate(scene);
+accel::accel(const device& dev, const scene_view& scene) : device_(dev), state_(std::make_shared<detail::scene_state>()) {
+    scene.validate_mesh();
     RTCDevice d = device_.native();
     state_->device = device_.state_;
     state_->triangles = scene.triangles.size();
@@ -365,7 +320,7 @@ float accel::ray_epsilon() const noexcept {
 }
 RTCSceneTy* accel::native() const noexcept { return state_->handle; }
 
-surface surface_at(const io::scene& scene, const ray& r, const hit& h) {
+surface surface_at(const scene_view& scene, const ray& r, const hit& h) {
     surface s;
     s.triangle = h.triangle;
     s.position = r.origin + h.t * r.direction;
@@ -387,7 +342,7 @@ surface surface_at(const io::scene& scene, const ray& r, const hit& h) {
     }
     if (glm::dot(n, r.direction) > 0.f) n = -n;
     s.normal = n;
-    s.albedo = scene.materials[scene.material_of[h.triangle]].kd;
+    s.albedo = scene.materials[scene.material_of[h.triangle]].albedo;
     return s;
 }
 

@@ -10,7 +10,7 @@
 
 namespace bounce::embree {
 
-void ray_cast_gbuffer(const accel& bvh, const io::scene& scene, const bounce::camera& cam, gbuffer_view<float> out) {
+void ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const bounce::camera& cam, gbuffer_view<float> out) {
     require_match(bvh, scene);
     cam.validate();
     const std::size_t w = out.depth.width(), h = out.depth.height();
@@ -53,7 +53,7 @@ void ray_cast_gbuffer(const accel& bvh, const io::scene& scene, const bounce::ca
     });
 }
 
-gbuffer<float> ray_cast_gbuffer(const accel& bvh, const io::scene& scene, const bounce::camera& cam, std::size_t width,
+gbuffer<float> ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const bounce::camera& cam, std::size_t width,
                                 std::size_t height) {
     require(width > 0 && height > 0, "width/height", "the G-buffer size must be positive");
     gbuffer<float> g(width, height);

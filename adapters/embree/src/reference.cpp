@@ -87,7 +87,7 @@ glm::vec3 hemisphere_samples::irradiance() const {
     return radiance.empty() ? glm::vec3(0.f) : glm::vec3(sum * (pi / double(radiance.size())));
 }
 
-reference_integrator::reference_integrator(const accel& bvh, const io::scene& scene, reference_settings settings)
+reference_integrator::reference_integrator(const accel& bvh, const scene_view& scene, reference_settings settings)
     : bvh_(bvh), scene_(scene), settings_(std::move(settings)) {
     require_match(bvh, scene);
     require(settings_.hemisphere_samples > 0, "hemisphere_samples", "must be positive");
@@ -98,26 +98,13 @@ reference_integrator::reference_integrator(const accel& bvh, const io::scene& sc
             "must be finite and non-negative");
     epsilon_ = settings_.ray_epsilon > 0.f ? settings_.ray_epsilon : bvh.ray_epsilon();
 
-    io::validate_lights(scene);
-    for (const io::light& light : scene.lights) {
-        prepared_light l{};
-        if (const auto* pl = std::get_if<io::point_light>(&light)) {
-            l = {0, pl->position, glm::vec3(0.f), pl->intensity, 0.f, 0.f};
-        } else if (const auto* sl = std::get_if<io::spot_light>(&light)) {
-            const float falloff = sl->falloff == io::spot_light::falloff_kind::cosine ? 1.f : 0.f;
-            l = {1, sl->position, glm::normalize(sl->direction), sl->intensity,
-                 float(std::cos(glm::radians(double(sl->cone_deg)))), falloff};
-        } else {
-            const auto& dl = std::get<io::directional_light>(light);
-            l = {2, glm::vec3(0.f), glm::normalize(dl.direction), dl.irradiance, 0.f, 0.f};
-        }
-        lights_.push_back(l);
-    }
+    validate_lights(scene.lights);
+    for (const light& l : scene.lights) lights_.push_back(pack(l));
 
     if (scene.use_emission) {
         for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
             const auto& mat = scene.materials[scene.material_of[t]];
-            if (!(mat.ke.x > 0.f || mat.ke.y > 0.f || mat.ke.z > 0.f)) continue;
+            if (!(mat.emission.x > 0.f || mat.emission.y > 0.f || mat.emission.z > 0.f)) continue;
             const glm::uvec3 tri = scene.triangles[t];
             const glm::vec3 p0 = scene.positions[tri.x], e1 = scene.positions[tri.y] - p0,
                             e2 = scene.positions[tri.z] - p0;
@@ -131,7 +118,7 @@ reference_integrator::reference_integrator(const accel& bvh, const io::scene& sc
                 const glm::vec3 sum = scene.normals[tri.x] + scene.normals[tri.y] + scene.normals[tri.z];
                 if (glm::dot(sum, normal) < 0.f) normal = -normal;
             }
-            emitters_.push_back({p0, e1, e2, normal, mat.ke});
+            emitters_.push_back({p0, e1, e2, normal, mat.emission});
             emitter_cdf_.push_back(area);
         }
         // Area-proportional choice: prefix sums normalized to [0, 1].
@@ -161,21 +148,22 @@ glm::dvec3 reference_integrator::direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 o
         glm::vec3 contribution(0.f);
         ray shadow;
         shadow.origin = origin;
-        if (l.kind == 0) {
-            contribution = point_light_irradiance<float, glm::vec3>(p, n, l.position, l.intensity);
-        } else if (l.kind == 1) {
-            contribution = spot_light_irradiance<float, glm::vec3>(p, n, l.position, l.direction, l.intensity,
-                                                                    l.cos_cone, l.cosine_falloff);
+        const light_kind kind = l.kind();
+        if (kind == light_kind::point) {
+            contribution = point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
+        } else if (kind == light_kind::spot) {
+            contribution = spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
+                                                                    l.cos_cone(), l.cosine_falloff());
         } else {
-            contribution = directional_light_irradiance<float, glm::vec3>(n, l.direction, l.intensity);
+            contribution = directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
         }
         if (!(contribution.x > 0.f || contribution.y > 0.f || contribution.z > 0.f)) continue;
-        if (l.kind == 2) {
-            shadow.direction = -l.direction;
+        if (kind == light_kind::directional) {
+            shadow.direction = -l.direction();
         } else {
             // Towards the light; stop short of it by epsilon so geometry at the light's
             // own position does not shadow it.
-            shadow.direction = l.position - origin;
+            shadow.direction = l.position() - origin;
             const float d = glm::length(shadow.direction);
             shadow.tfar = std::max(0.f, 1.f - epsilon_ / std::max(d, epsilon_));
         }
@@ -327,7 +315,7 @@ image<glm::vec3> reference_integrator::indirect_image(const gbuffer_view<float>&
     return out;
 }
 
-reference_images render_reference(const accel& bvh, const io::scene& scene, const gbuffer_view<float>& g,
+reference_images render_reference(const accel& bvh, const scene_view& scene, const gbuffer_view<float>& g,
                                   const reference_settings& settings) {
     const reference_integrator integrator(bvh, scene, settings);
     reference_images r;

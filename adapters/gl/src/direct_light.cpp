@@ -123,7 +123,7 @@ void direct_light_options::validate() const {
             "max_spot_map_cone_deg", "must lie in (0, 80]");
 }
 
-std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& scene, const direct_light_options& options) {
+std::vector<direct_light::light_entry> direct_light::prepare(const scene_view& scene, const direct_light_options& options) {
     options.validate();
     GLint max_2d = 0, max_cube = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_2d);
@@ -131,43 +131,32 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
     const int res = options.shadow_resolution;
     auto [lo, hi] = scene.bounds();
     if (scene.positions.empty()) lo = hi = glm::vec3(0.f);
-    io::validate_lights(scene);
+    validate_lights(scene.lights);
     std::vector<light_entry> lights;
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const std::string name = "scene.lights[" + std::to_string(i) + "]";
         const auto fail = [&](const char* what) { throw parameter_error(name, what); };
         light_entry l;
+        l.light = pack(scene.lights[i]);
+        const glm::vec3 position = l.light.position(), vector = l.light.direction();
         bool cube = false;
-        if (const auto* pl = std::get_if<io::point_light>(&scene.lights[i])) {
-            l.kind = 0;
-            l.position = pl->position;
-            l.intensity = pl->intensity;
+        if (l.light.kind() == light_kind::point) {
             cube = true;
-        } else if (const auto* sl = std::get_if<io::spot_light>(&scene.lights[i])) {
-            l.kind = 1;
-            l.position = sl->position;
-            l.vector = glm::normalize(sl->direction);
-            l.intensity = sl->intensity;
-            l.cos_cone = float(std::cos(glm::radians(double(sl->cone_deg))));
-            l.falloff = sl->falloff == io::spot_light::falloff_kind::cosine ? 1.f : 0.f;
+        } else if (const auto* sl = std::get_if<spot_light>(&scene.lights[i])) {
             cube = sl->cone_deg > options.max_spot_map_cone_deg;
             if (!cube) {
                 // The map covers the cone plus 3 texels for the PCF footprint (taps reach
                 // 1.5 texels out, each bilinear over one more): tan' = tan(cone) + 3 * 2 tan' / res.
                 l.map = map_kind::perspective;
                 l.tan_half_fov = float(std::tan(glm::radians(double(sl->cone_deg))) / (1.0 - 6.0 / res));
-                const auto [n, f] = depth_range(l.position, lo, hi);
+                const auto [n, f] = depth_range(position, lo, hi);
                 l.near_depth = n;
                 l.far_depth = f;
                 l.view_projection = glm::perspective(2.f * std::atan(l.tan_half_fov), 1.f, n, f) *
-                                    glm::lookAt(l.position, l.position + l.vector, up_for(l.vector));
+                                    glm::lookAt(position, position + vector, up_for(vector));
             }
         } else {
-            const auto& dl = std::get<io::directional_light>(scene.lights[i]);
-            l.kind = 2;
             l.map = map_kind::orthographic;
-            l.vector = glm::normalize(dl.direction);
-            l.intensity = dl.irradiance;
             // Seen from outside the scene's bounding sphere, the map spans the rectangle the
             // box's corners project to across the light (1% to spare, and 3 texels for the
             // PCF footprint as for spot maps). For a sun that is not along a diagonal this is
@@ -175,7 +164,7 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
             // 0.54 cm.
             const glm::vec3 centre = 0.5f * (lo + hi);
             const float r = std::max(0.505f * glm::length(hi - lo), 1e-3f);
-            const glm::mat4 view = glm::lookAt(centre - 2.f * r * l.vector, centre, up_for(l.vector));
+            const glm::mat4 view = glm::lookAt(centre - 2.f * r * vector, centre, up_for(vector));
             glm::vec2 half_extent(0.f);  // of the corners in the view's x and y, around the centre's
             const glm::vec2 middle(view * glm::vec4(centre, 1.f));
             for (int c = 0; c < 8; ++c)
@@ -192,14 +181,14 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
         if (cube) {
             if (res > max_cube) fail("shadow_resolution exceeds GL_MAX_CUBE_MAP_TEXTURE_SIZE");
             l.map = map_kind::cube;
-            const auto [n, f] = depth_range(l.position, lo, hi);
+            const auto [n, f] = depth_range(position, lo, hi);
             l.near_depth = n;
             l.far_depth = f;
             const glm::mat4 projection = glm::perspective(glm::radians(90.f), 1.f, n, f);
             for (std::size_t face = 0; face < 6; ++face) {
                 const auto& c = cube_faces[face];
                 l.face_view_projection[face] =
-                    projection * glm::lookAt(l.position, l.position + glm::vec3(c[0], c[1], c[2]), glm::vec3(c[3], c[4], c[5]));
+                    projection * glm::lookAt(position, position + glm::vec3(c[0], c[1], c[2]), glm::vec3(c[3], c[4], c[5]));
             }
             l.depth = make_depth_texture(GL_TEXTURE_CUBE_MAP, res);
         } else {
@@ -211,14 +200,14 @@ std::vector<direct_light::light_entry> direct_light::prepare(const io::scene& sc
     return lights;
 }
 
-direct_light::direct_light(const io::scene& scene, const scene_mesh& mesh, int shadow_resolution)
+direct_light::direct_light(const scene_view& scene, const scene_mesh& mesh, int shadow_resolution)
     : direct_light(scene, mesh, [&] {
           direct_light_options o;
           o.shadow_resolution = shadow_resolution;
           return o;
       }()) {}
 
-direct_light::direct_light(const io::scene& scene, const scene_mesh& mesh, const direct_light_options& options)
+direct_light::direct_light(const scene_view& scene, const scene_mesh& mesh, const direct_light_options& options)
     : mesh_(&mesh), options_(options), lights_(prepare(scene, options)),
       window_depth_program_(shadow_vertex, window_depth_fragment), radial_depth_program_(shadow_vertex, radial_depth_fragment()),
       radiance_program_(fullscreen_vertex, radiance_fragment_source()) {
@@ -252,7 +241,7 @@ void direct_light::render_shadow_maps() {
     };
     for (auto& l : lights_) {
         if (l.map == map_kind::cube) {
-            radial_depth_program_.set(1, l.position);
+            radial_depth_program_.set(1, l.light.position());
             radial_depth_program_.set(2, 1.f / l.far_depth);
             radial_depth_program_.set(3, options_.slope_bias);
             radial_depth_program_.set(4, options_.constant_bias);
@@ -313,9 +302,9 @@ std::string direct_light::glsl_source() const {
         const auto& l = lights_[i];
         const std::string I = std::to_string(i), at = "[" + I + "]";
         std::string e;
-        if (l.kind == 0)
+        if (l.light.kind() == light_kind::point)
             e = "bounce_dl_point_light_irradiance(p, n, bounce_dl_position" + at + ", bounce_dl_intensity" + at + ")";
-        else if (l.kind == 1)
+        else if (l.light.kind() == light_kind::spot)
             e = "bounce_dl_spot_light_irradiance(p, n, bounce_dl_position" + at + ", bounce_dl_vector" + at +
                 ", bounce_dl_intensity" + at + ", bounce_dl_cos_cone" + at + ", bounce_dl_falloff" + at + ")";
         else
@@ -364,11 +353,12 @@ void direct_light::bind(const program& p, unsigned first_texture_unit) const {
     glProgramUniform1f(id, loc("bounce_dl_normal_offset"), options_.normal_offset_texels);
     for (std::size_t i = 0; i < lights_.size(); ++i) {
         const auto& l = lights_[i];
-        glProgramUniform3fv(id, loc(indexed("bounce_dl_position", i)), 1, glm::value_ptr(l.position));
-        glProgramUniform3fv(id, loc(indexed("bounce_dl_vector", i)), 1, glm::value_ptr(l.vector));
-        glProgramUniform3fv(id, loc(indexed("bounce_dl_intensity", i)), 1, glm::value_ptr(l.intensity));
-        glProgramUniform1f(id, loc(indexed("bounce_dl_cos_cone", i)), l.cos_cone);
-        glProgramUniform1f(id, loc(indexed("bounce_dl_falloff", i)), l.falloff);
+        const glm::vec3 position = l.light.position(), vector = l.light.direction(), intensity = l.light.intensity();
+        glProgramUniform3fv(id, loc(indexed("bounce_dl_position", i)), 1, glm::value_ptr(position));
+        glProgramUniform3fv(id, loc(indexed("bounce_dl_vector", i)), 1, glm::value_ptr(vector));
+        glProgramUniform3fv(id, loc(indexed("bounce_dl_intensity", i)), 1, glm::value_ptr(intensity));
+        glProgramUniform1f(id, loc(indexed("bounce_dl_cos_cone", i)), l.light.cos_cone());
+        glProgramUniform1f(id, loc(indexed("bounce_dl_falloff", i)), l.light.cosine_falloff());
         glProgramUniformMatrix4fv(id, loc(indexed("bounce_dl_matrix", i)), 1, GL_FALSE, glm::value_ptr(l.view_projection));
         glProgramUniform1f(id, loc(indexed("bounce_dl_tan_half_fov", i)), l.tan_half_fov);
         glProgramUniform1f(id, loc(indexed("bounce_dl_texel", i)), l.texel_world);

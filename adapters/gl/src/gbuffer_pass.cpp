@@ -7,6 +7,10 @@
 
 #include "saved_state.hpp"
 
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -53,37 +57,46 @@ void main() {
 )";
 }
 
-std::string triangle_text(std::size_t t) { return "triangle " + std::to_string(t); }
-
 }  // namespace
 
 // ---- scene_mesh -------------------------------------------------------------------------
 
-scene_mesh::scene_mesh(const io::scene& s)
+scene_mesh::scene_mesh(const scene_view& s)
     : albedo_(std::max<std::size_t>(s.triangles.size(), 1) * sizeof(glm::vec4)), triangles_(s.triangles.size()) {
-    if (s.normals.size() != s.positions.size())
-        throw parameter_error("scene.normals", "has " + std::to_string(s.normals.size()) + " entries for " +
-                                                   std::to_string(s.positions.size()) + " positions");
-    if (s.material_of.size() != s.triangles.size())
-        throw parameter_error("scene.material_of", "has " + std::to_string(s.material_of.size()) + " entries for " +
-                                                       std::to_string(s.triangles.size()) + " triangles");
+    s.validate_mesh();
     std::vector<glm::vec4> kd(s.triangles.size());
-    for (std::size_t t = 0; t < s.triangles.size(); ++t) {
-        const auto& tri = s.triangles[t];
-        for (int k = 0; k < 3; ++k)
-            if (tri[k] >= s.positions.size())
-                throw parameter_error("scene.triangles", triangle_text(t) + " refers to vertex " + std::to_string(tri[k]) +
-                                                             " of " + std::to_string(s.positions.size()));
-        if (s.material_of[t] >= s.materials.size())
-            throw parameter_error("scene.material_of", triangle_text(t) + " has material " +
-                                                           std::to_string(s.material_of[t]) + " of " +
-                                                           std::to_string(s.materials.size()));
-        kd[t] = glm::vec4(s.materials[s.material_of[t]].kd, 0.f);
-    }
+    for (std::size_t t = 0; t < s.triangles.size(); ++t) kd[t] = glm::vec4(s.materials[s.material_of[t]].albedo, 0.f);
     if (triangles_ == 0) return;
-    positions_.emplace(std::span<const glm::vec3>(s.positions));
-    normals_.emplace(std::span<const glm::vec3>(s.normals));
-    indices_.emplace(std::span<const glm::uvec3>(s.triangles));
+    if (!s.normals.empty()) {
+        positions_.emplace(s.positions);
+        normals_.emplace(s.normals);
+        indices_.emplace(s.triangles);
+    } else {
+        // Without vertex normals every triangle is shaded with its own plane's normal: three
+        // vertices of its own each (a degenerate triangle gets 0, which the kernels treat as
+        // "faces nothing" and the rasterizer never covers anyway).
+        std::vector<glm::vec3> flat_positions, flat_normals;
+        std::vector<glm::uvec3> flat_triangles;
+        flat_positions.reserve(3 * triangles_);
+        flat_normals.reserve(3 * triangles_);
+        flat_triangles.reserve(triangles_);
+        for (std::size_t t = 0; t < triangles_; ++t) {
+            const glm::uvec3 tri = s.triangles[t];
+            const glm::vec3 p0 = s.positions[tri.x], p1 = s.positions[tri.y], p2 = s.positions[tri.z];
+            const glm::vec3 c = glm::cross(p1 - p0, p2 - p0);
+            const float len = glm::length(c);
+            const glm::vec3 n = len > 0.f && std::isfinite(len) ? c / len : glm::vec3(0.f);
+            const auto first = std::uint32_t(flat_positions.size());
+            for (const glm::vec3& p : {p0, p1, p2}) {
+                flat_positions.push_back(p);
+                flat_normals.push_back(n);
+            }
+            flat_triangles.emplace_back(first, first + 1, first + 2);
+        }
+        positions_.emplace(std::span<const glm::vec3>(flat_positions));
+        normals_.emplace(std::span<const glm::vec3>(flat_normals));
+        indices_.emplace(std::span<const glm::uvec3>(flat_triangles));
+    }
     albedo_.write(0, kd.data(), kd.size() * sizeof(glm::vec4));
 
     const GLuint vao = vao_.id();

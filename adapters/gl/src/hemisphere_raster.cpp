@@ -206,7 +206,7 @@ std::size_t checked_atlas_side(std::size_t tiles, const hemisphere_raster_option
 }
 }  // namespace
 
-hemisphere_raster::hemisphere_raster(const io::scene& scene, const scene_mesh& mesh, const direct_light& light,
+hemisphere_raster::hemisphere_raster(const scene_view& scene, const scene_mesh& mesh, const direct_light& light,
                                      const hemisphere_raster_options& options)
     : mesh_(mesh), light_(light), options_(options), columns_(columns_for(options)),
       rows_((options.batch + columns_ - 1) / columns_), vertex_source_(vertex_shader()),

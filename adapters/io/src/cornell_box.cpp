@@ -70,12 +70,13 @@ scene cornell_box() {
     s.name = "cornell";
     enum : std::uint32_t { white, red, green, light };
     s.materials = {
-        {"white", {0.725f, 0.71f, 0.68f}, glm::vec3(0.f)},
-        {"red", {0.63f, 0.065f, 0.05f}, glm::vec3(0.f)},
-        {"green", {0.14f, 0.45f, 0.091f}, glm::vec3(0.f)},
+        {{0.725f, 0.71f, 0.68f}, glm::vec3(0.f)},
+        {{0.63f, 0.065f, 0.05f}, glm::vec3(0.f)},
+        {{0.14f, 0.45f, 0.091f}, glm::vec3(0.f)},
         // The light's own reflectance is not published; 0.78 as in the Williams OBJ.
-        {"light", glm::vec3(0.78f), {17.f, 12.f, 4.f}},
+        {glm::vec3(0.78f), {17.f, 12.f, 4.f}},
     };
+    s.material_names = {"white", "red", "green", "light"};
 
     add_quad(s, floor_mm, white);
     add_quad(s, back_wall_mm, white);
@@ -111,7 +112,7 @@ scene cornell_box() {
     spot_light spot;
     spot.position = glm::vec3(0.5f * (343.f + 213.f), 548.8f - 1.f, 0.5f * (332.f + 227.f)) * mm;
     spot.direction = {0.f, -1.f, 0.f};
-    spot.intensity = s.materials[light].ke * area;
+    spot.intensity = s.materials[light].emission * area;
     spot.cone_deg = 89.f;
     spot.falloff = spot_light::falloff_kind::cosine;
     s.lights.emplace_back(spot);

@@ -240,7 +240,7 @@ std::string plural(std::size_t n, const char* one, const char* many) {
 
 }  // namespace
 
-void load_obj_mesh(const fs::path& file, const material& default_material, scene& out) {
+void load_obj_mesh(const fs::path& file, const bounce::material& default_material, scene& out) {
     const std::string text = read_text_file(file, max_obj_bytes);
     const obj_survey survey = survey_obj(file, text);
 
@@ -283,12 +283,11 @@ void load_obj_mesh(const fs::path& file, const material& default_material, scene
     }
 
     out.materials.clear();
+    out.material_names.clear();
     for (const auto& tm : tmaterials) {
-        material mat;
-        mat.name = tm.name;
-        mat.kd = {tm.diffuse[0], tm.diffuse[1], tm.diffuse[2]};
-        mat.ke = {tm.emission[0], tm.emission[1], tm.emission[2]};
-        out.materials.push_back(mat);
+        out.materials.push_back({{tm.diffuse[0], tm.diffuse[1], tm.diffuse[2]},
+                                 {tm.emission[0], tm.emission[1], tm.emission[2]}});
+        out.material_names.push_back(tm.name);
     }
     std::uint32_t default_index = std::numeric_limits<std::uint32_t>::max();  // appended when used
 
@@ -379,7 +378,7 @@ void load_obj_mesh(const fs::path& file, const material& default_material, scene
                 if (default_index == std::numeric_limits<std::uint32_t>::max()) {
                     default_index = std::uint32_t(out.materials.size());
                     out.materials.push_back(default_material);
-                    if (out.materials.back().name.empty()) out.materials.back().name = "default";
+                    out.material_names.push_back("default");
                 }
                 out.material_of.push_back(default_index);
             }

@@ -28,29 +28,6 @@ std::string located(const fs::path& file, std::size_t line, const std::string& w
 scene_error::scene_error(fs::path file, std::size_t line, const std::string& what)
     : bounce::error(located(file, line, what)), file_(std::move(file)), line_(line) {}
 
-std::vector<std::uint32_t> scene::emissive_triangles() const {
-    std::vector<std::uint32_t> out;
-    if (!use_emission) return out;
-    for (std::size_t t = 0; t < triangles.size(); ++t) {
-        const auto m = t < material_of.size() ? material_of[t] : std::uint32_t(materials.size());
-        if (m < materials.size()) {
-            const glm::vec3 ke = materials[m].ke;
-            if (ke.r > 0.f || ke.g > 0.f || ke.b > 0.f) out.push_back(std::uint32_t(t));
-        }
-    }
-    return out;
-}
-
-std::pair<glm::vec3, glm::vec3> scene::bounds() const {
-    if (positions.empty()) return {glm::vec3(0.f), glm::vec3(0.f)};
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const auto& p : positions) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    return {lo, hi};
-}
-
 namespace detail {
 void fit_clip_planes(bounce::camera& camera, const std::pair<glm::vec3, glm::vec3>& bounds) {
     float farthest = 0.f;
@@ -67,7 +44,7 @@ void fit_clip_planes(bounce::camera& camera, const std::pair<glm::vec3, glm::vec
 }
 }  // namespace detail
 
-scene load_obj(const fs::path& obj, const material& default_material) {
+scene load_obj(const fs::path& obj, const bounce::material& default_material) {
     scene s;
     s.name = obj.stem().string();
     s.source = obj;

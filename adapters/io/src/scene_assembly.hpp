@@ -14,7 +14,7 @@ namespace bounce::io::detail {
 
 /// Loads the OBJ (+MTL) `obj` into `out`: positions, normals, triangles, materials and
 /// warnings; lights and camera are left alone. Throws scene_error naming the file and line.
-void load_obj_mesh(const std::filesystem::path& obj, const material& default_material, scene& out);
+void load_obj_mesh(const std::filesystem::path& obj, const bounce::material& default_material, scene& out);
 
 /// Sets the camera's far plane to twice the distance from the eye to the farthest corner
 /// of `bounds` and the near plane to 1e-4 of that, so that a raster depth buffer keeps its

@@ -178,12 +178,11 @@ scene load_scene(const fs::path& file) {
     const std::string obj = r.string(r.member(root, "obj", ""), "obj");
     if (obj.empty()) r.fail("obj", "empty file name");
 
-    material default_material;
-    default_material.name = "default";
+    bounce::material default_material;
     if (const auto it = root.find("default_material"); it != root.end()) {
         r.expect_object(*it, "default_material");
         r.only_keys(*it, {"kd"}, "default_material");
-        default_material.kd = r.vec3(r.member(*it, "kd", "default_material"), "default_material.kd", field_reader::range::unit);
+        default_material.albedo = r.vec3(r.member(*it, "kd", "default_material"), "default_material.kd", field_reader::range::unit);
     }
 
     const json& cam = r.member(root, "camera", "");

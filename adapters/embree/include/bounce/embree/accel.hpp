@@ -1,13 +1,13 @@
 #pragma once
 /// \file accel.hpp
-/// Embree 3 behind RAII: a `device`, an `accel` (the BVH of an `io::scene`'s triangles),
+/// Embree 3 behind RAII: a `device`, an `accel` (the BVH of a `scene_view`'s triangles),
 /// closest-hit and occlusion queries for single rays and streams of rays, and the surface
 /// attributes at a hit. Embree's own headers stay private to the adapter; the native
 /// handles are exposed as Embree's opaque pointer types for renderers that add their own
 /// calls (the Debian build of Embree 3 declares them in the global namespace).
 
 #include <bounce/errors.hpp>
-#include <bounce/io/scene.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <cstdint>
 #include <limits>
@@ -97,23 +97,23 @@ struct ray {
 /// and third vertex: p = (1 - u - v) v0 + u v1 + v v2.
 struct hit {
     float t = std::numeric_limits<float>::infinity();  ///< ray parameter of the hit
-    std::uint32_t triangle = no_triangle;              ///< index into io::scene::triangles
+    std::uint32_t triangle = no_triangle;              ///< index into scene_view::triangles
     float u = 0.f, v = 0.f;                            ///< barycentrics of v1 and v2
     bool found() const noexcept { return triangle != no_triangle; }
 };
 
-/// A bounding volume hierarchy over the triangles of an io::scene (one Embree triangle
+/// A bounding volume hierarchy over the triangles of a scene_view (one Embree triangle
 /// mesh, robust traversal, high build quality). Immutable once built, so queries from any
 /// number of threads are safe. Cheap to copy (copies share the BVH). The scene data is
-/// copied into Embree's buffers: the io::scene need not outlive the accel.
+/// copied into Embree's buffers: the viewed arrays need not outlive the accel.
 class accel {
 public:
     /// Builds on a fresh device. Throws parameter_error naming the field of an invalid
     /// scene (index out of range, non-finite vertex, material index out of range, normals
     /// or material_of of the wrong length) and embree_error if Embree fails.
-    explicit accel(const io::scene& scene);
+    explicit accel(const scene_view& scene);
     /// Builds on `dev`.
-    accel(const device& dev, const io::scene& scene);
+    accel(const device& dev, const scene_view& scene);
 
     /// Closest hit along `r` (hit::found() false on a miss).
     hit intersect(const ray& r) const;
@@ -143,13 +143,9 @@ private:
     std::shared_ptr<detail::scene_state> state_;
 };
 
-/// Throws parameter_error unless `scene` is one `accel` can be built from and shaded with
-/// (see accel's constructor).
-void validate(const io::scene& scene);
-
 /// Throws parameter_error unless `bvh` was built from a scene with as many triangles as
 /// `scene` (a cheap guard against shading hits with the wrong scene).
-void require_match(const accel& bvh, const io::scene& scene);
+void require_match(const accel& bvh, const scene_view& scene);
 
 /// The surface a ray found: world position, unit interpolated (barycentric) vertex normal
 /// and unit geometric normal, both flipped to face the ray's origin, and the diffuse
@@ -164,6 +160,6 @@ struct surface {
 };
 
 /// Surface attributes at `h` (which must have found a triangle of `scene`) along `r`.
-surface surface_at(const io::scene& scene, const ray& r, const hit& h);
+surface surface_at(const scene_view& scene, const ray& r, const hit& h);
 
 }  // namespace bounce::embree

@@ -6,7 +6,7 @@
 #include <bounce/camera.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/io/scene.hpp>
+#include <bounce/scene_view.hpp>
 
 namespace bounce::embree {
 
@@ -20,10 +20,10 @@ namespace bounce::embree {
 /// pixel is computed on its own, so the result does not depend on the thread count.
 /// Throws parameter_error on mismatched or empty views, an invalid camera, or a scene that
 /// does not match `bvh`.
-void ray_cast_gbuffer(const accel& bvh, const io::scene& scene, const bounce::camera& cam, gbuffer_view<float> out);
+void ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const bounce::camera& cam, gbuffer_view<float> out);
 
 /// Convenience: a new `width` x `height` G-buffer from ray_cast_gbuffer.
-gbuffer<float> ray_cast_gbuffer(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
+gbuffer<float> ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const bounce::camera& cam,
                                 std::size_t width, std::size_t height);
 
 }  // namespace bounce::embree

@@ -20,7 +20,7 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
-#include <bounce/io/scene.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <cstdint>
 #include <functional>
@@ -104,7 +104,7 @@ public:
     /// cone_deg in (0, 180]) and the settings, and prepares the emissive triangles for area
     /// sampling. Throws parameter_error naming the light or setting, or when the scene does
     /// not match `bvh`.
-    reference_integrator(const accel& bvh, const io::scene& scene, reference_settings settings = {});
+    reference_integrator(const accel& bvh, const scene_view& scene, reference_settings settings = {});
 
     const reference_settings& settings() const noexcept { return settings_; }
     /// The offset of secondary ray origins along the normal (world units) in use.
@@ -149,21 +149,15 @@ private:
         glm::vec3 normal;      // unit, the emitting side
         glm::vec3 radiance;    // Ke
     };
-    struct prepared_light {
-        int kind;  // 0 point, 1 spot, 2 directional
-        glm::vec3 position, direction, intensity;
-        float cos_cone, cosine_falloff;
-    };
-
     glm::dvec3 direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal, std::uint32_t area_grid,
                          std::uint64_t seed) const;
     void check_point(glm::vec3 p, glm::vec3 n) const;
 
     const accel& bvh_;
-    const io::scene& scene_;
+    scene_view scene_;
     reference_settings settings_;
     float epsilon_;
-    std::vector<prepared_light> lights_;
+    std::vector<packed_light> lights_;
     std::vector<emitter> emitters_;
     std::vector<double> emitter_cdf_;  // cumulative area fractions, size emitters + 1
     double emitter_area_ = 0;
@@ -177,7 +171,7 @@ struct reference_images {
 
 /// Direct, indirect and combined images over the G-buffer `g` (one reference_integrator,
 /// both images in turn).
-reference_images render_reference(const accel& bvh, const io::scene& scene, const gbuffer_view<float>& g,
+reference_images render_reference(const accel& bvh, const scene_view& scene, const gbuffer_view<float>& g,
                                   const reference_settings& settings);
 
 }  // namespace bounce::embree

@@ -1,6 +1,6 @@
 #pragma once
 /// \file direct_light.hpp
-/// Direct lighting of an io::scene's point, spot and directional lights on OpenGL, with
+/// Direct lighting of a scene_view's point, spot and directional lights on OpenGL, with
 /// shadow maps and 16-tap percentage-closer filtering.
 ///
 /// Each light gets one depth map rendered from it:
@@ -32,7 +32,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/image.hpp>
-#include <bounce/io/scene.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <array>
 #include <cstddef>
@@ -64,8 +64,8 @@ public:
     /// Validates the lights (parameter_error naming "scene.lights[i]"), creates and
     /// renders the shadow maps of `mesh` (which must be `scene`'s geometry and must outlive
     /// this object). A context must be current.
-    direct_light(const io::scene& scene, const scene_mesh& mesh, int shadow_resolution = 1024);
-    direct_light(const io::scene& scene, const scene_mesh& mesh, const direct_light_options& options);
+    direct_light(const scene_view& scene, const scene_mesh& mesh, int shadow_resolution = 1024);
+    direct_light(const scene_view& scene, const scene_mesh& mesh, const direct_light_options& options);
 
     /// Renders every shadow map again (after the mesh's contents changed). Restores the GL
     /// state it changes.
@@ -105,10 +105,8 @@ public:
 
 private:
     struct light_entry {
-        int kind = 0;  // 0 point, 1 spot, 2 directional
+        packed_light light;
         map_kind map = map_kind::cube;
-        glm::vec3 position{0.f}, vector{0.f}, intensity{0.f};  // vector: spot axis / direction of travel
-        float cos_cone = -1.f, falloff = 0.f;
         glm::mat4 view_projection{1.f};  // 2D maps
         std::array<glm::mat4, 6> face_view_projection{};  // cube maps
         float tan_half_fov = 1.f;   // perspective maps
@@ -117,7 +115,7 @@ private:
         detail::object depth;       // GL_TEXTURE_2D or GL_TEXTURE_CUBE_MAP, depth32f
     };
 
-    static std::vector<light_entry> prepare(const io::scene& scene, const direct_light_options& options);
+    static std::vector<light_entry> prepare(const scene_view& scene, const direct_light_options& options);
     std::string radiance_fragment_source() const;
 
     const scene_mesh* mesh_;

@@ -10,7 +10,7 @@
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/gl/objects.hpp>
-#include <bounce/io/scene.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <cstddef>
 #include <optional>
@@ -18,14 +18,15 @@
 
 namespace bounce::gl {
 
-/// The geometry of an io::scene in GL buffers: positions and normals (one vertex array,
+/// The geometry of a scene_view in GL buffers: positions and normals (one vertex array,
 /// attributes 0 and 1), triangle indices, and per-triangle diffuse reflectance (Kd of the
 /// triangle's material) as a storage buffer of vec4 indexed by gl_PrimitiveID.
 class scene_mesh {
 public:
-    /// Uploads `s`. Throws parameter_error naming the field when normals or material_of
-    /// do not match in size, an index is out of range, or a material index is unknown.
-    explicit scene_mesh(const io::scene& s);
+    /// Uploads `s` (a copy: the viewed arrays need not outlive the mesh). A view without
+    /// vertex normals is drawn with each triangle's plane normal. Throws parameter_error
+    /// naming the span at fault as scene_view::validate_mesh does.
+    explicit scene_mesh(const scene_view& s);
 
     std::size_t triangle_count() const noexcept { return triangles_; }
     /// The vertex array: attribute 0 = position (vec3), 1 = normal (vec3), with the

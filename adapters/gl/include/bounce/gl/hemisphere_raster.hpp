@@ -24,7 +24,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/hemisphere.hpp>
 #include <bounce/image.hpp>
-#include <bounce/io/scene.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <array>
 #include <cstddef>
@@ -78,7 +78,7 @@ public:
     /// Compiles the programs and allocates the atlas for options.batch planes. `mesh` must be
     /// `scene`'s geometry and `light` built on it; both must outlive this object. Throws
     /// parameter_error on bad options, gl_error when the atlas exceeds GL_MAX_TEXTURE_SIZE.
-    hemisphere_raster(const io::scene& scene, const scene_mesh& mesh, const direct_light& light,
+    hemisphere_raster(const scene_view& scene, const scene_mesh& mesh, const direct_light& light,
                       const hemisphere_raster_options& options = {});
     ~hemisphere_raster();
     hemisphere_raster(const hemisphere_raster&) = delete;

@@ -6,12 +6,13 @@
 
 #include <bounce/camera.hpp>
 #include <bounce/errors.hpp>
+#include <bounce/light.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
-#include <variant>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -32,35 +33,8 @@ private:
     std::size_t line_;
 };
 
-/// A diffuse material: MTL `Kd` and `Ke`.
-struct material {
-    std::string name;
-    glm::vec3 kd{0.8f};  ///< diffuse reflectance rho_d, each channel in [0, 1]
-    glm::vec3 ke{0.f};   ///< emitted radiance (W / m^2 / sr), used when scene::use_emission
-};
-
-/// Isotropic point light; `intensity` in W/sr per channel.
-struct point_light {
-    glm::vec3 position{0.f}, intensity{1.f};
-};
-
-/// Spot light; `intensity` in W/sr on the axis; dark beyond `cone_deg` from the axis.
-struct spot_light {
-    enum class falloff_kind { none, cosine };
-    glm::vec3 position{0.f}, direction{0, -1, 0}, intensity{1.f};
-    float cone_deg = 45.f;
-    falloff_kind falloff = falloff_kind::cosine;
-};
-
-/// Distant light; `direction` is the way the light travels; `irradiance` in W/m^2 on a
-/// surface facing it.
-struct directional_light {
-    glm::vec3 direction{0, -1, 0}, irradiance{1.f};
-};
-
-using light = std::variant<point_light, spot_light, directional_light>;
-
-/// A triangle mesh with per-vertex normals, per-triangle materials, lights and a camera.
+/// A triangle mesh with per-vertex normals, per-triangle materials, lights and a camera, owned;
+/// `view()` hands the adapters the non-owning `scene_view` they take.
 struct scene {
     std::string name;                        ///< "cornell" or the scene folder's name
     std::filesystem::path source;            ///< the scene.json or OBJ it came from (empty if built in)
@@ -68,25 +42,28 @@ struct scene {
     std::vector<glm::vec3> normals;          ///< unit vertex normals, one per position
     std::vector<glm::uvec3> triangles;       ///< indices into positions/normals
     std::vector<std::uint32_t> material_of;  ///< material index per triangle
-    std::vector<material> materials;
-    std::vector<light> lights;
+    std::vector<bounce::material> materials;  ///< MTL Kd as albedo, Ke as emission
+    std::vector<std::string> material_names;  ///< one per material (MTL newmtl), for messages
+    std::vector<bounce::light> lights;
     bool use_emission = false;  ///< faces whose material has ke > 0 are area lights too
     bounce::camera camera;
     /// What the loader repaired or dropped without failing (degenerate triangles, repeated
     /// triangles, zero normals), one line each, for programs to print.
     std::vector<std::string> warnings;
 
-    /// Indices of triangles that emit (only when use_emission).
-    std::vector<std::uint32_t> emissive_triangles() const;
-    /// Axis-aligned bounds of all vertices: {min, max}.
-    std::pair<glm::vec3, glm::vec3> bounds() const;
-};
+    /// The view of this scene every adapter takes; valid while the scene lives and is not
+    /// resized (as a string_view is of its string).
+    scene_view view() const& noexcept {
+        return {positions, normals, triangles, material_of, materials, lights, use_emission};
+    }
+    /// The same view, so that a scene can be passed wherever a scene_view is taken.
+    operator scene_view() const& noexcept { return view(); }
 
-/// Throws parameter_error naming "scene.lights[i]" and the field unless every light can
-/// be rendered: finite positions, finite non-negative intensities and irradiances, finite
-/// non-zero directions, spot cones in (0, 180] degrees. Code that builds scenes by hand
-/// gets the same check from every adapter that shades lights.
-void validate_lights(const scene& s);
+    /// Indices of triangles that emit (only when use_emission).
+    std::vector<std::uint32_t> emissive_triangles() const { return view().emissive_triangles(); }
+    /// Axis-aligned bounds of all vertices: {min, max}.
+    std::pair<glm::vec3, glm::vec3> bounds() const noexcept { return view().bounds(); }
+};
 
 /// Loads a scene.json (and the OBJ+MTL it names), as docs/scenes.md specifies.
 /// \param scene_json path of the JSON file; the OBJ path inside it is relative to its folder.
@@ -98,7 +75,7 @@ scene load_scene(const std::filesystem::path& scene_json);
 /// giving about 1 W/m^2 at the centre, or none with use_emission when a used material has Ke.
 /// \param default_material the material of faces without `usemtl`.
 /// \throws scene_error naming the file and line.
-scene load_obj(const std::filesystem::path& obj, const material& default_material = {});
+scene load_obj(const std::filesystem::path& obj, const bounce::material& default_material = {});
 /// The Cornell box from its published dimensions (Cornell University Program of Computer
 /// Graphics, "Cornell Box Data"), in metres, with the published camera, the light quad as
 /// an emissive material (Ke = (17, 12, 4), use_emission false) and a cosine spot of the same

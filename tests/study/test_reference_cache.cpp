@@ -1,8 +1,8 @@
 // The on-disk cache of reference images: the key follows every input, entries come back
 // bitwise, and a damaged entry is recomputed rather than trusted.
-#include <bounce/embree/reference_cache.hpp>
+#include <bounce/study/reference_cache.hpp>
 
-#include "hand_built_scenes.hpp"
+#include "../embree/hand_built_scenes.hpp"
 #include "../scoped_environment.hpp"
 
 #include <catch2/catch.hpp>
@@ -16,6 +16,7 @@
 
 using namespace bounce;
 using namespace bounce::embree;
+using namespace bounce::study;
 namespace fs = std::filesystem;
 
 namespace {
@@ -39,7 +40,7 @@ io::scene small_scene() {
     const auto white = hand_built::add_material(s, glm::vec3(0.7f)), red = hand_built::add_material(s, {0.6f, 0.1f, 0.1f});
     hand_built::add_square_z(s, 0.f, 1.f, true, white);
     hand_built::add_quad(s, {-1, -1, 0}, {-1, 1, 0}, {-1, 1, 2}, {-1, -1, 2}, {1, 0, 0}, red);
-    s.lights.push_back(io::point_light{{0.f, 0.f, 1.5f}, glm::vec3(1.f)});
+    s.lights.push_back(bounce::point_light{{0.f, 0.f, 1.5f}, glm::vec3(1.f)});
     s.camera.position = {0.5f, -3.f, 1.f};
     s.camera.look_at = {0.f, 0.f, 0.5f};
     s.camera.up = {0.f, 0.f, 1.f};
@@ -66,10 +67,10 @@ TEST_CASE("the cache key changes with every input and only with them", "[referen
     moved.positions[3].z += 1e-6f;
     others.push_back(reference_cache_key(moved, s.camera, 32, 24, settings));
     io::scene brighter = s;
-    std::get<io::point_light>(brighter.lights[0]).intensity.y = 1.5f;
+    std::get<bounce::point_light>(brighter.lights[0]).intensity.y = 1.5f;
     others.push_back(reference_cache_key(brighter, s.camera, 32, 24, settings));
     io::scene redder = s;
-    redder.materials[1].kd.x = 0.61f;
+    redder.materials[1].albedo.x = 0.61f;
     others.push_back(reference_cache_key(redder, s.camera, 32, 24, settings));
     io::scene emitting = s;
     emitting.use_emission = true;

@@ -21,7 +21,7 @@
 #include <string>
 #include <string_view>
 
-namespace bounce::embree {
+namespace bounce::study {
 
 /// $BOUNCE_CACHE when set; else `cache/` beside the `bin/` folder the running program lives
 /// in (build/bin/reference -> build/cache); else ./build/cache.
@@ -31,29 +31,29 @@ std::filesystem::path default_cache_dir();
 /// `settings` on a device configured with `device_config` (device::config()):
 /// "<scene name>-<W>x<H>-<spp>spp-<16 hex digits>" (file-name safe).
 std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
-                                std::size_t height, const reference_settings& settings,
+                                std::size_t height, const embree::reference_settings& settings,
                                 std::string_view device_config = {});
 
 /// The cached images under `key` in `dir`, or nothing when an entry is missing, unreadable
 /// or of another size than `width` x `height` (the caller then recomputes). The combined
 /// image is recomputed as direct + indirect.
-std::optional<reference_images> load_cached_reference(const std::filesystem::path& dir, const std::string& key,
+std::optional<embree::reference_images> load_cached_reference(const std::filesystem::path& dir, const std::string& key,
                                                       std::size_t width, std::size_t height,
-                                                      const reference_settings& settings);
+                                                      const embree::reference_settings& settings);
 
 /// Writes `images` under `key` in `dir` (created when missing), with a JSON description
 /// (including `device_config` when not empty). Each file is written to a
 /// temporary name and renamed, so a reader never sees half an entry. Throws bounce::error
 /// (from the image writer) when the directory or a file cannot be written.
-void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
-                            const io::scene& scene, const bounce::camera& cam, const reference_settings& settings,
+void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const embree::reference_images& images,
+                            const io::scene& scene, const bounce::camera& cam, const embree::reference_settings& settings,
                             std::string_view device_config = {});
 
 /// The reference images of `scene` through `cam`: from the cache when present, else ray
 /// cast G-buffer + render_reference, stored for next time. `from_cache` (optional)
 /// receives whether the cache answered.
-reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
-                                  std::size_t width, std::size_t height, const reference_settings& settings,
+embree::reference_images cached_reference(const embree::accel& bvh, const io::scene& scene, const bounce::camera& cam,
+                                  std::size_t width, std::size_t height, const embree::reference_settings& settings,
                                   const std::filesystem::path& dir = default_cache_dir(), bool* from_cache = nullptr);
 
-}  // namespace bounce::embree
+}  // namespace bounce::study

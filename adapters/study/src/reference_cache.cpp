@@ -1,7 +1,7 @@
 // Reference images cached as EXR under a content hash of everything they depend on.
-#include <bounce/embree/reference_cache.hpp>
+#include <bounce/study/reference_cache.hpp>
 
-#include <bounce/content_hash.hpp>
+#include <bounce/study/content_hash.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/image_io.hpp>
 
@@ -14,7 +14,11 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
-namespace bounce::embree {
+namespace bounce::study {
+
+using embree::accel;
+using embree::reference_images;
+using embree::reference_settings;
 
 namespace {
 
@@ -46,7 +50,7 @@ void write_atomically(const std::filesystem::path& final_path, const char* exten
     std::filesystem::rename(tmp, final_path, ec);
     if (ec) {
         std::filesystem::remove(tmp, ec);
-        throw bounce::error("bounce::embree: cannot move " + tmp.string() + " to " + final_path.string());
+        throw bounce::error("bounce::study: cannot move " + tmp.string() + " to " + final_path.string());
     }
 }
 
@@ -78,23 +82,23 @@ std::string reference_cache_key(const io::scene& scene, const bounce::camera& ca
     for (auto m : scene.material_of) h.value(m);
     h.value(scene.materials.size());
     for (const auto& m : scene.materials) {
-        h.value(m.kd);
-        h.value(m.ke);
+        h.value(m.albedo);
+        h.value(m.emission);
     }
     h.value(scene.lights.size());
     for (const auto& l : scene.lights) {
         h.value(l.index());
-        if (const auto* p = std::get_if<io::point_light>(&l)) {
+        if (const auto* p = std::get_if<point_light>(&l)) {
             h.value(p->position);
             h.value(p->intensity);
-        } else if (const auto* s = std::get_if<io::spot_light>(&l)) {
+        } else if (const auto* s = std::get_if<spot_light>(&l)) {
             h.value(s->position);
             h.value(s->direction);
             h.value(s->intensity);
             h.value(s->cone_deg);
             h.value(int(s->falloff));
         } else {
-            const auto& d = std::get<io::directional_light>(l);
+            const auto& d = std::get<directional_light>(l);
             h.value(d.direction);
             h.value(d.irradiance);
         }
@@ -141,7 +145,7 @@ std::optional<reference_images> load_cached_reference(const std::filesystem::pat
     r.combined = image<glm::vec3>(width, height);
     for (std::size_t y = 0; y < height; ++y)
         for (std::size_t x = 0; x < width; ++x) r.combined(x, y) = r.direct(x, y) + r.indirect(x, y);
-    r.grid = hemisphere_grid_for(settings.hemisphere_samples);
+    r.grid = embree::hemisphere_grid_for(settings.hemisphere_samples);
     return r;
 }
 
@@ -201,4 +205,4 @@ reference_images cached_reference(const accel& bvh, const io::scene& scene, cons
     return r;
 }
 
-}  // namespace bounce::embree
+}  // namespace bounce::study

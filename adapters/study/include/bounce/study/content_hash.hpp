@@ -9,7 +9,7 @@
 #include <string_view>
 #include <type_traits>
 
-namespace bounce {
+namespace bounce::study {
 
 class fnv1a_hash {
 public:
@@ -37,4 +37,4 @@ private:
     std::uint64_t h_ = offset_basis;
 };
 
-}  // namespace bounce
+}  // namespace bounce::study
