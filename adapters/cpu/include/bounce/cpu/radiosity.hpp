@@ -1,0 +1,413 @@
+#pragma once
+/// \file radiosity.hpp
+/// Progressive refinement radiosity on the CPU (Cohen et al. 1988, on textures as in Coombe
+/// and Harris 2005, GPU Gems 2 ch. 39): `cpu::progressive_radiosity`, the solver a program or
+/// a renderer drives with step() / solve().
+///
+/// One step: choose the shooter with the largest unshot power (a parallel reduction over the
+/// shooters), prepare visibility from it (the caller's shot_visibility: an item buffer, ray
+/// casts, or all_visible), then add the shot's radiosity to every element in front of it
+/// (the kernel shot_radiosity of radiosity.hpp, the chapter's Listing 39-4) and zero the
+/// shooter's unshot radiosity. A shooter is one element or, with substructuring (Cohen et al.
+/// 1986; the chapter's section 39.4), one block of the atlas (block_texels^2 texels of one
+/// chart) shooting its total unshot power from its area-weighted centroid as one disc.
+/// Per shot the work is O(elements) over struct-of-arrays, with nothing stored per pair.
+///
+/// Lights: the scene's emissive triangles start with unshot radiosity E = pi L_e; point, spot
+/// and directional lights are shot once, first, as direct irradiance (lights.hpp) times
+/// visibility from the light (two hemispheres for a point light or a spot wider than 90
+/// degrees, parallel rays for a directional light). Their power is counted as what reaches
+/// the elements: emitted power = sum E_i A_i + sum of direct irradiance times area.
+///
+/// Energy: with the disc form factor a shot hands out dB_s sum_r F_{r->s} V A_r, which need not
+/// equal the shot power dB_s A_s (energy leaves open scenes; and the approximation is not
+/// exactly conservative). The solver keeps, in double per channel, absorbed power (the
+/// (1 - rho) share of what each element intercepts) and escaped power (shot power less
+/// intercepted power, negative where the disc approximation over-delivers), so that
+/// absorbed + unshot + escaped = emitted after every step, to rounding.
+///
+/// Determinism: elements are updated by exactly one task each, and sums run over fixed chunks
+/// of shooters added in chunk order, so results are bitwise the same for any thread count.
+
+#include <bounce/cpu/radiosity_item_buffer.hpp>
+#include <bounce/errors.hpp>
+#include <bounce/image.hpp>
+#include <bounce/light.hpp>
+#include <bounce/lightmap_atlas.hpp>
+#include <bounce/lights.hpp>
+#include <bounce/radiosity.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <numeric>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+namespace bounce::cpu {
+
+/// How the solver shoots.
+struct radiosity_options {
+    bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
+    int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16)
+    bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
+
+    void validate() const {
+        require(shooters_per_step >= 1 && shooters_per_step <= 4096, "radiosity_options.shooters_per_step",
+                "must lie in [1, 4096]");
+    }
+};
+
+/// Time spent per stage since construction, milliseconds.
+struct radiosity_timings {
+    double lights_ms = 0;        ///< shooting point, spot and directional lights (construction)
+    double visibility_ms = 0;    ///< begin_shot: item buffers, ray casts
+    double choice_ms = 0;        ///< choosing shooters (reduction)
+    double distribution_ms = 0;  ///< form factors and updates over the elements
+};
+
+/// Where a solve stands after a step.
+struct radiosity_progress {
+    std::size_t steps = 0, shots = 0;
+    double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
+};
+
+/// The solver. `Real` is the type of the radiosity arrays and of the kernel's arithmetic
+/// (float, as a GPU would; double for reference solutions). `Visibility` models
+/// shot_visibility.
+template <shot_visibility Visibility, floating Real = float>
+class progressive_radiosity {
+public:
+    using vec = glm::vec<3, Real>;
+
+    /// Keeps references to `atlas` and the visibility (moved in); `scene` is read only here
+    /// (its lights). Throws parameter_error on bad options or an atlas not built from `scene`.
+    progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, Visibility visibility,
+                          radiosity_options options = {})
+        : atlas_(&atlas), visibility_(std::move(visibility)), options_(options) {
+        options.validate();
+        scene.validate();
+        require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
+                "was not built from this scene (triangle counts differ)");
+        const std::size_t n = atlas.size();
+        radiosity_.resize(n);
+        unshot_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            radiosity_[i] = vec(atlas.emission[i]);
+            unshot_[i] = vec(atlas.emission[i]);
+            emitted_ += glm::dvec3(atlas.emission[i]) * double(atlas.area[i]);
+            total_area_ += double(atlas.area[i]);
+            albedo_area_ += glm::dvec3(atlas.albedo[i]) * double(atlas.area[i]);
+        }
+        // Shooters: the atlas's blocks, or one per element.
+        if (options.shoot_blocks) first_.assign(atlas.block_first.begin(), atlas.block_first.end());
+        else {
+            first_.resize(n + 1);
+            std::iota(first_.begin(), first_.end(), std::uint32_t(0));
+        }
+        const std::size_t shooters = first_.size() - 1;
+        centre_.resize(shooters);
+        shooter_area_.resize(shooters);
+        power_.resize(shooters);
+        for (std::size_t k = 0; k < shooters; ++k) {
+            glm::dvec3 c(0);
+            double a = 0;
+            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
+                c += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
+                a += double(atlas.area[i]);
+            }
+            centre_[k] = glm::vec3(c / a);
+            shooter_area_[k] = Real(a);
+        }
+        const auto start = clock::now();
+        for (const light& l : scene.lights) shoot_light(pack(l));
+        timings_.lights_ms = ms_since(start);
+        refresh_powers();
+    }
+
+    /// One step: choose shooters_per_step shooters by unshot power and shoot each in turn.
+    /// Returns false (and does nothing) when no unshot power is left.
+    bool step() {
+        auto start = clock::now();
+        const std::size_t count = std::min<std::size_t>(std::size_t(options_.shooters_per_step), power_.size());
+        std::vector<std::uint32_t> chosen;
+        if (count == 1) {
+            const auto best = largest_power();
+            if (best.first > 0) chosen.push_back(best.second);
+        } else {
+            std::vector<std::uint32_t> order(power_.size());
+            std::iota(order.begin(), order.end(), std::uint32_t(0));
+            const auto larger = [&](std::uint32_t a, std::uint32_t b) {
+                return power_[a] > power_[b] || (power_[a] == power_[b] && a < b);
+            };
+            std::nth_element(order.begin(), order.begin() + std::ptrdiff_t(count - 1), order.end(), larger);
+            order.resize(count);
+            std::sort(order.begin(), order.end(), larger);
+            for (const std::uint32_t k : order)
+                if (power_[k] > 0) chosen.push_back(k);
+        }
+        timings_.choice_ms += ms_since(start);
+        if (chosen.empty()) return false;
+        for (const std::uint32_t k : chosen) shoot(k);
+        ++steps_;
+        return true;
+    }
+
+    /// Steps until the unshot fraction is at most `fraction` (in [0, 1)) or nothing is left
+    /// to shoot, calling `progress` after each step (return false from it to stop early).
+    /// Returns the steps taken.
+    std::size_t solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress = {}) {
+        require(fraction >= 0 && fraction < 1, "fraction", "must lie in [0, 1)");
+        std::size_t taken = 0;
+        while (unshot_fraction() > fraction && step()) {
+            ++taken;
+            if (progress && !progress(radiosity_progress{steps_, shots_, unshot_fraction()})) break;
+        }
+        return taken;
+    }
+
+    /// Unshot power / emitted power, channels summed; 0 for a scene that emits nothing.
+    double unshot_fraction() const noexcept {
+        const double e = emitted_.x + emitted_.y + emitted_.z;
+        return e > 0 ? unshot_total_ / e : 0.0;
+    }
+
+    /// Power per channel, W: emitted (surfaces and the direct light that reached elements),
+    /// absorbed, escaped (see the file comment), and unshot (recomputed from the array).
+    glm::dvec3 emitted_power() const noexcept { return emitted_; }
+    glm::dvec3 absorbed_power() const noexcept { return absorbed_; }
+    glm::dvec3 escaped_power() const noexcept { return escaped_; }
+    glm::dvec3 unshot_power() const {
+        glm::dvec3 s(0);
+        for (std::size_t i = 0; i < unshot_.size(); ++i) s += glm::dvec3(unshot_[i]) * double(atlas_->area[i]);
+        return s;
+    }
+
+    /// Radiosity B per element, W/m^2 per channel (emission included).
+    std::span<const vec> radiosity() const noexcept { return radiosity_; }
+    /// Unshot radiosity per element, W/m^2 per channel.
+    std::span<const vec> unshot() const noexcept { return unshot_; }
+
+    /// The ambient radiosity (Cohen et al. 1988): 1 / (1 - rho_avg) times the area-weighted
+    /// mean unshot radiosity, per channel.
+    glm::dvec3 ambient() const {
+        const glm::dvec3 rho_avg = albedo_area_ / total_area_;
+        return unshot_power() / total_area_ / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
+    }
+
+    /// Radiosity to display now: B, plus rho times the ambient term when the options ask.
+    std::vector<glm::vec3> display_radiosity() const {
+        std::vector<glm::vec3> out(radiosity_.size());
+        const glm::vec3 amb = options_.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+        for (std::size_t i = 0; i < out.size(); ++i)
+            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(radiosity_[i]), atlas_->albedo[i], amb);
+        return out;
+    }
+
+    /// display_radiosity laid out as the atlas (lightmap_atlas::to_texels), for writing a
+    /// lightmap or texturing a view.
+    image<glm::vec3> lightmap() const {
+        const auto values = display_radiosity();
+        return atlas_->to_texels(std::span<const glm::vec3>(values));
+    }
+
+    const radiosity_timings& timings() const noexcept { return timings_; }
+    radiosity_progress progress() const noexcept { return {steps_, shots_, unshot_fraction()}; }
+    std::size_t shooters() const noexcept { return power_.size(); }
+    const lightmap_atlas& atlas() const noexcept { return *atlas_; }
+    Visibility& visibility() noexcept { return visibility_; }
+
+private:
+    using clock = std::chrono::steady_clock;
+    static double ms_since(clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(clock::now() - t).count();
+    }
+    // Shooters per chunk of the distribution: fixed, so sums do not depend on threads.
+    static constexpr std::size_t chunk = 64;
+
+    struct chunk_sums {
+        glm::dvec3 absorbed{0}, intercepted{0};
+        double unshot = 0;
+    };
+
+    static double channel_sum(const vec& v) { return double(v.x) + double(v.y) + double(v.z); }
+
+    // Largest (power, lowest index among equals): associative, so the reduction's grouping
+    // does not change the answer.
+    std::pair<double, std::uint32_t> largest_power() const {
+        using best = std::pair<double, std::uint32_t>;
+        const auto better = [](const best& a, const best& b) {
+            return (b.first > a.first || (b.first == a.first && b.second < a.second)) ? b : a;
+        };
+        return tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, power_.size(), 1024), best{-1.0, 0},
+            [&](const tbb::blocked_range<std::size_t>& r, best acc) {
+                for (std::size_t k = r.begin(); k != r.end(); ++k) acc = better(acc, best{power_[k], std::uint32_t(k)});
+                return acc;
+            },
+            better);
+    }
+
+    void refresh_powers() {
+        unshot_total_ = 0;
+        for (std::size_t k = 0; k < power_.size(); ++k) {
+            double p = 0;
+            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) p += channel_sum(unshot_[i]) * double(atlas_->area[i]);
+            power_[k] = p;
+            unshot_total_ += p;
+        }
+    }
+
+    // Runs `receive(i, sums)` for every element, chunk by chunk of shooters in parallel,
+    // refreshing each shooter's power; then adds the chunks' sums in order.
+    template <class Receive>
+    chunk_sums distribute(const Receive& receive) {
+        const std::size_t shooters = power_.size(), chunks = (shooters + chunk - 1) / chunk;
+        sums_.assign(chunks, chunk_sums{});
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                chunk_sums s;
+                const std::size_t k1 = std::min(shooters, (c + 1) * chunk);
+                for (std::size_t k = c * chunk; k < k1; ++k) {
+                    double p = 0;
+                    for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
+                        receive(i, s);
+                        p += channel_sum(unshot_[i]) * double(atlas_->area[i]);
+                    }
+                    power_[k] = p;
+                    s.unshot += p;
+                }
+                sums_[c] = s;
+            }
+        });
+        chunk_sums total;
+        for (const chunk_sums& s : sums_) {
+            total.absorbed += s.absorbed;
+            total.intercepted += s.intercepted;
+            total.unshot += s.unshot;
+        }
+        unshot_total_ = total.unshot;
+        return total;
+    }
+
+    void shoot(std::uint32_t k) {
+        const lightmap_atlas& at = *atlas_;
+        const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
+        // The shooter's unshot radiosity, area-weighted over its elements; then zeroed, so
+        // its elements' power (refreshed in the distribution) starts from 0.
+        glm::dvec3 power(0);
+        for (std::uint32_t i = i0; i < i1; ++i) {
+            power += glm::dvec3(unshot_[i]) * double(at.area[i]);
+            unshot_[i] = vec(0);
+        }
+        const Real area = shooter_area_[k];
+        const vec db = vec(power / double(area));
+        const vec ps = vec(centre_[k]);
+        const glm::vec3 ns_f = at.normal[i0];
+        const vec ns = vec(ns_f);
+        const std::uint32_t chart = at.chart[i0];
+
+        auto start = clock::now();
+        visibility_.begin_shot(shot_frame{centre_[k], ns_f, false, chart});
+        timings_.visibility_ms += ms_since(start);
+
+        start = clock::now();
+        const Visibility& vis = visibility_;
+        const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
+            const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
+            const Real f = disc_form_factor<Real, vec>(pr, nr, ps, ns, area);
+            if (!(f > Real(0))) return;
+            const Real v = Real(vis.visible(i));
+            if (!(v > Real(0))) return;
+            const vec rho = vec(at.albedo[i]);
+            const vec gain = shot_radiosity<Real, vec>(pr, nr, rho, ps, ns, area, db, v);
+            radiosity_[i] += gain;
+            unshot_[i] += gain;
+            const glm::dvec3 intercepted = glm::dvec3(db) * (double(f) * double(v) * double(at.area[i]));
+            s.intercepted += intercepted;
+            s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
+        });
+        timings_.distribution_ms += ms_since(start);
+        absorbed_ += total.absorbed;
+        escaped_ += power - total.intercepted;
+        ++shots_;
+    }
+
+    // Direct light from one point, spot or directional light: each element's irradiance
+    // E (lights.hpp) times visibility becomes incident power; rho E is its first radiosity.
+    void shoot_light(const packed_light& l) {
+        const lightmap_atlas& at = *atlas_;
+        const light_kind kind = l.kind();
+        std::vector<shot_frame> frames;
+        if (kind == light_kind::directional) frames.push_back({glm::vec3(0.f), l.direction(), true, shot_frame::none});
+        else {
+            const glm::vec3 axis = kind == light_kind::spot ? l.direction() : glm::vec3(0, 0, 1);
+            frames.push_back({l.position(), axis, false, shot_frame::none});
+            // A point light, or a spot wider than a hemisphere, needs the other half too.
+            if (kind == light_kind::point || l.cos_cone() < 0.f)
+                frames.push_back({l.position(), -axis, false, shot_frame::none});
+        }
+        for (std::size_t h = 0; h < frames.size(); ++h) {
+            const shot_frame& frame = frames[h];
+            const auto start = clock::now();
+            visibility_.begin_shot(frame);
+            timings_.visibility_ms += ms_since(start);
+            const Visibility& vis = visibility_;
+            const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
+                const glm::vec3 p = at.position[i], n = at.normal[i];
+                if (!frame.parallel) {
+                    // Each element belongs to exactly one of the hemispheres: z >= 0 of the
+                    // first, z < 0 of the second.
+                    const float z = glm::dot(p - frame.position, frame.axis);
+                    if (h == 0 ? !(z >= 0.f) : !(z > 0.f)) return;
+                }
+                glm::vec3 e;
+                if (kind == light_kind::point)
+                    e = point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
+                else if (kind == light_kind::spot)
+                    e = spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
+                                                               l.cos_cone(), l.cosine_falloff());
+                else
+                    e = directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
+                if (!(e.x > 0.f || e.y > 0.f || e.z > 0.f)) return;
+                const float v = vis.visible(i);
+                if (!(v > 0.f)) return;
+                const vec rho = vec(at.albedo[i]);
+                const vec gain = rho * vec(e * v);
+                radiosity_[i] += gain;
+                unshot_[i] += gain;
+                const glm::dvec3 intercepted = glm::dvec3(e * v) * double(at.area[i]);
+                s.intercepted += intercepted;
+                s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
+            });
+            emitted_ += total.intercepted;
+            absorbed_ += total.absorbed;
+        }
+    }
+
+    const lightmap_atlas* atlas_;
+    Visibility visibility_;
+    radiosity_options options_;
+    std::vector<vec> radiosity_, unshot_;
+    std::vector<std::uint32_t> first_;
+    std::vector<glm::vec3> centre_;
+    std::vector<Real> shooter_area_;
+    std::vector<double> power_;
+    std::vector<chunk_sums> sums_;
+    double unshot_total_ = 0, total_area_ = 0;
+    glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, albedo_area_{0};
+    radiosity_timings timings_;
+    std::size_t steps_ = 0, shots_ = 0;
+};
+
+}  // namespace bounce::cpu

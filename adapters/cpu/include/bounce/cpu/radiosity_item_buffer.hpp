@@ -1,0 +1,472 @@
+#pragma once
+/// \file radiosity_item_buffer.hpp
+/// Visibility for progressive radiosity on the CPU: a software rasterizer of the scene's
+/// triangles into an item buffer (chart id and depth per pixel) seen from the shooter, in
+/// the stereographic ("hemispherical") projection of Coombe and Harris 2005 (section 39.2.1)
+/// or on the five faces of a hemicube (Cohen and Greenberg 1985), or along parallel rays for
+/// a directional light; and the lookup that tells whether an element is seen.
+///
+/// The scan converter is the one GPUs use: vertices snapped to 1/256 pixel, integer edge
+/// functions, pixel centres at (x + 1/2, y + 1/2), and the top-left rule for centres exactly
+/// on an edge, so two triangles sharing an edge cover each pixel on it exactly once and a
+/// mesh without T-junctions covers every pixel inside its outline exactly once.
+///
+/// The stereographic projection bends straight edges into arcs (Figure 39-5), so before
+/// rasterizing with straight edges each triangle is cut into n x n smaller ones, n the power of
+/// two that brings the sagitta of every edge (distance, in pixels, between the projected
+/// midpoint of an edge and the midpoint of its projected chord) below `tolerance_px`:
+/// the sagitta of an arc falls as 1/n^2 with n pieces. Neighbouring triangles may pick different
+/// n; the T-junctions this leaves open cracks narrower than the tolerance along shared edges
+/// (the tests measure the pixels that differ from an exact per-pixel ray cast).
+/// The hemicube's faces are perspective projections, where straight edges stay straight and
+/// 1/depth is linear in screen space, so they need no tessellation and their depth is exact.
+///
+/// Lookup: an element is visible when the item buffer shows its chart at its pixel, or when
+/// whatever is there lies no nearer than the element less a relative 1e-3 and absolute 1e-5
+/// of the scene's diagonal: the id test alone would darken a row of elements along every
+/// concave corner, where the pixel's centre falls on the neighbouring chart at the same depth.
+
+#include <bounce/errors.hpp>
+#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity.hpp>
+#include <bounce/sampling.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <tbb/parallel_for.h>
+
+namespace bounce::cpu {
+
+/// Where a shot comes from, as the visibility pass needs it.
+struct shot_frame {
+    static constexpr std::uint32_t none = lightmap_atlas::none;
+    glm::vec3 position{0.f};        ///< the shooter (world); unused for parallel shots
+    glm::vec3 axis{0.f, 0.f, 1.f};  ///< unit normal of the hemisphere seen; for parallel shots
+                                    ///< the direction the light travels
+    bool parallel = false;          ///< a directional light: rays along `axis`, not from a point
+    std::uint32_t chart = none;     ///< the shooter's own chart, left out of the item buffer
+};
+
+/// What the solver asks of a visibility method: prepare for one shot, then answer for any
+/// element (concurrently: `visible` is const and called from many threads) with a value in
+/// [0, 1]. Only elements in front of the shot (local z > 0, or any element for a parallel
+/// shot) are asked.
+template <class V>
+concept shot_visibility = requires(V& v, const V& cv, const shot_frame& s, std::size_t e) {
+    v.begin_shot(s);
+    { cv.visible(e) } -> std::convertible_to<float>;
+};
+
+/// Every element sees every shooter: form factors without occlusion (open scenes, tests
+/// against the dense solve, and the unoccluded bound of a visibility method).
+struct all_visible {
+    void begin_shot(const shot_frame&) noexcept {}
+    float visible(std::size_t) const noexcept { return 1.f; }
+};
+
+/// Chart id and depth per pixel. `none` where nothing was drawn.
+struct item_buffer {
+    static constexpr std::uint32_t none = lightmap_atlas::none;
+    int width = 0, height = 0;
+    std::vector<std::uint32_t> id;
+    std::vector<float> depth;
+
+    void reset(int w, int h) {
+        width = w;
+        height = h;
+        id.assign(std::size_t(w) * std::size_t(h), none);
+        depth.assign(std::size_t(w) * std::size_t(h), std::numeric_limits<float>::infinity());
+    }
+};
+
+/// A vertex ready for the scan converter: pixel coordinates and the attribute interpolated
+/// linearly in screen space (depth for the stereographic and parallel projections, 1/depth
+/// for a hemicube face).
+struct raster_vertex {
+    glm::vec2 pixel;
+    float attribute;
+};
+
+/// Draws one triangle into `buffer` with id `id`: fixed-point edge functions (8 bits of
+/// sub-pixel precision, vertices within +-2^20 pixels), top-left rule, nearest depth wins
+/// (ties keep the earlier triangle). With `reciprocal`, the attribute is 1/depth and the
+/// depth stored is its reciprocal (perspective-correct depth). Either winding is drawn.
+inline void scan_triangle(item_buffer& buffer, raster_vertex a, raster_vertex b, raster_vertex c, std::uint32_t id,
+                          bool reciprocal = false, int row_begin = 0, int row_end = std::numeric_limits<int>::max()) {
+    constexpr double sub = 256.0;
+    constexpr double limit = double(1 << 20);
+    const auto fixed = [&](glm::vec2 p, std::int64_t& x, std::int64_t& y) {
+        x = std::int64_t(std::llround(std::clamp(double(p.x), -limit, limit) * sub));
+        y = std::int64_t(std::llround(std::clamp(double(p.y), -limit, limit) * sub));
+    };
+    std::int64_t ax, ay, bx, by, cx, cy;
+    fixed(a.pixel, ax, ay);
+    fixed(b.pixel, bx, by);
+    fixed(c.pixel, cx, cy);
+    // Twice the signed area; orient counter-clockwise in (x right, y down) so inside is E >= 0.
+    std::int64_t area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);
+    if (area == 0) return;
+    if (area < 0) {
+        std::swap(bx, cx);
+        std::swap(by, cy);
+        std::swap(b, c);
+        area = -area;
+    }
+    const int x0 = std::max(0, int(std::floor(double(std::min({ax, bx, cx})) / sub)));
+    const int x1 = std::min(buffer.width - 1, int(std::ceil(double(std::max({ax, bx, cx})) / sub)));
+    const int y0 = std::max({0, row_begin, int(std::floor(double(std::min({ay, by, cy})) / sub))});
+    const int y1 = std::min({buffer.height - 1, row_end - 1, int(std::ceil(double(std::max({ay, by, cy})) / sub))});
+    if (x0 > x1 || y0 > y1) return;
+    // Edge (p -> q): E(s) = (q.x - p.x)(s.y - p.y) - (q.y - p.y)(s.x - p.x). With this
+    // orientation a left edge has q.y < p.y and a top edge q.y == p.y, q.x > p.x; other edges
+    // do not own the centres exactly on them (bias -1). The rule flips with the edge's
+    // direction, so of two triangles sharing an edge exactly one owns it.
+    struct edge {
+        std::int64_t dx, dy, px, py, bias;
+        std::int64_t at(std::int64_t sx, std::int64_t sy) const { return dx * (sy - py) - dy * (sx - px) + bias; }
+    };
+    const auto make = [](std::int64_t px, std::int64_t py, std::int64_t qx, std::int64_t qy) {
+        const std::int64_t dx = qx - px, dy = qy - py;
+        const bool owner = dy < 0 || (dy == 0 && dx > 0);
+        return edge{dx, dy, px, py, owner ? 0 : -1};
+    };
+    const edge e0 = make(bx, by, cx, cy), e1 = make(cx, cy, ax, ay), e2 = make(ax, ay, bx, by);
+    const double inv_area = 1.0 / double(area);
+    const std::int64_t half = std::int64_t(sub / 2), step = std::int64_t(sub);
+    for (int y = y0; y <= y1; ++y) {
+        const std::int64_t sy = std::int64_t(y) * step + half;
+        std::int64_t sx = std::int64_t(x0) * step + half;
+        std::int64_t w0 = e0.at(sx, sy), w1 = e1.at(sx, sy), w2 = e2.at(sx, sy);
+        for (int x = x0; x <= x1; ++x, w0 -= e0.dy * step, w1 -= e1.dy * step, w2 -= e2.dy * step) {
+            if ((w0 | w1 | w2) < 0) continue;
+            // Barycentric weights from the unbiased edge functions (the bias is 0 or -1).
+            const double l0 = double(w0 - e0.bias) * inv_area, l1 = double(w1 - e1.bias) * inv_area;
+            const double attr = l0 * a.attribute + l1 * b.attribute + (1.0 - l0 - l1) * c.attribute;
+            const float depth = reciprocal ? float(1.0 / attr) : float(attr);
+            const std::size_t i = std::size_t(y) * std::size_t(buffer.width) + std::size_t(x);
+            if (depth < buffer.depth[i]) {
+                buffer.depth[i] = depth;
+                buffer.id[i] = id;
+            }
+        }
+    }
+}
+
+namespace detail {
+
+/// A convex polygon of points in some 3D frame, clipped in place to dot(p, plane) >= offset.
+/// Intersection points are computed from the edge's endpoints in a canonical order, so the
+/// same edge clipped from its two triangles gives the same point bit for bit.
+inline void clip_polygon(std::vector<glm::vec3>& poly, glm::vec3 plane, float offset, std::vector<glm::vec3>& scratch) {
+    scratch.clear();
+    const std::size_t n = poly.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 a = poly[i], b = poly[(i + 1) % n];
+        const float da = glm::dot(a, plane) - offset, db = glm::dot(b, plane) - offset;
+        if (da >= 0.f) scratch.push_back(a);
+        if ((da >= 0.f) != (db >= 0.f)) {
+            const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
+            const glm::vec3 p = swap ? b : a, q = swap ? a : b;
+            const float dp = swap ? db : da, dq = swap ? da : db;
+            scratch.push_back(p + (q - p) * (dp / (dp - dq)));
+        }
+    }
+    poly.swap(scratch);
+}
+
+/// The point t of the way from a to b, with a and b taken in a canonical order so that a
+/// shared edge gives the same points from both of its triangles.
+inline glm::vec3 canonical_lerp(glm::vec3 a, glm::vec3 b, float t) {
+    if (t == 0.f) return a;  // the endpoints exactly, which a + (b - a) 1 need not give
+    if (t == 1.f) return b;
+    const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
+    return swap ? b + (a - b) * (1.f - t) : a + (b - a) * t;
+}
+
+}  // namespace detail
+
+/// The projections an item buffer can hold.
+enum class item_projection { stereographic, hemicube };
+
+/// Item-buffer visibility (see the file comment). Holds a copy of the scene's triangles
+/// (positions and chart) and the elements' positions and charts; one buffer per shot.
+class item_buffer_visibility {
+public:
+    struct options {
+        item_projection projection = item_projection::stereographic;
+        int resolution = 256;          ///< item buffer side, pixels (hemicube: per face; typical: 128-512)
+        float tolerance_px = 0.25f;    ///< largest sagitta of a tessellated edge, pixels (stereographic)
+        int max_tessellation = 32;     ///< cap on the n x n pieces of one triangle (power of two)
+        int parallel_resolution = 1024; ///< side of the directional light's buffer, pixels
+    };
+
+    /// Throws parameter_error on bad options or a scene the atlas was not built from.
+    item_buffer_visibility(const scene_view& scene, const lightmap_atlas& atlas, options opt)
+        : opt_(opt), atlas_(&atlas) {
+        require(opt.resolution >= 8 && opt.resolution <= 8192, "options.resolution", "must lie in [8, 8192]");
+        require(opt.projection != item_projection::hemicube || opt.resolution % 2 == 0, "options.resolution",
+                "a hemicube needs an even resolution (its side faces keep half the rows)");
+        require(opt.tolerance_px > 0.f && std::isfinite(opt.tolerance_px), "options.tolerance_px", "must be positive");
+        require(opt.max_tessellation >= 1 && opt.max_tessellation <= 256 &&
+                    (opt.max_tessellation & (opt.max_tessellation - 1)) == 0,
+                "options.max_tessellation", "must be a power of two in [1, 256]");
+        require(opt.parallel_resolution >= 8 && opt.parallel_resolution <= 16384, "options.parallel_resolution",
+                "must lie in [8, 16384]");
+        require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
+                "was not built from this scene (triangle counts differ)");
+        for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+            if (atlas.chart_of_triangle[t] == lightmap_atlas::none) continue;
+            const auto& tri = scene.triangles[t];
+            corners_.push_back({scene.positions[tri.x], scene.positions[tri.y], scene.positions[tri.z]});
+            triangle_chart_.push_back(atlas.chart_of_triangle[t]);
+        }
+        const auto [lo, hi] = scene.bounds();
+        lo_ = lo;
+        hi_ = hi;
+        diagonal_ = std::max(glm::length(hi - lo), 1e-30f);
+    }
+
+    void begin_shot(const shot_frame& s) {
+        shot_ = s;
+        if (s.parallel) {
+            draw_parallel();
+            return;
+        }
+        const auto tb = orthonormal_basis<float, glm::vec3>(s.axis);
+        t_ = tb[0];
+        b_ = tb[1];
+        if (opt_.projection == item_projection::stereographic) draw_stereographic();
+        else draw_hemicube();
+    }
+
+    /// 1 if element `e` is seen from the current shot, else 0.
+    float visible(std::size_t e) const {
+        const glm::vec3 p = atlas_->position[e];
+        const std::uint32_t chart = atlas_->chart[e];
+        if (shot_.parallel) {
+            const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, glm::vec3(0.f), t_, b_, shot_.axis);
+            const int x = pixel_of((l.x - ortho_lo_.x) * ortho_scale_, buffers_[0].width);
+            const int y = pixel_of((l.y - ortho_lo_.y) * ortho_scale_, buffers_[0].height);
+            return seen(buffers_[0], x, y, chart, l.z, true) ? 1.f : 0.f;
+        }
+        const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, shot_.position, t_, b_, shot_.axis);
+        if (opt_.projection == item_projection::stereographic) {
+            const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
+            const item_buffer& buf = buffers_[0];
+            return seen(buf, pixel_of(uv.x * float(buf.width), buf.width), pixel_of(uv.y * float(buf.height), buf.height),
+                        chart, glm::length(l), false)
+                       ? 1.f
+                       : 0.f;
+        }
+        const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
+        const int face = std::clamp(int(f.x + 0.5f), 0, 4);
+        const item_buffer& buf = buffers_[std::size_t(face)];
+        // The element's depth on this face: its component along the face's forward axis.
+        const float depth = glm::dot(l, face_axes(face)[2]);
+        return seen(buf, pixel_of(f.y * float(buf.width), buf.width), pixel_of(f.z * float(buf.height), buf.height),
+                    chart, depth, false)
+                   ? 1.f
+                   : 0.f;
+    }
+
+    /// The buffers of the last shot: one (stereographic, parallel) or five (hemicube faces,
+    /// top then +x, -x, +y, -y).
+    std::span<const item_buffer> buffers() const noexcept {
+        return {buffers_.data(), shot_.parallel || opt_.projection == item_projection::stereographic ? 1u : 5u};
+    }
+    /// Sub-triangles drawn in the last shot (tessellation included).
+    std::size_t drawn_triangles() const noexcept { return drawn_; }
+    const options& settings() const noexcept { return opt_; }
+
+    /// The hemicube face frames (right, up, forward) of radiosity.hpp's table.
+    static std::array<glm::vec3, 3> face_axes(int face) {
+        switch (face) {
+            case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};
+            case 2: return {glm::vec3(0, -1, 0), glm::vec3(0, 0, 1), glm::vec3(-1, 0, 0)};
+            case 3: return {glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 1, 0)};
+            case 4: return {glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)};
+            default: return {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
+        }
+    }
+
+private:
+    static int pixel_of(float coord, int size) { return std::clamp(int(std::floor(coord)), 0, size - 1); }
+
+    bool seen(const item_buffer& buf, int x, int y, std::uint32_t chart, float depth, bool parallel) const {
+        const std::size_t i = std::size_t(y) * std::size_t(buf.width) + std::size_t(x);
+        if (buf.id[i] == chart) return true;
+        // Parallel depths are signed distances along the light; the rest are positive.
+        const float slack = 1e-3f * (parallel ? diagonal_ : std::abs(depth)) + 1e-5f * diagonal_;
+        return buf.depth[i] >= depth - slack;
+    }
+
+    // Local-frame corners of every triangle (the shooter's chart left out), in `local_`.
+    void to_local() {
+        local_.clear();
+        local_chart_.clear();
+        for (std::size_t k = 0; k < corners_.size(); ++k) {
+            if (triangle_chart_[k] == shot_.chart) continue;
+            std::array<glm::vec3, 3> l;
+            for (int m = 0; m < 3; ++m)
+                l[std::size_t(m)] =
+                    to_shooter_frame<float, glm::vec3>(corners_[k][std::size_t(m)], shot_.position, t_, b_, shot_.axis);
+            local_.push_back(l);
+            local_chart_.push_back(triangle_chart_[k]);
+        }
+    }
+
+    void draw_stereographic() {
+        item_buffer& buf = buffers_[0];
+        buf.reset(opt_.resolution, opt_.resolution);
+        to_local();
+        drawn_ = 0;
+        const float res = float(opt_.resolution);
+        const auto project = [&](glm::vec3 l) {
+            const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
+            return raster_vertex{uv * res, glm::length(l)};
+        };
+        // Clip just above the shooter's plane: a surface through the shooter's centre sees it
+        // edge-on and neither occludes nor is seen.
+        const float z_min = 1e-6f * diagonal_;
+        std::vector<glm::vec3> poly, scratch;
+        for (std::size_t k = 0; k < local_.size(); ++k) {
+            poly.assign(local_[k].begin(), local_[k].end());
+            detail::clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
+            for (std::size_t f = 1; f + 1 < poly.size(); ++f)
+                draw_tessellated(buf, poly[0], poly[f], poly[f + 1], local_chart_[k], project);
+        }
+    }
+
+    template <class Project>
+    void draw_tessellated(item_buffer& buf, glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t id,
+                          const Project& project) {
+        // Sagitta of each edge in pixels; pieces n with sagitta / n^2 <= tolerance.
+        const auto sagitta = [&](glm::vec3 p, glm::vec3 q) {
+            const glm::vec2 mid = project(detail::canonical_lerp(p, q, 0.5f)).pixel;
+            return glm::length(mid - 0.5f * (project(p).pixel + project(q).pixel));
+        };
+        const float s = std::max({sagitta(a, b), sagitta(b, c), sagitta(c, a)});
+        int n = 1;
+        while (n < opt_.max_tessellation && s / float(n * n) > opt_.tolerance_px) n *= 2;
+        // Grid points: on the edges from canonical_lerp (shared with the neighbours), inside
+        // from barycentric combinations.
+        const auto point = [&](int i, int j) {
+            // i along a->b, j along a->c, i + j <= n.
+            if (j == 0) return detail::canonical_lerp(a, b, float(i) / float(n));
+            if (i == 0) return detail::canonical_lerp(a, c, float(j) / float(n));
+            if (i + j == n) return detail::canonical_lerp(b, c, float(j) / float(n));
+            const float u = float(i) / float(n), v = float(j) / float(n);
+            return a * (1.f - u - v) + b * u + c * v;
+        };
+        std::vector<raster_vertex> row0(std::size_t(n) + 1), row1(std::size_t(n) + 1);
+        for (int i = 0; i <= n; ++i) row0[std::size_t(i)] = project(point(i, 0));
+        for (int j = 0; j < n; ++j) {
+            for (int i = 0; i + j + 1 <= n; ++i) row1[std::size_t(i)] = project(point(i, j + 1));
+            for (int i = 0; i + j < n; ++i) {
+                scan_triangle(buf, row0[std::size_t(i)], row0[std::size_t(i) + 1], row1[std::size_t(i)], id);
+                ++drawn_;
+                if (i + j + 1 < n) {
+                    scan_triangle(buf, row0[std::size_t(i) + 1], row1[std::size_t(i) + 1], row1[std::size_t(i)], id);
+                    ++drawn_;
+                }
+            }
+            row0.swap(row1);
+        }
+    }
+
+    void draw_hemicube() {
+        to_local();
+        const int res = opt_.resolution;
+        std::array<std::size_t, 5> counts{};
+        // Faces are independent: one task each, so the result does not depend on threads.
+        tbb::parallel_for(0, 5, [&](int face) {
+            item_buffer& buf = buffers_[std::size_t(face)];
+            buf.reset(res, face == 0 ? res : res / 2);
+            const auto axes = face_axes(face);
+            // Clip to the face's frustum widened by two pixels (so no covered centre is lost),
+            // and in front of the near plane; side faces keep the half above the horizon.
+            const float near_z = 1e-6f * diagonal_;
+            const float k = 1.f + 4.f / float(res);
+            std::vector<glm::vec3> poly, scratch;
+            for (std::size_t t = 0; t < local_.size(); ++t) {
+                poly.clear();
+                for (const glm::vec3& l : local_[t])
+                    poly.emplace_back(glm::dot(l, axes[0]), glm::dot(l, axes[1]), glm::dot(l, axes[2]));
+                detail::clip_polygon(poly, glm::vec3(0, 0, 1), near_z, scratch);
+                detail::clip_polygon(poly, glm::vec3(-1, 0, k), 0.f, scratch);
+                detail::clip_polygon(poly, glm::vec3(1, 0, k), 0.f, scratch);
+                detail::clip_polygon(poly, glm::vec3(0, -1, k), 0.f, scratch);
+                detail::clip_polygon(poly, glm::vec3(0, 1, face == 0 ? k : 4.f / float(res)), 0.f, scratch);
+                if (poly.size() < 3) continue;
+                const auto project = [&](glm::vec3 q) {
+                    const float s = q.x / q.z, tt = q.y / q.z;
+                    const float v = face == 0 ? tt * 0.5f + 0.5f : tt;
+                    return raster_vertex{glm::vec2((s * 0.5f + 0.5f) * float(res), v * float(buf.height)), 1.f / q.z};
+                };
+                for (std::size_t f = 1; f + 1 < poly.size(); ++f) {
+                    scan_triangle(buf, project(poly[0]), project(poly[f]), project(poly[f + 1]), local_chart_[t], true);
+                    ++counts[std::size_t(face)];
+                }
+            }
+        });
+        drawn_ = counts[0] + counts[1] + counts[2] + counts[3] + counts[4];
+    }
+
+    void draw_parallel() {
+        // Orthographic view along the light: the scene's bounding box projected across it.
+        const auto tb = orthonormal_basis<float, glm::vec3>(shot_.axis);
+        t_ = tb[0];
+        b_ = tb[1];
+        glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        for (int m = 0; m < 8; ++m) {
+            const glm::vec3 corner((m & 1) ? hi_.x : lo_.x, (m & 2) ? hi_.y : lo_.y, (m & 4) ? hi_.z : lo_.z);
+            const glm::vec2 q(glm::dot(corner, t_), glm::dot(corner, b_));
+            lo = glm::min(lo, q);
+            hi = glm::max(hi, q);
+        }
+        const int res = opt_.parallel_resolution;
+        const float side = std::max(std::max(hi.x - lo.x, hi.y - lo.y), 1e-30f) * (1.f + 2.f / float(res));
+        ortho_lo_ = 0.5f * (lo + hi) - glm::vec2(0.5f * side);
+        ortho_scale_ = float(res) / side;
+        item_buffer& buf = buffers_[0];
+        buf.reset(res, res);
+        drawn_ = 0;
+        for (std::size_t k = 0; k < corners_.size(); ++k) {
+            std::array<raster_vertex, 3> v;
+            for (int m = 0; m < 3; ++m) {
+                const glm::vec3 p = corners_[k][std::size_t(m)];
+                v[std::size_t(m)] = {(glm::vec2(glm::dot(p, t_), glm::dot(p, b_)) - ortho_lo_) * ortho_scale_,
+                                     glm::dot(p, shot_.axis)};
+            }
+            scan_triangle(buf, v[0], v[1], v[2], triangle_chart_[k]);
+            ++drawn_;
+        }
+    }
+
+    options opt_;
+    const lightmap_atlas* atlas_;
+    std::vector<std::array<glm::vec3, 3>> corners_;
+    std::vector<std::uint32_t> triangle_chart_;
+    std::vector<std::array<glm::vec3, 3>> local_;
+    std::vector<std::uint32_t> local_chart_;
+    glm::vec3 lo_{0.f}, hi_{0.f};
+    float diagonal_ = 1.f;
+    shot_frame shot_{};
+    glm::vec3 t_{1, 0, 0}, b_{0, 1, 0};
+    glm::vec2 ortho_lo_{0.f};
+    float ortho_scale_ = 1.f;
+    std::array<item_buffer, 5> buffers_{};
+    std::size_t drawn_ = 0;
+};
+
+}  // namespace bounce::cpu

@@ -1,0 +1,317 @@
+// The CPU progressive radiosity solver: its converged answer against a dense solve of
+// (I - rho F) B = E with the same form factors, energy bookkeeping after every step, lights,
+// thread-count independence and bad input.
+#include "radiosity_scenes.hpp"
+#include "ray_cast_visibility.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+
+#include <catch2/catch.hpp>
+#include <tbb/task_arena.h>
+
+#include <cmath>
+#include <numbers>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+namespace {
+
+// Solves A x = b in place by Gaussian elimination with partial pivoting (double).
+std::vector<double> dense_solve(std::vector<double> a, std::vector<double> b) {
+    const std::size_t n = b.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        std::size_t p = k;
+        for (std::size_t i = k + 1; i < n; ++i)
+            if (std::abs(a[i * n + k]) > std::abs(a[p * n + k])) p = i;
+        if (p != k) {
+            for (std::size_t j = 0; j < n; ++j) std::swap(a[k * n + j], a[p * n + j]);
+            std::swap(b[k], b[p]);
+        }
+        for (std::size_t i = k + 1; i < n; ++i) {
+            const double m = a[i * n + k] / a[k * n + k];
+            for (std::size_t j = k; j < n; ++j) a[i * n + j] -= m * a[k * n + j];
+            b[i] -= m * b[k];
+        }
+    }
+    for (std::size_t k = n; k-- > 0;) {
+        for (std::size_t j = k + 1; j < n; ++j) b[k] -= a[k * n + j] * b[j];
+        b[k] /= a[k * n + k];
+    }
+    return b;
+}
+
+// The dense reference: B_i = E_i + rho_i sum_j F_{i->j} V_ij B_j with the solver's own kernel
+// (double, from the atlas's float geometry) and the visibility V_ij the method gives with
+// element j as shooter; one solve per channel.
+template <class Visibility>
+std::vector<glm::dvec3> dense_radiosity(const lightmap_atlas& atlas, Visibility& vis) {
+    const std::size_t n = atlas.size();
+    std::vector<double> f(n * n, 0.0);
+    for (std::size_t j = 0; j < n; ++j) {
+        vis.begin_shot({atlas.position[j], atlas.normal[j], false, atlas.chart[j]});
+        for (std::size_t i = 0; i < n; ++i) {
+            const double fij = disc_form_factor<double, glm::dvec3>(glm::dvec3(atlas.position[i]), glm::dvec3(atlas.normal[i]),
+                                                                    glm::dvec3(atlas.position[j]), glm::dvec3(atlas.normal[j]),
+                                                                    double(atlas.area[j]));
+            if (fij > 0) f[i * n + j] = fij * double(vis.visible(i));
+        }
+    }
+    std::vector<glm::dvec3> out(n);
+    for (int c = 0; c < 3; ++c) {
+        std::vector<double> a(n * n), b(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t j = 0; j < n; ++j) a[i * n + j] = (i == j ? 1.0 : 0.0) - double(atlas.albedo[i][c]) * f[i * n + j];
+            b[i] = atlas.emission[i][c];
+        }
+        const auto x = dense_solve(a, b);
+        for (std::size_t i = 0; i < n; ++i) out[i][c] = x[i];
+    }
+    return out;
+}
+
+template <class Solver>
+double worst_relative(const Solver& solver, const std::vector<glm::dvec3>& reference) {
+    double worst = 0;
+    const auto b = solver.radiosity();
+    for (std::size_t i = 0; i < reference.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            if (reference[i][c] > 0) worst = std::max(worst, std::abs(double(b[i][c]) - reference[i][c]) / reference[i][c]);
+    return worst;
+}
+
+}  // namespace
+
+TEST_CASE("converged progressive radiosity equals the dense solve of (I - rho F) B = E", "[radiosity][solver]") {
+    // Shooting is Southwell iteration on the same linear system (Gortler et al. 1993), so run
+    // to an unshot fraction of 1e-13 in double it matches the direct solve to about 1e-12:
+    // the issue asks for 1e-5.
+    const auto box = closed_box(1.f, 0.8f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 150, .block_texels = 1});
+    cpu::all_visible none;
+    const auto reference = dense_radiosity(atlas, none);
+    cpu::progressive_radiosity<cpu::all_visible, double> solver(box.view(), atlas, {}, {.shoot_blocks = false});
+    solver.solve(1e-13);
+    INFO(solver.progress().shots << " shots");
+    CHECK(worst_relative(solver, reference) < 1e-5);
+    CHECK(solver.unshot_fraction() <= 1e-13);
+}
+
+TEST_CASE("with occlusion, the converged solution equals the dense solve with the same visibility",
+          "[radiosity][solver]") {
+    // The Cornell box (boxes occluding) with item-buffer visibility: the dense system takes
+    // V_ij from the very item buffers the solver uses, so the two must agree as above.
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 250, .block_texels = 1});
+    cpu::item_buffer_visibility vis(scene.view(), atlas, {.resolution = 128});
+    const auto reference = dense_radiosity(atlas, vis);
+    cpu::progressive_radiosity<cpu::item_buffer_visibility, double> solver(scene.view(), atlas, vis,
+                                                                           {.shoot_blocks = false});
+    solver.solve(1e-13);
+    CHECK(worst_relative(solver, reference) < 1e-5);
+}
+
+TEST_CASE("in float, the converged solution is within the accumulated rounding of the dense solve",
+          "[radiosity][solver]") {
+    // Each element's float radiosity is a sum of at most `shots` positive terms, each the
+    // float kernel's value (a few ulps from the double one): relative error at most about
+    // (shots + 8) 2^-24, plus the unshot remainder 1e-7 of the emitted power.
+    const auto box = closed_box(1.f, 0.8f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 150, .block_texels = 1});
+    cpu::all_visible none;
+    const auto reference = dense_radiosity(atlas, none);
+    cpu::progressive_radiosity<cpu::all_visible, float> solver(box.view(), atlas, {}, {.shoot_blocks = false});
+    solver.solve(1e-7);
+    const double shots = double(solver.progress().shots);
+    const double bound = (shots + 8) * 0x1p-24 + 1e-7 / (1 - 0.8) * 10;
+    INFO(shots << " shots, bound " << bound);
+    CHECK(worst_relative(solver, reference) < bound);
+}
+
+TEST_CASE("absorbed + unshot + escaped power equals emitted power after every step", "[radiosity][solver][energy]") {
+    // The solver's float arrays round each update to 2^-24 relative; the unshot power is
+    // recomputed from them, so the balance holds to (steps + 2) 2^-24 of the emitted power
+    // per element touched, which over the whole sum is still (steps + 2) 2^-24 relative.
+    const auto check_balance = [](auto& solver, int steps) {
+        for (int s = 0; s < steps && solver.step(); ++s) {
+            const glm::dvec3 e = solver.emitted_power();
+            const glm::dvec3 sum = solver.absorbed_power() + solver.unshot_power() + solver.escaped_power();
+            for (int c = 0; c < 3; ++c) CHECK(std::abs(sum[c] - e[c]) <= (s + 3) * 0x1p-24 * e[c] * 4);
+        }
+    };
+    SECTION("Cornell box, emitting light quad, stereographic item buffer, blocks") {
+        const auto scene = cornell_box();
+        const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 2000});
+        cpu::progressive_radiosity solver(scene.view(), atlas,
+                                          cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 128}));
+        check_balance(solver, 200);
+        CHECK(solver.emitted_power().x > 0);
+    }
+    SECTION("Cornell box, spot light of its scene.json, hemicube") {
+        const auto scene = cornell_box(true);
+        const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 2000});
+        cpu::progressive_radiosity solver(
+            scene.view(), atlas,
+            cpu::item_buffer_visibility(scene.view(), atlas, {.projection = cpu::item_projection::hemicube, .resolution = 64}),
+            {.shooters_per_step = 4});
+        check_balance(solver, 100);
+        CHECK(solver.emitted_power().x > 0);
+    }
+    SECTION("two facing squares: an open scene loses power, never gains it") {
+        // Far apart (gap 4 x side), the disc form factors sum to less than 1: what is not
+        // intercepted escapes, so escaped power is positive and grows.
+        const auto scene = facing_squares(1.f, 4.f, 0.5f, 1.f);
+        const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 200});
+        cpu::progressive_radiosity solver(scene.view(), atlas, cpu::all_visible{});
+        // The emitted power is pi L A: L = 1, A = 1.
+        CHECK(solver.emitted_power().x == Approx(std::numbers::pi).epsilon(1e-6));
+        check_balance(solver, 50);
+        CHECK(solver.escaped_power().x > 0);
+    }
+}
+
+TEST_CASE("a point light gives each element rho times the inverse-square cosine law", "[radiosity][solver][lights]") {
+    // One floor quad under a point light, nothing else: after the light's shot (in the
+    // constructor) each element's radiosity is rho I cos / d^2 at its centroid, as the kernel
+    // of lights.hpp gives it; the item buffer sees every element of an unoccluded floor.
+    owned_scene s;
+    s.use_emission = false;
+    const auto m = s.add_material(glm::vec3(0.5f, 0.25f, 1.f));
+    s.add_quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, m);
+    s.lights.push_back(point_light{{0.2f, 1.f, 0.1f}, glm::vec3(4.f)});
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 400});
+    cpu::progressive_radiosity solver(s.view(), atlas, cpu::item_buffer_visibility(s.view(), atlas, {}));
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+        const glm::vec3 e = point_light_irradiance<float, glm::vec3>(atlas.position[i], atlas.normal[i],
+                                                                      {0.2f, 1.f, 0.1f}, glm::vec3(4.f));
+        CHECK(solver.radiosity()[i].x == Approx(0.5f * e.x).epsilon(1e-6));
+        CHECK(solver.radiosity()[i].y == Approx(0.25f * e.y).epsilon(1e-6));
+    }
+}
+
+TEST_CASE("a directional light leaves the shadow of a blocker dark", "[radiosity][solver][lights]") {
+    // Light straight down onto a floor of side 2; a blocker square of side 1 above its middle
+    // (facing up). Elements whose centroid is more than 2 buffer pixels inside the blocker's
+    // shadow get nothing; those more than 2 pixels outside get rho E.
+    owned_scene s;
+    s.use_emission = false;
+    const auto m = s.add_material(glm::vec3(0.5f));
+    s.add_quad({-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, m);
+    s.add_quad({-0.5f, 0.5f, -0.5f}, {-0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, 0.5f}, {0.5f, 0.5f, -0.5f}, m);
+    s.lights.push_back(directional_light{{0, -1, 0}, glm::vec3(2.f)});
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 800});
+    const int res = 512;
+    cpu::progressive_radiosity solver(s.view(), atlas, cpu::item_buffer_visibility(s.view(), atlas, {.parallel_resolution = res}));
+    const float pixel = 2.f * (1.f + 2.f / res) / res;  // the buffer spans the box's 2 m plus a margin
+    int dark = 0, lit = 0;
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+        const glm::vec3 p = atlas.position[i];
+        if (p.y > 0.1f) continue;  // the blocker itself
+        const float inside = std::max(std::abs(p.x), std::abs(p.z));
+        if (inside < 0.5f - 2 * pixel) {
+            CHECK(solver.radiosity()[i].x == 0.f);
+            ++dark;
+        } else if (inside > 0.5f + 2 * pixel) {
+            CHECK(solver.radiosity()[i].x == Approx(1.f).epsilon(1e-6));
+            ++lit;
+        }
+    }
+    CHECK(dark > 50);
+    CHECK(lit > 50);
+}
+
+TEST_CASE("results do not depend on the number of threads", "[radiosity][solver]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 3000});
+    const auto run = [&](int threads) {
+        tbb::task_arena arena(threads);
+        std::vector<glm::vec3> out;
+        arena.execute([&] {
+            cpu::progressive_radiosity solver(scene.view(), atlas,
+                                              cpu::item_buffer_visibility(scene.view(), atlas,
+                                                                          {.projection = cpu::item_projection::hemicube,
+                                                                           .resolution = 64}));
+            for (int s = 0; s < 40; ++s) solver.step();
+            out.assign(solver.radiosity().begin(), solver.radiosity().end());
+            out.push_back(glm::vec3(solver.escaped_power()));
+        });
+        return out;
+    };
+    const auto one = run(1), two = run(2), four = run(4);
+    CHECK(one == two);
+    CHECK(one == four);
+}
+
+TEST_CASE("several shooters per step converge to the same solution", "[radiosity][solver]") {
+    const auto box = closed_box(1.f, 0.7f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 200, .block_texels = 2});
+    cpu::progressive_radiosity<cpu::all_visible, double> one(box.view(), atlas, {}, {.shooters_per_step = 1});
+    cpu::progressive_radiosity<cpu::all_visible, double> eight(box.view(), atlas, {}, {.shooters_per_step = 8});
+    one.solve(1e-12);
+    eight.solve(1e-12);
+    for (std::size_t i = 0; i < atlas.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            CHECK(eight.radiosity()[i][c] == Approx(one.radiosity()[i][c]).epsilon(1e-9));
+    CHECK(eight.progress().steps < one.progress().steps);
+}
+
+TEST_CASE("solve stops at the fraction asked, reporting the unshot fraction after each step", "[radiosity][solver]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 1000});
+    cpu::progressive_radiosity solver(scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 128}));
+    std::vector<double> fractions;
+    solver.solve(0.1, [&](const cpu::radiosity_progress& p) {
+        fractions.push_back(p.unshot_fraction);
+        return true;
+    });
+    REQUIRE(!fractions.empty());
+    CHECK(fractions.back() <= 0.1);
+    for (std::size_t k = 0; k + 1 < fractions.size(); ++k) CHECK(fractions[k] > 0.1);
+    CHECK(solver.unshot_fraction() == fractions.back());
+    // A callback that says stop stops after one step.
+    const std::size_t taken = solver.solve(0.01, [](const cpu::radiosity_progress&) { return false; });
+    CHECK(taken == 1);
+}
+
+TEST_CASE("the ambient term brightens the display before convergence and vanishes after", "[radiosity][solver]") {
+    const auto box = closed_box(1.f, 0.7f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 100, .block_texels = 1});
+    cpu::progressive_radiosity<cpu::all_visible, double> solver(box.view(), atlas, {}, {.ambient = true});
+    solver.step();
+    const auto early = solver.display_radiosity();
+    const glm::dvec3 amb = solver.ambient();
+    CHECK(amb.x > 0);
+    for (std::size_t i = 0; i < atlas.size(); ++i)
+        CHECK(double(early[i].x) == Approx(solver.radiosity()[i].x + atlas.albedo[i].x * amb.x).epsilon(1e-6));
+    solver.solve(1e-14);
+    CHECK(glm::length(solver.ambient()) < 1e-12);
+    // The lightmap holds the display radiosity at each element's texel.
+    const auto lm = solver.lightmap();
+    const auto shown = solver.display_radiosity();
+    for (std::size_t i = 0; i < atlas.size(); ++i) CHECK(lm(atlas.texel[i].x, atlas.texel[i].y) == shown[i]);
+}
+
+TEST_CASE("bad solver input raises parameter_error naming it", "[radiosity][solver][errors]") {
+    const auto box = closed_box(1.f, 0.7f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 100});
+    try {
+        cpu::progressive_radiosity solver(box.view(), atlas, cpu::all_visible{}, {.shooters_per_step = 0});
+        FAIL("no exception");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "radiosity_options.shooters_per_step");
+    }
+    cpu::progressive_radiosity solver(box.view(), atlas, cpu::all_visible{});
+    try {
+        solver.solve(1.5);
+        FAIL("no exception");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "fraction");
+    }
+    const auto other = cornell_box();
+    try {
+        cpu::progressive_radiosity wrong(other.view(), atlas, cpu::all_visible{});
+        FAIL("no exception");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "atlas");
+    }
+}
