@@ -1,0 +1,261 @@
+#pragma once
+/// \file indirect_renderer.hpp
+/// One frame of one-bounce indirect irradiance from reflective shadow maps on the CPU, by
+/// the RSM gather (DS05) or by splatting indirect illumination (DS06), optionally
+/// interleaved (Segovia et al. 2006) and energy-correct (docs/rsm-sii-interleaved.md):
+///
+///   split G-buffer -> shade each sub-buffer with its light subset -> gather -> blur
+///   (the RSM gather may also run at 1/f resolution, then upsample with fallback)
+///
+/// A renderer keeps one `indirect_renderer` and calls `render` per frame with views of its
+/// own G-buffer and reflective shadow maps; scratch buffers are kept between frames and
+/// reallocated only when the size changes. The result is irradiance (W/m^2 per channel);
+/// outgoing radiance is rho_d / pi times it (lambertian_radiance).
+
+#include <bounce/camera.hpp>
+#include <bounce/cpu/interleave.hpp>
+#include <bounce/cpu/rsm_gather.hpp>
+#include <bounce/cpu/sii_splat.hpp>
+#include <bounce/gbuffer.hpp>
+#include <bounce/interleaved_sampling.hpp>
+#include <bounce/vpl_sampling.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <span>
+#include <vector>
+
+namespace bounce::cpu {
+
+enum class indirect_technique {
+    rsm_gather,  ///< every pixel gathers a disc of map texels (DS05)
+    sii,         ///< every VPL is splatted over its screen bounds (DS06)
+};
+
+enum class vpl_selection {
+    grid,          ///< texels on a regular grid (seed 002 section 4.1.2)
+    flux_warping,  ///< hierarchical importance warping on the flux (DS06 section 3.3)
+};
+
+/// What `indirect_renderer` does per frame.
+struct indirect_options {
+    indirect_technique technique = indirect_technique::sii;
+    /// SII: VPLs per frame over all maps; RSM gather: disc samples per pixel and map before
+    /// interleaving (each sub-buffer uses count / (N M)). Typical: 400-4096.
+    std::size_t count = 1024;
+    interleave_pattern pattern{4, 4};  ///< 1 x 1: no interleaving (typical: 4 x 4, 8 x 8)
+    light_assignment assignment = light_assignment::interleaved;
+    int shift = 0;      ///< relabelling of the sub-buffers (assign_lights), in [0, N M); 0 normally
+    bool blur = true;   ///< geometry-aware tent over the gathered buffer (only when interleaved)
+    discontinuity_params discontinuity;
+    vpl_selection selection = vpl_selection::flux_warping;  ///< SII only
+    float r_max = 1.5f;            ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
+    pixel_light_params light;      ///< singularity remedies (rsm.hpp)
+    float sii_cutoff = 0.f;        ///< SII splat cutoff, W/m^2 (sii_params::cutoff); 0: whole screen
+    int low_resolution = 1;        ///< RSM gather at 1/f resolution with upsampling (f in 1..8)
+    upsample_params upsample;
+    std::uint64_t seed = 1;        ///< disc pattern and VPL sampling
+
+    void validate() const {
+        require(count > 0 && count <= (std::size_t(1) << 24), "count", "must lie in [1, 2^24]");
+        pattern.validate();
+        require(shift >= 0 && shift < pattern.cells(), "shift", "must lie in [0, N M)");
+        discontinuity.validate();
+        require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
+        light.validate();
+        require(std::isfinite(sii_cutoff) && sii_cutoff >= 0.f, "sii_cutoff", "must be finite and >= 0");
+        require(low_resolution >= 1 && low_resolution <= 8, "low_resolution", "must lie in [1, 8]");
+        require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
+                "applies to the RSM gather only");
+    }
+};
+
+/// Per-stage wall-clock times of one frame (milliseconds) and its counts.
+struct indirect_timings {
+    double split_ms = 0;     ///< G-buffer split into sub-buffers (and downsampling)
+    double shade_ms = 0;     ///< VPL selection and the gather or splat on the sub-buffers
+    double gather_ms = 0;    ///< sub-buffers back to image order
+    double blur_ms = 0;      ///< discontinuity buffer and geometry-aware blur
+    double upsample_ms = 0;  ///< low-resolution upsampling with full-resolution fallback
+    std::size_t vpls = 0;    ///< SII: VPLs splatted; RSM gather: disc samples per pixel and map
+    std::size_t fallback_pixels = 0;  ///< pixels the upsampling gathered at full resolution
+    double total_ms() const noexcept { return split_ms + shade_ms + gather_ms + blur_ms + upsample_ms; }
+};
+
+class indirect_renderer {
+public:
+    explicit indirect_renderer(const indirect_options& options = {}) : options_(options) { options_.validate(); }
+
+    const indirect_options& options() const noexcept { return options_; }
+
+    /// Fills `irradiance` (the G-buffer's size) with the one-bounce indirect irradiance that
+    /// `maps` (one per spot or directional light, six per point light) reflect onto the
+    /// G-buffer's pixels, unoccluded; 0 where the G-buffer sees nothing.
+    indirect_timings render(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
+                            image_view<glm::vec3> irradiance) {
+        cam.validate();
+        require(irradiance.width() == gb.width() && irradiance.height() == gb.height(), "irradiance",
+                "size differs from the G-buffer");
+        require(!gb.depth.empty(), "gb", "is empty");
+        for (const auto& m : maps) m.validate();
+        indirect_timings t;
+        const int f = options_.low_resolution;
+        if (f == 1) {
+            frame(gb, cam, maps, irradiance, full_, t);
+            return t;
+        }
+        auto start = clock::now();
+        const std::size_t lw = (gb.width() + std::size_t(f) - 1) / std::size_t(f);
+        const std::size_t lh = (gb.height() + std::size_t(f) - 1) / std::size_t(f);
+        if (low_gb_.width() != lw || low_gb_.height() != lh) {
+            low_gb_ = gbuffer<float>(lw, lh);
+            low_irradiance_ = image<glm::vec3>(lw, lh);
+        }
+        downsample_gbuffer(gb, f, low_gb_.view());
+        t.split_ms += ms_since(start);
+        frame(low_gb_.view(), cam, maps, low_irradiance_.view(), low_, t);
+        start = clock::now();
+        t.fallback_pixels = upsample_or_gather(gb, cam, low_gb_.view(), low_irradiance_.view(), f, options_.upsample,
+                                               maps, full_pattern_, options_.light, irradiance);
+        t.upsample_ms = ms_since(start);
+        return t;
+    }
+
+private:
+    using clock = std::chrono::steady_clock;
+    static double ms_since(clock::time_point s) {
+        return std::chrono::duration<double, std::milli>(clock::now() - s).count();
+    }
+
+    /// Scratch of one resolution.
+    struct buffers {
+        interleave_maps maps;
+        gbuffer<float> split_gb;
+        image<glm::vec3> split_out, gathered, scratch;
+        image<glm::vec2> edges;
+    };
+
+    void frame(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
+               image_view<glm::vec3> out, buffers& b, indirect_timings& t) {
+        const interleave_pattern& p = options_.pattern;
+        const bool interleaved = p.cells() > 1;
+        const std::size_t w = gb.width(), h = gb.height();
+        auto start = clock::now();
+        if (b.maps.width != w || b.maps.height != h || b.maps.pattern.n != p.n || b.maps.pattern.m != p.m) {
+            b.maps = interleave_maps(p, w, h);
+            if (interleaved) {
+                b.split_gb = gbuffer<float>(w, h);
+                b.split_out = image<glm::vec3>(w, h);
+                b.gathered = image<glm::vec3>(w, h);
+                b.scratch = image<glm::vec3>(w, h);
+                b.edges = image<glm::vec2>(w, h);
+            }
+        }
+        gbuffer_view<float> shaded_gb = gb;
+        image_view<glm::vec3> shaded_out = out;
+        if (interleaved) {
+            split_gbuffer(gb, b.split_gb.view(), b.maps);
+            shaded_gb = b.split_gb.view();
+            shaded_out = b.split_out.view();
+        }
+        t.split_ms += ms_since(start);
+
+        start = clock::now();
+        if (options_.technique == indirect_technique::rsm_gather) shade_gather(shaded_gb, maps, b.maps, shaded_out, t);
+        else shade_splat(shaded_gb, cam, maps, b.maps, shaded_out, t);
+        t.shade_ms += ms_since(start);
+        if (!interleaved) return;
+
+        start = clock::now();
+        image_view<glm::vec3> gathered = options_.blur ? b.gathered.view() : out;
+        gather_image<glm::vec3>(b.split_out.view(), gathered, b.maps);
+        t.gather_ms += ms_since(start);
+        if (!options_.blur) return;
+        start = clock::now();
+        discontinuity_buffer(gb, options_.discontinuity, b.edges.view());
+        geometry_aware_blur(b.gathered.view(), b.edges.view(), gb.depth, p, b.scratch.view(), out);
+        t.blur_ms += ms_since(start);
+    }
+
+    void shade_gather(const gbuffer_view<float>& gb, std::span<const rsm_view> maps, const interleave_maps& imaps,
+                      image_view<glm::vec3> out, indirect_timings& t) {
+        t.vpls = options_.count;
+        if (maps.empty()) {
+            fill_zero(out);
+            return;
+        }
+        // One pattern for every map, sized for the first (maps of one light share a size).
+        const std::size_t texels = maps[0].width() * maps[0].height();
+        if (full_pattern_.size() != options_.count || pattern_texels_ != texels) {
+            full_pattern_ = rsm_disc_pattern(options_.count, options_.r_max, texels, options_.seed);
+            pattern_texels_ = texels;
+        }
+        const light_groups g = assign_lights(full_pattern_.size(), imaps.pattern.cells(), light_assignment::interleaved,
+                                             {}, options_.shift);
+        const auto grouped = grouped_pattern(full_pattern_, g);
+        rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out);
+    }
+
+    void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
+                     const interleave_maps& imaps, image_view<glm::vec3> out, indirect_timings& t) {
+        vpls_.clear();
+        std::vector<double> totals;
+        double sum = 0;
+        for (const auto& m : maps) {
+            totals.push_back(flux_warping(m).total());
+            sum += totals.back();
+        }
+        for (std::size_t i = 0; i < maps.size(); ++i) {
+            if (!(totals[i] > 0)) continue;
+            // VPLs shared between maps in proportion to their flux, so each carries about
+            // the same flux whichever map it comes from.
+            const auto share = std::max<std::size_t>(1, std::size_t(std::llround(double(options_.count) * totals[i] / sum)));
+            std::vector<vpl> more;
+            if (options_.selection == vpl_selection::flux_warping) {
+                more = vpls_by_flux_warping(maps[i], share, options_.seed + i);
+            } else {
+                const double aspect = double(maps[i].width()) / double(maps[i].height());
+                const auto gx = std::max<std::size_t>(1, std::size_t(std::llround(std::sqrt(double(share) * aspect))));
+                const auto gy = std::max<std::size_t>(1, (share + gx - 1) / gx);
+                more = vpls_on_grid(maps[i], gx, gy);
+            }
+            vpls_.insert(vpls_.end(), more.begin(), more.end());
+        }
+        t.vpls = vpls_.size();
+        fill_zero(out);
+        std::vector<glm::vec3> positions;
+        if (options_.assignment == light_assignment::similarity)
+            for (const auto& l : vpls_) positions.push_back(l.position);
+        const light_groups g = assign_lights(vpls_.size(), imaps.pattern.cells(), options_.assignment, positions,
+                                             options_.shift);
+        sii_params sp;
+        sp.light = options_.light;
+        sp.cutoff = options_.sii_cutoff;
+        splat_vpls(gb, imaps, cam, vpls_, g, sp, out);
+    }
+
+    /// The groups of a pattern already reordered by grouped_pattern: run s is
+    /// [begin[s], begin[s + 1]) of the reordered list.
+    static light_groups identity_groups(const light_groups& g) {
+        light_groups id;
+        id.begin = g.begin;
+        id.order.resize(g.order.size());
+        for (std::size_t k = 0; k < id.order.size(); ++k) id.order[k] = std::uint32_t(k);
+        return id;
+    }
+
+    static void fill_zero(image_view<glm::vec3> img) {
+        for (std::size_t y = 0; y < img.height(); ++y)
+            for (auto& px : img.row(y)) px = glm::vec3(0.f);
+    }
+
+    indirect_options options_;
+    buffers full_, low_;
+    gbuffer<float> low_gb_;
+    image<glm::vec3> low_irradiance_;
+    std::vector<glm::vec3> full_pattern_;
+    std::size_t pattern_texels_ = 0;
+    std::vector<vpl> vpls_;
+};
+
+}  // namespace bounce::cpu

@@ -1,0 +1,207 @@
+#pragma once
+/// \file rsm_gather.hpp
+/// The RSM gather on the CPU (Dachsbacher and Stamminger 2005, section 3.2): every pixel
+/// sums the irradiance of the map texels a fixed disc pattern of samples picks around the
+/// pixel's own texel (rsm.hpp's rsm_disc_sample and pixel_light_irradiance); optionally at
+/// a lower resolution with the geometry-aware upsampling and full-resolution fallback of
+/// DS05 section 3.3.
+///
+/// Interleaved, the pixels of sub-buffer s use only the samples dealt to s, with their
+/// weights multiplied by N M (interleaved_sampling.hpp): a pixel of a split G-buffer reads
+/// one contiguous run of the (reordered) pattern, so an 8 x 8 pattern does 1/64 of the
+/// work per pixel. Each pixel is computed by one task in a fixed order: results do not
+/// depend on the thread count.
+
+#include <bounce/camera.hpp>
+#include <bounce/cpu/interleave.hpp>
+#include <bounce/gbuffer.hpp>
+#include <bounce/rsm.hpp>
+#include <bounce/sampling.hpp>
+#include <bounce/vpl_sampling.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <tbb/parallel_for.h>
+
+namespace bounce::cpu {
+
+/// Parameters of the pixel-light irradiance shared by the RSM gather and SII
+/// (rsm.hpp's pixel_light_irradiance).
+struct pixel_light_params {
+    float offset = 0.f;         ///< sender moved along -n_p (m, >= 0; typical: half a texel footprint)
+    float min_distance2 = 0.f;  ///< d^2 clamped below at this (m^2, >= 0; typical: texel footprint^2)
+
+    void validate() const {
+        require(std::isfinite(offset) && offset >= 0.f, "offset", "must be finite and >= 0");
+        require(std::isfinite(min_distance2) && min_distance2 >= 0.f, "min_distance2", "must be finite and >= 0");
+    }
+};
+
+/// `count` disc samples (du, dv, w) for a map of `texel_count` texels: rsm_disc_sample on
+/// the points of the Halton sequence (stratified over the disc), listed in a shuffled order
+/// so that dealing them interleaved gives each sub-buffer a random subset rather than one
+/// radius band (the base-2 coordinate of every 64th Halton point lies in one 1/64 interval).
+/// `r_max` in map units (0, 2]: 1.5 reaches every texel from any centre inside the map.
+inline std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count,
+                                               std::uint64_t seed = 1) {
+    require(count > 0, "count", "must be positive");
+    require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
+    require(texel_count > 0, "texel_count", "must be positive");
+    pcg32 rng(seed);
+    const glm::dvec2 shift(rng.next_double(), rng.next_double());
+    std::vector<glm::vec3> out(count);
+    for (std::size_t k = 0; k < count; ++k) {
+        const glm::dvec2 xi = halton2(k, shift);
+        out[k] = rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count));
+    }
+    for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
+    return out;
+}
+
+/// The pattern in the order the sub-buffers read it: group s's samples contiguous, from
+/// `groups.begin[s]`.
+inline std::vector<glm::vec3> grouped_pattern(std::span<const glm::vec3> pattern, const light_groups& groups) {
+    std::vector<glm::vec3> out(groups.order.size());
+    for (std::size_t k = 0; k < out.size(); ++k) out[k] = pattern[groups.order[k]];
+    return out;
+}
+
+namespace detail {
+/// Where world point `p` falls in `map` as texel coordinates in [0, 1)^2 and whether it is
+/// in front of the map's projection centre.
+inline bool map_coordinates(const rsm_view& map, const glm::vec3& p, glm::vec2& uv) {
+    const glm::vec4 clip = map.light_view_projection * glm::vec4(p, 1.f);
+    if (!(clip.w > 0.f)) return false;
+    uv = glm::vec2(clip.x / clip.w * 0.5f + 0.5f, 0.5f - clip.y / clip.w * 0.5f);
+    return true;
+}
+
+/// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
+/// receiver from every map.
+inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<const rsm_view> maps,
+                           std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp) {
+    glm::vec3 e(0.f);
+    for (const rsm_view& map : maps) {
+        glm::vec2 centre;
+        if (!map_coordinates(map, x, centre)) continue;
+        const float w = float(map.width()), h = float(map.height());
+        for (const glm::vec3& s : pattern) {
+            const float tu = (centre.x + s.x) * w, tv = (centre.y + s.y) * h;
+            if (!(tu >= 0.f && tu < w && tv >= 0.f && tv < h)) continue;
+            const std::size_t tx = std::size_t(tu), ty = std::size_t(tv);
+            const glm::vec3 flux = map.flux(tx, ty);
+            if (flux.x == 0.f && flux.y == 0.f && flux.z == 0.f) continue;
+            e += pixel_light_irradiance<float, glm::vec3>(x, n, map.position(tx, ty), map.normal(tx, ty),
+                                                          flux * (s.z * scale), lp.offset, lp.min_distance2);
+        }
+    }
+    return e;
+}
+}  // namespace detail
+
+/// The gather over a (split) G-buffer `gb`: pixel (u, v) of sub-buffer s = maps.cell(u, v)
+/// uses `pattern[groups.begin[s] .. groups.begin[s + 1])` (grouped_pattern) with weights
+/// times interleaved_weight_scale(n, m). `out` (irradiance, W/m^2) is written everywhere; 0
+/// where the G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather.
+inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& imaps, std::span<const rsm_view> maps,
+                       std::span<const glm::vec3> pattern, const light_groups& groups, const pixel_light_params& lp,
+                       image_view<glm::vec3> out) {
+    lp.validate();
+    for (const auto& m : maps) m.validate();
+    detail::require_size(gb.width(), gb.height(), imaps, "gb");
+    detail::require_size(out.width(), out.height(), imaps, "out");
+    require(groups.begin.size() == std::size_t(imaps.pattern.cells()) + 1 && pattern.size() == groups.order.size(),
+            "pattern", "must be grouped for the pattern's sub-buffers");
+    const float scale = interleaved_weight_scale<float>(float(imaps.pattern.n), float(imaps.pattern.m));
+    tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t v) {
+        for (std::size_t u = 0; u < gb.width(); ++u) {
+            if (!gb.covered(u, v)) {
+                out(u, v) = glm::vec3(0.f);
+                continue;
+            }
+            const int s = imaps.cell(u, v);
+            const auto group = pattern.subspan(groups.begin[std::size_t(s)],
+                                               groups.begin[std::size_t(s) + 1] - groups.begin[std::size_t(s)]);
+            out(u, v) = detail::gather_at(gb.position(u, v), gb.normal(u, v), maps, group, scale, lp);
+        }
+    });
+}
+
+/// Tolerances of the geometry-aware upsampling (geometry_aware_upsample_weights).
+struct upsample_params {
+    float cos_normal = 0.9f;       ///< smallest cosine between a sample's normal and the pixel's (typical: 0.9)
+    float plane_footprints = 2.f;  ///< largest distance to the pixel's tangent plane, in low-resolution pixel
+                                   ///< footprints at the pixel's depth (typical: 1-4)
+};
+
+/// Picks the G-buffer pixel at the centre of each factor x factor block
+/// (pixel (f x + f/2, f y + f/2), clamped) into `low`, whose size is ceil(size / f).
+inline void downsample_gbuffer(const gbuffer_view<float>& gb, int factor, const gbuffer_view<float>& low) {
+    require(factor >= 1, "factor", "must be positive");
+    const std::size_t f = std::size_t(factor);
+    require(low.width() == (gb.width() + f - 1) / f && low.height() == (gb.height() + f - 1) / f, "low",
+            "must be ceil(size / factor)");
+    tbb::parallel_for(std::size_t(0), low.height(), [&](std::size_t y) {
+        const std::size_t sy = std::min(gb.height() - 1, y * f + f / 2);
+        for (std::size_t x = 0; x < low.width(); ++x) {
+            const std::size_t sx = std::min(gb.width() - 1, x * f + f / 2);
+            low.position(x, y) = gb.position(sx, sy);
+            low.normal(x, y) = gb.normal(sx, sy);
+            low.albedo(x, y) = gb.albedo(sx, sy);
+            low.depth(x, y) = gb.depth(sx, sy);
+        }
+    });
+}
+
+/// Geometry-aware upsampling of `low_irradiance` (computed on the downsampled G-buffer
+/// `low`) to `out`: a pixel interpolates the four low-resolution samples around it with the
+/// weights of geometry_aware_upsample_weights when at least three are suitable (DS05); the
+/// others are gathered at full resolution with the whole `pattern` (not interleaved).
+/// Returns the number of pixels gathered at full resolution.
+inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camera& cam,
+                                      const gbuffer_view<float>& low, image_view<const glm::vec3> low_irradiance,
+                                      int factor, const upsample_params& up, std::span<const rsm_view> maps,
+                                      std::span<const glm::vec3> pattern, const pixel_light_params& lp,
+                                      image_view<glm::vec3> out) {
+    require(out.width() == gb.width() && out.height() == gb.height(), "out", "size differs from the G-buffer");
+    const float f = float(factor);
+    std::vector<std::size_t> fallbacks(gb.height(), 0);
+    tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t y) {
+        for (std::size_t x = 0; x < gb.width(); ++x) {
+            if (!gb.covered(x, y)) {
+                out(x, y) = glm::vec3(0.f);
+                continue;
+            }
+            // Low-resolution sample c sits at full-resolution pixel f c + f/2.
+            const float lx = (float(x) - float(factor / 2)) / f, ly = (float(y) - float(factor / 2)) / f;
+            const float fx0 = std::floor(lx), fy0 = std::floor(ly);
+            std::array<glm::vec3, 4> ps, ns, es;
+            for (int k = 0; k < 4; ++k) {
+                const auto cx = std::size_t(std::clamp(fx0 + float(k & 1), 0.f, float(low.width() - 1)));
+                const auto cy = std::size_t(std::clamp(fy0 + float(k >> 1), 0.f, float(low.height() - 1)));
+                ps[std::size_t(k)] = low.covered(cx, cy) ? low.position(cx, cy) : glm::vec3(1e30f);
+                ns[std::size_t(k)] = low.covered(cx, cy) ? low.normal(cx, cy) : glm::vec3(0.f);
+                es[std::size_t(k)] = low_irradiance(cx, cy);
+            }
+            const float tolerance = up.plane_footprints * f * cam.pixel_footprint(gb.depth(x, y), gb.height());
+            const auto w = geometry_aware_upsample_weights<float, glm::vec3>(
+                gb.position(x, y), gb.normal(x, y), ps, ns, std::clamp(lx - fx0, 0.f, 1.f),
+                std::clamp(ly - fy0, 0.f, 1.f), tolerance, up.cos_normal);
+            if (w[4] >= 3.f && w[0] + w[1] + w[2] + w[3] > 0.f) {
+                out(x, y) = es[0] * w[0] + es[1] * w[1] + es[2] * w[2] + es[3] * w[3];
+            } else {
+                out(x, y) = detail::gather_at(gb.position(x, y), gb.normal(x, y), maps, pattern, 1.f, lp);
+                ++fallbacks[y];
+            }
+        }
+    });
+    std::size_t total = 0;
+    for (auto c : fallbacks) total += c;
+    return total;
+}
+
+}  // namespace bounce::cpu

@@ -1,0 +1,298 @@
+// The CPU passes and cpu::indirect_renderer: energy-correct interleaving (the expectation
+// over relabellings of the sub-buffers is the non-interleaved value, the thesis's Section
+// 5.2 loss avoided), thread-count independence, the splat cutoff's bound, the blur and
+// upsampling at discontinuities, and bad input.
+#include "corner_scene.hpp"
+
+#include <bounce/cpu/indirect_renderer.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+using namespace bounce;
+using rsm_test::corner_scene;
+
+namespace {
+constexpr double u32 = 0x1p-24;
+double higham_gamma(double n) { return n * u32 / (1 - n * u32); }
+
+image<glm::vec3> render(const corner_scene& s, cpu::indirect_options o, cpu::indirect_timings* t = nullptr) {
+    cpu::indirect_renderer r(o);
+    image<glm::vec3> out(s.gb.width(), s.gb.height());
+    const rsm_view maps[] = {s.map()};
+    auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
+    const auto timings = r.render(gbv, s.cam, maps, out.view());
+    if (t) *t = timings;
+    return out;
+}
+
+// Luminance-free relative RMS over covered pixels, channel x.
+double rel_rms(const corner_scene& s, const image<glm::vec3>& a, const image<glm::vec3>& ref) {
+    double num = 0, den = 0;
+    for (std::size_t y = 0; y < s.gb.height(); ++y)
+        for (std::size_t x = 0; x < s.gb.width(); ++x) {
+            if (!(s.gb.depth(x, y) < std::numeric_limits<float>::infinity())) continue;
+            num += std::pow(double(a(x, y).x) - double(ref(x, y).x), 2);
+            den += std::pow(double(ref(x, y).x), 2);
+        }
+    return std::sqrt(num / den);
+}
+
+// Sum of channel x over covered pixels.
+double energy(const corner_scene& s, const image<glm::vec3>& a) {
+    double sum = 0;
+    for (std::size_t y = 0; y < s.gb.height(); ++y)
+        for (std::size_t x = 0; x < s.gb.width(); ++x)
+            if (s.gb.depth(x, y) < std::numeric_limits<float>::infinity()) sum += a(x, y).x;
+    return sum;
+}
+
+// The full RSM sum (every texel a pixel light), in double: what RSM and SII estimate.
+image<glm::vec3> full_rsm_sum(const corner_scene& s, double min_distance2 = 0) {
+    image<glm::vec3> out(s.gb.width(), s.gb.height());
+    for (std::size_t y = 0; y < s.gb.height(); ++y)
+        for (std::size_t x = 0; x < s.gb.width(); ++x) {
+            if (!(s.gb.depth(x, y) < std::numeric_limits<float>::infinity())) continue;
+            glm::dvec3 e(0.0);
+            for (std::size_t j = 0; j < s.map_flux.height(); ++j)
+                for (std::size_t i = 0; i < s.map_flux.width(); ++i)
+                    e += pixel_light_irradiance<double, glm::dvec3>(
+                        glm::dvec3(s.gb.position(x, y)), glm::dvec3(s.gb.normal(x, y)), glm::dvec3(s.map_position(i, j)),
+                        glm::dvec3(s.map_normal(i, j)), glm::dvec3(s.map_flux(i, j)), 0.0, min_distance2);
+            out(x, y) = glm::vec3(e);
+        }
+    return out;
+}
+}  // namespace
+
+TEST_CASE("averaged over every relabelling of the sub-buffers, interleaved SII and RSM equal the plain ones",
+          "[indirect][energy]") {
+    // The interleaved pixel sums its subset's terms times N M; averaged over the N M
+    // relabellings every term appears once, so the mean equals the plain sum. Both are float
+    // sums of at most K positive terms (each within gamma_K of its exact sum, Higham), the
+    // scale N M rounds each term once (u) and the mean of N M values adds gamma_(N M):
+    // |mean - plain| <= (2 gamma_K + gamma_(N M) + 2 u) plain.
+    const corner_scene s(50, 37);
+    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather})
+        for (const interleave_pattern p : {interleave_pattern{3, 2}, interleave_pattern{4, 4}})
+            for (const auto how : {light_assignment::interleaved, light_assignment::blocked, light_assignment::similarity}) {
+                if (tech == cpu::indirect_technique::rsm_gather && how != light_assignment::interleaved) continue;
+                cpu::indirect_options o;
+                o.technique = tech;
+                o.count = 301;  // not a multiple of N M
+                o.pattern = {1, 1};
+                const auto plain = render(s, o);
+                o.pattern = p;
+                o.assignment = how;
+                o.blur = false;
+                image<glm::dvec3> mean(s.gb.width(), s.gb.height(), glm::dvec3(0.0));
+                for (int shift = 0; shift < p.cells(); ++shift) {
+                    o.shift = shift;
+                    const auto one = render(s, o);
+                    for (std::size_t y = 0; y < s.gb.height(); ++y)
+                        for (std::size_t x = 0; x < s.gb.width(); ++x) mean(x, y) += glm::dvec3(one(x, y)) / double(p.cells());
+                }
+                const double tol = 2 * higham_gamma(double(o.count)) + higham_gamma(p.cells()) + 2 * u32;
+                double worst = 0;
+                for (std::size_t y = 0; y < s.gb.height(); ++y)
+                    for (std::size_t x = 0; x < s.gb.width(); ++x)
+                        for (int c = 0; c < 3; ++c) {
+                            const double ref = plain(x, y)[c];
+                            worst = std::max(worst, std::abs(mean(x, y)[c] - ref) / std::max(ref, 1e-30));
+                        }
+                INFO("technique " << int(tech) << " pattern " << p.n << "x" << p.m << " assignment " << int(how));
+                CHECK(worst <= tol);
+            }
+}
+
+TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the full RSM sum",
+          "[indirect][energy]") {
+    // The thesis splatted each VPL into one sub-buffer at weight 1: its images held 1/(N M)
+    // of the energy (1 - 1/(N M) >= 0.75 relative error from 2 x 2 on). With the N M weight
+    // the blurred image keeps the plain image's energy up to noise, and its error against
+    // the exact sum grows only with the blur's smoothing of steep gradients (the floor next
+    // to the emitting wall). Measured on this scene (1024 VPLs/samples, d^2 clamped at a
+    // texel's footprint squared): SII 0.040 plain, 0.080 / 0.103 / 0.112 for 2x2 / 4x4 / 8x8;
+    // RSM gather 0.023 plain, 0.034 / 0.061 / 0.103. The bound 0.15 has margin for that.
+    const corner_scene s(96, 72);
+    const float texel = 2.f / 32.f;
+    const auto exact = full_rsm_sum(s, texel * texel);
+    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
+        cpu::indirect_options o;
+        o.technique = tech;
+        o.count = 1024;
+        o.light.min_distance2 = texel * texel;
+        o.pattern = {1, 1};
+        const auto plain = render(s, o);
+        for (const interleave_pattern p : {interleave_pattern{2, 2}, interleave_pattern{4, 4}, interleave_pattern{8, 8}}) {
+            o.pattern = p;
+            const auto inter = render(s, o);
+            const double e = rel_rms(s, inter, exact);
+            const double ratio = energy(s, inter) / energy(s, plain);
+            INFO("technique " << int(tech) << " pattern " << p.n << "x" << p.m << " rel_rms " << e << " energy ratio "
+                              << ratio);
+            CHECK(e < 0.15);
+            CHECK(std::abs(ratio - 1) < 0.05);
+        }
+    }
+}
+
+TEST_CASE("SII and the RSM gather converge to the full RSM sum", "[indirect]") {
+    const corner_scene s(64, 48);
+    const auto exact = full_rsm_sum(s);
+    cpu::indirect_options o;
+    o.pattern = {1, 1};
+    o.count = 4096;
+    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
+        o.technique = tech;
+        const double e = rel_rms(s, render(s, o), exact);
+        INFO("technique " << int(tech) << " rel_rms " << e);
+        CHECK(e < 0.05);
+    }
+    // Every texel as a VPL (a grid the map's size) is the full sum itself, up to float
+    // summation of 1024 terms.
+    o.technique = cpu::indirect_technique::sii;
+    o.selection = cpu::vpl_selection::grid;
+    o.count = s.map_flux.width() * s.map_flux.height();
+    CHECK(rel_rms(s, render(s, o), exact) < 2 * higham_gamma(double(o.count)) + 1e-5);
+}
+
+TEST_CASE("results are bitwise the same for one thread and for two", "[indirect]") {
+    const corner_scene s(61, 45);
+    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
+        cpu::indirect_options o;
+        o.technique = tech;
+        o.count = 512;
+        o.pattern = {4, 2};
+        image<glm::vec3> one, two;
+        tbb::task_arena(1).execute([&] { one = render(s, o); });
+        tbb::task_arena(2).execute([&] { two = render(s, o); });
+        for (std::size_t y = 0; y < s.gb.height(); ++y)
+            for (std::size_t x = 0; x < s.gb.width(); ++x) REQUIRE(one(x, y) == two(x, y));
+    }
+}
+
+TEST_CASE("the SII splat bounds cut off at most the cutoff at any pixel", "[indirect]") {
+    const corner_scene s(64, 48);
+    cpu::indirect_options o;
+    o.pattern = {1, 1};
+    o.count = 2048;
+    const auto full = render(s, o);
+    double mean = 0;
+    for (std::size_t y = 0; y < 48; ++y)
+        for (std::size_t x = 0; x < 64; ++x) mean += full(x, y).x / (64.0 * 48.0);
+    for (float fraction : {1e-3f, 1e-2f, 1e-1f}) {
+        o.sii_cutoff = fraction * float(mean);
+        const auto cut = render(s, o);
+        for (std::size_t y = 0; y < 48; ++y)
+            for (std::size_t x = 0; x < 64; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const double lost = double(full(x, y)[c]) - double(cut(x, y)[c]);
+                    // The cut sum drops terms of the same float sum: rounding gamma_K of the full value.
+                    REQUIRE(lost <= double(o.sii_cutoff) + 2 * higham_gamma(2048) * double(full(x, y)[c]));
+                    REQUIRE(lost >= -2 * higham_gamma(2048) * double(full(x, y)[c]));
+                }
+    }
+}
+
+TEST_CASE("the geometry-aware blur keeps each surface's value: nothing bleeds across the floor-wall edge",
+          "[indirect]") {
+    const corner_scene s(53, 40);
+    const interleave_pattern p{8, 8};
+    image<glm::vec3> in(53, 40), scratch(53, 40), out(53, 40);
+    image<glm::vec2> edges(53, 40);
+    for (std::size_t y = 0; y < 40; ++y)
+        for (std::size_t x = 0; x < 53; ++x) in(x, y) = glm::vec3(s.gb.normal(x, y).z > 0.5f ? 1.f : 7.f);
+    auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
+    cpu::discontinuity_buffer(gbv, {}, edges.view());
+    cpu::geometry_aware_blur(in.view(), edges.view(), s.gb.depth.view(), p, scratch.view(), out.view());
+    int floor = 0, wall = 0;
+    for (std::size_t y = 0; y < 40; ++y)
+        for (std::size_t x = 0; x < 53; ++x) {
+            if (!(s.gb.depth(x, y) < std::numeric_limits<float>::infinity())) continue;
+            (in(x, y).x == 1.f ? floor : wall)++;
+            REQUIRE(out(x, y).x == Approx(in(x, y).x).epsilon(1e-6));
+        }
+    CHECK(floor > 100);
+    CHECK(wall > 100);
+}
+
+TEST_CASE("the low-resolution gather interpolates on smooth surfaces and gathers at full resolution at edges",
+          "[indirect]") {
+    cpu::indirect_options o;
+    o.technique = cpu::indirect_technique::rsm_gather;
+    o.count = 256;
+    o.pattern = {1, 1};
+    const corner_scene floor_only(64, 48, 32, false);
+    o.light.min_distance2 = 0.0625f * 0.0625f;
+    o.low_resolution = 2;
+    cpu::indirect_timings t;
+    const auto low = render(floor_only, o, &t);
+    // On one plane every sample is suitable, except beside the floor's silhouette, where a
+    // low-resolution sample may see nothing: only pixels within f = 2 pixels of an uncovered
+    // one may fall back.
+    std::size_t band = 0;
+    const auto covered = [&](int x, int y) {
+        return x < 0 || y < 0 || x >= 64 || y >= 48 ||
+               floor_only.gb.depth(std::size_t(x), std::size_t(y)) < std::numeric_limits<float>::infinity();
+    };
+    for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 64; ++x) {
+            if (!covered(x, y)) continue;
+            bool near_hole = false;
+            for (int dy = -2; dy <= 2; ++dy)
+                for (int dx = -2; dx <= 2; ++dx) near_hole = near_hole || !covered(x + dx, y + dy);
+            band += near_hole ? 1 : 0;
+        }
+    CHECK(t.fallback_pixels <= band);
+    o.low_resolution = 1;
+    const auto full = render(floor_only, o);
+    const double e = rel_rms(floor_only, low, full);
+    // Bilinear interpolation of a smooth field over 2-pixel cells; measured 0.02 (the field
+    // is steep where the floor meets the emitting wall).
+    INFO("floor only: rel_rms of the upsampled gather " << e);
+    CHECK(e < 0.04);
+
+    const corner_scene corner(64, 48);
+    o.low_resolution = 2;
+    render(corner, o, &t);
+    CHECK(t.fallback_pixels > 0);
+    CHECK(t.fallback_pixels < 64 * 48 / 4);
+}
+
+TEST_CASE("bad options and sizes raise parameter_error naming the parameter", "[indirect]") {
+    const auto name_of = [](auto&& f) {
+        try {
+            f();
+        } catch (const parameter_error& e) {
+            return e.parameter();
+        }
+        return std::string("(nothing thrown)");
+    };
+    cpu::indirect_options o;
+    o.count = 0;
+    CHECK(name_of([&] { cpu::indirect_renderer r(o); }) == "count");
+    o = {};
+    o.shift = 16;
+    CHECK(name_of([&] { cpu::indirect_renderer r(o); }) == "shift");
+    o = {};
+    o.low_resolution = 2;  // SII
+    CHECK(name_of([&] { cpu::indirect_renderer r(o); }) == "low_resolution");
+    o = {};
+    o.light.offset = -1.f;
+    CHECK(name_of([&] { cpu::indirect_renderer r(o); }) == "offset");
+    o = {};
+    o.r_max = 0.f;
+    CHECK(name_of([&] { cpu::indirect_renderer r(o); }) == "r_max");
+    const corner_scene s(16, 12);
+    cpu::indirect_renderer r;
+    image<glm::vec3> wrong(15, 12);
+    const rsm_view maps[] = {s.map()};
+    auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
+    CHECK(name_of([&] { r.render(gbv, s.cam, maps, wrong.view()); }) == "irradiance");
+}
