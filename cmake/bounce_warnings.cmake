@@ -28,6 +28,10 @@ function(bounce_adapter name)
   endif()
   set_target_properties(bounce_${name} PROPERTIES EXPORT_NAME ${name})
   add_library(bounce::${name} ALIAS bounce_${name})
-  install(TARGETS bounce_${name} EXPORT bounceTargets)
+  # One export file per component, so find_package(bounce COMPONENTS gl embree) reads (and
+  # finds the dependencies of) only what the consumer asked for.
+  install(TARGETS bounce_${name} EXPORT bounce_${name}Targets)
+  install(EXPORT bounce_${name}Targets NAMESPACE bounce:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bounce)
   install(DIRECTORY include/bounce DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  set_property(GLOBAL APPEND PROPERTY BOUNCE_COMPONENTS ${name})
 endfunction()
