@@ -43,6 +43,19 @@ T perspective_texel_solid_angle(T x0, T y0, T x1, T y1) {
     return quadrant(x1, y1) - quadrant(x0, y1) - quadrant(x1, y0) + quadrant(x0, y0);
 }
 
+/// Solid angle (sr) of a small texel of size dx x dy centred at (x, y) on the image plane at
+/// unit distance (tangent units): the midpoint rule dw = dx dy / (1 + x^2 + y^2)^(3/2).
+/// Its relative error is below 1.3 t^2 for texels of side t inside a 90-degree face (the
+/// integrand's second derivatives are at most 3 in size and it is at least 3^(-3/2)), while
+/// the exact form above, evaluated in float, loses about 2.4e-7 / dw relatively to the
+/// cancellation of its four O(1) terms: use this one in float for maps finer than about
+/// 100 texels per side (t < 0.02), the exact one in double or for coarse maps.
+template <real T>
+T perspective_texel_solid_angle_midpoint(T x, T y, T dx, T dy) {
+    const T r2 = T(1) + x * x + y * y;
+    return dx * dy * inversesqrt(r2) / r2;
+}
+
 /// Reflected flux (W) of the texel that sees the surface point `p` (unit normal `n`,
 /// diffuse reflectance `albedo`) through the solid angle `solid_angle` (sr) of a point
 /// light at `light_position` of intensity `intensity` (W/sr): the light sends I dw through
