@@ -9,7 +9,11 @@
 ///   Hann:    h_l = (1 + cos(pi l / w)) / 2   for l < w, 0 beyond
 ///   Lanczos: h_l = sin(pi l / w) / (pi l / w) (h_0 = 1), for l < w, 0 beyond
 /// What a window costs is reported by `sh_window_cost`: the fraction of the energy
-/// (int f^2 dw) and of the peak value it keeps.
+/// (int f^2 dw) and of the peak value it keeps. `sh_nonnegative_window_width` finds the
+/// widest window of a family that leaves no negative value: for a directional light's
+/// irradiance that is w ~ 2 for both families (bands 0 and 1 only, a quarter of the energy
+/// gone) at every order, since any weight on band 2 and above with band 1 intact dips below
+/// zero somewhere (docs/sh-and-irradiance-volumes.md has the table).
 
 #include <bounce/errors.hpp>
 #include <bounce/sh_basis.hpp>
@@ -19,6 +23,7 @@
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -45,6 +50,15 @@ std::array<double, std::size_t(L)> lanczos_window(double width) {
         h[std::size_t(l)] = l < width ? std::sin(x) / x : 0.0;
     }
     return h;
+}
+
+/// The windows of this file, by name.
+enum class sh_window_family { hann, lanczos };
+
+/// The window of `family` with width `width` for bands 0 .. L - 1.
+template <int L>
+std::array<double, std::size_t(L)> sh_window(sh_window_family family, double width) {
+    return family == sh_window_family::hann ? hann_window<L>(width) : lanczos_window<L>(width);
 }
 
 /// `c` with band l scaled by `window[l]`.
@@ -100,6 +114,36 @@ window_cost sh_window_cost(const sh_coefficients<L, double>& c, const std::array
         lo_w = std::min(lo_w, fw);
     }
     return {kept / energy, peak_w / peak, lo, lo_w};
+}
+
+/// The widest width w <= `max_width` (typical: L), on a grid of step `resolution`
+/// (typical: 1/64), for which the window of `family` leaves no negative value of the
+/// function `c` on `probes` spherical Fibonacci directions (typical: 4096). The scan runs
+/// downwards from `max_width` because the smallest value is not monotonic in w; it ends by
+/// w = 1 at the latest, where only band 0 is left. Between probes the function can dip
+/// below zero by at most 1/2 max|f''| (probe spacing)^2. Throws parameter_error naming "c"
+/// when c_00 < 0 (no window can help), or when the arguments are out of range.
+template <int L>
+double sh_nonnegative_window_width(const sh_coefficients<L, double>& c, sh_window_family family, double max_width,
+                                   std::size_t probes = 4096, double resolution = 1.0 / 64) {
+    require(c[0] >= 0, "c", "the function's mean is negative: no window makes it non-negative");
+    require(max_width > 0 && std::isfinite(max_width), "max_width", "must be positive");
+    require(resolution > 0 && resolution < max_width, "resolution", "must be positive and below max_width");
+    require(probes > 0, "probes", "need at least one probe direction");
+    std::vector<std::array<double, sh_count(L)>> basis(probes);
+    for (std::size_t j = 0; j < probes; ++j) basis[j] = sh_basis<L, double, glm::dvec3>(spherical_fibonacci_direction(j, probes));
+    for (double w = max_width; w > 0; w -= resolution) {
+        const auto h = sh_window<L>(family, w);
+        const auto cw = sh_apply_window<L, double>(c, h);
+        bool nonnegative = true;
+        for (std::size_t j = 0; j < probes && nonnegative; ++j) {
+            double f = 0;
+            for (std::size_t i = 0; i < sh_count(L); ++i) f += cw[i] * basis[j][i];
+            nonnegative = f >= 0;
+        }
+        if (nonnegative) return w;
+    }
+    return resolution;
 }
 
 }  // namespace bounce
