@@ -46,7 +46,7 @@ namespace bounce {
 /// How to cut a scene into elements.
 struct atlas_options {
     std::size_t elements = 10000;  ///< target element count (the program's --elements N); the
-                                   ///< result is within a few percent above it (typical: 1e4-1e5)
+                                   ///< result is within a few percent of it (typical: 1e4-1e5)
     int padding = 1;               ///< texels around each chart in the atlas, >= 0 (typical: 1; 2 for mipmaps)
     int block_texels = 4;          ///< side of a shooting block, texels, >= 1 (typical: 4; 1 = no substructuring)
     double coplanar_degrees = 0.05;  ///< largest angle between the normals of one chart's triangles (degrees)
@@ -376,14 +376,21 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
     double total_area = 0;
     for (std::size_t t = 0; t < nt; ++t) total_area += face_area[t];
     require(total_area > 0, "scene.triangles", "the scene has no triangle of positive area");
-    // The count grows like 1/h^2 plus the charts' boundaries: three secant steps on h bring
-    // it within a few percent of the target for the scenes measured (docs/radiosity.md).
-    double h = std::sqrt(total_area / double(options.elements));
-    for (int iteration = 0; iteration < 3; ++iteration) {
+    // The count grows like 1/h^2 plus the charts' boundaries and jumps where a chart's
+    // ceil(extent / h) steps: secant steps on h, keeping the closest count seen.
+    double h = std::sqrt(total_area / double(options.elements)), best_h = h;
+    double best_miss = std::numeric_limits<double>::infinity();
+    for (int iteration = 0; iteration < 8; ++iteration) {
         const std::size_t count = cut(h);
+        const double miss = std::abs(double(count) - double(options.elements));
+        if (miss < best_miss) {
+            best_miss = miss;
+            best_h = h;
+        }
+        if (miss <= 0.01 * double(options.elements)) break;
         h *= std::sqrt(double(count) / double(options.elements));
     }
-    cut(h);
+    cut(best_h);
 
     // Shelf packing: charts by decreasing padded height, rows as wide as a square atlas.
     const std::uint32_t pad = std::uint32_t(options.padding);

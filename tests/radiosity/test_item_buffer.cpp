@@ -258,7 +258,7 @@ TEST_CASE("bad item-buffer options raise parameter_error naming them", "[radiosi
     named({.resolution = 4}, "options.resolution");
     named({.projection = cpu::item_projection::hemicube, .resolution = 129}, "options.resolution");
     named({.tolerance_px = 0.f}, "options.tolerance_px");
-    named({.max_tessellation = 3}, "options.max_tessellation");
+    named({.max_tessellation_depth = 17}, "options.max_tessellation_depth");
     const auto other = closed_box(1.f, 0.5f, 1.f);
     try {
         cpu::item_buffer_visibility vis(other.view(), atlas, {});

@@ -12,19 +12,26 @@
 /// mesh without T-junctions covers every pixel inside its outline exactly once.
 ///
 /// The stereographic projection bends straight edges into arcs (Figure 39-5), so before
-/// rasterizing with straight edges each triangle is cut into n x n smaller ones, n the power of
-/// two that brings the sagitta of every edge (distance, in pixels, between the projected
-/// midpoint of an edge and the midpoint of its projected chord) below `tolerance_px`:
-/// the sagitta of an arc falls as 1/n^2 with n pieces. Neighbouring triangles may pick different
-/// n; the T-junctions this leaves open cracks narrower than the tolerance along shared edges
-/// (the tests measure the pixels that differ from an exact per-pixel ray cast).
+/// rasterizing with straight edges each triangle is split in four at its edges' midpoints,
+/// recursively, until the sagitta of each edge (distance, in pixels, between the projected
+/// midpoint of an edge and the midpoint of its projected chord) is below `tolerance_px`
+/// (halving an edge quarters its sagitta); the pieces gather next to the shooter, where the
+/// projection bends most (a wall through the shooter's corner). Neighbouring triangles may
+/// split a shared edge differently; the T-junctions this leaves open cracks narrower than
+/// the tolerance (the tests measure the pixels that differ from an exact per-pixel ray cast).
 /// The hemicube's faces are perspective projections, where straight edges stay straight and
 /// 1/depth is linear in screen space, so they need no tessellation and their depth is exact.
 ///
-/// Lookup: an element is visible when the item buffer shows its chart at its pixel, or when
-/// whatever is there lies no nearer than the element less a relative 1e-3 and absolute 1e-5
-/// of the scene's diagonal: the id test alone would darken a row of elements along every
-/// concave corner, where the pixel's centre falls on the neighbouring chart at the same depth.
+/// Depth is exact at every pixel centre: the distance along the centre's direction to the
+/// triangle's plane (stereographic), 1/depth interpolated (hemicube faces), the distance along
+/// the light (parallel).
+///
+/// Lookup: an element is visible when the item buffer shows its chart (or nothing) at its
+/// pixel, or when the surface shown there, extended as a plane, is met along the element's
+/// own ray beyond the element: the id test alone (Listing 39-3) would darken a row of
+/// elements along every concave corner, where the pixel's centre falls on the neighbouring
+/// wall at the same depth. A GPU backend can do the same with the triangle's plane in the
+/// item buffer.
 
 #include <bounce/errors.hpp>
 #include <bounce/lightmap_atlas.hpp>
@@ -74,17 +81,19 @@ struct all_visible {
     float visible(std::size_t) const noexcept { return 1.f; }
 };
 
-/// Chart id and depth per pixel. `none` where nothing was drawn.
+/// Chart id, depth and the drawing's own primitive number per pixel; `none` where nothing
+/// was drawn.
 struct item_buffer {
     static constexpr std::uint32_t none = lightmap_atlas::none;
     int width = 0, height = 0;
-    std::vector<std::uint32_t> id;
+    std::vector<std::uint32_t> id, primitive;
     std::vector<float> depth;
 
     void reset(int w, int h) {
         width = w;
         height = h;
         id.assign(std::size_t(w) * std::size_t(h), none);
+        primitive.assign(std::size_t(w) * std::size_t(h), none);
         depth.assign(std::size_t(w) * std::size_t(h), std::numeric_limits<float>::infinity());
     }
 };
@@ -97,12 +106,16 @@ struct raster_vertex {
     float attribute;
 };
 
-/// Draws one triangle into `buffer` with id `id`: fixed-point edge functions (8 bits of
+/// Draws one triangle into `buffer` with id `id` (and `primitive`, the caller's own number
+/// for it): fixed-point edge functions (8 bits of
 /// sub-pixel precision, vertices within +-2^20 pixels), top-left rule, nearest depth wins
-/// (ties keep the earlier triangle). With `reciprocal`, the attribute is 1/depth and the
-/// depth stored is its reciprocal (perspective-correct depth). Either winding is drawn.
-inline void scan_triangle(item_buffer& buffer, raster_vertex a, raster_vertex b, raster_vertex c, std::uint32_t id,
-                          bool reciprocal = false, int row_begin = 0, int row_end = std::numeric_limits<int>::max()) {
+/// (ties keep the earlier triangle). `depth_at(x, y, attribute)` gives the depth stored at
+/// pixel (x, y) from the attribute interpolated there. Either winding is drawn; only rows
+/// [row_begin, row_end) are touched.
+template <class DepthAt>
+void scan_triangle_with(item_buffer& buffer, raster_vertex a, raster_vertex b, raster_vertex c, std::uint32_t id,
+                        const DepthAt& depth_at, std::uint32_t primitive = item_buffer::none, int row_begin = 0,
+                        int row_end = std::numeric_limits<int>::max()) {
     constexpr double sub = 256.0;
     constexpr double limit = double(1 << 20);
     const auto fixed = [&](glm::vec2 p, std::int64_t& x, std::int64_t& y) {
@@ -152,14 +165,25 @@ inline void scan_triangle(item_buffer& buffer, raster_vertex a, raster_vertex b,
             // Barycentric weights from the unbiased edge functions (the bias is 0 or -1).
             const double l0 = double(w0 - e0.bias) * inv_area, l1 = double(w1 - e1.bias) * inv_area;
             const double attr = l0 * a.attribute + l1 * b.attribute + (1.0 - l0 - l1) * c.attribute;
-            const float depth = reciprocal ? float(1.0 / attr) : float(attr);
+            const float depth = depth_at(x, y, attr);
             const std::size_t i = std::size_t(y) * std::size_t(buffer.width) + std::size_t(x);
             if (depth < buffer.depth[i]) {
                 buffer.depth[i] = depth;
                 buffer.id[i] = id;
+                buffer.primitive[i] = primitive;
             }
         }
     }
+}
+
+/// scan_triangle_with storing the interpolated attribute as depth, or, with `reciprocal`,
+/// its reciprocal (the attribute is then 1/depth, linear in screen space under a
+/// perspective projection: perspective-correct depth).
+inline void scan_triangle(item_buffer& buffer, raster_vertex a, raster_vertex b, raster_vertex c, std::uint32_t id,
+                          bool reciprocal = false, std::uint32_t primitive = item_buffer::none) {
+    if (reciprocal)
+        scan_triangle_with(buffer, a, b, c, id, [](int, int, double attr) { return float(1.0 / attr); }, primitive);
+    else scan_triangle_with(buffer, a, b, c, id, [](int, int, double attr) { return float(attr); }, primitive);
 }
 
 namespace detail {
@@ -206,7 +230,7 @@ public:
         item_projection projection = item_projection::stereographic;
         int resolution = 256;          ///< item buffer side, pixels (hemicube: per face; typical: 128-512)
         float tolerance_px = 0.25f;    ///< largest sagitta of a tessellated edge, pixels (stereographic)
-        int max_tessellation = 32;     ///< cap on the n x n pieces of one triangle (power of two)
+        int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges (4^depth pieces at most)
         int parallel_resolution = 1024; ///< side of the directional light's buffer, pixels
     };
 
@@ -217,9 +241,8 @@ public:
         require(opt.projection != item_projection::hemicube || opt.resolution % 2 == 0, "options.resolution",
                 "a hemicube needs an even resolution (its side faces keep half the rows)");
         require(opt.tolerance_px > 0.f && std::isfinite(opt.tolerance_px), "options.tolerance_px", "must be positive");
-        require(opt.max_tessellation >= 1 && opt.max_tessellation <= 256 &&
-                    (opt.max_tessellation & (opt.max_tessellation - 1)) == 0,
-                "options.max_tessellation", "must be a power of two in [1, 256]");
+        require(opt.max_tessellation_depth >= 0 && opt.max_tessellation_depth <= 16, "options.max_tessellation_depth",
+                "must lie in [0, 16]");
         require(opt.parallel_resolution >= 8 && opt.parallel_resolution <= 16384, "options.parallel_resolution",
                 "must lie in [8, 16384]");
         require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
@@ -229,6 +252,20 @@ public:
             const auto& tri = scene.triangles[t];
             corners_.push_back({scene.positions[tri.x], scene.positions[tri.y], scene.positions[tri.z]});
             triangle_chart_.push_back(atlas.chart_of_triangle[t]);
+            const glm::dvec3 a(corners_.back()[0]), b(corners_.back()[1]), c(corners_.back()[2]);
+            const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+            world_plane_.emplace_back(glm::vec3(n), float(glm::dot(n, a)));
+        }
+        if (opt.projection == item_projection::stereographic) {
+            // The unit direction through each pixel centre (inverse projection), for depths.
+            const int res = opt.resolution;
+            pixel_direction_.resize(std::size_t(res) * std::size_t(res));
+            for (int y = 0; y < res; ++y)
+                for (int x = 0; x < res; ++x) {
+                    const glm::dvec2 q((x + 0.5) / res * 2 - 1, (y + 0.5) / res * 2 - 1);
+                    pixel_direction_[std::size_t(y) * std::size_t(res) + std::size_t(x)] =
+                        glm::vec3(stereographic_direction<double, glm::dvec3, glm::dvec2>(q));
+                }
         }
         const auto [lo, hi] = scene.bounds();
         lo_ = lo;
@@ -257,24 +294,22 @@ public:
             const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, glm::vec3(0.f), t_, b_, shot_.axis);
             const int x = pixel_of((l.x - ortho_lo_.x) * ortho_scale_, buffers_[0].width);
             const int y = pixel_of((l.y - ortho_lo_.y) * ortho_scale_, buffers_[0].height);
-            return seen(buffers_[0], x, y, chart, l.z, true) ? 1.f : 0.f;
+            return seen(buffers_[0], x, y, chart, p, true) ? 1.f : 0.f;
         }
         const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, shot_.position, t_, b_, shot_.axis);
         if (opt_.projection == item_projection::stereographic) {
             const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
             const item_buffer& buf = buffers_[0];
             return seen(buf, pixel_of(uv.x * float(buf.width), buf.width), pixel_of(uv.y * float(buf.height), buf.height),
-                        chart, glm::length(l), false)
+                        chart, l, false)
                        ? 1.f
                        : 0.f;
         }
         const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
         const int face = std::clamp(int(f.x + 0.5f), 0, 4);
         const item_buffer& buf = buffers_[std::size_t(face)];
-        // The element's depth on this face: its component along the face's forward axis.
-        const float depth = glm::dot(l, face_axes(face)[2]);
         return seen(buf, pixel_of(f.y * float(buf.width), buf.width), pixel_of(f.z * float(buf.height), buf.height),
-                    chart, depth, false)
+                    chart, l, false)
                    ? 1.f
                    : 0.f;
     }
@@ -302,18 +337,39 @@ public:
 private:
     static int pixel_of(float coord, int size) { return std::clamp(int(std::floor(coord)), 0, size - 1); }
 
-    bool seen(const item_buffer& buf, int x, int y, std::uint32_t chart, float depth, bool parallel) const {
+    // Whether the element at `p` (shooter frame, or world for a parallel shot) of chart `chart`
+    // is seen through pixel (x, y): the pixel shows its chart, or nothing, or a surface whose
+    // plane, met along the element's own ray, lies beyond the element (less a relative 1e-4
+    // and 1e-6 of the scene's diagonal). Comparing along the element's ray rather than the
+    // pixel centre's keeps a surface seen at a grazing angle from hiding elements just in
+    // front of it (concave corners, where the pixel's centre falls on the other wall) and
+    // from letting through elements just behind it (a ceiling behind a light 1 cm below it).
+    bool seen(const item_buffer& buf, int x, int y, std::uint32_t chart, glm::vec3 p, bool parallel) const {
         const std::size_t i = std::size_t(y) * std::size_t(buf.width) + std::size_t(x);
-        if (buf.id[i] == chart) return true;
-        // Parallel depths are signed distances along the light; the rest are positive.
-        const float slack = 1e-3f * (parallel ? diagonal_ : std::abs(depth)) + 1e-5f * diagonal_;
-        return buf.depth[i] >= depth - slack;
+        if (buf.id[i] == chart || buf.id[i] == item_buffer::none) return true;
+        const std::uint32_t k = buf.primitive[i];
+        if (parallel) {
+            // Distance s along the light from p to the plane: upstream (s < 0) occludes.
+            const glm::vec4 plane = world_plane_[k];
+            const float nd = glm::dot(glm::vec3(plane), shot_.axis);
+            if (std::abs(nd) <= 1e-6f) return buf.depth[i] >= glm::dot(p, shot_.axis) - 1e-6f * diagonal_;
+            const float s = (plane.w - glm::dot(glm::vec3(plane), p)) / nd;
+            return s >= -1e-6f * diagonal_;
+        }
+        const glm::vec4 plane = local_plane_[k];
+        const float dist = glm::length(p);
+        const float nw = glm::dot(glm::vec3(plane), p) / dist;
+        const float slack = 1e-4f * dist + 1e-6f * diagonal_;
+        if (nw <= 1e-6f) return buf.depth[i] >= dist - slack;
+        return plane.w / nw >= dist - slack;
     }
 
-    // Local-frame corners of every triangle (the shooter's chart left out), in `local_`.
+    glm::vec3 n_local(glm::vec3 n) const { return {glm::dot(n, t_), glm::dot(n, b_), glm::dot(n, shot_.axis)}; }
+
     void to_local() {
         local_.clear();
         local_chart_.clear();
+        local_plane_.clear();
         for (std::size_t k = 0; k < corners_.size(); ++k) {
             if (triangle_chart_[k] == shot_.chart) continue;
             std::array<glm::vec3, 3> l;
@@ -322,6 +378,10 @@ private:
                     to_shooter_frame<float, glm::vec3>(corners_[k][std::size_t(m)], shot_.position, t_, b_, shot_.axis);
             local_.push_back(l);
             local_chart_.push_back(triangle_chart_[k]);
+            // Its plane n . x = d in the shooter's frame, d >= 0.
+            const glm::vec3 n = n_local(glm::vec3(world_plane_[k]));
+            const float d = glm::dot(n, l[0]);
+            local_plane_.push_back(d >= 0.f ? glm::vec4(n, d) : glm::vec4(-n, -d));
         }
     }
 
@@ -342,46 +402,47 @@ private:
         for (std::size_t k = 0; k < local_.size(); ++k) {
             poly.assign(local_[k].begin(), local_[k].end());
             detail::clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
+            if (poly.size() < 3) continue;
+            const glm::vec4 plane = local_plane_[k];
             for (std::size_t f = 1; f + 1 < poly.size(); ++f)
-                draw_tessellated(buf, poly[0], poly[f], poly[f + 1], local_chart_[k], project);
+                draw_tessellated(buf, poly[0], poly[f], poly[f + 1], std::uint32_t(k), project, glm::vec3(plane), plane.w);
         }
     }
 
+    // Draws (a, b, c), split in four at its edges' midpoints, recursively, while the sagitta
+    // of an edge exceeds the tolerance and the depth allows: pieces concentrate where the
+    // projection bends most, next to the shooter.
     template <class Project>
-    void draw_tessellated(item_buffer& buf, glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t id,
-                          const Project& project) {
-        // Sagitta of each edge in pixels; pieces n with sagitta / n^2 <= tolerance.
-        const auto sagitta = [&](glm::vec3 p, glm::vec3 q) {
-            const glm::vec2 mid = project(detail::canonical_lerp(p, q, 0.5f)).pixel;
-            return glm::length(mid - 0.5f * (project(p).pixel + project(q).pixel));
-        };
-        const float s = std::max({sagitta(a, b), sagitta(b, c), sagitta(c, a)});
-        int n = 1;
-        while (n < opt_.max_tessellation && s / float(n * n) > opt_.tolerance_px) n *= 2;
-        // Grid points: on the edges from canonical_lerp (shared with the neighbours), inside
-        // from barycentric combinations.
-        const auto point = [&](int i, int j) {
-            // i along a->b, j along a->c, i + j <= n.
-            if (j == 0) return detail::canonical_lerp(a, b, float(i) / float(n));
-            if (i == 0) return detail::canonical_lerp(a, c, float(j) / float(n));
-            if (i + j == n) return detail::canonical_lerp(b, c, float(j) / float(n));
-            const float u = float(i) / float(n), v = float(j) / float(n);
-            return a * (1.f - u - v) + b * u + c * v;
-        };
-        std::vector<raster_vertex> row0(std::size_t(n) + 1), row1(std::size_t(n) + 1);
-        for (int i = 0; i <= n; ++i) row0[std::size_t(i)] = project(point(i, 0));
-        for (int j = 0; j < n; ++j) {
-            for (int i = 0; i + j + 1 <= n; ++i) row1[std::size_t(i)] = project(point(i, j + 1));
-            for (int i = 0; i + j < n; ++i) {
-                scan_triangle(buf, row0[std::size_t(i)], row0[std::size_t(i) + 1], row1[std::size_t(i)], id);
-                ++drawn_;
-                if (i + j + 1 < n) {
-                    scan_triangle(buf, row0[std::size_t(i) + 1], row1[std::size_t(i) + 1], row1[std::size_t(i)], id);
-                    ++drawn_;
-                }
-            }
-            row0.swap(row1);
+    void draw_tessellated(item_buffer& buf, glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t k,
+                          const Project& project, glm::vec3 plane_n, float plane_d, int depth = 0) {
+        const raster_vertex pa = project(a), pb = project(b), pc = project(c);
+        const glm::vec3 ab = detail::canonical_lerp(a, b, 0.5f), bc = detail::canonical_lerp(b, c, 0.5f),
+                        ca = detail::canonical_lerp(c, a, 0.5f);
+        const raster_vertex pab = project(ab), pbc = project(bc), pca = project(ca);
+        const float s = std::max({glm::length(pab.pixel - 0.5f * (pa.pixel + pb.pixel)),
+                                  glm::length(pbc.pixel - 0.5f * (pb.pixel + pc.pixel)),
+                                  glm::length(pca.pixel - 0.5f * (pc.pixel + pa.pixel))});
+        if (!(s > opt_.tolerance_px) || depth >= opt_.max_tessellation_depth) {
+            // Depth: the distance along the pixel centre's direction w to the triangle's plane,
+            // d / (n . w), exact where the interpolated radial distance would be off by up to
+            // the triangle's bulge (centimetres for a ceiling light seen from the floor); the
+            // interpolated one only where the plane is seen edge-on.
+            const int width = buf.width;
+            scan_triangle_with(
+                buf, pa, pb, pc, local_chart_[k],
+                [&](int x, int y, double attr) {
+                    const float nw =
+                        glm::dot(plane_n, pixel_direction_[std::size_t(y) * std::size_t(width) + std::size_t(x)]);
+                    return nw > 1e-6f ? plane_d / nw : float(attr);
+                },
+                k);
+            ++drawn_;
+            return;
         }
+        draw_tessellated(buf, a, ab, ca, k, project, plane_n, plane_d, depth + 1);
+        draw_tessellated(buf, ab, b, bc, k, project, plane_n, plane_d, depth + 1);
+        draw_tessellated(buf, ca, bc, c, k, project, plane_n, plane_d, depth + 1);
+        draw_tessellated(buf, ab, bc, ca, k, project, plane_n, plane_d, depth + 1);
     }
 
     void draw_hemicube() {
@@ -414,7 +475,8 @@ private:
                     return raster_vertex{glm::vec2((s * 0.5f + 0.5f) * float(res), v * float(buf.height)), 1.f / q.z};
                 };
                 for (std::size_t f = 1; f + 1 < poly.size(); ++f) {
-                    scan_triangle(buf, project(poly[0]), project(poly[f]), project(poly[f + 1]), local_chart_[t], true);
+                    scan_triangle(buf, project(poly[0]), project(poly[f]), project(poly[f + 1]), local_chart_[t], true,
+                                  std::uint32_t(t));
                     ++counts[std::size_t(face)];
                 }
             }
@@ -448,7 +510,7 @@ private:
                 v[std::size_t(m)] = {(glm::vec2(glm::dot(p, t_), glm::dot(p, b_)) - ortho_lo_) * ortho_scale_,
                                      glm::dot(p, shot_.axis)};
             }
-            scan_triangle(buf, v[0], v[1], v[2], triangle_chart_[k]);
+            scan_triangle(buf, v[0], v[1], v[2], triangle_chart_[k], false, std::uint32_t(k));
             ++drawn_;
         }
     }
@@ -459,6 +521,8 @@ private:
     std::vector<std::uint32_t> triangle_chart_;
     std::vector<std::array<glm::vec3, 3>> local_;
     std::vector<std::uint32_t> local_chart_;
+    std::vector<glm::vec3> pixel_direction_;
+    std::vector<glm::vec4> world_plane_, local_plane_;  // (unit normal, offset) per triangle
     glm::vec3 lo_{0.f}, hi_{0.f};
     float diagonal_ = 1.f;
     shot_frame shot_{};
