@@ -18,7 +18,11 @@
 #include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/study/reference_cache.hpp>
-#include <bounce/hemisphere.hpp>
+#include <bounce/cpu/plane_estimate.hpp>
+#include <bounce/luminance.hpp>
+#include <bounce/plane_camera.hpp>
+#include <bounce/plane_weights.hpp>
+#include <bounce/radial_profile.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/report.hpp>
 #include <bounce/io/scene.hpp>
@@ -242,8 +246,8 @@ estimates ray_cast(const embree::reference_integrator& ref, const std::vector<st
             image<float> distance(cam.resolution, cam.resolution);
             embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
             const plane_view v{radiance.view(), distance.view()};
-            out.stretch[k] = estimate_plane(t.stretch, v).irradiance;
-            out.plane[k] = estimate_plane(t.plane, v).irradiance;
+            out.stretch[k] = cpu::estimate_plane(t.stretch, v).irradiance;
+            out.plane[k] = cpu::estimate_plane(t.plane, v).irradiance;
             profiles.local().add(radiance.view());
         });
         std::fill(out.running_kappa.begin() + std::ptrdiff_t(first), out.running_kappa.begin() + std::ptrdiff_t(last),
@@ -273,7 +277,7 @@ void batch_points(const std::vector<study_point>& pts, std::size_t first, std::s
 }
 
 struct raster_result {
-    estimates cpu;              // PBO read-back + CPU sums (estimate_plane)
+    estimates cpu;              // PBO read-back + CPU sums (cpu::estimate_plane)
     double gpu_seconds = 0;     // render + GPU reduction (stretch table), all records
     double cpu_gpu_difference = 0;  // max relative difference of E_stretch between the two sums
 };
@@ -299,8 +303,8 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
     const auto sum = [&](std::size_t first) {
         const auto planes = r.finish_read();
         tbb::parallel_for(std::size_t(0), planes.size(), [&](std::size_t k) {
-            out.cpu.stretch[first + k] = estimate_plane(t.stretch, planes.view(k)).irradiance;
-            out.cpu.plane[first + k] = estimate_plane(t.plane, planes.view(k)).irradiance;
+            out.cpu.stretch[first + k] = cpu::estimate_plane(t.stretch, planes.view(k)).irradiance;
+            out.cpu.plane[first + k] = cpu::estimate_plane(t.plane, planes.view(k)).irradiance;
         });
         for (std::size_t k = 0; k < planes.size(); ++k) profile.add(planes.radiance[k].view());
         std::fill_n(out.cpu.running_kappa.begin() + std::ptrdiff_t(first), planes.size(), profile.falloff_factor());

@@ -1,10 +1,18 @@
-// Single-plane hemisphere sampling (include/bounce/hemisphere.hpp): the rectangle closed
-// forms against quadrature, the three weight tables' totals against closed forms, exact
-// answers for uniform and half-space environments, and irradiance, gradients and harmonic
-// mean distance of a half-lit ceiling against the closed forms of test_irradiance_gradients.
+// Single-plane hemisphere sampling (bounce/rectangle_solid_angle.hpp, plane_pixel.hpp,
+// plane_camera.hpp, plane_weights.hpp, radial_profile.hpp, cpu/plane_estimate.hpp): the
+// rectangle closed forms against quadrature, the three weight tables' totals against
+// closed forms, exact answers for uniform and half-space environments, and irradiance,
+// gradients and harmonic mean distance of a half-lit ceiling against the closed forms of
+// test_irradiance_gradients.
 #include "half_lit_ceiling.hpp"
 
-#include <bounce/hemisphere.hpp>
+#include <bounce/cpu/plane_estimate.hpp>
+#include <bounce/luminance.hpp>
+#include <bounce/plane_camera.hpp>
+#include <bounce/plane_pixel.hpp>
+#include <bounce/plane_weights.hpp>
+#include <bounce/radial_profile.hpp>
+#include <bounce/rectangle_solid_angle.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -187,7 +195,7 @@ TEST_CASE("a uniform environment gives E = pi L and no gradient for coverage and
     const glm::vec3 L(0.25f, 1.f, 3.f);
     const auto plane = render(cam, [&](const glm::dvec3&) { return std::pair{L, 2.5f}; });
     for (auto kind : {plane_weighting::coverage, plane_weighting::stretch}) {
-        const auto e = estimate_plane(make_plane_weights(cam, kind), plane.view());
+        const auto e = cpu::estimate_plane(make_plane_weights(cam, kind), plane.view());
         CAPTURE(N, aperture, to_string(kind));
         // N^2 positive terms summed in double: relative error ~N^2 * 1e-16.
         CHECK(e.irradiance.x == Approx(pi * 0.25).epsilon(1e-12));
@@ -200,7 +208,7 @@ TEST_CASE("a uniform environment gives E = pi L and no gradient for coverage and
         CHECK(e.harmonic_mean_distance == Approx(2.5).epsilon(1e-12));
     }
     // The plane alone sees L times its own cosine-weighted solid angle.
-    const auto e = estimate_plane(make_plane_weights(cam, plane_weighting::plane), plane.view());
+    const auto e = cpu::estimate_plane(make_plane_weights(cam, plane_weighting::plane), plane.view());
     CHECK(e.irradiance.y == Approx(plane_cosine_solid_angle(aperture)).epsilon(1e-12));
 }
 
@@ -214,7 +222,7 @@ TEST_CASE("stretching is exact for an environment split by a plane through the n
     const auto t = make_plane_weights(cam, plane_weighting::stretch);
     const auto along_x = render(cam, [](const glm::dvec3& d) { return std::pair{glm::vec3(d.x > 0 ? 2.f : 0.f), 1.f}; });
     const auto along_y = render(cam, [](const glm::dvec3& d) { return std::pair{glm::vec3(d.y > 0 ? 2.f : 0.f), 1.f}; });
-    const auto ex = estimate_plane(t, along_x.view()), ey = estimate_plane(t, along_y.view());
+    const auto ex = cpu::estimate_plane(t, along_x.view()), ey = cpu::estimate_plane(t, along_y.view());
     CAPTURE(N, aperture);
     CHECK(ex.irradiance.x == Approx(pi).epsilon(1e-12));
     CHECK(ex.rotation[0].x == Approx(0).margin(1e-12));
@@ -251,7 +259,7 @@ TEST_CASE("stretching recovers irradiance, gradients and distance of a half-lit 
         const double x0 = hc.h * (3 * rng.next_double() - 1.5);  // the edge crosses the plane: |x0 / h| < a
         const half_lit_ceiling ceiling{hc.h, x0, hc.L0, hc.rot};
         const auto p = render(cam, [&](const glm::dvec3& d) { return ceiling.trace(d); });
-        const auto e = estimate_plane(stretch, p.view());
+        const auto e = cpu::estimate_plane(stretch, p.view());
         const auto bound = mixed_cells(cam, ceiling, true);
         CAPTURE(ceiling.h, ceiling.x0, ceiling.rot);
         // Rigorous: error <= L0 * (weights of the mixed cells), plus rounding.
@@ -283,7 +291,7 @@ TEST_CASE("the plane alone integrates the lit part of the square exactly up to i
     for (int c = 0; c < 200; ++c) {
         const half_lit_ceiling hc{0.5 + 2 * rng.next_double(), 6 * rng.next_double() - 3, double(float(1 + rng.next_double())), 0.0};
         const auto p = render(cam, [&](const glm::dvec3& d) { return hc.trace(d); });
-        const auto e = estimate_plane(plane, p.view());
+        const auto e = cpu::estimate_plane(plane, p.view());
         const double x_edge = std::clamp(-hc.x0 / hc.h, -a, a);
         const glm::dvec3 m = rectangle_moment<double, glm::dvec3>(x_edge, -a, a, a) * hc.L0;
         const auto bound = mixed_cells(cam, hc, false);
@@ -291,7 +299,7 @@ TEST_CASE("the plane alone integrates the lit part of the square exactly up to i
         CHECK(std::abs(e.irradiance.x - m.z) <= hc.L0 * bound.E + 1e-12);
         CHECK(glm::length(e.rotation[0] - glm::dvec3(-m.y, m.x, 0)) <= hc.L0 * bound.rotation + 1e-12);
         // Coverage scales the same estimate by pi / plane_cosine_solid_angle.
-        const auto ec = estimate_plane(make_plane_weights(cam, plane_weighting::coverage), p.view());
+        const auto ec = cpu::estimate_plane(make_plane_weights(cam, plane_weighting::coverage), p.view());
         CHECK(ec.irradiance.x == Approx(e.irradiance.x * pi / plane_cosine_solid_angle(126.0)).epsilon(1e-12));
     }
 }
@@ -320,13 +328,13 @@ TEST_CASE("fall-off stretching interpolates between the plane and stretching", "
         return std::pair{glm::vec3(float(rng.next_double()), float(rng.next_double()), 0.f), float(0.5 + rng.next_double())};
     });
     const double kappa = 0.8;
-    const auto ef = estimate_plane(make_plane_weights(cam, plane_weighting::falloff, kappa), p.view());
-    const auto ep = estimate_plane(plane, p.view()), es = estimate_plane(stretch, p.view());
+    const auto ef = cpu::estimate_plane(make_plane_weights(cam, plane_weighting::falloff, kappa), p.view());
+    const auto ep = cpu::estimate_plane(plane, p.view()), es = cpu::estimate_plane(stretch, p.view());
     CHECK(ef.irradiance.x == Approx(ep.irradiance.x + kappa * (es.irradiance.x - ep.irradiance.x)).epsilon(1e-12));
     CHECK(ef.harmonic_mean_distance == Approx(es.harmonic_mean_distance).epsilon(1e-12));
     // A uniform environment: the steps at the plane's edge cancel around it.
     const auto u = render(cam, [](const glm::dvec3&) { return std::pair{glm::vec3(1.f), 2.f}; });
-    const auto eu = estimate_plane(make_plane_weights(cam, plane_weighting::falloff, kappa), u.view());
+    const auto eu = cpu::estimate_plane(make_plane_weights(cam, plane_weighting::falloff, kappa), u.view());
     CHECK(glm::length(eu.translation[0]) < 1e-12);
     CHECK(glm::length(eu.rotation[0]) < 1e-12);
     CHECK_THROWS_AS(make_plane_weights(cam, plane_weighting::falloff, 1.5), parameter_error);
@@ -476,16 +484,16 @@ TEST_CASE("bad cameras and planes are refused", "[hemisphere][bad-input]") {
     const plane_camera cam{4, 90.0};
     const auto t = make_plane_weights(cam, plane_weighting::stretch);
     auto p = render(cam, [](const glm::dvec3&) { return std::pair{glm::vec3(1.f), 1.f}; });
-    CHECK_NOTHROW(estimate_plane(t, p.view()));
+    CHECK_NOTHROW(cpu::estimate_plane(t, p.view()));
     image<glm::vec3> small(3, 4);
-    CHECK_THROWS_AS(estimate_plane(t, plane_view{small.view(), p.distance.view()}), parameter_error);
+    CHECK_THROWS_AS(cpu::estimate_plane(t, plane_view{small.view(), p.distance.view()}), parameter_error);
     p.radiance(1, 2).y = std::numeric_limits<float>::infinity();
-    CHECK_THROWS_AS(estimate_plane(t, p.view()), parameter_error);
+    CHECK_THROWS_AS(cpu::estimate_plane(t, p.view()), parameter_error);
     p.radiance(1, 2).y = 1.f;
     p.distance(3, 3) = 0.f;
-    CHECK_THROWS_AS(estimate_plane(t, p.view()), parameter_error);
+    CHECK_THROWS_AS(cpu::estimate_plane(t, p.view()), parameter_error);
     p.distance(3, 3) = std::numeric_limits<float>::infinity();  // an escaped ray is fine
-    CHECK(estimate_plane(t, p.view()).harmonic_mean_distance > 1.0);
+    CHECK(cpu::estimate_plane(t, p.view()).harmonic_mean_distance > 1.0);
     const auto other = make_plane_weights(plane_camera{5, 90.0}, plane_weighting::stretch);
-    CHECK_THROWS_AS(estimate_plane(other, p.view()), parameter_error);
+    CHECK_THROWS_AS(cpu::estimate_plane(other, p.view()), parameter_error);
 }

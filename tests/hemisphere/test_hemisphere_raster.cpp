@@ -11,7 +11,9 @@
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/kernel_map.hpp>
 #include <bounce/gl/raster_record_sampler.hpp>
-#include <bounce/hemisphere.hpp>
+#include <bounce/cpu/plane_estimate.hpp>
+#include <bounce/plane_camera.hpp>
+#include <bounce/plane_weights.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -224,7 +226,7 @@ TEST_CASE("rasterized planes of a half-lit ceiling match the analytic plane, and
         // CPU sum (double, from the read-back) and GPU reduction (float): sums of N^2 float
         // terms of size <= max weight * L; float accumulation in 256 partial sums and a tree
         // keeps the relative error within a few 1e-7 per level: 1e-5 relative covers it.
-        const auto cpu = estimate_plane(stretch, batch.view(k));
+        const auto cpu = cpu::estimate_plane(stretch, batch.view(k));
         const auto& gpu = gpu_stretch[k];
         CHECK(gpu.irradiance.x == Approx(cpu.irradiance.x).epsilon(1e-5));
         CHECK(gpu.irradiance.z == Approx(cpu.irradiance.z).epsilon(1e-5));
@@ -304,7 +306,7 @@ TEST_CASE("the raster record sampler makes the same records one at a time and in
         // The estimate from the analytic plane: the raster plane differs only in texels the
         // edge crosses (test above), each by at most L, so by at most L times their weights.
         const analytic_ceiling c(H, x_edge, L, options.camera, p[k], options.offset);
-        const auto analytic = estimate_plane(stretch, analytic_plane(options.camera, c).view());
+        const auto analytic = cpu::estimate_plane(stretch, analytic_plane(options.camera, c).view());
         double crossed = 0;
         for (std::uint32_t j = 0; j < options.camera.resolution; ++j)
             for (std::uint32_t i = 0; i < options.camera.resolution; ++i)

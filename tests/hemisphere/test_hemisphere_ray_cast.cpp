@@ -7,7 +7,9 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/hemisphere.hpp>
+#include <bounce/cpu/plane_estimate.hpp>
+#include <bounce/plane_camera.hpp>
+#include <bounce/plane_weights.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -41,7 +43,7 @@ TEST_CASE("ray-cast planes of a half-lit ceiling give the closed-form irradiance
         image<glm::vec3> radiance(cam.resolution, cam.resolution);
         image<float> distance(cam.resolution, cam.resolution);
         embree::sample_plane(ref, cam, p, n, radiance.view(), distance.view());
-        const auto e = estimate_plane(stretch, {radiance.view(), distance.view()});
+        const auto e = cpu::estimate_plane(stretch, {radiance.view(), distance.view()});
         // The record at p sees the lit side where world x > x_edge: the core test's ceiling
         // (ceiling_seen_from), its rigorous bound on E (mixed cells) and its translation
         // budget for N = 64.

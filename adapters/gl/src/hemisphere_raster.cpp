@@ -1,7 +1,7 @@
 // The raster hemisphere sampler: an atlas of record planes drawn by one instanced draw per
 // batch, read back through pixel buffer objects, or reduced by a compute shader. The
 // shaders are plumbing; the per-texel maths are emitted kernels (surface.hpp's
-// facing_normal, lights.hpp's lambertian_radiance, hemisphere.hpp's plane_hit_distance and
+// facing_normal, lights.hpp's lambertian_radiance, plane_pixel.hpp's plane_hit_distance and
 // plane_pixel_terms) and gl::direct_light's direct_irradiance.
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/glsl/emit.hpp>

@@ -2,7 +2,7 @@
 /// \file hemisphere_raster.hpp
 /// Hemisphere sampling by rasterization onto one plane per record (seed 000, section 8.4),
 /// many records per batch in an atlas of planes, with the two summations the seed weighs:
-/// read-back through pixel buffer objects and a CPU sum (estimate_plane), or a reduction on
+/// read-back through pixel buffer objects and a CPU sum (cpu::estimate_plane), or a reduction on
 /// the GPU (a compute shader running the emitted plane_pixel_terms kernel).
 ///
 /// One instanced draw renders a whole batch: instance k is record k, placed on its tile of
@@ -14,7 +14,7 @@
 /// shadow-mapped `direct_irradiance` through the emitted lambertian_radiance and stores
 /// (radiance rgb, hit distance) in RGBA32F; texels that see nothing keep (environment, +inf).
 ///
-/// A record's plane is its local frame of hemisphere.hpp: x, y = the camera's
+/// A record's plane is its local frame of plane_camera.hpp: x, y = the camera's
 /// plane_camera::frame(p, n), z = n; pixel (i, j) of tile k is texel (i, j) of the tile in
 /// memory order (the projection flips y so that row 0, the first in memory, is +y). The
 /// record's eye is p + offset n, as a ray caster offsets its origins.
@@ -22,7 +22,8 @@
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/objects.hpp>
-#include <bounce/hemisphere.hpp>
+#include <bounce/plane_camera.hpp>
+#include <bounce/plane_weights.hpp>
 #include <bounce/image.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -57,14 +58,14 @@ struct hemisphere_raster_options {
     void validate() const;
 };
 
-/// The planes of one batch on the CPU, row 0 at the top (+y) as hemisphere.hpp says.
+/// The planes of one batch on the CPU, row 0 at the top (+y) as plane_camera.hpp says.
 struct plane_batch {
     plane_camera camera;
     std::vector<image<glm::vec3>> radiance;  ///< per record, N x N
     std::vector<image<float>> distance;      ///< per record, N x N (+infinity: nothing hit)
 
     std::size_t size() const noexcept { return radiance.size(); }
-    /// Record k's plane for estimate_plane.
+    /// Record k's plane for cpu::estimate_plane.
     plane_view view(std::size_t k) const { return {radiance.at(k).view(), distance.at(k).view()}; }
 };
 
@@ -118,7 +119,7 @@ public:
     /// Sums the last render on the GPU with the weights set: for each record, the sums of
     /// plane_pixel_terms over its plane (one work group of 256 invocations per record, a
     /// tree reduction in shared memory), read back as hemisphere_estimates in the local
-    /// frame, irradiance and gradients times weights.scale, like estimate_plane. Throws
+    /// frame, irradiance and gradients times weights.scale, like cpu::estimate_plane. Throws
     /// parameter_error before any render or set_weights.
     std::vector<hemisphere_estimate> reduce();
 

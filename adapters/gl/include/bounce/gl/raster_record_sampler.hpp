@@ -11,8 +11,9 @@
 /// to the rounding of the atlas placement.
 
 #include <bounce/gl/hemisphere_raster.hpp>
-#include <bounce/hemisphere.hpp>
+#include <bounce/plane_weights.hpp>
 #include <bounce/irradiance_record.hpp>
+#include <bounce/record_sampler.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -70,5 +71,7 @@ private:
     radius_limits limits_;
     plane_weights weights_;
 };
+
+static_assert(bounce::record_sampler<raster_record_sampler>);
 
 }  // namespace bounce::gl

@@ -1,0 +1,65 @@
+#pragma once
+/// \file rectangle_solid_angle.hpp
+/// Exact integrals over a rectangle [u0, u1] x [v0, v1] on a plane at unit distance along
+/// its normal w (d = sqrt(1 + u^2 + v^2), direction omega = (u, v, 1) / d,
+/// d omega = du dv / d^3): its solid angle and the first moment int omega d omega, whose
+/// normal component is the cosine-weighted solid angle. Each is a corner function F with
+/// int = F(u1, v1) - F(u0, v1) - F(u1, v0) + F(u0, v0):
+///  - solid angle:      F = atan(u v / d)                                     (Eq. H1)
+///  - int omega_w dw:   F = (u/cu atan(v/cu) + v/cv atan(u/cv)) / 2            (Eq. H2)
+///  - int omega_u dw:   F = -atan(v/cu) / (2 cu)                               (Eq. H3)
+///  - int omega_v dw:   F = -atan(u/cv) / (2 cv),   cu = sqrt(1+u^2), cv = sqrt(1+v^2)
+/// (each checked by differentiating: d2F/du dv is the integrand). H2 is the cosine-weighted
+/// solid angle (the differential-area-to-parallel-rectangle form factor times pi), H3 the
+/// in-plane moments a rotation gradient needs. Derivations: docs/hemisphere-sampling.md.
+/// Kernels: instantiated on the CPU and emitted as GLSL.
+
+#include <bounce/concepts.hpp>
+#include <bounce/vocabulary.hpp>
+
+namespace bounce {
+
+/// Corner function of the solid angle of a rectangle on the plane at unit distance
+/// (Eq. H1): atan(u v / sqrt(1 + u^2 + v^2)). Dimensionless (u, v in units of the distance).
+template <real T>
+T rectangle_solid_angle_corner(T u, T v) {
+    return atan(u * v, sqrt(T(1) + u * u + v * v));
+}
+
+/// Solid angle (sr) subtended at the origin by the rectangle [u0, u1] x [v0, v1] on the
+/// plane at unit distance (corner differences of Eq. H1; exact, unlike the midpoint rule
+/// cos^3 du dv). Requires u0 <= u1, v0 <= v1.
+template <real T>
+T rectangle_solid_angle(T u0, T v0, T u1, T v1) {
+    return rectangle_solid_angle_corner<T>(u1, v1) - rectangle_solid_angle_corner<T>(u0, v1) -
+           rectangle_solid_angle_corner<T>(u1, v0) + rectangle_solid_angle_corner<T>(u0, v0);
+}
+
+/// Corner function of the first moment int omega d omega of a rectangle on the plane at
+/// unit distance (Eqs. H2, H3), as (u component, v component, normal component).
+template <real T, vec3_of<T> V>
+V rectangle_moment_corner(T u, T v) {
+    const T cu = sqrt(T(1) + u * u), cv = sqrt(T(1) + v * v);
+    const T au = atan(v, cu), av = atan(u, cv);  // atan(v / cu), atan(u / cv): cu, cv > 0
+    return V(-au / (T(2) * cu), -av / (T(2) * cv), (u / cu * au + v / cv * av) / T(2));
+}
+
+/// The first moment int omega d omega over the rectangle [u0, u1] x [v0, v1] on the plane at
+/// unit distance, in the plane's frame: (int omega_u, int omega_v, int omega_w) in sr. Its
+/// normal component is the rectangle's cosine-weighted solid angle int cos(theta) d omega
+/// (pi times the form factor from a differential area facing the plane); the in-plane
+/// components give the rotation gradient's weights. Requires u0 <= u1, v0 <= v1.
+template <real T, vec3_of<T> V>
+V rectangle_moment(T u0, T v0, T u1, T v1) {
+    return rectangle_moment_corner<T, V>(u1, v1) - rectangle_moment_corner<T, V>(u0, v1) -
+           rectangle_moment_corner<T, V>(u1, v0) + rectangle_moment_corner<T, V>(u0, v0);
+}
+
+/// Cosine-weighted solid angle (sr) of the rectangle [u0, u1] x [v0, v1] on the plane at
+/// unit distance: int cos(theta) d omega, theta measured from the plane's normal (Eq. H2).
+template <real T, vec3_of<T> V>
+T rectangle_cosine_solid_angle(T u0, T v0, T u1, T v1) {
+    return rectangle_moment<T, V>(u0, v0, u1, v1).z;
+}
+
+}  // namespace bounce
