@@ -1,0 +1,230 @@
+#pragma once
+/// \file sh_projection.hpp
+/// SH projection of many RGB cube maps of one size at once (a probe bake's worth): the
+/// direction set of a size x size cube map is the same for every probe, so Y_i(texel) times
+/// the texel's exact solid angle is tabulated once (sh_projection.hpp of the core defines
+/// the layout and the quadrature), and projecting a map is a matrix product:
+/// c_i = sum over texels of table_i(texel) f(texel).
+///
+/// How the product is laid out for the memory system:
+/// - The table is stored per face row and coefficient with each weight repeated for the r,
+///   g and b floats of its texel, so a row of packed RGB texels multiplies the table row
+///   float by float (no de-interleaving); float j of a row belongs to channel j mod 3, and
+///   three 8-float accumulators per coefficient cover the period of 24 floats (8 texels).
+/// - Maps are taken in groups (one TBB task each); the group walks the faces two rows at a
+///   time and projects those rows of every map in the group while the rows' table (2 x 9 x
+///   192 floats = 14 KB for L = 3, size 64) stays in L1. The table (2.7 MB at that size)
+///   is thus read from memory once per group, not once per map.
+/// - On x86-64 with AVX2 and FMA (checked at run time) the row products use 256-bit fused
+///   multiply-adds, three coefficients at a time (nine accumulators in registers); elsewhere
+///   a portable loop the compiler vectorizes for the baseline ISA.
+/// Float accumulators run over one face (at most 8 x 64 = 512 terms per lane for size 64:
+/// relative rounding below 512 x 2^-24 = 3e-5, 1e-6 typical), then add into double sums.
+/// Each map is summed in the same order whatever the thread count and the grouping, so
+/// results are bitwise reproducible for a given path (the AVX2 and portable paths differ by
+/// rounding, a few float ulps of the result).
+
+#include <bounce/errors.hpp>
+#include <bounce/image.hpp>
+#include <bounce/sh_basis.hpp>
+#include <bounce/sh_projection.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define BOUNCE_SH_PROJECTION_AVX2 1
+#else
+#define BOUNCE_SH_PROJECTION_AVX2 0
+#endif
+
+namespace bounce::cpu {
+
+/// Which row-product code `cube_map_sh_projector` runs.
+enum class sh_projection_path {
+    automatic,  ///< AVX2 + FMA where the CPU has them, else portable
+    portable,   ///< plain loops only (for comparison and testing)
+};
+
+/// Projects RGB cube maps of a fixed size (glm::vec3 texels, packed rows) onto bands
+/// 0 .. L - 1. Construct once per size (it computes 6 size^2 L^2 table entries), then call
+/// `project` for each batch of maps.
+template <int L>
+class cube_map_sh_projector {
+public:
+    static constexpr std::size_t coefficients = sh_count(L);
+    static constexpr std::size_t rows_per_block = 2;  ///< face rows projected per table block
+    static constexpr std::size_t maps_per_task = 16;  ///< maps one TBB task projects together
+
+    /// Tables for size x size faces (typical: 64; 1 to 4096). Throws parameter_error naming
+    /// "size" outside that range.
+    explicit cube_map_sh_projector(std::size_t size, sh_projection_path path = sh_projection_path::automatic)
+        : size_(size), avx2_(path == sh_projection_path::automatic && cpu_has_avx2_fma()) {
+        static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "texel rows are read as packed floats");
+        require(size >= 1 && size <= 4096, "size", "cube-map size must be 1 to 4096 texels");
+        const std::size_t row = 3 * size_;
+        table_.assign(6 * size_ * coefficients * row, 0.f);
+        for (int f = 0; f < 6; ++f)
+            for (std::size_t y = 0; y < size_; ++y)
+                for (std::size_t x = 0; x < size_; ++x) {
+                    const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face(f), size_, x, y));
+                    const double dw = cube_texel_solid_angle(size_, x, y);
+                    for (std::size_t i = 0; i < coefficients; ++i)
+                        for (std::size_t c = 0; c < 3; ++c) table_[table_row(std::size_t(f), y, i) + 3 * x + c] = float(basis[i] * dw);
+                }
+    }
+
+    std::size_t size() const noexcept { return size_; }
+    /// True when the AVX2 + FMA row product runs.
+    bool uses_avx2() const noexcept { return avx2_; }
+    /// Bytes of the tables (4 x 3 x 6 size^2 L^2).
+    std::size_t table_bytes() const noexcept { return table_.size() * sizeof(float); }
+
+    /// SH coefficients of every map of `maps` into `out` (one per map), in parallel over
+    /// groups of maps. Throws parameter_error naming "out" when the counts differ and
+    /// "maps" when a map is not a cube of this projector's size.
+    void project(std::span<const cube_map_view<const glm::vec3>> maps, std::span<sh_coefficients<L, glm::vec3>> out) const {
+        require(out.size() == maps.size(), "out", "one coefficient set per map");
+        for (const auto& m : maps) {
+            require_cube_map(m, "maps");
+            require(m.size() == size_, "maps", "a map's size differs from the projector's");
+        }
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, maps.size(), maps_per_task),
+                          [&](const tbb::blocked_range<std::size_t>& r) { project_group(maps, out, r.begin(), r.end()); });
+    }
+
+    /// The coefficients of one map (no parallelism).
+    sh_coefficients<L, glm::vec3> project(const cube_map_view<const glm::vec3>& map) const {
+        require_cube_map(map, "map");
+        require(map.size() == size_, "map", "the map's size differs from the projector's");
+        sh_coefficients<L, glm::vec3> out{};
+        const std::array<cube_map_view<const glm::vec3>, 1> one{map};
+        project_group(std::span<const cube_map_view<const glm::vec3>>(one), std::span<sh_coefficients<L, glm::vec3>>(&out, 1), 0, 1);
+        return out;
+    }
+
+private:
+    static constexpr std::size_t lanes = 24;  // floats per accumulator period: 8 texels x 3 channels
+
+    static bool cpu_has_avx2_fma() noexcept {
+#if BOUNCE_SH_PROJECTION_AVX2
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+        return false;
+#endif
+    }
+
+    std::size_t table_row(std::size_t face, std::size_t y, std::size_t i) const noexcept {
+        return ((face * size_ + y) * coefficients + i) * 3 * size_;
+    }
+
+    // acc[i * 24 + j] += sum over steps s of table_i[24 s + j] * row[24 s + j], for the
+    // rows [y0, y1) of one face; a partial last step fills lanes 0 .. tail - 1.
+    void accumulate_portable(const image_view<const glm::vec3>& face_view, std::size_t face, std::size_t y0,
+                             std::size_t y1, float* acc) const {
+        const std::size_t floats = 3 * size_;
+        for (std::size_t y = y0; y < y1; ++y) {
+            const float* row = &face_view(0, y).x;
+            for (std::size_t i = 0; i < coefficients; ++i) {
+                const float* t = table_.data() + table_row(face, y, i);
+                float* a = acc + i * lanes;
+                std::size_t s = 0;
+                for (; s + lanes <= floats; s += lanes)
+                    for (std::size_t j = 0; j < lanes; ++j) a[j] += t[s + j] * row[s + j];
+                for (std::size_t j = 0; s + j < floats; ++j) a[j] += t[s + j] * row[s + j];
+            }
+        }
+    }
+
+#if BOUNCE_SH_PROJECTION_AVX2
+    // The same sums with 256-bit FMAs, G coefficients (3 G accumulators) at a time.
+    template <std::size_t G>
+    __attribute__((target("avx2,fma"))) void accumulate_group_avx2(const image_view<const glm::vec3>& face_view,
+                                                                    std::size_t face, std::size_t y0, std::size_t y1,
+                                                                    std::size_t first, float* acc) const {
+        const std::size_t floats = 3 * size_;
+        __m256 a[G][3];
+        for (std::size_t g = 0; g < G; ++g)
+            for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_loadu_ps(acc + (first + g) * lanes + 8 * v);
+        for (std::size_t y = y0; y < y1; ++y) {
+            const float* row = &face_view(0, y).x;
+            const float* t[G];
+            for (std::size_t g = 0; g < G; ++g) t[g] = table_.data() + table_row(face, y, first + g);
+            std::size_t s = 0;
+            for (; s + lanes <= floats; s += lanes) {
+                const __m256 d0 = _mm256_loadu_ps(row + s), d1 = _mm256_loadu_ps(row + s + 8),
+                             d2 = _mm256_loadu_ps(row + s + 16);
+                for (std::size_t g = 0; g < G; ++g) {
+                    a[g][0] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s), d0, a[g][0]);
+                    a[g][1] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s + 8), d1, a[g][1]);
+                    a[g][2] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s + 16), d2, a[g][2]);
+                }
+            }
+            if (s < floats) {  // a partial period: the remaining floats into lanes 0 .. floats - s - 1
+                alignas(32) float tail[G][lanes] = {};
+                for (std::size_t g = 0; g < G; ++g)
+                    for (std::size_t j = 0; s + j < floats; ++j) tail[g][j] = t[g][s + j] * row[s + j];
+                for (std::size_t g = 0; g < G; ++g)
+                    for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_add_ps(a[g][v], _mm256_load_ps(tail[g] + 8 * v));
+            }
+        }
+        for (std::size_t g = 0; g < G; ++g)
+            for (std::size_t v = 0; v < 3; ++v) _mm256_storeu_ps(acc + (first + g) * lanes + 8 * v, a[g][v]);
+    }
+
+    void accumulate_avx2(const image_view<const glm::vec3>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
+                         float* acc) const {
+        std::size_t i = 0;
+        for (; i + 3 <= coefficients; i += 3) accumulate_group_avx2<3>(face_view, face, y0, y1, i, acc);
+        if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(face_view, face, y0, y1, i, acc);
+        if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(face_view, face, y0, y1, i, acc);
+    }
+#endif
+
+    void project_group(std::span<const cube_map_view<const glm::vec3>> maps, std::span<sh_coefficients<L, glm::vec3>> out,
+                       std::size_t begin, std::size_t end) const {
+        const std::size_t count = end - begin;
+        std::vector<float> acc(count * coefficients * lanes);
+        std::vector<double> sums(count * coefficients * 3, 0.0);
+        for (std::size_t face = 0; face < 6; ++face) {
+            std::fill(acc.begin(), acc.end(), 0.f);
+            for (std::size_t y0 = 0; y0 < size_; y0 += rows_per_block) {
+                const std::size_t y1 = std::min(size_, y0 + rows_per_block);
+                for (std::size_t k = 0; k < count; ++k) {
+                    const auto& face_view = maps[begin + k].faces[face];
+                    float* a = acc.data() + k * coefficients * lanes;
+#if BOUNCE_SH_PROJECTION_AVX2
+                    if (avx2_) {
+                        accumulate_avx2(face_view, face, y0, y1, a);
+                        continue;
+                    }
+#endif
+                    accumulate_portable(face_view, face, y0, y1, a);
+                }
+            }
+            // Lane j of a period holds channel j mod 3 (periods start at a multiple of 3).
+            for (std::size_t k = 0; k < count; ++k)
+                for (std::size_t i = 0; i < coefficients; ++i)
+                    for (std::size_t j = 0; j < lanes; ++j)
+                        sums[(k * coefficients + i) * 3 + j % 3] += double(acc[(k * coefficients + i) * lanes + j]);
+        }
+        for (std::size_t k = 0; k < count; ++k)
+            for (std::size_t i = 0; i < coefficients; ++i)
+                for (std::size_t c = 0; c < 3; ++c)
+                    out[begin + k][i][int(c)] = float(sums[(k * coefficients + i) * 3 + c]);
+    }
+
+    std::size_t size_;
+    bool avx2_;
+    std::vector<float> table_;
+};
+
+}  // namespace bounce::cpu

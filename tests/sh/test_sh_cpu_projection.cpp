@@ -1,0 +1,133 @@
+// The table-driven batch projection of cpu/sh_projection.hpp against the core's double
+// reference (within a recursive-summation bound), bitwise the same for any thread count and
+// any batching, on sizes with and without a partial 8-texel period, on both code paths.
+#include "sphere_quadrature.hpp"
+
+#include <bounce/cpu/sh_projection.hpp>
+#include <bounce/sh_irradiance.hpp>
+#include <bounce/sh_projection.hpp>
+
+#include <catch2/catch.hpp>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+using namespace bounce;
+using namespace bounce::sh_test;
+
+namespace {
+
+constexpr int L = 3;
+
+struct cube_set {
+    std::size_t size;
+    std::vector<std::array<image<glm::vec3>, 6>> storage;
+    std::vector<cube_map_view<const glm::vec3>> views;
+
+    // `count` maps of a smooth random RGB function plus a bright lobe (a sun), different per map.
+    cube_set(std::size_t n, std::size_t count, std::uint64_t seed) : size(n), storage(count) {
+        pcg32 rng(seed);
+        for (auto& faces : storage) {
+            const glm::dvec3 sun = glm::normalize(glm::dvec3(rng.next_double() - 0.5, rng.next_double() - 0.5, 0.3));
+            const glm::dvec3 tint(rng.next_double(), rng.next_double(), rng.next_double());
+            for (int f = 0; f < 6; ++f) {
+                faces[std::size_t(f)] = image<glm::vec3>(n, n);
+                for (std::size_t y = 0; y < n; ++y)
+                    for (std::size_t x = 0; x < n; ++x) {
+                        const glm::dvec3 d = cube_texel_direction(cube_face(f), n, x, y);
+                        const double lobe = std::pow(std::max(0.0, glm::dot(d, sun)), 32.0) * 20;
+                        faces[std::size_t(f)](x, y) = glm::vec3(tint * (1 + d.z) + glm::dvec3(lobe));
+                    }
+            }
+        }
+        for (auto& faces : storage) {
+            cube_map_view<const glm::vec3> v;
+            for (int f = 0; f < 6; ++f) v.faces[std::size_t(f)] = faces[std::size_t(f)].view();
+            views.push_back(v);
+        }
+    }
+};
+
+// Recursive summation of m float products has error at most (m + 1) u sum |t f|
+// (Higham, Accuracy and Stability, Eq. 4.4, plus one rounding per product), u = 2^-24;
+// the table entries are themselves rounded (u relative) and the lanes' partial sums are added
+// in double. m = the terms one lane sums over a face: size rows x ceil(3 size / 24) periods.
+double error_bound(const cube_set& set, std::size_t map, std::size_t i, int channel) {
+    const std::size_t n = set.size, m = n * ((3 * n + 23) / 24);
+    double magnitude = 0;
+    for (int f = 0; f < 6; ++f)
+        for (std::size_t y = 0; y < n; ++y)
+            for (std::size_t x = 0; x < n; ++x) {
+                const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face(f), n, x, y));
+                magnitude += std::abs(basis[i] * cube_texel_solid_angle(n, x, y) * set.views[map].faces[std::size_t(f)](x, y)[channel]);
+            }
+    return double(m + 3) * 0x1p-24 * magnitude + 0x1p-24 * 4;  // + rounding the result to float
+}
+
+}  // namespace
+
+TEST_CASE("batch cube-map projection matches the double reference within the float summation bound", "[sh][cpu]") {
+    for (const std::size_t n : {64u, 13u}) {
+        const cube_set set(n, 5, 40 + n);
+        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::portable}) {
+            const cpu::cube_map_sh_projector<L> projector(n, path);
+            std::vector<sh_coefficients<L, glm::vec3>> out(set.views.size());
+            projector.project(set.views, out);
+            for (std::size_t k = 0; k < set.views.size(); ++k) {
+                const auto reference = sh_project_cube_map<L>(set.views[k]);
+                for (std::size_t i = 0; i < sh_count(L); ++i)
+                    for (int c = 0; c < 3; ++c) {
+                        INFO("size " << n << ", avx2 " << projector.uses_avx2() << ", map " << k << ", coefficient " << i);
+                        CHECK(std::abs(double(out[k][i][c]) - reference[i][c]) <= error_bound(set, k, i, c));
+                    }
+            }
+        }
+    }
+}
+
+TEST_CASE("batch cube-map projection is bitwise the same for any thread count and batching", "[sh][cpu]") {
+    const cube_set set(32, 40, 7);
+    const cpu::cube_map_sh_projector<L> projector(32);
+    std::vector<sh_coefficients<L, glm::vec3>> one_thread(set.views.size()), two_threads(set.views.size());
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        projector.project(set.views, one_thread);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        projector.project(set.views, two_threads);
+    }
+    CHECK(std::memcmp(one_thread.data(), two_threads.data(), one_thread.size() * sizeof(one_thread[0])) == 0);
+    for (std::size_t k = 0; k < set.views.size(); k += 7) {
+        const auto single = projector.project(set.views[k]);
+        CHECK(std::memcmp(&single, &one_thread[k], sizeof(single)) == 0);
+    }
+}
+
+TEST_CASE("a constant cube map projected in float gives E = pi L to float accuracy", "[sh][cpu]") {
+    image<glm::vec3> face(64, 64, glm::vec3(0.5f, 1.f, 2.f));
+    cube_map_view<const glm::vec3> cube;
+    for (auto& f : cube.faces) f = face.view();
+    const auto c = cpu::cube_map_sh_projector<L>(64).project(cube);
+    std::array<glm::dvec3, 9> rgb{};
+    for (std::size_t i = 0; i < 9; ++i) rgb[i] = glm::dvec3(c[i]);
+    // 512-term float sums per lane: relative error below 512 x 2^-24 = 3e-5 in the worst case.
+    for (const auto& n : test_directions(5, 50)) {
+        const glm::dvec3 e = sh_irradiance<L, double, glm::dvec3>(rgb, n);
+        CHECK(std::abs(e.x / (std::numbers::pi * 0.5) - 1) < 3e-5);
+        CHECK(std::abs(e.z / (std::numbers::pi * 2.0) - 1) < 3e-5);
+    }
+}
+
+TEST_CASE("the batch projector rejects sizes and maps that do not fit", "[sh][cpu][errors]") {
+    CHECK_THROWS_AS(cpu::cube_map_sh_projector<L>(0), parameter_error);
+    const cube_set set(8, 2, 3);
+    const cpu::cube_map_sh_projector<L> projector(16);
+    std::vector<sh_coefficients<L, glm::vec3>> out(2), short_out(1);
+    CHECK_THROWS_AS(projector.project(set.views, out), parameter_error);
+    const cpu::cube_map_sh_projector<L> right(8);
+    CHECK_THROWS_AS(right.project(set.views, short_out), parameter_error);
+    CHECK_NOTHROW(right.project(set.views, out));
+}
