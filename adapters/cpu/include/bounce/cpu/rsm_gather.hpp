@@ -131,6 +131,17 @@ inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& ima
     });
 }
 
+/// The plain gather (no interleaving, DS05): every pixel of `gb` sums the whole `pattern`.
+inline void rsm_gather(const gbuffer_view<float>& gb, std::span<const rsm_view> maps,
+                       std::span<const glm::vec3> pattern, const pixel_light_params& lp, image_view<glm::vec3> out) {
+    const interleave_maps imaps({1, 1}, gb.width(), gb.height());
+    light_groups all;
+    all.begin = {0, std::uint32_t(pattern.size())};
+    all.order.resize(pattern.size());
+    for (std::size_t k = 0; k < pattern.size(); ++k) all.order[k] = std::uint32_t(k);
+    rsm_gather(gb, imaps, maps, pattern, all, lp, out);
+}
+
 /// Tolerances of the geometry-aware upsampling (geometry_aware_upsample_weights).
 struct upsample_params {
     float cos_normal = 0.9f;       ///< smallest cosine between a sample's normal and the pixel's (typical: 0.9)

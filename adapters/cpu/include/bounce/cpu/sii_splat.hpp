@@ -126,4 +126,12 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
     });
 }
 
+/// The plain splat (no interleaving): every VPL, in index order, over the G-buffer `gb`
+/// (the image itself), added to `out`.
+inline void splat_vpls(const gbuffer_view<float>& gb, const camera& cam, std::span<const vpl> vpls,
+                       const sii_params& params, image_view<glm::vec3> out) {
+    const interleave_maps maps({1, 1}, gb.width(), gb.height());
+    splat_vpls(gb, maps, cam, vpls, assign_lights(vpls.size(), 1, light_assignment::interleaved), params, out);
+}
+
 }  // namespace bounce::cpu
