@@ -103,7 +103,8 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
 }
 }  // namespace detail
 
-/// The gather over a (split) G-buffer `gb`: pixel (u, v) of sub-buffer s = maps.cell(u, v)
+/// The gather over a (split) G-buffer `gb` from `maps` (one per light, six for a point
+/// light's cube; all the size `pattern` was made for): pixel (u, v) of sub-buffer s = maps.cell(u, v)
 /// uses `pattern[groups.begin[s] .. groups.begin[s + 1])` (grouped_pattern) with weights
 /// times interleaved_weight_scale(n, m). `out` (irradiance, W/m^2) is written everywhere; 0
 /// where the G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather.
@@ -111,7 +112,12 @@ inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& ima
                        std::span<const glm::vec3> pattern, const light_groups& groups, const pixel_light_params& lp,
                        image_view<glm::vec3> out) {
     lp.validate();
-    for (const auto& m : maps) m.validate();
+    for (const auto& m : maps) {
+        m.validate();
+        // The pattern's weights hold one texel count (rsm_disc_pattern).
+        require(m.width() == maps[0].width() && m.height() == maps[0].height(), "maps",
+                "must all have the size the pattern was made for");
+    }
     detail::require_size(gb.width(), gb.height(), imaps, "gb");
     detail::require_size(out.width(), out.height(), imaps, "out");
     require(groups.begin.size() == std::size_t(imaps.pattern.cells()) + 1 && pattern.size() == groups.order.size(),
