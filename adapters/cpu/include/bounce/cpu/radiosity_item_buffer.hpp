@@ -400,6 +400,7 @@ private:
         const float z_min = 1e-6f * diagonal_;
         std::vector<glm::vec3> poly, scratch;
         for (std::size_t k = 0; k < local_.size(); ++k) {
+            if (local_[k][0].z < z_min && local_[k][1].z < z_min && local_[k][2].z < z_min) continue;
             poly.assign(local_[k].begin(), local_[k].end());
             detail::clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
             if (poly.size() < 3) continue;
@@ -459,15 +460,25 @@ private:
             const float near_z = 1e-6f * diagonal_;
             const float k = 1.f + 4.f / float(res);
             std::vector<glm::vec3> poly, scratch;
+            const float bottom = face == 0 ? k : 4.f / float(res);
             for (std::size_t t = 0; t < local_.size(); ++t) {
                 poly.clear();
                 for (const glm::vec3& l : local_[t])
                     poly.emplace_back(glm::dot(l, axes[0]), glm::dot(l, axes[1]), glm::dot(l, axes[2]));
+                // Most triangles miss most faces: reject those wholly outside one clip plane
+                // before clipping.
+                const auto outside = [&](auto plane_value) {
+                    return plane_value(poly[0]) < 0.f && plane_value(poly[1]) < 0.f && plane_value(poly[2]) < 0.f;
+                };
+                if (outside([&](glm::vec3 q) { return q.z - near_z; }) || outside([&](glm::vec3 q) { return k * q.z - q.x; }) ||
+                    outside([&](glm::vec3 q) { return k * q.z + q.x; }) || outside([&](glm::vec3 q) { return k * q.z - q.y; }) ||
+                    outside([&](glm::vec3 q) { return bottom * q.z + q.y; }))
+                    continue;
                 detail::clip_polygon(poly, glm::vec3(0, 0, 1), near_z, scratch);
                 detail::clip_polygon(poly, glm::vec3(-1, 0, k), 0.f, scratch);
                 detail::clip_polygon(poly, glm::vec3(1, 0, k), 0.f, scratch);
                 detail::clip_polygon(poly, glm::vec3(0, -1, k), 0.f, scratch);
-                detail::clip_polygon(poly, glm::vec3(0, 1, face == 0 ? k : 4.f / float(res)), 0.f, scratch);
+                detail::clip_polygon(poly, glm::vec3(0, 1, bottom), 0.f, scratch);
                 if (poly.size() < 3) continue;
                 const auto project = [&](glm::vec3 q) {
                     const float s = q.x / q.z, tt = q.y / q.z;
