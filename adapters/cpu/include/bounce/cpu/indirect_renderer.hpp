@@ -41,8 +41,9 @@ enum class vpl_selection {
 struct indirect_options {
     indirect_technique technique = indirect_technique::sii;
     /// SII: VPLs per frame over all maps; RSM gather: disc samples per pixel and map before
-    /// interleaving (each sub-buffer uses count / (N M)). Typical: 400-4096.
-    std::size_t count = 1024;
+    /// interleaving (each sub-buffer uses count / (N M)). Default 400, DS05's choice for the
+    /// gather; typical 400-4096.
+    std::size_t count = 400;
     interleave_pattern pattern{4, 4};  ///< 1 x 1: no interleaving (typical: 4 x 4, 8 x 8)
     light_assignment assignment = light_assignment::interleaved;
     int shift = 0;      ///< relabelling of the sub-buffers (assign_lights), in [0, N M); 0 normally
