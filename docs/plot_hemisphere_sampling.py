@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Plots the hemisphere study's sweep (examples/hemisphere_study --sweep --json X.json).
+"""Plots a sweep run of the hemisphere study (examples/hemisphere_study --sweep), read from
+the study's results file by run name:
 
-    python3 docs/plot_hemisphere_sampling.py docs/hemisphere-sampling-sweep.json \
+    python3 docs/plot_hemisphere_sampling.py docs/results/hemisphere_sampling.json sweep \
         docs/hemisphere-sampling.png
 
 Left: RMS error of the four weightings against the plane resolution at the aperture of the
@@ -24,10 +25,13 @@ COLOURS = ["#777777", "#1f77b4", "#d62728", "#2ca02c"]
 
 
 def main(argv):
-    if len(argv) != 3:
+    if len(argv) != 4:
         sys.exit(__doc__)
     with open(argv[1]) as f:
-        study = json.load(f)
+        runs = {r["name"]: r for r in json.load(f)["runs"]}
+    if argv[2] not in runs:
+        sys.exit(f"{argv[1]} has no run {argv[2]!r} (runs: {', '.join(runs)})")
+    study = runs[argv[2]]
     rows = study["sweep"]
     aperture = study["parameters"]["aperture_deg"]
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 5), dpi=90)
@@ -66,7 +70,7 @@ def main(argv):
     right.grid(True, alpha=0.3)
     right.legend(fontsize=7, title="aperture", ncol=4, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     fig.tight_layout()
-    fig.savefig(argv[2])
+    fig.savefig(argv[3])
 
 
 if __name__ == "__main__":

@@ -1,20 +1,21 @@
 #!/usr/bin/python3
-"""Tabulates docs/studies/hemisphere_turn.sh's runs: RMS error of each weighting against the
-plane's turn, per scene, in Markdown, and stretching's ratio to the plane alone.
+"""Tabulates docs/studies/hemisphere_turn.sh's runs (docs/results/hemisphere_turn.json): RMS
+error of each weighting against the plane's turn, per scene, in Markdown, and stretching's
+ratio to the plane alone.
 
-    /usr/bin/python3 docs/studies/hemisphere_turn_table.py docs/data/hemisphere-turn"""
+    /usr/bin/python3 docs/studies/hemisphere_turn_table.py docs/results/hemisphere_turn.json"""
 import json
-import pathlib
 import sys
 
 KEYS = ("rms_plane", "rms_coverage", "rms_stretch", "rms_falloff")
 SCENES = {"sponza": "Sponza", "cornell": "Cornell box"}
 
 
-def rows(folder, scene):
+def rows(results, scene):
     runs = []
-    for path in pathlib.Path(folder).glob(f"{scene}-*.json"):
-        d = json.loads(path.read_text())
+    for d in results["runs"]:
+        if not d["name"].startswith(f"{scene}-"):
+            continue
         p = d["parameters"]
         label = "hashed" if p["hashed_turn"] else f"{p['plane_turn_deg']:g}"
         order = 1e9 if p["hashed_turn"] else p["plane_turn_deg"]
@@ -22,9 +23,11 @@ def rows(folder, scene):
     return sorted(runs, key=lambda r: r[0])
 
 
-def main(folder):
+def main(path):
+    with open(path) as f:
+        results = json.load(f)
     for scene in ("sponza", "cornell"):
-        runs = rows(folder, scene)
+        runs = rows(results, scene)
         if not runs:
             continue
         print(f"\n**{SCENES[scene]}**, ray-cast, 64^2 at 126 deg, {runs[0][3]} points:\n")
@@ -37,4 +40,4 @@ def main(folder):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "docs/data/hemisphere-turn")
+    main(sys.argv[1] if len(sys.argv) > 1 else "docs/results/hemisphere_turn.json")

@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
 # Runs the irradiance-splatting measurements behind docs/irradiance-splatting.md and
-# docs/report.md, writing one JSON per run into docs/data/ (small, committed), then
-# regenerates the report. Usage: docs/studies/ic_splatting.sh [cornell|sponza|all]
+# docs/report.md, adding each run's report (with its commit and machine) to the study's one
+# results file, docs/results/ic_splatting.json (committed), then regenerates the report. Usage: docs/studies/ic_splatting.sh [cornell|sponza|all]
 # Takes minutes on 2 cores (Sponza's reference is computed once and cached).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bin=build/bin/ic_splatting
 scenes="${BOUNCE_SCENES:-../shared/scenes}"
 which="${1:-all}"
-mkdir -p docs/data docs/figures
+results=docs/results/ic_splatting.json
+mkdir -p build/runs docs/figures
 
-run() {  # run NAME ARGS...: one measured run
+run() {  # run NAME ARGS...: one measured run, added to the results file under NAME
   local name=$1; shift
   echo "== $name: $*"
-  "$bin" "$@" --json "docs/data/$name.json"
+  "$bin" "$@" --json "build/runs/$name.json"
+  python3 docs/studies/results.py add "$results" "$name" "build/runs/$name.json"
 }
 
 rays() {  # rays TAG ARGS...: gradients on/off and Ward's weight with 4096 rays per record (less record noise)
