@@ -168,4 +168,18 @@ V rsm_disc_sample(T xi1, T xi2, T r_max, T texel_count, T sample_count) {
              T(2.0 * std::numbers::pi) * r_max * r_max * xi1 * texel_count / sample_count);
 }
 
+/// DS05's published weighting of the same offsets, for comparison: w proportional to xi1^2,
+/// scaled by 3 so that its expectation is the unbiased weight's (E[3 xi1^2] = 2 E[xi1] = 1):
+///   w = 3 pi r_max^2 xi1^2 * texel_count / sample_count.
+/// It estimates the sum of f (3/2)(rho / r_max) over the disc instead of the sum of f, i.e.
+/// it over-weights texels far from the centre (docs, section 4); a constant f is estimated
+/// without bias, which is why the error is easy to miss. Returns (du, dv, w).
+template <real T, vec3_of<T> V>
+V rsm_disc_sample_xi1_squared(T xi1, T xi2, T r_max, T texel_count, T sample_count) {
+    const T angle = T(2.0 * std::numbers::pi) * xi2;
+    const T r = r_max * xi1;
+    return V(r * sin(angle), r * cos(angle),
+             T(3.0 * std::numbers::pi) * r_max * r_max * xi1 * xi1 * texel_count / sample_count);
+}
+
 }  // namespace bounce

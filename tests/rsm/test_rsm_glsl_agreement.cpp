@@ -158,6 +158,11 @@ TEST_CASE("texel-flux, solid-angle, bounding-sphere and disc-sample kernels agre
         std::vector<glm::vec3> cpu;
         for (const auto& a : in) cpu.push_back(std::apply(rsm_disc_sample<float, glm::vec3>, a));
         const auto gpu = gl::map_kernel(rsm_disc_sample<f32, vec3>, in);
+        std::vector<glm::vec3> cpu_sq;
+        for (const auto& a : in) cpu_sq.push_back(std::apply(rsm_disc_sample_xi1_squared<float, glm::vec3>, a));
+        const auto gpu_sq = gl::map_kernel(rsm_disc_sample_xi1_squared<f32, vec3>, in);
+        for (std::size_t e = 0; e < in.size(); ++e)
+            CHECK(std::abs(double(gpu_sq[e].z - cpu_sq[e].z)) <= tolerance * std::max(1e-30, double(cpu_sq[e].z)));
         // Offsets are r_max-sized, the weight its own size.
         double worst = 0;
         for (std::size_t e = 0; e < in.size(); ++e) {

@@ -51,6 +51,7 @@ struct indirect_options {
     discontinuity_params discontinuity;
     vpl_selection selection = vpl_selection::flux_warping;  ///< SII only
     float r_max = 1.5f;            ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
+    disc_weighting disc = disc_weighting::unbiased;  ///< RSM gather sample weights (DS05's xi1^2 to compare)
     pixel_light_params light;      ///< singularity remedies (rsm.hpp)
     float sii_cutoff = 0.f;        ///< SII splat cutoff, W/m^2 (sii_params::cutoff); 0: whole screen
     int low_resolution = 1;        ///< RSM gather at 1/f resolution with upsampling (f in 1..8)
@@ -188,7 +189,7 @@ private:
         // One pattern for every map, sized for the first (maps of one light share a size).
         const std::size_t texels = maps[0].width() * maps[0].height();
         if (full_pattern_.size() != options_.count || pattern_texels_ != texels) {
-            full_pattern_ = rsm_disc_pattern(options_.count, options_.r_max, texels, options_.seed);
+            full_pattern_ = rsm_disc_pattern(options_.count, options_.r_max, texels, options_.seed, options_.disc);
             pattern_texels_ = texels;
         }
         const light_groups g = assign_lights(full_pattern_.size(), imaps.pattern.cells(), light_assignment::interleaved,

@@ -46,8 +46,15 @@ struct pixel_light_params {
 /// so that dealing them interleaved gives each sub-buffer a random subset rather than one
 /// radius band (the base-2 coordinate of every 64th Halton point lies in one 1/64 interval).
 /// `r_max` in map units (0, 2]: 1.5 reaches every texel from any centre inside the map.
+/// How the disc samples are weighted (rsm.hpp).
+enum class disc_weighting {
+    unbiased,      ///< w proportional to xi1 (rsm_disc_sample): estimates the disc's texel sum
+    xi1_squared,   ///< DS05's xi1^2 (rsm_disc_sample_xi1_squared): over-weights the rim
+};
+
 inline std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count,
-                                               std::uint64_t seed = 1) {
+                                               std::uint64_t seed = 1,
+                                               disc_weighting weighting = disc_weighting::unbiased) {
     require(count > 0, "count", "must be positive");
     require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
     require(texel_count > 0, "texel_count", "must be positive");
@@ -56,7 +63,10 @@ inline std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, s
     std::vector<glm::vec3> out(count);
     for (std::size_t k = 0; k < count; ++k) {
         const glm::dvec2 xi = halton2(k, shift);
-        out[k] = rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count));
+        out[k] = weighting == disc_weighting::unbiased
+                     ? rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count))
+                     : rsm_disc_sample_xi1_squared<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count),
+                                                                       double(count));
     }
     for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
     return out;
