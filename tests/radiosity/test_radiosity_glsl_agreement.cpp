@@ -1,0 +1,196 @@
+// Emission agreement of the radiosity kernels: each, printed as GLSL and run in a compute
+// shader (llvmpipe through EGL in CI), gives what its CPU float instantiation gives, over
+// random inputs and the hard cases of each kernel.
+//
+// Tolerance: |gpu - cpu| <= 1e-5 * scale per output, scale the size of the output's terms
+// rather than of the output itself (a cosine near zero keeps the absolute error of the dot
+// product it comes from): A / (pi d^2 + A) for the form factor (its value with both cosines
+// 1), times rho dB for a shot, 1 for projections, directions and texture coordinates (unit
+// vectors and points of the unit square), the vector's length for frame changes. A kernel of
+// k rounded float operations (GLSL allows 2-3 ulp for division and inversesqrt, and fused
+// multiply-adds) is off by about 2 k ulp of its terms; 1e-5 is that for k up to 40, more
+// than any kernel here has. The hemicube's face numbers come from comparisons of the same
+// float values on both sides and must agree exactly.
+#include "../gl/shared_context.hpp"
+
+#include <bounce/gl/kernel_map.hpp>
+#include <bounce/radiosity.hpp>
+#include <bounce/sampling.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <tuple>
+#include <vector>
+
+using namespace bounce;
+using glsl::f32;
+using glsl::vec2;
+using glsl::vec3;
+
+namespace {
+constexpr double tolerance = 1e-5;
+constexpr int random_count = 5000;
+
+glm::vec3 random_unit(pcg32& rng) {
+    const float z = 2 * rng.next_float() - 1, phi = 6.2831853f * rng.next_float();
+    const float r = std::sqrt(std::max(0.f, 1 - z * z));
+    return glm::normalize(glm::vec3(r * std::cos(phi), r * std::sin(phi), z));
+}
+glm::vec3 random_upper(pcg32& rng) {
+    glm::vec3 v = random_unit(rng);
+    v.z = std::abs(v.z);
+    return v;
+}
+
+template <class R, class Scale>
+double worst_scaled(const std::vector<R>& gpu, const std::vector<R>& cpu, Scale scale) {
+    REQUIRE(gpu.size() == cpu.size());
+    double worst = 0;
+    for (std::size_t e = 0; e < cpu.size(); ++e) {
+        const auto diff = [&](double g, double c) {
+            REQUIRE(std::isfinite(g));
+            REQUIRE(std::isfinite(c));
+            worst = std::max(worst, std::abs(g - c) / scale(e));
+        };
+        if constexpr (std::is_same_v<R, float>) diff(gpu[e], cpu[e]);
+        else
+            for (int c = 0; c < R::length(); ++c) diff(gpu[e][c], cpu[e][c]);
+    }
+    return worst;
+}
+const auto unit_scale = [](std::size_t) { return 1.0; };
+}  // namespace
+
+TEST_CASE("disc_form_factor and shot_radiosity agree on the GPU and the CPU, hard cases included",
+          "[glsl][radiosity]") {
+    gl_test::shared_context();
+    pcg32 rng(31);
+    using ff_args = std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, float>;
+    std::vector<ff_args> in;
+    const glm::vec3 up(0, 0, 1), down(0, 0, -1);
+    in.emplace_back(glm::vec3(0.5f), up, glm::vec3(0.5f), down, 0.01f);             // coincident
+    in.emplace_back(glm::vec3(0), up, glm::vec3(0, 0, 1), up, 0.01f);               // shooter faces away
+    in.emplace_back(glm::vec3(0), down, glm::vec3(0, 0, 1), up, 0.01f);             // both away
+    in.emplace_back(glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), down, 0.01f);  // grazing receiver
+    in.emplace_back(glm::vec3(0), up, glm::vec3(0, 0, 1e-3f), down, 0.01f);         // very close
+    for (int k = 0; k < random_count; ++k) {
+        const glm::vec3 ps = random_unit(rng) * rng.next_float();
+        const glm::vec3 pr = ps + random_unit(rng) * (0.001f + 3 * rng.next_float());
+        in.emplace_back(pr, random_unit(rng), ps, random_unit(rng), 1e-4f + 0.1f * rng.next_float());
+    }
+    std::vector<float> cpu;
+    for (const auto& a : in) cpu.push_back(std::apply(disc_form_factor<float, glm::vec3>, a));
+    const auto gpu = gl::map_kernel(disc_form_factor<f32, vec3>, in);
+    const auto scale = [&](std::size_t e) {
+        const auto& [pr, nr, ps, ns, area] = in[e];
+        const double d2 = glm::dot(ps - pr, ps - pr);
+        return double(area) / (std::numbers::pi * d2 + double(area));
+    };
+    const double worst = worst_scaled(gpu, cpu, scale);
+    INFO("worst scaled difference " << worst);
+    CHECK(worst <= tolerance);
+    CHECK(gpu[0] == 0.f);
+    CHECK(gpu[1] == 0.f);
+    CHECK(gpu[2] == 0.f);
+
+    using shot_args = std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, float, glm::vec3, float>;
+    std::vector<shot_args> shots;
+    for (std::size_t e = 0; e < in.size(); ++e) {
+        const auto& [pr, nr, ps, ns, area] = in[e];
+        shots.emplace_back(pr, nr, glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()), ps, ns, area,
+                           glm::vec3(10 * rng.next_float(), rng.next_float(), 0.f), e % 4 == 0 ? 0.f : 1.f);
+    }
+    std::vector<glm::vec3> cpu_shot;
+    for (const auto& a : shots) cpu_shot.push_back(std::apply(shot_radiosity<float, glm::vec3>, a));
+    const auto gpu_shot = gl::map_kernel(shot_radiosity<f32, vec3>, shots);
+    const double worst_shot = worst_scaled(gpu_shot, cpu_shot, [&](std::size_t e) {
+        const glm::vec3 rho = std::get<2>(shots[e]), db = std::get<6>(shots[e]);
+        return std::max(1e-30, scale(e) * double(glm::length(rho * db)));
+    });
+    INFO("worst scaled shot difference " << worst_shot);
+    CHECK(worst_shot <= tolerance);
+}
+
+TEST_CASE("the stereographic projection, its inverse and its texture coordinates agree on the GPU and the CPU",
+          "[glsl][radiosity]") {
+    gl_test::shared_context();
+    pcg32 rng(32);
+    std::vector<std::tuple<glm::vec3>> dirs = {{glm::vec3(0, 0, 1)}, {glm::vec3(1, 0, 0)}, {glm::vec3(0, -1, 0)},
+                                               {glm::vec3(1e-6f, 0, 1)}, {glm::vec3(3, 4, 1e-7f)}};
+    for (int k = 0; k < random_count; ++k) dirs.emplace_back(random_upper(rng) * (0.01f + 5 * rng.next_float()));
+    std::vector<glm::vec2> cpu, cpu_uv;
+    for (const auto& [d] : dirs) {
+        cpu.push_back(stereographic_project<float, glm::vec3, glm::vec2>(d));
+        cpu_uv.push_back(stereographic_item_coords<float, glm::vec3, glm::vec2>(d));
+    }
+    CHECK(worst_scaled(gl::map_kernel(stereographic_project<f32, vec3, vec2>, dirs), cpu, unit_scale) <= tolerance);
+    CHECK(worst_scaled(gl::map_kernel(stereographic_item_coords<f32, vec3, vec2>, dirs), cpu_uv, unit_scale) <=
+          tolerance);
+
+    std::vector<std::tuple<glm::vec2>> qs = {{glm::vec2(0)}, {glm::vec2(1, 0)}, {glm::vec2(0.6f, -0.8f)}};
+    for (int k = 0; k < random_count; ++k) qs.emplace_back(glm::vec2(rng.next_float(), rng.next_float()) * 2.f - 1.f);
+    std::vector<glm::vec3> cpu_dir;
+    for (const auto& [q] : qs) cpu_dir.push_back(stereographic_direction<float, glm::vec3, glm::vec2>(q));
+    CHECK(worst_scaled(gl::map_kernel(stereographic_direction<f32, vec3, vec2>, qs), cpu_dir, unit_scale) <= tolerance);
+
+    std::vector<std::tuple<glm::vec3, float, float>> depth_in;
+    for (int k = 0; k < random_count; ++k) depth_in.emplace_back(random_unit(rng) * (0.1f + 10 * rng.next_float()), 0.05f, 20.f);
+    std::vector<float> cpu_depth;
+    for (const auto& a : depth_in) cpu_depth.push_back(std::apply(hemisphere_depth<float, glm::vec3>, a));
+    CHECK(worst_scaled(gl::map_kernel(hemisphere_depth<f32, vec3>, depth_in), cpu_depth, unit_scale) <= tolerance);
+}
+
+TEST_CASE("hemicube face coordinates and directions agree on the GPU and the CPU, face edges included",
+          "[glsl][radiosity]") {
+    gl_test::shared_context();
+    pcg32 rng(33);
+    // Face edges and corners: the ties that decide between faces.
+    std::vector<std::tuple<glm::vec3>> dirs = {{glm::vec3(0, 0, 1)}, {glm::vec3(1, 0, 1)},  {glm::vec3(-1, 0, 1)},
+                                               {glm::vec3(0, 1, 1)}, {glm::vec3(0, -1, 1)}, {glm::vec3(1, 1, 1)},
+                                               {glm::vec3(1, 1, 0.5f)}, {glm::vec3(-1, 1, 0.5f)}, {glm::vec3(1, 0, 0)},
+                                               {glm::vec3(0, -1, 0)}};
+    for (int k = 0; k < random_count; ++k) dirs.emplace_back(random_upper(rng) * (0.01f + 5 * rng.next_float()));
+    std::vector<glm::vec3> cpu;
+    for (const auto& [d] : dirs) cpu.push_back(hemicube_face_coords<float, glm::vec3>(d));
+    const auto gpu = gl::map_kernel(hemicube_face_coords<f32, vec3>, dirs);
+    for (std::size_t e = 0; e < cpu.size(); ++e) REQUIRE(gpu[e].x == cpu[e].x);
+    CHECK(worst_scaled(gpu, cpu, unit_scale) <= tolerance);
+
+    std::vector<std::tuple<float, float, float>> in;
+    for (int face = 0; face < 5; ++face) {
+        in.emplace_back(float(face), 0.f, 0.f);
+        in.emplace_back(float(face), 1.f, 1.f);
+        for (int k = 0; k < random_count / 5; ++k) in.emplace_back(float(face), rng.next_float(), rng.next_float());
+    }
+    std::vector<glm::vec3> cpu_dir;
+    for (const auto& a : in) cpu_dir.push_back(std::apply(hemicube_direction<float, glm::vec3>, a));
+    CHECK(worst_scaled(gl::map_kernel(hemicube_direction<f32, vec3>, in), cpu_dir, unit_scale) <= tolerance);
+}
+
+TEST_CASE("the shooter frame and the ambient display agree on the GPU and the CPU", "[glsl][radiosity]") {
+    gl_test::shared_context();
+    pcg32 rng(34);
+    std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3>> in;
+    for (int k = 0; k < random_count; ++k) {
+        const glm::vec3 n = random_unit(rng);
+        const auto tb = orthonormal_basis<float, glm::vec3>(n);
+        in.emplace_back(random_unit(rng) * 3.f, random_unit(rng) * rng.next_float(), tb[0], tb[1], n);
+    }
+    std::vector<glm::vec3> cpu;
+    for (const auto& a : in) cpu.push_back(std::apply(to_shooter_frame<float, glm::vec3>, a));
+    CHECK(worst_scaled(gl::map_kernel(to_shooter_frame<f32, vec3>, in), cpu, [&](std::size_t e) {
+              return std::max(1e-30, double(glm::length(std::get<0>(in[e]) - std::get<1>(in[e]))));
+          }) <= tolerance);
+
+    std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3>> amb;
+    for (int k = 0; k < random_count; ++k)
+        amb.emplace_back(glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()) * 5.f,
+                         glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()),
+                         glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()));
+    std::vector<glm::vec3> cpu_amb;
+    for (const auto& a : amb) cpu_amb.push_back(std::apply(radiosity_with_ambient<float, glm::vec3>, a));
+    CHECK(worst_scaled(gl::map_kernel(radiosity_with_ambient<f32, vec3>, amb), cpu_amb, [](std::size_t) { return 6.0; }) <=
+          tolerance);
+}
