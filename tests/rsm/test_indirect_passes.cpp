@@ -190,6 +190,34 @@ TEST_CASE("the plain splat and gather passes give what the renderer gives withou
         for (std::size_t x = 0; x < 40; ++x) REQUIRE(direct(x, y) == gathered(x, y));
 }
 
+TEST_CASE("the gather reaches every texel whatever the map's projection, receivers behind it included",
+          "[indirect]") {
+    // A perspective projection looking away from every receiver (all clip w < 0), as a
+    // point light's cube face behind a receiver: the disc centres on the map's centre and
+    // still covers the whole map, so the gather converges to the full sum as before.
+    corner_scene s(64, 48);
+    s.light_view_projection = glm::perspective(1.5f, 1.f, 0.1f, 10.f) *
+                              glm::lookAt(glm::vec3(-5, 0, 1), glm::vec3(-10, 0, 1), glm::vec3(0, 0, 1));
+    const glm::vec4 clip = s.light_view_projection * glm::vec4(s.gb.position(32, 24), 1.f);
+    REQUIRE(clip.w < 0.f);
+    cpu::indirect_options o;
+    o.technique = cpu::indirect_technique::rsm_gather;
+    o.pattern = {1, 1};
+    // Unbiased but noisier than centring on the receiver's texel (the near texels fall where
+    // the disc's samples are sparse): measured 0.25, 0.12, 0.022 at 1024, 4096, 16384
+    // samples, against 0.008 at 4096 with the projection of section 4.
+    const auto exact = full_rsm_sum(s);
+    double previous = 1e30;
+    for (std::size_t k : {std::size_t(1024), std::size_t(4096), std::size_t(16384)}) {
+        o.count = k;
+        const double e = rel_rms(s, render(s, o), exact);
+        INFO("count " << k << " rel_rms " << e);
+        CHECK(e < previous);
+        previous = e;
+    }
+    CHECK(previous < 0.05);
+}
+
 TEST_CASE("results are bitwise the same for one thread and for two", "[indirect]") {
     const corner_scene s(61, 45);
     for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {

@@ -81,13 +81,18 @@ inline std::vector<glm::vec3> grouped_pattern(std::span<const glm::vec3> pattern
 }
 
 namespace detail {
-/// Where world point `p` falls in `map` as texel coordinates in [0, 1)^2 and whether it is
-/// in front of the map's projection centre.
-inline bool map_coordinates(const rsm_view& map, const glm::vec3& p, glm::vec2& uv) {
+/// The centre of a receiver's disc in `map` (map coordinates): where the world point `p`
+/// projects, clamped into [0, 1]^2, or the map's centre when p is behind the projection
+/// centre (clip w <= 0, as happens for a point light's cube faces). The disc estimate is
+/// unbiased for the texels the disc covers whatever its centre, so with r_max >= sqrt 2
+/// (the renderer's 1.5) every texel of every face is reached from any centre: cube maps
+/// converge like the others. DS05 centres on the receiver's own texel because nearby texels
+/// matter most and the disc's samples crowd its centre.
+inline glm::vec2 disc_centre(const rsm_view& map, const glm::vec3& p) {
     const glm::vec4 clip = map.light_view_projection * glm::vec4(p, 1.f);
-    if (!(clip.w > 0.f)) return false;
-    uv = glm::vec2(clip.x / clip.w * 0.5f + 0.5f, 0.5f - clip.y / clip.w * 0.5f);
-    return true;
+    if (!(clip.w > 0.f)) return glm::vec2(0.5f);
+    const glm::vec2 uv(clip.x / clip.w * 0.5f + 0.5f, 0.5f - clip.y / clip.w * 0.5f);
+    return glm::clamp(uv, glm::vec2(0.f), glm::vec2(1.f));
 }
 
 /// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
@@ -96,8 +101,7 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
                            std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp) {
     glm::vec3 e(0.f);
     for (const rsm_view& map : maps) {
-        glm::vec2 centre;
-        if (!map_coordinates(map, x, centre)) continue;
+        const glm::vec2 centre = disc_centre(map, x);
         const float w = float(map.width()), h = float(map.height());
         for (const glm::vec3& s : pattern) {
             const float tu = (centre.x + s.x) * w, tv = (centre.y + s.y) * h;
