@@ -115,6 +115,22 @@ struct lightmap_atlas {
                 float(ch.atlas_y) + glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v)};
     }
 
+    /// Lightmap coordinates in [0, 1]^2 of every triangle corner of `scene` (the scene the
+    /// atlas was built from), three per triangle, (0, 0) for degenerate triangles: what a
+    /// renderer's vertex buffer needs to sample a lightmap of width x height texels.
+    std::vector<glm::vec2> corner_uvs(const scene_view& scene) const {
+        require(scene.triangles.size() == chart_of_triangle.size(), "scene",
+                "is not the scene the atlas was built from (triangle counts differ)");
+        std::vector<glm::vec2> uv(3 * scene.triangles.size(), glm::vec2(0.f));
+        const glm::vec2 size(float(std::max<std::uint32_t>(width, 1)), float(std::max<std::uint32_t>(height, 1)));
+        for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+            if (chart_of_triangle[t] == none) continue;
+            for (int k = 0; k < 3; ++k)
+                uv[3 * t + std::size_t(k)] = atlas_coords(chart_of_triangle[t], scene.positions[scene.triangles[t][k]]) / size;
+        }
+        return uv;
+    }
+
     /// A per-element quantity laid out as the atlas: texel (x, y) holds values[element_at(x, y)],
     /// `background` where no chart is. `values` has one entry per element.
     template <class T>

@@ -133,6 +133,31 @@ TEST_CASE("atlas coordinates of a chart's corners land on its texel rectangle", 
     }
 }
 
+TEST_CASE("each element's position maps into its own texel, and corner UVs are atlas coordinates",
+          "[radiosity][atlas]") {
+    // An element's position is the centroid of its texel's overlap with the chart, which lies
+    // inside the texel: its atlas coordinates fall in that texel (to float rounding of a
+    // coordinate below 1000: 1e-4 texel).
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 1500});
+    for (std::size_t e = 0; e < atlas.size(); ++e) {
+        const glm::vec2 c = atlas.atlas_coords(atlas.chart[e], atlas.position[e]);
+        CHECK(c.x >= float(atlas.texel[e].x) - 1e-4f);
+        CHECK(c.x <= float(atlas.texel[e].x + 1) + 1e-4f);
+        CHECK(c.y >= float(atlas.texel[e].y) - 1e-4f);
+        CHECK(c.y <= float(atlas.texel[e].y + 1) + 1e-4f);
+    }
+    const auto uv = atlas.corner_uvs(scene.view());
+    REQUIRE(uv.size() == 3 * scene.triangles.size());
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec2 expected = atlas.atlas_coords(atlas.chart_of_triangle[t], scene.positions[scene.triangles[t][k]]) /
+                                       glm::vec2(float(atlas.width), float(atlas.height));
+            CHECK(uv[3 * t + std::size_t(k)] == expected);
+        }
+    CHECK_THROWS_AS(atlas.corner_uvs(closed_box(1.f, 0.5f, 1.f).view()), parameter_error);
+}
+
 TEST_CASE("emitting materials give elements the radiosity pi L_e", "[radiosity][atlas]") {
     const auto box = closed_box(1.f, 0.5f, 3.f);
     const auto atlas = build_lightmap_atlas(box.view(), {.elements = 300});
