@@ -11,6 +11,8 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <bit>
+#include <cstdint>
 #include <cstring>
 #include <vector>
 
@@ -130,4 +132,66 @@ TEST_CASE("the batch projector rejects sizes and maps that do not fit", "[sh][cp
     const cpu::cube_map_sh_projector<L> right(8);
     CHECK_THROWS_AS(right.project(set.views, short_out), parameter_error);
     CHECK_NOTHROW(right.project(set.views, out));
+}
+
+TEST_CASE("binary16 texels decode exactly, including subnormals, infinities and signs", "[sh][cpu]") {
+    CHECK(cpu::half_to_float(0x3c00) == 1.f);
+    CHECK(cpu::half_to_float(0xc000) == -2.f);
+    CHECK(cpu::half_to_float(0x7bff) == 65504.f);
+    CHECK(cpu::half_to_float(0x0001) == 0x1p-24f);
+    CHECK(cpu::half_to_float(0x03ff) == 1023 * 0x1p-24f);
+    CHECK(cpu::half_to_float(0x3555) == 0x1.554p-2f);
+    CHECK(cpu::half_to_float(0x7c00) == INFINITY);
+    CHECK(std::signbit(cpu::half_to_float(0x8000)));
+    CHECK(std::isnan(cpu::half_to_float(0x7e00)));
+}
+
+TEST_CASE("float_to_half rounds to nearest even and inverts half_to_float on every half", "[sh][cpu]") {
+    for (std::uint32_t h = 0; h < 0x10000u; ++h) {
+        const float f = cpu::half_to_float(std::uint16_t(h));
+        if (std::isnan(f)) continue;
+        INFO("half " << h);
+        CHECK(cpu::float_to_half(f) == h);
+    }
+    CHECK(cpu::float_to_half(65520.f) == 0x7c00);              // halfway to 2^16: ties to even = infinity
+    CHECK(cpu::float_to_half(65519.f) == 0x7bff);
+    CHECK(cpu::float_to_half(1.f + 0x1p-11f) == 0x3c00);      // halfway, even neighbour 1.0
+    CHECK(cpu::float_to_half(1.f + 3 * 0x1p-11f) == 0x3c02);  // halfway, even neighbour above
+    CHECK(cpu::float_to_half(0x1p-25f) == 0x0000);             // halfway to the smallest subnormal
+    CHECK(cpu::float_to_half(0x1.8p-25f) == 0x0001);
+    CHECK(cpu::float_to_half(-0x1p-30f) == 0x8000);
+    CHECK(cpu::float_to_half(NAN) == 0x7e00);
+}
+
+TEST_CASE("half-float maps project as their decoded float values do, on both paths", "[sh][cpu]") {
+    for (const std::size_t n : {64u, 13u}) {
+        const cube_set set(n, 4, 70 + n);
+        std::vector<std::array<image<cpu::half_rgb>, 6>> halves(set.views.size());
+        std::vector<std::array<image<glm::vec3>, 6>> decoded(set.views.size());
+        std::vector<cube_map_view<const cpu::half_rgb>> half_views(set.views.size());
+        std::vector<cube_map_view<const glm::vec3>> decoded_views(set.views.size());
+        for (std::size_t k = 0; k < set.views.size(); ++k)
+            for (int f = 0; f < 6; ++f) {
+                auto& h = halves[k][std::size_t(f)];
+                auto& d = decoded[k][std::size_t(f)];
+                h = image<cpu::half_rgb>(n, n);
+                d = image<glm::vec3>(n, n);
+                for (std::size_t y = 0; y < n; ++y)
+                    for (std::size_t x = 0; x < n; ++x)
+                        for (int c = 0; c < 3; ++c) {
+                            h(x, y).bits[c] = cpu::float_to_half(set.views[k].faces[std::size_t(f)](x, y)[c]);
+                            d(x, y)[c] = cpu::half_to_float(h(x, y).bits[c]);
+                        }
+                half_views[k].faces[std::size_t(f)] = h.view();
+                decoded_views[k].faces[std::size_t(f)] = d.view();
+            }
+        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::portable}) {
+            const cpu::cube_map_sh_projector<L> projector(n, path);
+            std::vector<sh_coefficients<L, glm::vec3>> from_half(half_views.size()), from_float(half_views.size());
+            projector.project(half_views, from_half);
+            projector.project(decoded_views, from_float);
+            // The same floats through the same products in the same order: bitwise equal.
+            CHECK(std::memcmp(from_half.data(), from_float.data(), from_half.size() * sizeof(from_half[0])) == 0);
+        }
+    }
 }

@@ -15,9 +15,13 @@
 ///   time and projects those rows of every map in the group while the rows' table (2 x 9 x
 ///   192 floats = 14 KB for L = 3, size 64) stays in L1. The table (2.7 MB at that size)
 ///   is thus read from memory once per group, not once per map.
-/// - On x86-64 with AVX2 and FMA (checked at run time) the row products use 256-bit fused
+/// - On x86-64 with AVX2, FMA and F16C (checked at run time) the row products use 256-bit fused
 ///   multiply-adds, three coefficients at a time (nine accumulators in registers); elsewhere
 ///   a portable loop the compiler vectorizes for the baseline ISA.
+/// - Texels are glm::vec3 (12 bytes) or `half_rgb` (IEEE binary16, 6 bytes: what a GL
+///   RGB16F render target reads back as). A bake of many maps streams from memory, where
+///   the bytes per texel set the pace (docs/sh-and-irradiance-volumes.md): half texels are
+///   converted in registers (F16C) on the AVX2 path.
 /// Float accumulators run over one face (at most 8 x 64 = 512 terms per lane for size 64:
 /// relative rounding below 512 x 2^-24 = 3e-5, 1e-6 typical), then add into double sums.
 /// Each map is summed in the same order whatever the thread count and the grouping, so
@@ -31,8 +35,11 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstddef>
+#include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -47,6 +54,46 @@
 #endif
 
 namespace bounce::cpu {
+
+/// One RGB texel of three IEEE-754 binary16 numbers (GL_RGB16F read back with
+/// GL_HALF_FLOAT), as raw bits.
+struct half_rgb {
+    std::uint16_t bits[3];
+};
+static_assert(sizeof(half_rgb) == 6, "half texels are read as packed rows");
+
+/// The float value of binary16 bits `h` (exact: every binary16 value is a float).
+constexpr float half_to_float(std::uint16_t h) noexcept {
+    const std::uint32_t sign = std::uint32_t(h & 0x8000u) << 16, exponent = (h >> 10) & 0x1fu, mantissa = h & 0x3ffu;
+    if (exponent == 0x1f) return std::bit_cast<float>(sign | 0x7f800000u | (mantissa << 13));  // inf, NaN
+    if (exponent != 0) return std::bit_cast<float>(sign | ((exponent + 112) << 23) | (mantissa << 13));
+    // Zero and subnormals: mantissa * 2^-24, exact in float.
+    const float magnitude = float(mantissa) * 0x1p-24f;
+    return sign ? -magnitude : magnitude;
+}
+
+/// The binary16 bits nearest to `f` (round to nearest, ties to even; overflow to
+/// infinity, NaN to a quiet NaN), as GL converts floats to RGB16F.
+constexpr std::uint16_t float_to_half(float f) noexcept {
+    const std::uint32_t b = std::bit_cast<std::uint32_t>(f);
+    const auto sign = std::uint16_t((b >> 16) & 0x8000u);
+    const std::uint32_t a = b & 0x7fffffffu;
+    if (a > 0x7f800000u) return std::uint16_t(sign | 0x7e00u);
+    if (a >= 0x47800000u) return std::uint16_t(sign | 0x7c00u);  // >= 2^16
+    if (a >= 0x38800000u) {                                       // >= 2^-14: a normal half
+        std::uint32_t h = (((a >> 23) - 112) << 10) | ((a >> 13) & 0x3ffu);
+        const std::uint32_t rest = a & 0x1fffu;
+        if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;  // a carry may reach infinity, as it should
+        return std::uint16_t(sign | h);
+    }
+    const std::uint32_t e = a >> 23;  // subnormal half: round(|f| 2^24)
+    if (e < 102) return sign;         // below 2^-25
+    const std::uint32_t m = (a & 0x7fffffu) | 0x800000u, shift = 126 - e;
+    std::uint32_t h = m >> shift;
+    const std::uint32_t rest = m & ((1u << shift) - 1), halfway = 1u << (shift - 1);
+    if (rest > halfway || (rest == halfway && (h & 1u))) ++h;
+    return std::uint16_t(sign | h);
+}
 
 /// Which row-product code `cube_map_sh_projector` runs.
 enum class sh_projection_path {
@@ -101,6 +148,17 @@ public:
                           [&](const tbb::blocked_range<std::size_t>& r) { project_group(maps, out, r.begin(), r.end()); });
     }
 
+    /// `project` for half-float maps.
+    void project(std::span<const cube_map_view<const half_rgb>> maps, std::span<sh_coefficients<L, glm::vec3>> out) const {
+        require(out.size() == maps.size(), "out", "one coefficient set per map");
+        for (const auto& m : maps) {
+            require_cube_map(m, "maps");
+            require(m.size() == size_, "maps", "a map's size differs from the projector's");
+        }
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, maps.size(), maps_per_task),
+                          [&](const tbb::blocked_range<std::size_t>& r) { project_group(maps, out, r.begin(), r.end()); });
+    }
+
     /// The coefficients of one map (no parallelism).
     sh_coefficients<L, glm::vec3> project(const cube_map_view<const glm::vec3>& map) const {
         require_cube_map(map, "map");
@@ -116,7 +174,7 @@ private:
 
     static bool cpu_has_avx2_fma() noexcept {
 #if BOUNCE_SH_PROJECTION_AVX2
-        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
 #else
         return false;
 #endif
@@ -128,11 +186,22 @@ private:
 
     // acc[i * 24 + j] += sum over steps s of table_i[24 s + j] * row[24 s + j], for the
     // rows [y0, y1) of one face; a partial last step fills lanes 0 .. tail - 1.
-    void accumulate_portable(const image_view<const glm::vec3>& face_view, std::size_t face, std::size_t y0,
-                             std::size_t y1, float* acc) const {
+    template <class Texel>
+    void accumulate_portable(const image_view<const Texel>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
+                             float* acc) const {
         const std::size_t floats = 3 * size_;
+        std::vector<float> converted;
+        if constexpr (std::is_same_v<Texel, half_rgb>) converted.resize(floats);
         for (std::size_t y = y0; y < y1; ++y) {
-            const float* row = &face_view(0, y).x;
+            const float* row = nullptr;
+            if constexpr (std::is_same_v<Texel, half_rgb>) {
+                const half_rgb* h = &face_view(0, y);
+                for (std::size_t x = 0; x < size_; ++x)
+                    for (std::size_t c = 0; c < 3; ++c) converted[3 * x + c] = half_to_float(h[x].bits[c]);
+                row = converted.data();
+            } else {
+                row = &face_view(0, y).x;
+            }
             for (std::size_t i = 0; i < coefficients; ++i) {
                 const float* t = table_.data() + table_row(face, y, i);
                 float* a = acc + i * lanes;
@@ -145,23 +214,31 @@ private:
     }
 
 #if BOUNCE_SH_PROJECTION_AVX2
-    // The same sums with 256-bit FMAs, G coefficients (3 G accumulators) at a time.
-    template <std::size_t G>
-    __attribute__((target("avx2,fma"))) void accumulate_group_avx2(const image_view<const glm::vec3>& face_view,
-                                                                    std::size_t face, std::size_t y0, std::size_t y1,
-                                                                    std::size_t first, float* acc) const {
+    // The same sums with 256-bit FMAs, G coefficients (3 G accumulators) at a time; half
+    // texels are widened to float in registers.
+    template <class Texel>
+    __attribute__((target("avx2,fma,f16c"))) static __m256 load8(const Texel* row, std::size_t s) {
+        if constexpr (std::is_same_v<Texel, half_rgb>)
+            return _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(reinterpret_cast<const std::uint16_t*>(row) + s)));
+        else
+            return _mm256_loadu_ps(&row->x + s);
+    }
+
+    template <std::size_t G, class Texel>
+    __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const image_view<const Texel>& face_view,
+                                                                         std::size_t face, std::size_t y0, std::size_t y1,
+                                                                         std::size_t first, float* acc) const {
         const std::size_t floats = 3 * size_;
         __m256 a[G][3];
         for (std::size_t g = 0; g < G; ++g)
             for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_loadu_ps(acc + (first + g) * lanes + 8 * v);
         for (std::size_t y = y0; y < y1; ++y) {
-            const float* row = &face_view(0, y).x;
+            const Texel* row = &face_view(0, y);
             const float* t[G];
             for (std::size_t g = 0; g < G; ++g) t[g] = table_.data() + table_row(face, y, first + g);
             std::size_t s = 0;
             for (; s + lanes <= floats; s += lanes) {
-                const __m256 d0 = _mm256_loadu_ps(row + s), d1 = _mm256_loadu_ps(row + s + 8),
-                             d2 = _mm256_loadu_ps(row + s + 16);
+                const __m256 d0 = load8(row, s), d1 = load8(row, s + 8), d2 = load8(row, s + 16);
                 for (std::size_t g = 0; g < G; ++g) {
                     a[g][0] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s), d0, a[g][0]);
                     a[g][1] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s + 8), d1, a[g][1]);
@@ -170,8 +247,12 @@ private:
             }
             if (s < floats) {  // a partial period: the remaining floats into lanes 0 .. floats - s - 1
                 alignas(32) float tail[G][lanes] = {};
-                for (std::size_t g = 0; g < G; ++g)
-                    for (std::size_t j = 0; s + j < floats; ++j) tail[g][j] = t[g][s + j] * row[s + j];
+                for (std::size_t j = 0; s + j < floats; ++j) {
+                    float value = 0;
+                    if constexpr (std::is_same_v<Texel, half_rgb>) value = half_to_float(row[(s + j) / 3].bits[(s + j) % 3]);
+                    else value = (&row->x)[s + j];
+                    for (std::size_t g = 0; g < G; ++g) tail[g][j] = t[g][s + j] * value;
+                }
                 for (std::size_t g = 0; g < G; ++g)
                     for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_add_ps(a[g][v], _mm256_load_ps(tail[g] + 8 * v));
             }
@@ -180,7 +261,8 @@ private:
             for (std::size_t v = 0; v < 3; ++v) _mm256_storeu_ps(acc + (first + g) * lanes + 8 * v, a[g][v]);
     }
 
-    void accumulate_avx2(const image_view<const glm::vec3>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
+    template <class Texel>
+    void accumulate_avx2(const image_view<const Texel>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
                          float* acc) const {
         std::size_t i = 0;
         for (; i + 3 <= coefficients; i += 3) accumulate_group_avx2<3>(face_view, face, y0, y1, i, acc);
@@ -189,7 +271,8 @@ private:
     }
 #endif
 
-    void project_group(std::span<const cube_map_view<const glm::vec3>> maps, std::span<sh_coefficients<L, glm::vec3>> out,
+    template <class Texel>
+    void project_group(std::span<const cube_map_view<const Texel>> maps, std::span<sh_coefficients<L, glm::vec3>> out,
                        std::size_t begin, std::size_t end) const {
         const std::size_t count = end - begin;
         std::vector<float> acc(count * coefficients * lanes);
@@ -201,6 +284,13 @@ private:
                 for (std::size_t k = 0; k < count; ++k) {
                     const auto& face_view = maps[begin + k].faces[face];
                     float* a = acc.data() + k * coefficients * lanes;
+                    // The next map's rows are a separate stream the hardware prefetcher has
+                    // not seen yet: ask for them while this map's rows are multiplied.
+                    if (k + 1 < count)
+                        for (std::size_t y = y0; y < y1; ++y) {
+                            const char* next = reinterpret_cast<const char*>(&maps[begin + k + 1].faces[face](0, y));
+                            for (std::size_t b = 0; b < sizeof(Texel) * size_; b += 64) __builtin_prefetch(next + b);
+                        }
 #if BOUNCE_SH_PROJECTION_AVX2
                     if (avx2_) {
                         accumulate_avx2(face_view, face, y0, y1, a);
