@@ -168,6 +168,22 @@ V rsm_disc_sample(T xi1, T xi2, T r_max, T texel_count, T sample_count) {
              T(2.0 * std::numbers::pi) * r_max * r_max * xi1 * texel_count / sample_count);
 }
 
+/// Centre (u, v in [0, 1], row 0 at the top) of a receiver's gather disc in a map, from the
+/// receiver's clip-space position (clip_x, clip_y, clip_w) under the map's view-projection:
+/// its projection clamped into the map, or the map's centre when the receiver is behind the
+/// projection centre (clip_w <= 0, e.g. a point light's cube face behind it). The disc's
+/// estimate is unbiased for the texels it covers whatever its centre, so with r_max >= sqrt 2
+/// every texel stays reachable; DS05 centres on the receiver's own texel because near texels
+/// matter most and the samples crowd the centre.
+template <real T, vec2_of<T> V2>
+V2 rsm_disc_centre(T clip_x, T clip_y, T clip_w) {
+    const auto front = clip_w > T(0);
+    const T inv_w = T(1) / select(front, clip_w, T(1));
+    const T u = clamp(clip_x * inv_w * T(0.5) + T(0.5), T(0), T(1));
+    const T v = clamp(T(0.5) - clip_y * inv_w * T(0.5), T(0), T(1));
+    return V2(select(front, u, T(0.5)), select(front, v, T(0.5)));
+}
+
 /// DS05's published weighting of the same offsets, for comparison: w proportional to xi1^2,
 /// scaled by 3 so that its expectation is the unbiased weight's (E[3 xi1^2] = 2 E[xi1] = 1):
 ///   w = 3 pi r_max^2 xi1^2 * texel_count / sample_count.

@@ -175,6 +175,20 @@ TEST_CASE("texel-flux, solid-angle, bounding-sphere and disc-sample kernels agre
     }
 }
 
+TEST_CASE("the gather disc's centre agrees on the GPU and the CPU, behind the projection included", "[glsl][rsm]") {
+    gl_test::shared_context();
+    pcg32 rng(25);
+    std::vector<std::tuple<float, float, float>> in = {{0.f, 0.f, 0.f}, {1.f, -1.f, -2.f}, {3.f, 0.2f, 1.f}};
+    for (int k = 0; k < random_count; ++k)
+        in.emplace_back(rng.next_float() * 4 - 2, rng.next_float() * 4 - 2, rng.next_float() * 4 - 1);
+    std::vector<glm::vec2> cpu;
+    for (const auto& a : in) cpu.push_back(std::apply(rsm_disc_centre<float, glm::vec2>, a));
+    const auto gpu = gl::map_kernel(rsm_disc_centre<f32, glsl::vec2>, in);
+    // Map coordinates lie in [0, 1]: scale 1.
+    CHECK(worst_scaled(gpu, cpu, [](std::size_t) { return 1.0; }) <= tolerance);
+    CHECK(gpu[0] == glm::vec2(0.5f));
+}
+
 TEST_CASE("the interleave index maps agree exactly on the GPU and the CPU", "[glsl][interleave]") {
     gl_test::shared_context();
     pcg32 rng(23);

@@ -81,18 +81,10 @@ inline std::vector<glm::vec3> grouped_pattern(std::span<const glm::vec3> pattern
 }
 
 namespace detail {
-/// The centre of a receiver's disc in `map` (map coordinates): where the world point `p`
-/// projects, clamped into [0, 1]^2, or the map's centre when p is behind the projection
-/// centre (clip w <= 0, as happens for a point light's cube faces). The disc estimate is
-/// unbiased for the texels the disc covers whatever its centre, so with r_max >= sqrt 2
-/// (the renderer's 1.5) every texel of every face is reached from any centre: cube maps
-/// converge like the others. DS05 centres on the receiver's own texel because nearby texels
-/// matter most and the disc's samples crowd its centre.
+/// The centre of a receiver's disc in `map` (rsm_disc_centre).
 inline glm::vec2 disc_centre(const rsm_view& map, const glm::vec3& p) {
     const glm::vec4 clip = map.light_view_projection * glm::vec4(p, 1.f);
-    if (!(clip.w > 0.f)) return glm::vec2(0.5f);
-    const glm::vec2 uv(clip.x / clip.w * 0.5f + 0.5f, 0.5f - clip.y / clip.w * 0.5f);
-    return glm::clamp(uv, glm::vec2(0.f), glm::vec2(1.f));
+    return rsm_disc_centre<float, glm::vec2>(clip.x, clip.y, clip.w);
 }
 
 /// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
