@@ -136,6 +136,25 @@ TEST_CASE("texel-flux, solid-angle, bounding-sphere and disc-sample kernels agre
         CHECK(worst <= tolerance);
     }
     {
+        // Point and directional texel flux: products of inputs behind a facing test; inputs
+        // within 1e-5 of grazing (where the test may flip) are left out.
+        std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, float>> point_in;
+        std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, float>> dir_in;
+        while (point_in.size() < std::size_t(random_count)) {
+            const glm::vec3 p = random_point(rng, 2.f), n = random_unit(rng), l = random_point(rng, 2.f), d = random_unit(rng);
+            if (std::abs(glm::dot(n, l - p)) < 1e-5f || std::abs(glm::dot(n, d)) < 1e-5f) continue;
+            point_in.emplace_back(glm::vec3(rng.next_float()), p, n, l, glm::vec3(3.f), 1e-3f);
+            dir_in.emplace_back(glm::vec3(rng.next_float()), n, d, glm::vec3(2.f), 1e-4f);
+        }
+        std::vector<glm::vec3> cpu_point, cpu_dir;
+        for (const auto& a : point_in) cpu_point.push_back(std::apply(point_light_texel_flux<float, glm::vec3>, a));
+        for (const auto& a : dir_in) cpu_dir.push_back(std::apply(directional_light_texel_flux<float, glm::vec3>, a));
+        CHECK(worst_scaled(gl::map_kernel(point_light_texel_flux<f32, vec3>, point_in), cpu_point,
+                           [](std::size_t) { return 3e-3; }) <= tolerance);
+        CHECK(worst_scaled(gl::map_kernel(directional_light_texel_flux<f32, vec3>, dir_in), cpu_dir,
+                           [](std::size_t) { return 2e-4; }) <= tolerance);
+    }
+    {
         std::vector<std::tuple<glm::vec3, glm::vec3, float, float, float>> in;
         for (int k = 0; k < random_count; ++k)
             in.emplace_back(random_point(rng, 3.f), random_unit(rng), rng.next_float() * 10, 1e-3f + rng.next_float(),
@@ -201,6 +220,19 @@ TEST_CASE("the interleave index maps agree exactly on the GPU and the CPU", "[gl
     for (const auto& [x, size, n] : in) {
         cpu_split.push_back(interleave_split_coordinate<float>(x, size, n));
         cpu_gather.push_back(interleave_gather_coordinate<float>(x, size, n));
+    }
+    std::vector<std::tuple<float, float, float>> cells;
+    std::vector<float> cpu_origin, cpu_extent;
+    for (const auto& [x, size, n] : in) {
+        cells.emplace_back(std::min(x, n - 1), size, n);
+        cpu_origin.push_back(interleave_sub_buffer_origin<float>(std::min(x, n - 1), size, n));
+        cpu_extent.push_back(interleave_sub_buffer_extent<float>(std::min(x, n - 1), size, n));
+    }
+    const auto gpu_origin = gl::map_kernel(interleave_sub_buffer_origin<f32>, cells);
+    const auto gpu_extent = gl::map_kernel(interleave_sub_buffer_extent<f32>, cells);
+    for (std::size_t e = 0; e < cells.size(); ++e) {
+        REQUIRE(gpu_origin[e] == cpu_origin[e]);
+        REQUIRE(gpu_extent[e] == cpu_extent[e]);
     }
     const auto gpu_split = gl::map_kernel(interleave_split_coordinate<f32>, in);
     const auto gpu_gather = gl::map_kernel(interleave_gather_coordinate<f32>, in);
