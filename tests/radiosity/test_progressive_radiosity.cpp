@@ -223,23 +223,24 @@ TEST_CASE("a directional light leaves the shadow of a blocker dark", "[radiosity
 TEST_CASE("results do not depend on the number of threads", "[radiosity][solver]") {
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 3000});
-    const auto run = [&](int threads) {
-        tbb::task_arena arena(threads);
-        std::vector<glm::vec3> out;
-        arena.execute([&] {
-            cpu::progressive_radiosity solver(scene.view(), atlas,
-                                              cpu::item_buffer_visibility(scene.view(), atlas,
-                                                                          {.projection = cpu::item_projection::hemicube,
-                                                                           .resolution = 64}));
-            for (int s = 0; s < 40; ++s) solver.step();
-            out.assign(solver.radiosity().begin(), solver.radiosity().end());
-            out.push_back(glm::vec3(solver.escaped_power()));
-        });
-        return out;
-    };
-    const auto one = run(1), two = run(2), four = run(4);
-    CHECK(one == two);
-    CHECK(one == four);
+    for (const auto projection : {cpu::item_projection::stereographic, cpu::item_projection::hemicube}) {
+        const auto run = [&](int threads) {
+            tbb::task_arena arena(threads);
+            std::vector<glm::vec3> out;
+            arena.execute([&] {
+                cpu::progressive_radiosity solver(
+                    scene.view(), atlas,
+                    cpu::item_buffer_visibility(scene.view(), atlas, {.projection = projection, .resolution = 64}));
+                for (int s = 0; s < 40; ++s) solver.step();
+                out.assign(solver.radiosity().begin(), solver.radiosity().end());
+                out.push_back(glm::vec3(solver.escaped_power()));
+            });
+            return out;
+        };
+        const auto one = run(1), two = run(2), four = run(4);
+        CHECK(one == two);
+        CHECK(one == four);
+    }
 }
 
 TEST_CASE("several shooters per step converge to the same solution", "[radiosity][solver]") {

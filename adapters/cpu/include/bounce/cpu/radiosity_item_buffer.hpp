@@ -389,7 +389,7 @@ private:
         item_buffer& buf = buffers_[0];
         buf.reset(opt_.resolution, opt_.resolution);
         to_local();
-        drawn_ = 0;
+        pieces_.clear();
         const float res = float(opt_.resolution);
         const auto project = [&](glm::vec3 l) {
             const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
@@ -403,19 +403,40 @@ private:
             if (local_[k][0].z < z_min && local_[k][1].z < z_min && local_[k][2].z < z_min) continue;
             poly.assign(local_[k].begin(), local_[k].end());
             detail::clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
-            if (poly.size() < 3) continue;
-            const glm::vec4 plane = local_plane_[k];
             for (std::size_t f = 1; f + 1 < poly.size(); ++f)
-                draw_tessellated(buf, poly[0], poly[f], poly[f + 1], std::uint32_t(k), project, glm::vec3(plane), plane.w);
+                tessellate(poly[0], poly[f], poly[f + 1], std::uint32_t(k), project);
         }
+        drawn_ = pieces_.size();
+        // Scan the pieces in bands of rows, one task per band: each pixel sees the pieces in
+        // the same order whatever the thread count.
+        const int width = buf.width, band = 16;
+        tbb::parallel_for(0, (buf.height + band - 1) / band, [&](int b) {
+            const int y0 = b * band, y1 = std::min(buf.height, y0 + band);
+            for (const piece& pc : pieces_) {
+                if (pc.y1 < float(y0) || pc.y0 > float(y1)) continue;
+                const glm::vec4 plane = local_plane_[pc.k];
+                const glm::vec3 n(plane);
+                // Depth: the distance along the pixel centre's direction w to the triangle's
+                // plane, d / (n . w), exact where the interpolated radial distance would be off
+                // by up to the triangle's bulge (centimetres for a ceiling light seen from the
+                // floor); the interpolated one only where the plane is seen edge-on.
+                scan_triangle_with(
+                    buf, pc.v[0], pc.v[1], pc.v[2], local_chart_[pc.k],
+                    [&](int x, int y, double attr) {
+                        const float nw =
+                            glm::dot(n, pixel_direction_[std::size_t(y) * std::size_t(width) + std::size_t(x)]);
+                        return nw > 1e-6f ? plane.w / nw : float(attr);
+                    },
+                    pc.k, y0, y1);
+            }
+        });
     }
 
-    // Draws (a, b, c), split in four at its edges' midpoints, recursively, while the sagitta
-    // of an edge exceeds the tolerance and the depth allows: pieces concentrate where the
-    // projection bends most, next to the shooter.
+    // Adds (a, b, c) to the pieces, split in four at its edges' midpoints, recursively, while
+    // the sagitta of an edge exceeds the tolerance and the depth allows: pieces concentrate
+    // where the projection bends most, next to the shooter.
     template <class Project>
-    void draw_tessellated(item_buffer& buf, glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t k,
-                          const Project& project, glm::vec3 plane_n, float plane_d, int depth = 0) {
+    void tessellate(glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t k, const Project& project, int depth = 0) {
         const raster_vertex pa = project(a), pb = project(b), pc = project(c);
         const glm::vec3 ab = detail::canonical_lerp(a, b, 0.5f), bc = detail::canonical_lerp(b, c, 0.5f),
                         ca = detail::canonical_lerp(c, a, 0.5f);
@@ -424,26 +445,15 @@ private:
                                   glm::length(pbc.pixel - 0.5f * (pb.pixel + pc.pixel)),
                                   glm::length(pca.pixel - 0.5f * (pc.pixel + pa.pixel))});
         if (!(s > opt_.tolerance_px) || depth >= opt_.max_tessellation_depth) {
-            // Depth: the distance along the pixel centre's direction w to the triangle's plane,
-            // d / (n . w), exact where the interpolated radial distance would be off by up to
-            // the triangle's bulge (centimetres for a ceiling light seen from the floor); the
-            // interpolated one only where the plane is seen edge-on.
-            const int width = buf.width;
-            scan_triangle_with(
-                buf, pa, pb, pc, local_chart_[k],
-                [&](int x, int y, double attr) {
-                    const float nw =
-                        glm::dot(plane_n, pixel_direction_[std::size_t(y) * std::size_t(width) + std::size_t(x)]);
-                    return nw > 1e-6f ? plane_d / nw : float(attr);
-                },
-                k);
-            ++drawn_;
+            const float y0 = std::min({pa.pixel.y, pb.pixel.y, pc.pixel.y}) - 1.f;
+            const float y1 = std::max({pa.pixel.y, pb.pixel.y, pc.pixel.y}) + 1.f;
+            pieces_.push_back({{pa, pb, pc}, k, y0, y1});
             return;
         }
-        draw_tessellated(buf, a, ab, ca, k, project, plane_n, plane_d, depth + 1);
-        draw_tessellated(buf, ab, b, bc, k, project, plane_n, plane_d, depth + 1);
-        draw_tessellated(buf, ca, bc, c, k, project, plane_n, plane_d, depth + 1);
-        draw_tessellated(buf, ab, bc, ca, k, project, plane_n, plane_d, depth + 1);
+        tessellate(a, ab, ca, k, project, depth + 1);
+        tessellate(ab, b, bc, k, project, depth + 1);
+        tessellate(ca, bc, c, k, project, depth + 1);
+        tessellate(ab, bc, ca, k, project, depth + 1);
     }
 
     void draw_hemicube() {
@@ -533,6 +543,12 @@ private:
     std::vector<std::array<glm::vec3, 3>> local_;
     std::vector<std::uint32_t> local_chart_;
     std::vector<glm::vec3> pixel_direction_;
+    struct piece {
+        std::array<raster_vertex, 3> v;
+        std::uint32_t k;   // local triangle
+        float y0, y1;      // rows it may touch (widened by a pixel)
+    };
+    std::vector<piece> pieces_;
     std::vector<glm::vec4> world_plane_, local_plane_;  // (unit normal, offset) per triangle
     glm::vec3 lo_{0.f}, hi_{0.f};
     float diagonal_ = 1.f;
