@@ -218,6 +218,34 @@ TEST_CASE("the gather reaches every texel whatever the map's projection, receive
     CHECK(previous < 0.05);
 }
 
+TEST_CASE("images smaller than the pattern (empty sub-buffers) render, and keep the energy property",
+          "[indirect]") {
+    for (const auto& [w, h] : {std::pair{1, 1}, std::pair{3, 2}, std::pair{9, 5}}) {
+        const corner_scene s{std::size_t(w), std::size_t(h)};
+        for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
+            cpu::indirect_options o;
+            o.technique = tech;
+            o.count = 128;
+            o.pattern = {1, 1};
+            const auto plain = render(s, o);
+            o.pattern = {8, 8};
+            o.blur = false;
+            image<glm::dvec3> mean(std::size_t(w), std::size_t(h), glm::dvec3(0.0));
+            for (int shift = 0; shift < 64; ++shift) {
+                o.shift = shift;
+                const auto one = render(s, o);
+                for (std::size_t y = 0; y < std::size_t(h); ++y)
+                    for (std::size_t x = 0; x < std::size_t(w); ++x) mean(x, y) += glm::dvec3(one(x, y)) / 64.0;
+            }
+            // As in the energy test: (2 gamma_K + gamma_64 + 2 u) of the plain value.
+            const double tol = 2 * higham_gamma(128) + higham_gamma(64) + 2 * u32;
+            for (std::size_t y = 0; y < std::size_t(h); ++y)
+                for (std::size_t x = 0; x < std::size_t(w); ++x)
+                    REQUIRE(std::abs(mean(x, y).x - plain(x, y).x) <= tol * plain(x, y).x + 1e-30);
+        }
+    }
+}
+
 TEST_CASE("results are bitwise the same for one thread and for two", "[indirect]") {
     const corner_scene s(61, 45);
     for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
