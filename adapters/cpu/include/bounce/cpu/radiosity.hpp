@@ -70,8 +70,8 @@ struct radiosity_options {
 
 /// Time spent per stage since construction, milliseconds.
 struct radiosity_timings {
-    double lights_ms = 0;        ///< shooting point, spot and directional lights (construction)
-    double visibility_ms = 0;    ///< begin_shot: item buffers, ray casts
+    double lights_ms = 0;        ///< shooting point, spot and directional lights, their visibility included (construction)
+    double visibility_ms = 0;    ///< begin_shot of the surface shots: item buffers, ray casts
     double choice_ms = 0;        ///< choosing shooters (reduction)
     double distribution_ms = 0;  ///< form factors and updates over the elements
 };
@@ -90,8 +90,8 @@ class progressive_radiosity {
 public:
     using vec = glm::vec<3, Real>;
 
-    /// Keeps references to `atlas` and the visibility (moved in); `scene` is read only here
-    /// (its lights). Throws parameter_error on bad options or an atlas not built from `scene`.
+    /// Keeps a reference to `atlas` (which must outlive the solver) and the visibility (moved
+    /// in); `scene` is read only here (its lights). Throws parameter_error on bad options or an atlas not built from `scene`.
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, Visibility visibility,
                           radiosity_options options = {})
         : atlas_(&atlas), visibility_(std::move(visibility)), options_(options) {
@@ -359,9 +359,7 @@ private:
         }
         for (std::size_t h = 0; h < frames.size(); ++h) {
             const shot_frame& frame = frames[h];
-            const auto start = clock::now();
             visibility_.begin_shot(frame);
-            timings_.visibility_ms += ms_since(start);
             const Visibility& vis = visibility_;
             const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
                 const glm::vec3 p = at.position[i], n = at.normal[i];

@@ -222,8 +222,9 @@ inline glm::vec3 canonical_lerp(glm::vec3 a, glm::vec3 b, float t) {
 /// The projections an item buffer can hold.
 enum class item_projection { stereographic, hemicube };
 
-/// Item-buffer visibility (see the file comment). Holds a copy of the scene's triangles
-/// (positions and chart) and the elements' positions and charts; one buffer per shot.
+/// Item-buffer visibility (see the file comment). Copies the scene's triangles (positions,
+/// chart, plane) and keeps a reference to the atlas, which must outlive it; one set of
+/// buffers, redrawn each shot.
 class item_buffer_visibility {
 public:
     struct options {
