@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -127,28 +128,42 @@ inline void discontinuity_buffer(const gbuffer_view<float>& gb, const discontinu
 }
 
 namespace detail {
-/// One pass of the tent along x (`vertical` false) or y, with a compile-time radius R >= n - 1.
-template <int R>
+/// One pass of the tent along x (`Vertical` false) or y, with a compile-time radius R >= n - 1.
+template <int R, bool Vertical>
 void tent_pass(image_view<const glm::vec3> in, image_view<const glm::vec2> edges, image_view<const float> depth,
-               int n, bool vertical, image_view<glm::vec3> out) {
+               int n, image_view<glm::vec3> out) {
     const std::size_t w = in.width(), h = in.height();
+    const std::ptrdiff_t size = std::ptrdiff_t(Vertical ? h : w);
     tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
         std::array<glm::vec3, 2 * R + 1> values;
         std::array<float, 2 * R> cuts;
+        const auto at = [&](std::size_t x, std::ptrdiff_t t) {
+            return Vertical ? std::pair{x, std::size_t(t)} : std::pair{std::size_t(t), y};
+        };
         for (std::size_t x = 0; x < w; ++x) {
             if (!(depth(x, y) < std::numeric_limits<float>::infinity())) {
                 out(x, y) = in(x, y);
                 continue;
             }
-            const std::ptrdiff_t along = std::ptrdiff_t(vertical ? y : x), size = std::ptrdiff_t(vertical ? h : w);
-            for (int k = 0; k <= 2 * R; ++k) {
-                const std::ptrdiff_t t = along - R + k;
-                const bool inside = t >= 0 && t < size;
-                const std::size_t tx = vertical ? x : std::size_t(inside ? t : along);
-                const std::size_t ty = vertical ? std::size_t(inside ? t : along) : y;
-                values[std::size_t(k)] = in(tx, ty);
-                // Edge between taps k and k + 1: the edge flag of tap k towards +axis.
-                if (k < 2 * R) cuts[std::size_t(k)] = inside && t + 1 < size ? (vertical ? edges(tx, ty).y : edges(tx, ty).x) : 1.f;
+            const std::ptrdiff_t along = std::ptrdiff_t(Vertical ? y : x);
+            if (along >= R && along + R < size) {
+                // Every tap inside the image: no clamping.
+                for (int k = 0; k <= 2 * R; ++k) {
+                    const auto [tx, ty] = at(x, along - R + k);
+                    values[std::size_t(k)] = in(tx, ty);
+                    if (k < 2 * R) cuts[std::size_t(k)] = Vertical ? edges(tx, ty).y : edges(tx, ty).x;
+                }
+            } else {
+                for (int k = 0; k <= 2 * R; ++k) {
+                    const std::ptrdiff_t t = along - R + k;
+                    const bool inside = t >= 0 && t < size;
+                    const auto [tx, ty] = at(x, inside ? t : along);
+                    values[std::size_t(k)] = in(tx, ty);
+                    // Edge between taps k and k + 1: the edge flag of tap k towards +axis;
+                    // the image border counts as an edge.
+                    if (k < 2 * R)
+                        cuts[std::size_t(k)] = inside && t + 1 < size ? (Vertical ? edges(tx, ty).y : edges(tx, ty).x) : 1.f;
+                }
             }
             out(x, y) = geometry_aware_tent<R, float, glm::vec3>(values, cuts, float(n));
         }
@@ -158,8 +173,8 @@ void tent_pass(image_view<const glm::vec3> in, image_view<const glm::vec2> edges
 template <int R>
 void tent_blur(image_view<const glm::vec3> in, image_view<const glm::vec2> edges, image_view<const float> depth,
                const interleave_pattern& p, image_view<glm::vec3> scratch, image_view<glm::vec3> out) {
-    tent_pass<R>(in, edges, depth, p.n, false, scratch);
-    tent_pass<R>(scratch, edges, depth, p.m, true, out);
+    tent_pass<R, false>(in, edges, depth, p.n, scratch);
+    tent_pass<R, true>(scratch, edges, depth, p.m, out);
 }
 }  // namespace detail
 

@@ -114,10 +114,14 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
             const auto& r = rects[k];
             const vpl& l = vpls[groups.order[k]];
             const glm::vec3 flux = l.flux * scale;
+            const glm::vec3 sender = l.position - l.normal * params.light.offset;
             for (int v = std::max(r.y0, y_lo); v <= std::min(r.y1, y_hi); ++v)
                 for (int u = std::max(r.x0, x_lo); u <= std::min(r.x1, x_hi); ++u) {
                     const std::size_t uu = std::size_t(u), vv = std::size_t(v);
                     if (!gb.covered(uu, vv)) continue;
+                    // Receivers behind the sender's plane get 0 from the kernel (its cos
+                    // theta_p clamp): skipping them adds nothing and saves its square root.
+                    if (!(glm::dot(l.normal, gb.position(uu, vv) - sender) > 0.f)) continue;
                     out(uu, vv) += pixel_light_irradiance<float, glm::vec3>(gb.position(uu, vv), gb.normal(uu, vv),
                                                                             l.position, l.normal, flux,
                                                                             params.light.offset, params.light.min_distance2);
