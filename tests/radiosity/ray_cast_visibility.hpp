@@ -44,17 +44,17 @@ inline std::pair<std::uint32_t, double> nearest_chart(const owned_scene& s, cons
     return best;
 }
 
-// Exact element visibility (models cpu::shot_visibility): the segment from the shooter to
-// the element crosses no triangle of another chart than the element's and the shooter's,
-// short of the element by more than 1e-6 of its distance.
+// Exact visibility (models cpu::shot_visibility): the segment from the shooter to the point
+// crosses no triangle of another chart than the point's and the shooter's, short of the
+// point by more than 1e-6 of its distance.
 struct ray_cast_visibility {
     const owned_scene* scene;
     const lightmap_atlas* atlas;
     cpu::shot_frame shot{};
 
     void begin_shot(const cpu::shot_frame& s) { shot = s; }
-    float visible(std::size_t e) const {
-        const glm::dvec3 p(atlas->position[e]);
+    float visible(const glm::vec3& position, std::uint32_t own) const {
+        const glm::dvec3 p(position);
         glm::dvec3 o(shot.position), d;
         double dist;
         if (shot.parallel) {
@@ -66,7 +66,6 @@ struct ray_cast_visibility {
             dist = glm::length(d);
             d /= dist;
         }
-        const std::uint32_t own = atlas->chart[e];
         for (std::size_t t = 0; t < scene->triangles.size(); ++t) {
             const std::uint32_t c = atlas->chart_of_triangle[t];
             if (c == lightmap_atlas::none || c == own || c == shot.chart) continue;

@@ -210,7 +210,8 @@ TEST_CASE("item-buffer visibility disagrees with exact visibility only at the bu
             for (std::size_t e = 0; e < atlas.size(); ++e) {
                 if (glm::dot(atlas.position[e] - shot.position, shot.axis) <= 1e-4f) continue;
                 ++asked;
-                if (vis.visible(e) == exact.visible(e)) continue;
+                if (vis.visible(atlas.position[e], atlas.chart[e]) == exact.visible(atlas.position[e], atlas.chart[e]))
+                    continue;
                 ++wrong;
                 // Find its pixel and look around it.
                 const auto tb = orthonormal_basis<float, glm::vec3>(shot.axis);

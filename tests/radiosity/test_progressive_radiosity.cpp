@@ -54,7 +54,7 @@ std::vector<glm::dvec3> dense_radiosity(const lightmap_atlas& atlas, Visibility&
             const double fij = disc_form_factor<double, glm::dvec3>(glm::dvec3(atlas.position[i]), glm::dvec3(atlas.normal[i]),
                                                                     glm::dvec3(atlas.position[j]), glm::dvec3(atlas.normal[j]),
                                                                     double(atlas.area[j]));
-            if (fij > 0) f[i * n + j] = fij * double(vis.visible(i));
+            if (fij > 0) f[i * n + j] = fij * double(vis.visible(atlas.position[i], atlas.chart[i]));
         }
     }
     std::vector<glm::dvec3> out(n);

@@ -327,7 +327,7 @@ private:
             const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
             const Real f = disc_form_factor<Real, vec>(pr, nr, ps, ns, area);
             if (!(f > Real(0))) return;
-            const Real v = Real(vis.visible(i));
+            const Real v = Real(vis.visible(at.position[i], at.chart[i]));
             if (!(v > Real(0))) return;
             const vec rho = vec(at.albedo[i]);
             const vec gain = shot_radiosity<Real, vec>(pr, nr, rho, ps, ns, area, db, v);
@@ -378,7 +378,7 @@ private:
                 else
                     e = directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
                 if (!(e.x > 0.f || e.y > 0.f || e.z > 0.f)) return;
-                const float v = vis.visible(i);
+                const float v = vis.visible(p, at.chart[i]);
                 if (!(v > 0.f)) return;
                 const vec rho = vec(at.albedo[i]);
                 const vec gain = rho * vec(e * v);

@@ -65,20 +65,22 @@ struct shot_frame {
 };
 
 /// What the solver asks of a visibility method: prepare for one shot, then answer for any
-/// element (concurrently: `visible` is const and called from many threads) with a value in
-/// [0, 1]. Only elements in front of the shot (local z > 0, or any element for a parallel
-/// shot) are asked.
+/// receiving point (an element's position, world space, and its chart, which does not occlude
+/// it) with a value in [0, 1]; `visible` is const and called from many threads at once. Only
+/// points in front of the shot (local z > 0, or any point for a parallel shot) are asked.
+/// Elements are passed as points, not indices, so a method needs no element array and
+/// survives adaptive subdivision.
 template <class V>
-concept shot_visibility = requires(V& v, const V& cv, const shot_frame& s, std::size_t e) {
+concept shot_visibility = requires(V& v, const V& cv, const shot_frame& s, const glm::vec3& p, std::uint32_t chart) {
     v.begin_shot(s);
-    { cv.visible(e) } -> std::convertible_to<float>;
+    { cv.visible(p, chart) } -> std::convertible_to<float>;
 };
 
 /// Every element sees every shooter: form factors without occlusion (open scenes, tests
 /// against the dense solve, and the unoccluded bound of a visibility method).
 struct all_visible {
     void begin_shot(const shot_frame&) noexcept {}
-    float visible(std::size_t) const noexcept { return 1.f; }
+    float visible(const glm::vec3&, std::uint32_t) const noexcept { return 1.f; }
 };
 
 /// Chart id, depth and the drawing's own primitive number per pixel; `none` where nothing
@@ -223,8 +225,7 @@ inline glm::vec3 canonical_lerp(glm::vec3 a, glm::vec3 b, float t) {
 enum class item_projection { stereographic, hemicube };
 
 /// Item-buffer visibility (see the file comment). Copies the scene's triangles (positions,
-/// chart, plane) and keeps a reference to the atlas, which must outlive it; one set of
-/// buffers, redrawn each shot.
+/// chart from the atlas, plane); one set of buffers, redrawn each shot.
 class item_buffer_visibility {
 public:
     struct options {
@@ -237,7 +238,7 @@ public:
 
     /// Throws parameter_error on bad options or a scene the atlas was not built from.
     item_buffer_visibility(const scene_view& scene, const lightmap_atlas& atlas, options opt)
-        : opt_(opt), atlas_(&atlas) {
+        : opt_(opt) {
         require(opt.resolution >= 8 && opt.resolution <= 8192, "options.resolution", "must lie in [8, 8192]");
         require(opt.projection != item_projection::hemicube || opt.resolution % 2 == 0, "options.resolution",
                 "a hemicube needs an even resolution (its side faces keep half the rows)");
@@ -287,10 +288,8 @@ public:
         else draw_hemicube();
     }
 
-    /// 1 if element `e` is seen from the current shot, else 0.
-    float visible(std::size_t e) const {
-        const glm::vec3 p = atlas_->position[e];
-        const std::uint32_t chart = atlas_->chart[e];
+    /// 1 if the point `p` (world) of chart `chart` is seen from the current shot, else 0.
+    float visible(const glm::vec3& p, std::uint32_t chart) const {
         if (shot_.parallel) {
             const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, glm::vec3(0.f), t_, b_, shot_.axis);
             const int x = pixel_of((l.x - ortho_lo_.x) * ortho_scale_, buffers_[0].width);
@@ -538,7 +537,6 @@ private:
     }
 
     options opt_;
-    const lightmap_atlas* atlas_;
     std::vector<std::array<glm::vec3, 3>> corners_;
     std::vector<std::uint32_t> triangle_chart_;
     std::vector<std::array<glm::vec3, 3>> local_;
