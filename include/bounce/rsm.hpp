@@ -22,6 +22,7 @@
 
 #include <bounce/concepts.hpp>
 #include <bounce/lights.hpp>
+#include <bounce/rectangle_solid_angle.hpp>
 #include <bounce/vocabulary.hpp>
 
 #include <numbers>
@@ -31,23 +32,16 @@ namespace bounce {
 
 // ---- what a texel reflects --------------------------------------------------------------
 
-/// Exact solid angle (sr) of the rectangle [x0, x1] x [y0, y1] of the image plane at unit
-/// distance from a perspective centre (coordinates in tangent units: a texel of a square map
-/// with tan(fov/2) = t and R texels per side spans 2t/R). The solid angle of the corner
-/// quadrant [0, x] x [0, y] is atan(x y / sqrt(1 + x^2 + y^2)) (e.g. the exact cube-map
-/// texel solid angle used by Filament and by Driscoll 2012), and the rectangle's is the
-/// inclusion-exclusion of its four corners. The six faces of a cube map sum to 4 pi.
-template <real T>
-T perspective_texel_solid_angle(T x0, T y0, T x1, T y1) {
-    const auto quadrant = [](T x, T y) { return atan(x * y, sqrt(T(1) + x * x + y * y)); };
-    return quadrant(x1, y1) - quadrant(x0, y1) - quadrant(x1, y0) + quadrant(x0, y0);
-}
+// The exact solid angle of a perspective texel (the rectangle [x0, x1] x [y0, y1] of the
+// image plane at unit distance, tangent units: a texel of a square map with tan(fov/2) = t
+// and R texels per side spans 2t/R) is rectangle_solid_angle (rectangle_solid_angle.hpp);
+// the six faces of a cube map sum to 4 pi (tested in tests/rsm).
 
 /// Solid angle (sr) of a small texel of size dx x dy centred at (x, y) on the image plane at
 /// unit distance (tangent units): the midpoint rule dw = dx dy / (1 + x^2 + y^2)^(3/2).
 /// Its relative error is below 1.3 t^2 for texels of side t inside a 90-degree face (the
 /// integrand's second derivatives are at most 3 in size and it is at least 3^(-3/2)), while
-/// the exact form above, evaluated in float, loses about 2.4e-7 / dw relatively to the
+/// rectangle_solid_angle, evaluated in float, loses about 2.4e-7 / dw relatively to the
 /// cancellation of its four O(1) terms: use this one in float for maps finer than about
 /// 100 texels per side (t < 0.02), the exact one in double or for coarse maps.
 template <real T>

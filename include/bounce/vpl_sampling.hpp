@@ -11,6 +11,7 @@
 
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
+#include <bounce/luminance.hpp>
 #include <bounce/sampling.hpp>
 
 #include <algorithm>
@@ -56,9 +57,9 @@ struct vpl {
     glm::vec3 flux{0.f};      ///< W per channel, already divided by the sampling probability
 };
 
-/// Luminance weights (Rec. 709) used as the importance of a texel's flux.
+/// The importance of a texel's flux: its Rec. 709 luminance (W, luminance-weighted).
 inline float flux_importance(const glm::vec3& flux) noexcept {
-    return 0.2126f * flux.x + 0.7152f * flux.y + 0.0722f * flux.z;
+    return rec709_luminance<float, glm::vec3>(flux);
 }
 
 /// VPLs at the centres of a `grid_x` x `grid_y` grid of cells over the map (seed 002

@@ -109,10 +109,10 @@ TEST_CASE("texel-flux, solid-angle, bounding-sphere and disc-sample kernels agre
             mid_in.emplace_back(x0, y0, t, t);
         }
         std::vector<float> cpu, cpu_mid;
-        for (const auto& a : in) cpu.push_back(std::apply(perspective_texel_solid_angle<float>, a));
+        for (const auto& a : in) cpu.push_back(std::apply(rectangle_solid_angle<float>, a));
         for (const auto& a : mid_in) cpu_mid.push_back(std::apply(perspective_texel_solid_angle_midpoint<float>, a));
         // The exact form's four atans are of size <= pi/4: scale 1.
-        CHECK(worst_scaled(gl::map_kernel(perspective_texel_solid_angle<f32>, in), cpu, [](std::size_t) { return 1.0; }) <=
+        CHECK(worst_scaled(gl::map_kernel(rectangle_solid_angle<f32>, in), cpu, [](std::size_t) { return 1.0; }) <=
               tolerance);
         CHECK(worst_scaled(gl::map_kernel(perspective_texel_solid_angle_midpoint<f32>, mid_in), cpu_mid,
                            [&](std::size_t e) { return double(cpu_mid[e]); }) <= tolerance);

@@ -72,10 +72,10 @@ TEST_CASE("the texel solid angles of a cube-map face sum to 4 pi / 6", "[rsm]") 
             for (int i = 0; i < r; ++i) {
                 const double x0 = -1 + 2.0 * i / r, x1 = -1 + 2.0 * (i + 1) / r;
                 const double y0 = -1 + 2.0 * j / r, y1 = -1 + 2.0 * (j + 1) / r;
-                const double w = perspective_texel_solid_angle<double>(x0, y0, x1, y1);
+                const double w = rectangle_solid_angle<double>(x0, y0, x1, y1);
                 CHECK(w > 0);
                 sum += w;
-                sum_f += perspective_texel_solid_angle<float>(float(x0), float(y0), float(x1), float(y1));
+                sum_f += rectangle_solid_angle<float>(float(x0), float(y0), float(x1), float(y1));
             }
         CHECK(sum == Approx(4 * std::numbers::pi / 6).epsilon(1e-12));
         // Each float texel is the difference of four atans of size <= pi/4: a few ulps of 1
@@ -229,9 +229,9 @@ TEST_CASE("the midpoint texel solid angle is within 1.3 t^2 of the exact one, an
         for (int j = 0; j < r; j += 1 + r / 64)
             for (int i = 0; i < r; i += 1 + r / 64) {
                 const double x0 = -1 + t * i, y0 = -1 + t * j;
-                const double exact = perspective_texel_solid_angle<double>(x0, y0, x0 + t, y0 + t);
+                const double exact = rectangle_solid_angle<double>(x0, y0, x0 + t, y0 + t);
                 const double mid = perspective_texel_solid_angle_midpoint<float>(float(x0 + t / 2), float(y0 + t / 2), float(t), float(t));
-                const double ef = perspective_texel_solid_angle<float>(float(x0), float(y0), float(x0 + t), float(y0 + t));
+                const double ef = rectangle_solid_angle<float>(float(x0), float(y0), float(x0 + t), float(y0 + t));
                 worst_mid = std::max(worst_mid, std::abs(mid / exact - 1));
                 worst_exact_float = std::max(worst_exact_float, std::abs(ef / exact - 1));
             }
@@ -262,7 +262,7 @@ TEST_CASE("the sum over a spot light's RSM converges to the closed-form irradian
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
                 const double x0 = -tan_a + t * i, y0 = -tan_a + t * j;
-                const double dw = perspective_texel_solid_angle<double>(x0, y0, x0 + t, y0 + t);
+                const double dw = rectangle_solid_angle<double>(x0, y0, x0 + t, y0 + t);
                 const glm::vec3 p(float((x0 + t / 2) * h), float((y0 + t / 2) * h), 0.f);
                 const glm::vec3 f = spot_light_texel_flux<float, glm::vec3>(glm::vec3(float(rho)), p, np, light, axis,
                                                                             glm::vec3(float(intensity)),
