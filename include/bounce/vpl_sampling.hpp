@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -156,7 +157,10 @@ private:
 };
 
 /// `count` VPLs drawn by flux_warping from the points of the Halton sequence (bases 2, 3;
-/// rotated by a shift derived from `seed`), so their density follows the flux. Each VPL's
+/// rotated by a shift derived from `seed`), so their density follows the flux, listed in a
+/// shuffled order: every (N M)-th Halton point has the same low base-2 digits, so dealing
+/// the sequence in order to N M sub-buffers would give each one a strip of the map instead
+/// of a random subset (interleaved_sampling.hpp's light_assignment). Each VPL's
 /// flux is its texel's divided by (count x probability): every VPL carries total / count of
 /// the importance, and the sum of the VPL fluxes estimates the map's total without bias
 /// (DS06's rescaled sample weights, "the total weight remains equal").
@@ -173,6 +177,7 @@ inline std::vector<vpl> vpls_by_flux_warping(const rsm_view& map, std::size_t co
         const double scale = 1.0 / (double(count) * c.probability);
         out.push_back({map.position(c.x, c.y), map.normal(c.x, c.y), glm::vec3(glm::dvec3(map.flux(c.x, c.y)) * scale)});
     }
+    for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
     return out;
 }
 
