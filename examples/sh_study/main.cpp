@@ -367,7 +367,7 @@ int main(int argc, char** argv) {
     double bytes = texels * 12;
     auto per_s = [](double count, double ms) { return count / (ms * 1e-3); };
     fmt::print("SH projection, {} bands RGB, {} maps of 6 x {}^2 texels ({:.0f} MB), {} threads, {} path\n", L, maps, size,
-               bytes / 1e6, used_threads, projector->uses_avx2() ? "AVX2+FMA" : "portable");
+               bytes / 1e6, used_threads, projector->path_name());
     fmt::print("  load average {:.2f} before, {:.2f} after (other processes share the cores: compare CPU time)\n", load_before,
                load_after);
     fmt::print("  {:<32} {:>9} {:>9} {:>9} {:>7} {:>13}\n", "", "wall ms", "Gtexel/s", "GB/s", "CPU ms", "Gtexel/CPU-s");
@@ -418,12 +418,13 @@ int main(int argc, char** argv) {
             {"technique", "sh"},
             {"backend", "cpu"},
             {"parameters", {{"bands", L}, {"maps", maps}, {"size", size}, {"repeat", repeat}, {"threads", used_threads},
-                            {"path", projector->uses_avx2() ? "avx2-fma" : "portable"}}},
+                            {"path", projector->path_name()}}},
             {"timings_ms", {{"table", table.wall_ms}, {"plain_read", read.wall_ms}, {"projection", project.wall_ms},
                             {"projection_cache_resident", resident_run.wall_ms}, {"projection_portable", portable_run.wall_ms},
                             {"plain_read_half", half_read.wall_ms}, {"projection_half", half_run.wall_ms}}},
             {"cpu_ms", {{"plain_read", read.cpu_ms}, {"projection", project.cpu_ms},
-                        {"projection_cache_resident", resident_run.cpu_ms}, {"projection_portable", portable_run.cpu_ms}}},
+                        {"projection_cache_resident", resident_run.cpu_ms}, {"projection_portable", portable_run.cpu_ms},
+                        {"plain_read_half", half_read.cpu_ms}, {"projection_half", half_run.cpu_ms}}},
             {"throughput", {{"projection_texels_per_s", per_s(texels, project.wall_ms)},
                             {"projection_gb_per_s", per_s(bytes, project.wall_ms) / 1e9},
                             {"plain_read_texels_per_s", per_s(texels, read.wall_ms)},

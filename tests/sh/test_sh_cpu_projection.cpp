@@ -81,7 +81,7 @@ TEST_CASE("batch cube-map projection matches the double reference within the flo
                 const auto reference = sh_project_cube_map<L>(set.views[k]);
                 for (std::size_t i = 0; i < sh_count(L); ++i)
                     for (int c = 0; c < 3; ++c) {
-                        INFO("size " << n << ", avx2 " << projector.uses_avx2() << ", map " << k << ", coefficient " << i);
+                        INFO("size " << n << ", path " << projector.path_name() << ", map " << k << ", coefficient " << i);
                         CHECK(std::abs(double(out[k][i][c]) - reference[i][c]) <= error_bound(set, k, i, c));
                     }
             }
@@ -91,7 +91,9 @@ TEST_CASE("batch cube-map projection matches the double reference within the flo
 
 TEST_CASE("batch cube-map projection is bitwise the same for any thread count and batching", "[sh][cpu]") {
     const cube_set set(32, 40, 7);
-    const cpu::cube_map_sh_projector<L> projector(32);
+    const auto path = GENERATE(cpu::sh_projection_path::automatic, cpu::sh_projection_path::portable);
+    const cpu::cube_map_sh_projector<L> projector(32, path);
+    INFO("path " << projector.path_name());
     std::vector<sh_coefficients<L, glm::vec3>> one_thread(set.views.size()), two_threads(set.views.size());
     {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);

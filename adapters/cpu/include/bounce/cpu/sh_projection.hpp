@@ -11,13 +11,17 @@
 ///   g and b floats of its texel, so a row of packed RGB texels multiplies the table row
 ///   float by float (no de-interleaving); float j of a row belongs to channel j mod 3, and
 ///   three 8-float accumulators per coefficient cover the period of 24 floats (8 texels).
-/// - Maps are taken in groups (one TBB task each); the group walks the faces two rows at a
-///   time and projects those rows of every map in the group while the rows' table (2 x 9 x
-///   192 floats = 14 KB for L = 3, size 64) stays in L1. The table (2.7 MB at that size)
-///   is thus read from memory once per group, not once per map.
-/// - On x86-64 with AVX2, FMA and F16C (checked at run time) the row products use 256-bit fused
-///   multiply-adds, three coefficients at a time (nine accumulators in registers); elsewhere
-///   a portable loop the compiler vectorizes for the baseline ISA.
+/// - Maps are taken in groups (one TBB task each); the group walks the faces a few rows at
+///   a time and projects those rows of every map in the group while the rows' table
+///   (4 x 9 x 192 floats = 28 KB for L = 3, size 64) stays in L1/L2. The table (2.7 MB at
+///   that size) is thus read from memory once per group, not once per map. Packed rows
+///   (stride = width) and the table's per-coefficient rows are contiguous, so a block is one
+///   long run for the vector loop rather than short rows.
+/// - On x86-64 with AVX2, FMA and F16C (checked at run time) the row products use 256-bit
+///   fused multiply-adds, three coefficients at a time (nine accumulators in registers);
+///   elsewhere a portable loop the compiler vectorizes for the baseline ISA. (A 512-bit
+///   variant with all 27 accumulators in registers was slower on the AMD EPYC this was
+///   measured on, 0.45 against 0.58 Gtexel per CPU-second, and was dropped.)
 /// - Texels are glm::vec3 (12 bytes) or `half_rgb` (IEEE binary16, 6 bytes: what a GL
 ///   RGB16F render target reads back as). A bake of many maps streams from memory, where
 ///   the bytes per texel set the pace (docs/sh-and-irradiance-volumes.md): half texels are
@@ -25,8 +29,8 @@
 /// Float accumulators run over one face (at most 8 x 64 = 512 terms per lane for size 64:
 /// relative rounding below 512 x 2^-24 = 3e-5, 1e-6 typical), then add into double sums.
 /// Each map is summed in the same order whatever the thread count and the grouping, so
-/// results are bitwise reproducible for a given path (the AVX2 and portable paths differ by
-/// rounding, a few float ulps of the result).
+/// results are bitwise reproducible for a given path (the paths differ by rounding, a few
+/// float ulps of the result).
 
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
@@ -96,8 +100,9 @@ constexpr std::uint16_t float_to_half(float f) noexcept {
 }
 
 /// Which row-product code `cube_map_sh_projector` runs.
+/// Which row-product code `cube_map_sh_projector` runs.
 enum class sh_projection_path {
-    automatic,  ///< AVX2 + FMA where the CPU has them, else portable
+    automatic,  ///< AVX2 + FMA + F16C where the CPU has them, else portable
     portable,   ///< plain loops only (for comparison and testing)
 };
 
@@ -108,7 +113,7 @@ template <int L>
 class cube_map_sh_projector {
 public:
     static constexpr std::size_t coefficients = sh_count(L);
-    static constexpr std::size_t rows_per_block = 2;  ///< face rows projected per table block
+    static constexpr std::size_t rows_per_block = 4;  ///< face rows projected per table block
     static constexpr std::size_t maps_per_task = 16;  ///< maps one TBB task projects together
 
     /// Tables for size x size faces (typical: 64; 1 to 4096). Throws parameter_error naming
@@ -130,8 +135,8 @@ public:
     }
 
     std::size_t size() const noexcept { return size_; }
-    /// True when the AVX2 + FMA row product runs.
-    bool uses_avx2() const noexcept { return avx2_; }
+    /// The row product that runs: "avx2" or "portable".
+    const char* path_name() const noexcept { return avx2_ ? "avx2" : "portable"; }
     /// Bytes of the tables (4 x 3 x 6 size^2 L^2).
     std::size_t table_bytes() const noexcept { return table_.size() * sizeof(float); }
 
@@ -170,7 +175,8 @@ public:
     }
 
 private:
-    static constexpr std::size_t lanes = 24;  // floats per accumulator period: 8 texels x 3 channels
+    static constexpr std::size_t lanes = 24;       // floats per accumulator period: 8 texels x 3 channels
+    static constexpr std::size_t acc_stride = 24;  // accumulator floats per coefficient
 
     static bool cpu_has_avx2_fma() noexcept {
 #if BOUNCE_SH_PROJECTION_AVX2
@@ -180,8 +186,16 @@ private:
 #endif
     }
 
+
+    // Table layout [face][coefficient][row][3 size]: one coefficient's rows follow each
+    // other, so a block of packed rows multiplies one contiguous run of the table.
     std::size_t table_row(std::size_t face, std::size_t y, std::size_t i) const noexcept {
-        return ((face * size_ + y) * coefficients + i) * 3 * size_;
+        return ((face * coefficients + i) * size_ + y) * 3 * size_;
+    }
+    // Rows of a view with stride == width are contiguous: a block of them is one run.
+    template <class Texel>
+    std::size_t rows_per_run(const image_view<const Texel>& v, std::size_t y0, std::size_t y1) const noexcept {
+        return v.stride() == size_ ? y1 - y0 : 1;
     }
 
     // acc[i * 24 + j] += sum over steps s of table_i[24 s + j] * row[24 s + j], for the
@@ -189,14 +203,14 @@ private:
     template <class Texel>
     void accumulate_portable(const image_view<const Texel>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
                              float* acc) const {
-        const std::size_t floats = 3 * size_;
+        const std::size_t run = rows_per_run(face_view, y0, y1), floats = 3 * size_ * run;
         std::vector<float> converted;
         if constexpr (std::is_same_v<Texel, half_rgb>) converted.resize(floats);
-        for (std::size_t y = y0; y < y1; ++y) {
+        for (std::size_t y = y0; y < y1; y += run) {
             const float* row = nullptr;
             if constexpr (std::is_same_v<Texel, half_rgb>) {
                 const half_rgb* h = &face_view(0, y);
-                for (std::size_t x = 0; x < size_; ++x)
+                for (std::size_t x = 0; x < size_ * run; ++x)
                     for (std::size_t c = 0; c < 3; ++c) converted[3 * x + c] = half_to_float(h[x].bits[c]);
                 row = converted.data();
             } else {
@@ -204,7 +218,7 @@ private:
             }
             for (std::size_t i = 0; i < coefficients; ++i) {
                 const float* t = table_.data() + table_row(face, y, i);
-                float* a = acc + i * lanes;
+                float* a = acc + i * acc_stride;
                 std::size_t s = 0;
                 for (; s + lanes <= floats; s += lanes)
                     for (std::size_t j = 0; j < lanes; ++j) a[j] += t[s + j] * row[s + j];
@@ -228,11 +242,11 @@ private:
     __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const image_view<const Texel>& face_view,
                                                                          std::size_t face, std::size_t y0, std::size_t y1,
                                                                          std::size_t first, float* acc) const {
-        const std::size_t floats = 3 * size_;
+        const std::size_t run = rows_per_run(face_view, y0, y1), floats = 3 * size_ * run;
         __m256 a[G][3];
         for (std::size_t g = 0; g < G; ++g)
-            for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_loadu_ps(acc + (first + g) * lanes + 8 * v);
-        for (std::size_t y = y0; y < y1; ++y) {
+            for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_loadu_ps(acc + (first + g) * acc_stride + 8 * v);
+        for (std::size_t y = y0; y < y1; y += run) {
             const Texel* row = &face_view(0, y);
             const float* t[G];
             for (std::size_t g = 0; g < G; ++g) t[g] = table_.data() + table_row(face, y, first + g);
@@ -258,7 +272,7 @@ private:
             }
         }
         for (std::size_t g = 0; g < G; ++g)
-            for (std::size_t v = 0; v < 3; ++v) _mm256_storeu_ps(acc + (first + g) * lanes + 8 * v, a[g][v]);
+            for (std::size_t v = 0; v < 3; ++v) _mm256_storeu_ps(acc + (first + g) * acc_stride + 8 * v, a[g][v]);
     }
 
     template <class Texel>
@@ -269,13 +283,14 @@ private:
         if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(face_view, face, y0, y1, i, acc);
         if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(face_view, face, y0, y1, i, acc);
     }
+
 #endif
 
     template <class Texel>
     void project_group(std::span<const cube_map_view<const Texel>> maps, std::span<sh_coefficients<L, glm::vec3>> out,
                        std::size_t begin, std::size_t end) const {
         const std::size_t count = end - begin;
-        std::vector<float> acc(count * coefficients * lanes);
+        std::vector<float> acc(count * coefficients * acc_stride);
         std::vector<double> sums(count * coefficients * 3, 0.0);
         for (std::size_t face = 0; face < 6; ++face) {
             std::fill(acc.begin(), acc.end(), 0.f);
@@ -283,7 +298,7 @@ private:
                 const std::size_t y1 = std::min(size_, y0 + rows_per_block);
                 for (std::size_t k = 0; k < count; ++k) {
                     const auto& face_view = maps[begin + k].faces[face];
-                    float* a = acc.data() + k * coefficients * lanes;
+                    float* a = acc.data() + k * coefficients * acc_stride;
                     // The next map's rows are a separate stream the hardware prefetcher has
                     // not seen yet: ask for them while this map's rows are multiplied.
                     if (k + 1 < count)
@@ -303,8 +318,8 @@ private:
             // Lane j of a period holds channel j mod 3 (periods start at a multiple of 3).
             for (std::size_t k = 0; k < count; ++k)
                 for (std::size_t i = 0; i < coefficients; ++i)
-                    for (std::size_t j = 0; j < lanes; ++j)
-                        sums[(k * coefficients + i) * 3 + j % 3] += double(acc[(k * coefficients + i) * lanes + j]);
+                    for (std::size_t j = 0; j < acc_stride; ++j)
+                        sums[(k * coefficients + i) * 3 + j % 3] += double(acc[(k * coefficients + i) * acc_stride + j]);
         }
         for (std::size_t k = 0; k < count; ++k)
             for (std::size_t i = 0; i < coefficients; ++i)
