@@ -2,8 +2,9 @@
 // A floor (z = 0, |x|, |y| <= 1, normal +z) meeting a wall (x = 1, normal -x) seen by a
 // camera, as an exact ray-cast G-buffer, and a reflective shadow map of a lit wall facing
 // them (x = -1, normal +x, |y| <= 1, 0 <= z <= 2) with an uneven flux, seen by an
-// orthographic projection along the wall's normal (u along +y, v down z). The floor-wall edge gives the blur and the upsampling
-// a discontinuity; the image sizes are not multiples of the patterns.
+// orthographic projection along the wall's normal (u along +y, v down z). The floor-wall
+// edge gives the blur and the upsampling a discontinuity; the image sizes are not multiples
+// of the patterns.
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/vpl_sampling.hpp>
