@@ -246,3 +246,25 @@ TEST_CASE("projections and fits reject bad input, naming the parameter", "[sh][p
     bad.faces[3] = b.view();
     CHECK(names([&] { sh_project_cube_map<2>(bad); }, "cube"));
 }
+
+TEST_CASE("Parseval: the integral of f^2 is the sum of its squared coefficients", "[sh][projection]") {
+    // f = sum_i c_i Y_i with bands < 6: f^2 has bands < 11, integrated exactly by 12 x 24
+    // product-quadrature points; what remains is rounding of ~300 terms of size ~10.
+    constexpr int L = 6;
+    const auto c = random_coefficients<L>(14);
+    double integral = 0, sum = 0;
+    for (const auto& p : sphere_quadrature(12, 24)) integral += p.w * std::pow(sh_evaluate<L, double, glm::dvec3>(c, p.d), 2);
+    for (const double ci : c) sum += ci * ci;
+    CHECK(std::abs(integral - sum) < 1e-12 * sum);
+    // And for a projected light: a cone's energy 2 pi (1 - cos alpha) L^2 is approached from
+    // below as bands are added (Bessel's inequality), never exceeded.
+    const auto cone = sh_project_cone_light<16, double>({0, 0, 1}, std::cos(0.6), 1.0);
+    double kept = 0, previous = 0;
+    for (int l = 0; l < 16; ++l) {
+        for (int m = -l; m <= l; ++m) kept += cone[sh_index(l, m)] * cone[sh_index(l, m)];
+        CHECK(kept >= previous);
+        previous = kept;
+    }
+    CHECK(kept < 2 * pi * (1 - std::cos(0.6)));
+    CHECK(kept > 0.9 * 2 * pi * (1 - std::cos(0.6)));
+}
