@@ -109,8 +109,7 @@ inline constexpr double coincident_distance2 = 1e-30;
 /// Both 0 gives the plain formula. Coincident points (d^2 <= coincident_distance2) get 0,
 /// never NaN or infinity in float32; so do grazing (cos = 0) and back-facing pairs.
 template <real T, vec3_of<T> V>
-V pixel_light_irradiance(const V& x, const V& n, const V& xp, const V& np, const V& flux, T offset,
-                         T min_distance2) {
+V pixel_light_irradiance(const V& x, const V& n, const V& xp, const V& np, const V& flux, T offset, T min_distance2) {
     const V v = x - (xp - np * offset);
     const T d2 = dot(v, v);
     const auto apart = d2 > T(coincident_distance2);

@@ -53,15 +53,13 @@ struct rsm_view {
 
 /// A virtual point light: a texel of a reflective shadow map with the flux it stands for.
 struct vpl {
-    glm::vec3 position{0.f};  ///< world position of the texel's surface point
+    glm::vec3 position{0.f};          ///< world position of the texel's surface point
     glm::vec3 normal{0.f, 0.f, 1.f};  ///< its unit normal
-    glm::vec3 flux{0.f};      ///< W per channel, already divided by the sampling probability
+    glm::vec3 flux{0.f};              ///< W per channel, already divided by the sampling probability
 };
 
 /// The importance of a texel's flux: its Rec. 709 luminance (W, luminance-weighted).
-inline float flux_importance(const glm::vec3& flux) noexcept {
-    return rec709_luminance<float, glm::vec3>(flux);
-}
+inline float flux_importance(const glm::vec3& flux) noexcept { return rec709_luminance<float, glm::vec3>(flux); }
 
 /// VPLs at the centres of a `grid_x` x `grid_y` grid of cells over the map (seed 002
 /// section 4.1.2, "a regular grid of sample positions"): each stands for the
@@ -133,13 +131,17 @@ public:
         while (x1 - x0 > 1 || y1 - y0 > 1) {
             if (y1 - y0 > 1) {
                 const std::size_t ym = (y0 + y1) / 2;
-                if (choose(rect(x0, y0, x1, ym), rect(x0, y0, x1, y1), u.y)) y1 = ym;
-                else y0 = ym;
+                if (choose(rect(x0, y0, x1, ym), rect(x0, y0, x1, y1), u.y))
+                    y1 = ym;
+                else
+                    y0 = ym;
             }
             if (x1 - x0 > 1) {
                 const std::size_t xm = (x0 + x1) / 2;
-                if (choose(rect(x0, y0, xm, y1), rect(x0, y0, x1, y1), u.x)) x1 = xm;
-                else x0 = xm;
+                if (choose(rect(x0, y0, xm, y1), rect(x0, y0, x1, y1), u.x))
+                    x1 = xm;
+                else
+                    x0 = xm;
             }
         }
         return {x0, y0, rect(x0, y0, x1, y1) / total()};
@@ -175,7 +177,8 @@ inline std::vector<vpl> vpls_by_flux_warping(const rsm_view& map, std::size_t co
     for (std::size_t k = 0; k < count; ++k) {
         const auto c = warping.warp(halton2(k, shift));
         const double scale = 1.0 / (double(count) * c.probability);
-        out.push_back({map.position(c.x, c.y), map.normal(c.x, c.y), glm::vec3(glm::dvec3(map.flux(c.x, c.y)) * scale)});
+        out.push_back(
+            {map.position(c.x, c.y), map.normal(c.x, c.y), glm::vec3(glm::dvec3(map.flux(c.x, c.y)) * scale)});
     }
     for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
     return out;

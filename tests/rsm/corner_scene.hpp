@@ -24,7 +24,9 @@ struct corner_scene {
     glm::mat4 light_view_projection{1.f};
 
     corner_scene(std::size_t w, std::size_t h, std::size_t map_size = 32, bool with_wall = true)
-        : gb(w, h), map_position(map_size, map_size), map_normal(map_size, map_size, glm::vec3(1, 0, 0)),
+        : gb(w, h),
+          map_position(map_size, map_size),
+          map_normal(map_size, map_size, glm::vec3(1, 0, 0)),
           map_flux(map_size, map_size) {
         cam.position = {-0.6f, -2.6f, 2.2f};
         cam.look_at = {0.2f, 0.1f, 0.4f};

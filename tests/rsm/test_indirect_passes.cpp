@@ -62,8 +62,9 @@ image<glm::vec3> full_rsm_sum(const corner_scene& s, double min_distance2 = 0) {
             for (std::size_t j = 0; j < s.map_flux.height(); ++j)
                 for (std::size_t i = 0; i < s.map_flux.width(); ++i)
                     e += pixel_light_irradiance<double, glm::dvec3>(
-                        glm::dvec3(s.gb.position(x, y)), glm::dvec3(s.gb.normal(x, y)), glm::dvec3(s.map_position(i, j)),
-                        glm::dvec3(s.map_normal(i, j)), glm::dvec3(s.map_flux(i, j)), 0.0, min_distance2);
+                        glm::dvec3(s.gb.position(x, y)), glm::dvec3(s.gb.normal(x, y)),
+                        glm::dvec3(s.map_position(i, j)), glm::dvec3(s.map_normal(i, j)), glm::dvec3(s.map_flux(i, j)),
+                        0.0, min_distance2);
             out(x, y) = glm::vec3(e);
         }
     return out;
@@ -80,7 +81,8 @@ TEST_CASE("averaged over every relabelling of the sub-buffers, interleaved SII a
     const corner_scene s(50, 37);
     for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather})
         for (const interleave_pattern p : {interleave_pattern{3, 2}, interleave_pattern{4, 4}})
-            for (const auto how : {light_assignment::interleaved, light_assignment::blocked, light_assignment::similarity}) {
+            for (const auto how :
+                 {light_assignment::interleaved, light_assignment::blocked, light_assignment::similarity}) {
                 if (tech == cpu::indirect_technique::rsm_gather && how != light_assignment::interleaved) continue;
                 cpu::indirect_options o;
                 o.technique = tech;
@@ -95,7 +97,8 @@ TEST_CASE("averaged over every relabelling of the sub-buffers, interleaved SII a
                     o.shift = shift;
                     const auto one = render(s, o);
                     for (std::size_t y = 0; y < s.gb.height(); ++y)
-                        for (std::size_t x = 0; x < s.gb.width(); ++x) mean(x, y) += glm::dvec3(one(x, y)) / double(p.cells());
+                        for (std::size_t x = 0; x < s.gb.width(); ++x)
+                            mean(x, y) += glm::dvec3(one(x, y)) / double(p.cells());
                 }
                 const double tol = 2 * higham_gamma(double(o.count)) + higham_gamma(p.cells()) + 2 * u32;
                 double worst = 0;
@@ -110,8 +113,7 @@ TEST_CASE("averaged over every relabelling of the sub-buffers, interleaved SII a
             }
 }
 
-TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the full RSM sum",
-          "[indirect][energy]") {
+TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the full RSM sum", "[indirect][energy]") {
     // The thesis splatted each VPL into one sub-buffer at weight 1: its images held 1/(N M)
     // of the energy (1 - 1/(N M) >= 0.75 relative error from 2 x 2 on). With the N M weight
     // the blurred image keeps the plain image's energy up to noise, and its error against
@@ -129,7 +131,8 @@ TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the
         o.light.min_distance2 = texel * texel;
         o.pattern = {1, 1};
         const auto plain = render(s, o);
-        for (const interleave_pattern p : {interleave_pattern{2, 2}, interleave_pattern{4, 4}, interleave_pattern{8, 8}}) {
+        for (const interleave_pattern p :
+             {interleave_pattern{2, 2}, interleave_pattern{4, 4}, interleave_pattern{8, 8}}) {
             o.pattern = p;
             const auto inter = render(s, o);
             const double e = rel_rms(s, inter, exact);
@@ -190,8 +193,7 @@ TEST_CASE("the plain splat and gather passes give what the renderer gives withou
         for (std::size_t x = 0; x < 40; ++x) REQUIRE(direct(x, y) == gathered(x, y));
 }
 
-TEST_CASE("the gather reaches every texel whatever the map's projection, receivers behind it included",
-          "[indirect]") {
+TEST_CASE("the gather reaches every texel whatever the map's projection, receivers behind it included", "[indirect]") {
     // A perspective projection looking away from every receiver (all clip w < 0), as a
     // point light's cube face behind a receiver: the disc centres on the map's centre and
     // still covers the whole map, so the gather converges to the full sum as before.
@@ -218,8 +220,7 @@ TEST_CASE("the gather reaches every texel whatever the map's projection, receive
     CHECK(previous < 0.05);
 }
 
-TEST_CASE("images smaller than the pattern (empty sub-buffers) render, and keep the energy property",
-          "[indirect]") {
+TEST_CASE("images smaller than the pattern (empty sub-buffers) render, and keep the energy property", "[indirect]") {
     for (const auto& [w, h] : {std::pair{1, 1}, std::pair{3, 2}, std::pair{9, 5}}) {
         const corner_scene s{std::size_t(w), std::size_t(h)};
         for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {

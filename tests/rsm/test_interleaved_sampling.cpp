@@ -100,15 +100,15 @@ TEST_CASE("every light is dealt to exactly one sub-buffer, by every assignment a
                 for (int c : count) REQUIRE(c == 1);
                 // Interleaved and similarity dealing fill the groups evenly.
                 if (how != light_assignment::blocked)
-                    for (int s = 0; s < cells; ++s)
-                        REQUIRE(g.group(s).size() >= positions.size() / std::size_t(cells));
+                    for (int s = 0; s < cells; ++s) REQUIRE(g.group(s).size() >= positions.size() / std::size_t(cells));
             }
 }
 
 TEST_CASE("the tent gives every residue class of the pattern the same total weight 1/n", "[interleave]") {
     for (int n = 1; n <= 64; ++n) {
         std::vector<double> per_class(std::size_t(n), 0.0);
-        for (int o = -(n - 1); o <= n - 1; ++o) per_class[std::size_t(((o % n) + n) % n)] += interleave_tent_weight<double>(o, n);
+        for (int o = -(n - 1); o <= n - 1; ++o)
+            per_class[std::size_t(((o % n) + n) % n)] += interleave_tent_weight<double>(o, n);
         for (double s : per_class) REQUIRE(s == Approx(1.0 / n).epsilon(1e-12));
         REQUIRE(interleave_tent_weight<double>(n, n) == 0.0);
     }

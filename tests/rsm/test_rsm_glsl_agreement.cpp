@@ -54,7 +54,8 @@ double worst_scaled(const std::vector<R>& gpu, const std::vector<R>& cpu, Scale 
             REQUIRE(std::isfinite(c));
             worst = std::max(worst, std::abs(g - c) / scale(e));
         };
-        if constexpr (std::is_same_v<R, float>) diff(gpu[e], cpu[e]);
+        if constexpr (std::is_same_v<R, float>)
+            diff(gpu[e], cpu[e]);
         else
             for (int c = 0; c < R::length(); ++c) diff(gpu[e][c], cpu[e][c]);
     }
@@ -118,10 +119,11 @@ TEST_CASE("texel-flux, solid-angle, bounding-sphere and disc-sample kernels agre
                            [&](std::size_t e) { return double(cpu_mid[e]); }) <= tolerance);
     }
     {
-        std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, float, float, float>> in;
+        std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, float, float, float>>
+            in;
         for (int k = 0; k < random_count; ++k)
-            in.emplace_back(glm::vec3(rng.next_float()), random_point(rng, 2.f), random_unit(rng), random_point(rng, 2.f),
-                            random_unit(rng), glm::vec3(5.f), 0.7f, float(k % 2), 1e-3f);
+            in.emplace_back(glm::vec3(rng.next_float()), random_point(rng, 2.f), random_unit(rng),
+                            random_point(rng, 2.f), random_unit(rng), glm::vec3(5.f), 0.7f, float(k % 2), 1e-3f);
         std::vector<glm::vec3> cpu;
         for (const auto& a : in) cpu.push_back(std::apply(spot_light_texel_flux<float, glm::vec3>, a));
         const auto gpu = gl::map_kernel(spot_light_texel_flux<f32, vec3>, in);
@@ -141,7 +143,8 @@ TEST_CASE("texel-flux, solid-angle, bounding-sphere and disc-sample kernels agre
         std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, glm::vec3, float>> point_in;
         std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec3, float>> dir_in;
         while (point_in.size() < std::size_t(random_count)) {
-            const glm::vec3 p = random_point(rng, 2.f), n = random_unit(rng), l = random_point(rng, 2.f), d = random_unit(rng);
+            const glm::vec3 p = random_point(rng, 2.f), n = random_unit(rng), l = random_point(rng, 2.f),
+                            d = random_unit(rng);
             if (std::abs(glm::dot(n, l - p)) < 1e-5f || std::abs(glm::dot(n, d)) < 1e-5f) continue;
             point_in.emplace_back(glm::vec3(rng.next_float()), p, n, l, glm::vec3(3.f), 1e-3f);
             dir_in.emplace_back(glm::vec3(rng.next_float()), n, d, glm::vec3(2.f), 1e-4f);
@@ -214,7 +217,8 @@ TEST_CASE("the interleave index maps agree exactly on the GPU and the CPU", "[gl
     std::vector<std::tuple<float, float, float>> in;
     for (int n : {1, 2, 3, 4, 7, 8, 64})
         for (int size : {1, 5, 63, 64, 65, 767, 1280, 16383})
-            for (int k = 0; k < 40; ++k) in.emplace_back(float(k == 0 ? size - 1 : rng.next_u32() % std::uint32_t(size)), float(size), float(n));
+            for (int k = 0; k < 40; ++k)
+                in.emplace_back(float(k == 0 ? size - 1 : rng.next_u32() % std::uint32_t(size)), float(size), float(n));
     std::vector<float> cpu_split;
     std::vector<std::array<float, 2>> cpu_gather;
     for (const auto& [x, size, n] : in) {
@@ -259,8 +263,8 @@ TEST_CASE("the geometry-aware tent, the discontinuity test and the upsampling we
         }
         std::vector<glm::vec3> cpu;
         for (const auto& a : in) cpu.push_back(std::apply(geometry_aware_tent<R, float, glm::vec3>, a));
-        CHECK(worst_scaled(gl::map_kernel(geometry_aware_tent<R, f32, vec3>, in), cpu, [](std::size_t) { return 10.0; }) <=
-              tolerance);
+        CHECK(worst_scaled(gl::map_kernel(geometry_aware_tent<R, f32, vec3>, in), cpu,
+                           [](std::size_t) { return 10.0; }) <= tolerance);
     }
     {
         std::vector<std::tuple<float, glm::vec3, float, glm::vec3, float, float>> in;
@@ -268,7 +272,8 @@ TEST_CASE("the geometry-aware tent, the discontinuity test and the upsampling we
             const float da = 0.1f + 10 * rng.next_float(), db = da * (0.8f + 0.4f * rng.next_float());
             const glm::vec3 na = random_unit(rng), nb = glm::normalize(na + random_unit(rng) * rng.next_float());
             // Away from the thresholds, where a rounding difference would flip the answer.
-            if (std::abs(std::abs(da - db) - 0.05f * std::min(da, db)) < 1e-4f * da || std::abs(glm::dot(na, nb) - 0.9f) < 1e-4f)
+            if (std::abs(std::abs(da - db) - 0.05f * std::min(da, db)) < 1e-4f * da ||
+                std::abs(glm::dot(na, nb) - 0.9f) < 1e-4f)
                 continue;
             in.emplace_back(da, na, db, nb, 0.05f, 0.9f);
         }
@@ -278,7 +283,8 @@ TEST_CASE("the geometry-aware tent, the discontinuity test and the upsampling we
         for (std::size_t e = 0; e < in.size(); ++e) REQUIRE(gpu[e] == cpu[e]);
     }
     {
-        using args = std::tuple<glm::vec3, glm::vec3, std::array<glm::vec3, 4>, std::array<glm::vec3, 4>, float, float, float, float>;
+        using args = std::tuple<glm::vec3, glm::vec3, std::array<glm::vec3, 4>, std::array<glm::vec3, 4>, float, float,
+                                float, float>;
         std::vector<args> in;
         while (in.size() < std::size_t(random_count)) {
             const glm::vec3 x = random_point(rng, 1.f), n = random_unit(rng);
@@ -298,7 +304,8 @@ TEST_CASE("the geometry-aware tent, the discontinuity test and the upsampling we
         double worst = 0;
         for (std::size_t e = 0; e < in.size(); ++e) {
             REQUIRE(gpu[e][4] == cpu[e][4]);  // the same samples count
-            for (int k = 0; k < 4; ++k) worst = std::max(worst, double(std::abs(gpu[e][std::size_t(k)] - cpu[e][std::size_t(k)])));
+            for (int k = 0; k < 4; ++k)
+                worst = std::max(worst, double(std::abs(gpu[e][std::size_t(k)] - cpu[e][std::size_t(k)])));
         }
         CHECK(worst <= tolerance);
     }

@@ -94,16 +94,17 @@ TEST_CASE("a texel reflects rho I dw of a point or spot light, nothing from behi
     CHECK(point_light_texel_flux<float, glm::vec3>(albedo, p, -up, light, intensity, dw).x == 0.f);
     const glm::vec3 axis(0, 0, -1);
     const float cos_cone = std::cos(0.5f);
-    const glm::vec3 inside = spot_light_texel_flux<float, glm::vec3>(albedo, p, up, light, axis, intensity, cos_cone, 1.f, dw);
+    const glm::vec3 inside =
+        spot_light_texel_flux<float, glm::vec3>(albedo, p, up, light, axis, intensity, cos_cone, 1.f, dw);
     const float cos_axis = 2.f / glm::length(p - light);
     CHECK(inside.x == Approx(0.5f * 4.f * cos_axis * dw));
     const glm::vec3 far_point(5.f, 0.f, 0.f);
-    CHECK(spot_light_texel_flux<float, glm::vec3>(albedo, far_point, up, light, axis, intensity, cos_cone, 1.f, dw).x == 0.f);
+    CHECK(spot_light_texel_flux<float, glm::vec3>(albedo, far_point, up, light, axis, intensity, cos_cone, 1.f, dw).x ==
+          0.f);
     CHECK(directional_light_texel_flux<float, glm::vec3>(albedo, -up, axis, intensity, 0.01f).x == 0.f);
 }
 
-TEST_CASE("the disc pattern's weights estimate the sum over the disc without bias; DS05's xi1^2 does not",
-          "[rsm]") {
+TEST_CASE("the disc pattern's weights estimate the sum over the disc without bias; DS05's xi1^2 does not", "[rsm]") {
     // Sum of w f over K samples for f = (distance from the centre)^k over a disc of radius
     // r: exact integrals r^2 pi T (k = 0) and 2 pi r^3 T / 3 (k = 1), T texels per unit area.
     // Only xi1 matters and the estimate is (2 pi r^(2+k) T) mean(xi1^(1+k)); van der Corput's
@@ -139,15 +140,15 @@ TEST_CASE("pixel-light irradiance: coincident, grazing and back-facing pairs giv
     const auto e = [&](glm::vec3 x, glm::vec3 n, glm::vec3 np, float offset = 0.f, float d2 = 0.f) {
         return pixel_light_irradiance<float, glm::vec3>(x, n, xp, np, flux, offset, d2).x;
     };
-    CHECK(e(xp, down, up) == 0.f);                                   // coincident
+    CHECK(e(xp, down, up) == 0.f);  // coincident
     CHECK(e(xp, up, up) == 0.f);
     const float tiny = std::numeric_limits<float>::denorm_min();
-    CHECK(e(xp + glm::vec3(0, 0, tiny), down, up) == 0.f);           // below the coincidence radius
-    CHECK(std::isfinite(e(xp + glm::vec3(0, 0, 1e-15f), down, up)));  // just above it: finite
-    CHECK(e(xp + glm::vec3(1, 0, 0), down, up) == 0.f);              // receiver in the sender's plane
+    CHECK(e(xp + glm::vec3(0, 0, tiny), down, up) == 0.f);             // below the coincidence radius
+    CHECK(std::isfinite(e(xp + glm::vec3(0, 0, 1e-15f), down, up)));   // just above it: finite
+    CHECK(e(xp + glm::vec3(1, 0, 0), down, up) == 0.f);                // receiver in the sender's plane
     CHECK(e(xp + glm::vec3(0, 0, 1), glm::vec3(1, 0, 0), up) == 0.f);  // grazing at the receiver
-    CHECK(e(xp - glm::vec3(0, 0, 1), up, up) == 0.f);                // receiver behind the sender
-    CHECK(e(xp + glm::vec3(0, 0, 1), up, up) == 0.f);                // sender behind the receiver
+    CHECK(e(xp - glm::vec3(0, 0, 1), up, up) == 0.f);                  // receiver behind the sender
+    CHECK(e(xp + glm::vec3(0, 0, 1), up, up) == 0.f);                  // sender behind the receiver
     CHECK(e(xp + glm::vec3(0, 0, 2), down, up) == Approx(1.0 / (std::numbers::pi * 4)));
     for (float offset : {0.f, 0.01f})
         for (float d2 : {0.f, 1e-4f}) CHECK(e(xp, down, up, offset, d2) >= 0.f);
@@ -171,8 +172,7 @@ TEST_CASE("at a shared boundary the offset and the clamp bound the irradiance as
     }
 }
 
-TEST_CASE("float32 accumulation over thousands of pixel lights stays within Higham's bound of double",
-          "[rsm][hard]") {
+TEST_CASE("float32 accumulation over thousands of pixel lights stays within Higham's bound of double", "[rsm][hard]") {
     // Recursive summation of K terms: |fl(sum) - sum| <= gamma_(K-1) sum |x_k|, gamma_n =
     // n u / (1 - n u) (Higham 2002, Eq. 4.4). Each float term differs from the double kernel
     // by at most ~30 u of itself (about 30 roundings, no cancellation: senders are at least
@@ -188,7 +188,8 @@ TEST_CASE("float32 accumulation over thousands of pixel lights stays within High
             const glm::vec3 flux(rng.next_float() * 0.01f);
             sum_f += pixel_light_irradiance<float, glm::vec3>(x, n, xp, np, flux, 0.f, 0.f).x;
             const double term = pixel_light_irradiance<double, glm::dvec3>(glm::dvec3(x), glm::dvec3(n), glm::dvec3(xp),
-                                                                          glm::dvec3(np), glm::dvec3(flux), 0.0, 0.0).x;
+                                                                           glm::dvec3(np), glm::dvec3(flux), 0.0, 0.0)
+                                    .x;
             sum_d += term;
             sum_abs += std::abs(term);
         }
@@ -208,7 +209,8 @@ TEST_CASE("outside its bounding sphere a pixel light gives less than the cutoff"
         CHECK(radius < 0.63f * reach);
         int outside = 0;
         for (int k = 0; k < 20000; ++k) {
-            const glm::vec3 d = glm::vec3(rng.next_float() * 2 - 1, rng.next_float() * 2 - 1, rng.next_float() * 2 - 1) * reach * 1.2f;
+            const glm::vec3 d =
+                glm::vec3(rng.next_float() * 2 - 1, rng.next_float() * 2 - 1, rng.next_float() * 2 - 1) * reach * 1.2f;
             const glm::vec3 x = xp + d;
             if (glm::length(x - centre) <= radius) continue;
             ++outside;
@@ -221,8 +223,9 @@ TEST_CASE("outside its bounding sphere a pixel light gives less than the cutoff"
     }
 }
 
-TEST_CASE("the midpoint texel solid angle is within 1.3 t^2 of the exact one, and beats float's exact form on fine maps",
-          "[rsm]") {
+TEST_CASE(
+    "the midpoint texel solid angle is within 1.3 t^2 of the exact one, and beats float's exact form on fine maps",
+    "[rsm]") {
     for (int r : {16, 128, 1024}) {
         const double t = 2.0 / r;
         double worst_mid = 0, worst_exact_float = 0;
@@ -230,7 +233,8 @@ TEST_CASE("the midpoint texel solid angle is within 1.3 t^2 of the exact one, an
             for (int i = 0; i < r; i += 1 + r / 64) {
                 const double x0 = -1 + t * i, y0 = -1 + t * j;
                 const double exact = rectangle_solid_angle<double>(x0, y0, x0 + t, y0 + t);
-                const double mid = perspective_texel_solid_angle_midpoint<float>(float(x0 + t / 2), float(y0 + t / 2), float(t), float(t));
+                const double mid = perspective_texel_solid_angle_midpoint<float>(float(x0 + t / 2), float(y0 + t / 2),
+                                                                                 float(t), float(t));
                 const double ef = rectangle_solid_angle<float>(float(x0), float(y0), float(x0 + t), float(y0 + t));
                 worst_mid = std::max(worst_mid, std::abs(mid / exact - 1));
                 worst_exact_float = std::max(worst_exact_float, std::abs(ef / exact - 1));
@@ -270,7 +274,8 @@ TEST_CASE("the sum over a spot light's RSM converges to the closed-form irradian
                 sum += pixel_light_irradiance<float, glm::vec3>(x, nx, p, np, f, 0.f, 0.f).x;
             }
         const double edge = 2 * std::numbers::pi * tan_a * std::sqrt(2.0) * t * rho * intensity *
-                            std::pow(std::cos(std::max(0.0, alpha - std::sqrt(2.0) * t)), 4) / (std::numbers::pi * h * h);
+                            std::pow(std::cos(std::max(0.0, alpha - std::sqrt(2.0) * t)), 4) /
+                            (std::numbers::pi * h * h);
         INFO("n " << n << " error " << std::abs(sum - exact) << " bound " << edge);
         CHECK(std::abs(sum - exact) <= edge + 10 * u32 * exact);
     }

@@ -46,17 +46,17 @@ struct indirect_options {
     std::size_t count = 400;
     interleave_pattern pattern{4, 4};  ///< 1 x 1: no interleaving (typical: 4 x 4, 8 x 8)
     light_assignment assignment = light_assignment::interleaved;
-    int shift = 0;      ///< relabelling of the sub-buffers (assign_lights), in [0, N M); 0 normally
-    bool blur = true;   ///< geometry-aware tent over the gathered buffer (only when interleaved)
+    int shift = 0;     ///< relabelling of the sub-buffers (assign_lights), in [0, N M); 0 normally
+    bool blur = true;  ///< geometry-aware tent over the gathered buffer (only when interleaved)
     discontinuity_params discontinuity;
     vpl_selection selection = vpl_selection::flux_warping;  ///< SII only
-    float r_max = 1.5f;            ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
+    float r_max = 1.5f;  ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
     disc_weighting disc = disc_weighting::unbiased;  ///< RSM gather sample weights (DS05's xi1^2 to compare)
-    pixel_light_params light;      ///< singularity remedies (rsm.hpp)
-    float sii_cutoff = 0.f;        ///< SII splat cutoff, W/m^2 (sii_params::cutoff); 0: whole screen
-    int low_resolution = 1;        ///< RSM gather at 1/f resolution with upsampling (f in 1..8)
+    pixel_light_params light;                        ///< singularity remedies (rsm.hpp)
+    float sii_cutoff = 0.f;                          ///< SII splat cutoff, W/m^2 (sii_params::cutoff); 0: whole screen
+    int low_resolution = 1;                          ///< RSM gather at 1/f resolution with upsampling (f in 1..8)
     upsample_params upsample;
-    std::uint64_t seed = 1;        ///< disc pattern and VPL sampling
+    std::uint64_t seed = 1;  ///< disc pattern and VPL sampling
 
     void validate() const {
         require(count > 0 && count <= (std::size_t(1) << 24), "count", "must lie in [1, 2^24]");
@@ -74,12 +74,12 @@ struct indirect_options {
 
 /// Per-stage wall-clock times of one frame (milliseconds) and its counts.
 struct indirect_timings {
-    double split_ms = 0;     ///< G-buffer split into sub-buffers (and downsampling)
-    double shade_ms = 0;     ///< VPL selection and the gather or splat on the sub-buffers
-    double gather_ms = 0;    ///< sub-buffers back to image order
-    double blur_ms = 0;      ///< discontinuity buffer and geometry-aware blur
-    double upsample_ms = 0;  ///< low-resolution upsampling with full-resolution fallback
-    std::size_t vpls = 0;    ///< SII: VPLs splatted; RSM gather: disc samples per pixel and map
+    double split_ms = 0;              ///< G-buffer split into sub-buffers (and downsampling)
+    double shade_ms = 0;              ///< VPL selection and the gather or splat on the sub-buffers
+    double gather_ms = 0;             ///< sub-buffers back to image order
+    double blur_ms = 0;               ///< discontinuity buffer and geometry-aware blur
+    double upsample_ms = 0;           ///< low-resolution upsampling with full-resolution fallback
+    std::size_t vpls = 0;             ///< SII: VPLs splatted; RSM gather: disc samples per pixel and map
     std::size_t fallback_pixels = 0;  ///< pixels the upsampling gathered at full resolution
     double total_ms() const noexcept { return split_ms + shade_ms + gather_ms + blur_ms + upsample_ms; }
 };
@@ -163,8 +163,10 @@ private:
         t.split_ms += ms_since(start);
 
         start = clock::now();
-        if (options_.technique == indirect_technique::rsm_gather) shade_gather(shaded_gb, maps, b.maps, shaded_out, t);
-        else shade_splat(shaded_gb, cam, maps, b.maps, shaded_out, t);
+        if (options_.technique == indirect_technique::rsm_gather)
+            shade_gather(shaded_gb, maps, b.maps, shaded_out, t);
+        else
+            shade_splat(shaded_gb, cam, maps, b.maps, shaded_out, t);
         t.shade_ms += ms_since(start);
         if (!interleaved) return;
 
@@ -211,7 +213,8 @@ private:
             if (!(totals[i] > 0)) continue;
             // VPLs shared between maps in proportion to their flux, so each carries about
             // the same flux whichever map it comes from.
-            const auto share = std::max<std::size_t>(1, std::size_t(std::llround(double(options_.count) * totals[i] / sum)));
+            const auto share =
+                std::max<std::size_t>(1, std::size_t(std::llround(double(options_.count) * totals[i] / sum)));
             std::vector<vpl> more;
             if (options_.selection == vpl_selection::flux_warping) {
                 more = vpls_by_flux_warping(maps[i], share, options_.seed + i);
@@ -228,8 +231,8 @@ private:
         std::vector<glm::vec3> positions;
         if (options_.assignment == light_assignment::similarity)
             for (const auto& l : vpls_) positions.push_back(l.position);
-        const light_groups g = assign_lights(vpls_.size(), imaps.pattern.cells(), options_.assignment, positions,
-                                             options_.shift);
+        const light_groups g =
+            assign_lights(vpls_.size(), imaps.pattern.cells(), options_.assignment, positions, options_.shift);
         sii_params sp;
         sp.light = options_.light;
         sp.cutoff = options_.sii_cutoff;

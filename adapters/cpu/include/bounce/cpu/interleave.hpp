@@ -37,8 +37,8 @@ struct interleave_maps {
         p.validate();
         require(w > 0 && h > 0, "width/height", "must be positive");
         require(w < (std::size_t(1) << 24) && h < (std::size_t(1) << 24), "width/height", "must be below 2^24");
-        const auto axis = [](std::size_t size, int n, std::vector<std::uint32_t>& split, std::vector<std::uint32_t>& gather,
-                             std::vector<std::uint32_t>& cell) {
+        const auto axis = [](std::size_t size, int n, std::vector<std::uint32_t>& split,
+                             std::vector<std::uint32_t>& gather, std::vector<std::uint32_t>& cell) {
             split.resize(size);
             gather.resize(size);
             cell.resize(size);
@@ -89,7 +89,8 @@ void gather_image(image_view<const T> split, image_view<T> image, const interlea
 }
 
 /// split_image on every plane of a G-buffer.
-inline void split_gbuffer(const gbuffer_view<float>& gb, const gbuffer_view<float>& split, const interleave_maps& maps) {
+inline void split_gbuffer(const gbuffer_view<float>& gb, const gbuffer_view<float>& split,
+                          const interleave_maps& maps) {
     split_image<glm::vec3>(gb.position, split.position, maps);
     split_image<glm::vec3>(gb.normal, split.normal, maps);
     split_image<glm::vec3>(gb.albedo, split.albedo, maps);
@@ -130,8 +131,8 @@ inline void discontinuity_buffer(const gbuffer_view<float>& gb, const discontinu
 namespace detail {
 /// One pass of the tent along x (`Vertical` false) or y, with a compile-time radius R >= n - 1.
 template <int R, bool Vertical>
-void tent_pass(image_view<const glm::vec3> in, image_view<const glm::vec2> edges, image_view<const float> depth,
-               int n, image_view<glm::vec3> out) {
+void tent_pass(image_view<const glm::vec3> in, image_view<const glm::vec2> edges, image_view<const float> depth, int n,
+               image_view<glm::vec3> out) {
     const std::size_t w = in.width(), h = in.height();
     const std::ptrdiff_t size = std::ptrdiff_t(Vertical ? h : w);
     tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
@@ -162,7 +163,8 @@ void tent_pass(image_view<const glm::vec3> in, image_view<const glm::vec2> edges
                     // Edge between taps k and k + 1: the edge flag of tap k towards +axis;
                     // the image border counts as an edge.
                     if (k < 2 * R)
-                        cuts[std::size_t(k)] = inside && t + 1 < size ? (Vertical ? edges(tx, ty).y : edges(tx, ty).x) : 1.f;
+                        cuts[std::size_t(k)] =
+                            inside && t + 1 < size ? (Vertical ? edges(tx, ty).y : edges(tx, ty).x) : 1.f;
                 }
             }
             out(x, y) = geometry_aware_tent<R, float, glm::vec3>(values, cuts, float(n));
@@ -194,12 +196,18 @@ inline void geometry_aware_blur(image_view<const glm::vec3> in, image_view<const
                 scratch.height() == in.height(),
             "out/scratch", "size differs from the image");
     const int reach = std::max(p.n, p.m) - 1;
-    if (reach <= 1) detail::tent_blur<1>(in, edges, depth, p, scratch, out);
-    else if (reach <= 3) detail::tent_blur<3>(in, edges, depth, p, scratch, out);
-    else if (reach <= 7) detail::tent_blur<7>(in, edges, depth, p, scratch, out);
-    else if (reach <= 15) detail::tent_blur<15>(in, edges, depth, p, scratch, out);
-    else if (reach <= 31) detail::tent_blur<31>(in, edges, depth, p, scratch, out);
-    else detail::tent_blur<63>(in, edges, depth, p, scratch, out);
+    if (reach <= 1)
+        detail::tent_blur<1>(in, edges, depth, p, scratch, out);
+    else if (reach <= 3)
+        detail::tent_blur<3>(in, edges, depth, p, scratch, out);
+    else if (reach <= 7)
+        detail::tent_blur<7>(in, edges, depth, p, scratch, out);
+    else if (reach <= 15)
+        detail::tent_blur<15>(in, edges, depth, p, scratch, out);
+    else if (reach <= 31)
+        detail::tent_blur<31>(in, edges, depth, p, scratch, out);
+    else
+        detail::tent_blur<63>(in, edges, depth, p, scratch, out);
 }
 
 }  // namespace bounce::cpu

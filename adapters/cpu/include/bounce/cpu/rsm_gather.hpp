@@ -48,8 +48,8 @@ struct pixel_light_params {
 /// `r_max` in map units (0, 2]: 1.5 reaches every texel from any centre inside the map.
 /// How the disc samples are weighted (rsm.hpp).
 enum class disc_weighting {
-    unbiased,      ///< w proportional to xi1 (rsm_disc_sample): estimates the disc's texel sum
-    xi1_squared,   ///< DS05's xi1^2 (rsm_disc_sample_xi1_squared): over-weights the rim
+    unbiased,     ///< w proportional to xi1 (rsm_disc_sample): estimates the disc's texel sum
+    xi1_squared,  ///< DS05's xi1^2 (rsm_disc_sample_xi1_squared): over-weights the rim
 };
 
 inline std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count,
@@ -63,10 +63,11 @@ inline std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, s
     std::vector<glm::vec3> out(count);
     for (std::size_t k = 0; k < count; ++k) {
         const glm::dvec2 xi = halton2(k, shift);
-        out[k] = weighting == disc_weighting::unbiased
-                     ? rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count))
-                     : rsm_disc_sample_xi1_squared<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count),
-                                                                       double(count));
+        out[k] =
+            weighting == disc_weighting::unbiased
+                ? rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count))
+                : rsm_disc_sample_xi1_squared<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count),
+                                                                  double(count));
     }
     for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
     return out;
@@ -185,11 +186,10 @@ inline void downsample_gbuffer(const gbuffer_view<float>& gb, int factor, const 
 /// weights of geometry_aware_upsample_weights when at least three are suitable (DS05); the
 /// others are gathered at full resolution with the whole `pattern` (not interleaved).
 /// Returns the number of pixels gathered at full resolution.
-inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camera& cam,
-                                      const gbuffer_view<float>& low, image_view<const glm::vec3> low_irradiance,
-                                      int factor, const upsample_params& up, std::span<const rsm_view> maps,
-                                      std::span<const glm::vec3> pattern, const pixel_light_params& lp,
-                                      image_view<glm::vec3> out) {
+inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camera& cam, const gbuffer_view<float>& low,
+                                      image_view<const glm::vec3> low_irradiance, int factor, const upsample_params& up,
+                                      std::span<const rsm_view> maps, std::span<const glm::vec3> pattern,
+                                      const pixel_light_params& lp, image_view<glm::vec3> out) {
     require(out.width() == gb.width() && out.height() == gb.height(), "out", "size differs from the G-buffer");
     const float f = float(factor);
     std::vector<std::size_t> fallbacks(gb.height(), 0);

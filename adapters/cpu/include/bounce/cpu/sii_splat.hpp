@@ -86,7 +86,8 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
             b += int(origin);
         };
         for (std::uint32_t k = groups.begin[s]; k < groups.begin[s + 1]; ++k) {
-            const pixel_rect r = sii_splat_rect(cam, view, vpls[groups.order[k]], vpls.size(), params, maps.width, maps.height);
+            const pixel_rect r =
+                sii_splat_rect(cam, view, vpls[groups.order[k]], vpls.size(), params, maps.width, maps.height);
             pixel_rect q;
             if (!r.empty() && sub.width > 0 && sub.height > 0) {
                 local(r.x0, r.x1, i, p.n, sub.width, sub.x0, q.x0, q.x1);
@@ -104,7 +105,8 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
         const auto& r = rects[k];
         if (r.empty()) continue;
         for (int ty = r.y0 / tile; ty <= r.y1 / tile; ++ty)
-            for (int tx = r.x0 / tile; tx <= r.x1 / tile; ++tx) bins[std::size_t(ty) * std::size_t(tw) + std::size_t(tx)].push_back(std::uint32_t(k));
+            for (int tx = r.x0 / tile; tx <= r.x1 / tile; ++tx)
+                bins[std::size_t(ty) * std::size_t(tw) + std::size_t(tx)].push_back(std::uint32_t(k));
     }
     tbb::parallel_for(std::size_t(0), bins.size(), [&](std::size_t t) {
         const int tx = int(t % std::size_t(tw)), ty = int(t / std::size_t(tw));
@@ -122,9 +124,9 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
                     // Receivers behind the sender's plane get 0 from the kernel (its cos
                     // theta_p clamp): skipping them adds nothing and saves its square root.
                     if (!(glm::dot(l.normal, gb.position(uu, vv) - sender) > 0.f)) continue;
-                    out(uu, vv) += pixel_light_irradiance<float, glm::vec3>(gb.position(uu, vv), gb.normal(uu, vv),
-                                                                            l.position, l.normal, flux,
-                                                                            params.light.offset, params.light.min_distance2);
+                    out(uu, vv) += pixel_light_irradiance<float, glm::vec3>(
+                        gb.position(uu, vv), gb.normal(uu, vv), l.position, l.normal, flux, params.light.offset,
+                        params.light.min_distance2);
                 }
         }
     });
