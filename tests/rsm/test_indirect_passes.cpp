@@ -141,6 +141,12 @@ TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the
                               << ratio);
             CHECK(e < 0.15);
             CHECK(std::abs(ratio - 1) < 0.05);
+            // The thesis's weight 1 keeps 1/(N M) of the energy (up to the same noise).
+            o.energy_correct = false;
+            const double lost = energy(s, render(s, o)) / energy(s, plain);
+            o.energy_correct = true;
+            INFO("weight 1: energy ratio " << lost);
+            CHECK(std::abs(lost * p.cells() - 1) < 0.05);
         }
     }
 }

@@ -48,6 +48,9 @@ struct indirect_options {
     light_assignment assignment = light_assignment::interleaved;
     int shift = 0;     ///< relabelling of the sub-buffers (assign_lights), in [0, N M); 0 normally
     bool blur = true;  ///< geometry-aware tent over the gathered buffer (only when interleaved)
+    /// Interleaved lights weighted N M (docs section 5); false reproduces the thesis's
+    /// weight 1 and its loss of 1 - 1/(N M) of the energy, for comparison.
+    bool energy_correct = true;
     discontinuity_params discontinuity;
     vpl_selection selection = vpl_selection::flux_warping;  ///< SII only
     float r_max = 1.5f;  ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
@@ -197,7 +200,7 @@ private:
         const light_groups g = assign_lights(full_pattern_.size(), imaps.pattern.cells(), light_assignment::interleaved,
                                              {}, options_.shift);
         const auto grouped = grouped_pattern(full_pattern_, g);
-        rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out);
+        rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out, options_.energy_correct);
     }
 
     void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
@@ -236,6 +239,7 @@ private:
         sii_params sp;
         sp.light = options_.light;
         sp.cutoff = options_.sii_cutoff;
+        sp.energy_correct = options_.energy_correct;
         splat_vpls(gb, imaps, cam, vpls_, g, sp, out);
     }
 

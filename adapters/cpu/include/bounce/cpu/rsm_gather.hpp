@@ -113,11 +113,12 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
 /// The gather over a (split) G-buffer `gb` from `maps` (one per light, six for a point
 /// light's cube; all the size `pattern` was made for): pixel (u, v) of sub-buffer s = maps.cell(u, v)
 /// uses `pattern[groups.begin[s] .. groups.begin[s + 1])` (grouped_pattern) with weights
-/// times interleaved_weight_scale(n, m). `out` (irradiance, W/m^2) is written everywhere; 0
-/// where the G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather.
+/// times interleaved_weight_scale(n, m) (weight 1 with `energy_correct` false, the thesis's
+/// choice, for comparison). `out` (irradiance, W/m^2) is written everywhere; 0 where the
+/// G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather.
 inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& imaps, std::span<const rsm_view> maps,
                        std::span<const glm::vec3> pattern, const light_groups& groups, const pixel_light_params& lp,
-                       image_view<glm::vec3> out) {
+                       image_view<glm::vec3> out, bool energy_correct = true) {
     lp.validate();
     for (const auto& m : maps) {
         m.validate();
@@ -129,7 +130,8 @@ inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& ima
     detail::require_size(out.width(), out.height(), imaps, "out");
     require(groups.begin.size() == std::size_t(imaps.pattern.cells()) + 1 && pattern.size() == groups.order.size(),
             "pattern", "must be grouped for the pattern's sub-buffers");
-    const float scale = interleaved_weight_scale<float>(float(imaps.pattern.n), float(imaps.pattern.m));
+    const float scale =
+        energy_correct ? interleaved_weight_scale<float>(float(imaps.pattern.n), float(imaps.pattern.m)) : 1.f;
     tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t v) {
         for (std::size_t u = 0; u < gb.width(); ++u) {
             if (!gb.covered(u, v)) {

@@ -38,6 +38,10 @@ struct sii_params {
     /// cut). Typical: 1e-3 of the scene's indirect irradiance.
     float cutoff = 0.f;
     int tile = 32;  ///< tile side in pixels of the split buffer (typical: 16-64)
+    /// Interleaved VPLs carry N M times their flux (interleaved_weight_scale). false
+    /// reproduces the thesis's splat at weight 1 (seed 002 section 5.2) for comparison: the
+    /// image then holds 1/(N M) of the energy.
+    bool energy_correct = true;
 
     void validate() const {
         light.validate();
@@ -70,7 +74,7 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
             "must deal every VPL to the pattern's sub-buffers");
     if (vpls.empty()) return;
     const glm::mat4 view = cam.view_matrix();
-    const float scale = interleaved_weight_scale<float>(float(p.n), float(p.m));
+    const float scale = params.energy_correct ? interleaved_weight_scale<float>(float(p.n), float(p.m)) : 1.f;
 
     // Rectangles in the split buffer, one per VPL, in the order of `groups.order`.
     std::vector<pixel_rect> rects(vpls.size());
