@@ -7,24 +7,23 @@
 // Stages (the names of timings_ms): gbuffer, splat_existing (step 2), scan (step 4 minus
 // record computation), compute_records, interpolate (making the indirect image from the
 // cache: the final splat of step 5, or the octree's lookups), normalize, total.
-#include <bounce/cpu/batched_scan.hpp>
-#include <bounce/cpu/neighbour_index.hpp>
-#include <bounce/cpu/octree_cache.hpp>
-#include <bounce/cpu/splatting.hpp>
+#include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/io/image_io.hpp>
-#include <bounce/io/record_cache.hpp>
-#include <bounce/io/report.hpp>
+#include <bounce/study/image_comparison.hpp>
+#include <bounce/study/record_cache.hpp>
+#include <bounce/study/run_report.hpp>
 #include <bounce/io/scene.hpp>
 #ifdef BOUNCE_IC_WITH_GL
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
+#include <bounce/gl/irradiance_splatter.hpp>
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/raster_record_sampler.hpp>
 #include <bounce/gl/splat_pass.hpp>
@@ -90,30 +89,21 @@ struct options {
 weighting_kind parse_weight(const std::string& w) {
     if (w == "ward") return weighting_kind::ward;
     if (w == "ward-smooth") return weighting_kind::ward_smooth;
-    if (w == "ward-gpu") return weighting_kind::ward_gpu;
-    if (w == "ward-gpu-shader") return weighting_kind::ward_gpu_shader;
+    if (w == "ward-gpu") return weighting_kind::ward_early_reject;
+    if (w == "ward-gpu-shader") return weighting_kind::ward_scaled_normal;
     if (w == "tabellion") return weighting_kind::tabellion;
     throw parameter_error("--weight", "unknown weighting function '" + w + "'");
 }
 
-// Everything a frame needs that does not change with a or the camera.
-struct context {
-    const options& opt;
-    const io::scene& scene;
-    const embree::accel& bvh;
-    const embree::reference_integrator& integrator;
-    /// The record sampler (Embree rays or the GL plane rasterizer): a record at (p, n).
-    std::function<std::optional<irradiance_record>(glm::vec3, glm::vec3, double)> sampler;
-    /// The records so far for --neighbour-clamp (null when off); mirrors `records`.
-    cpu::neighbour_index* clamp = nullptr;
-    /// The sampler's batch form (the GL raster sampler: one atlas per batch); when empty,
-    /// batches are measured with `sampler` in parallel (Embree: thread-safe). Both samplers
-    /// are pure functions of the point, so the scans may measure records ahead.
+// The record sampler the options chose, behind one type (it models bounce::record_sampler).
+struct chosen_sampler {
     std::function<void(std::span<const glm::vec3>, std::span<const glm::vec3>, std::span<const double>,
                        std::span<std::optional<irradiance_record>>)>
-        batch_sampler{};
-    cpu::scan_batch batch{};
-    std::vector<std::uint32_t> order{};  // the cache-miss scan's pixel order; empty: row by row
+        measure;
+    void operator()(std::span<const glm::vec3> p, std::span<const glm::vec3> n, std::span<const double> footprint,
+                    std::span<std::optional<irradiance_record>> out) {
+        measure(p, n, footprint, out);
+    }
 };
 
 // The parameters records depend on (not a: records are valid for every a). falloff_kappa
@@ -127,310 +117,47 @@ nlohmann::json cache_parameters(const options& o, const io::scene& s) {
             {"gradient_limit", o.gradient_limit}, {"height", o.height}};
 }
 
-// One frame of the chosen interpolation for `cam`: Algorithm 5 with the splat buffer, or
-// the classical two passes with the octree. `records` grows with the new records.
+// What one frame gives the report: what it saw, its indirect image, the GL backend's
+// composed image, and the scan's counts.
 struct frame_result {
-    gbuffer<float> g;                      // what the frame saw
-    image<glm::vec3> indirect;             // rho/pi * E from the cache
-    std::optional<image<glm::vec3>> combined;  // direct + indirect, when the backend composed it
-    std::size_t new_records = 0;
-    std::size_t measured = 0, wasted = 0;  // batched scan: records measured, guesses dropped
+    gbuffer<float> g;
+    image<glm::vec3> indirect;
+    std::optional<image<glm::vec3>> combined;
+    std::size_t new_records = 0, measured = 0, wasted = 0;
 };
 
-// What a batched scan reports: its records, the wall time of its measuring, its guesses.
-void take_scan_stats(const cpu::scan_stats& stats, frame_result& fr, double& record_ms) {
-    fr.new_records = stats.created;
-    record_ms = stats.measure_ms;
-    fr.measured = stats.measured;
-    fr.wasted = stats.wasted;
-}
-
-cpu::splat_params splat_params_for(const options& o, float a) {
-    cpu::splat_params sp;
-    sp.a = a;
-    sp.gradients = o.gradients;
-    sp.max_extrapolation = o.max_extrapolation;
-    sp.front_tolerance = o.front_tolerance;
-    return sp;
-}
-
-// A record at pixel (x, y): the sampler at its point, with the pixel footprint for radius
-// clamps.
-auto record_measurer(const context& ctx, const camera& cam, const gbuffer<float>& g) {
-    return [&ctx, &cam, &g](std::size_t x, std::size_t y) {
-        return ctx.sampler(g.position(x, y), g.normal(x, y), cam.pixel_footprint(g.depth(x, y), g.height()));
-    };
-}
-
-// Records for a batch of pixels (the batched scans' guesses): one call of the batch sampler,
-// or the per-point sampler on the worker threads.
-auto record_batch_measurer(const context& ctx, const camera& cam, const gbuffer<float>& g) {
-    return [&ctx, &cam, &g](std::span<const cpu::pixel_xy> px, std::span<std::optional<irradiance_record>> out) {
-        if (ctx.batch_sampler) {
-            std::vector<glm::vec3> p(px.size()), n(px.size());
-            std::vector<double> footprint(px.size());
-            for (std::size_t k = 0; k < px.size(); ++k) {
-                p[k] = g.position(px[k].x, px[k].y);
-                n[k] = g.normal(px[k].x, px[k].y);
-                footprint[k] = cam.pixel_footprint(g.depth(px[k].x, px[k].y), g.height());
-            }
-            ctx.batch_sampler(p, n, footprint, out);
-            return;
-        }
-        const auto one = record_measurer(ctx, cam, g);
-        tbb::parallel_for(std::size_t(0), px.size(), [&](std::size_t k) { out[k] = one(px[k].x, px[k].y); });
-    };
-}
-
-// What a new record owes to the records before it, applied in scan order: neighbour clamping.
-auto record_committer(const context& ctx, const std::vector<irradiance_record>& records) {
-    return [&ctx, &records](irradiance_record& rec) {
-        if (!ctx.clamp) return;
-        ctx.clamp->sync(records);
-        rec.radius = ctx.clamp->clamped_radius(rec);
-    };
-}
-
-// The sequential scans' record-creation callback: measure then commit, adding the time to
-// `record_ms`.
-auto record_creator(const context& ctx, const camera& cam, const gbuffer<float>& g,
-                    const std::vector<irradiance_record>& records, double& record_ms) {
-    return [measure = record_measurer(ctx, cam, g), commit = record_committer(ctx, records),
-            &record_ms](std::size_t x, std::size_t y) -> std::optional<irradiance_record> {
-        const auto t0 = clock_type::now();
-        auto rec = measure(x, y);
-        if (rec) commit(*rec);
-        record_ms += ms_since(t0);
-        return rec;
-    };
-}
-
-// Step 4 over a splat buffer, for the CPU and GL backends alike: the batched scan (guesses
-// measured together) or the sequential one; sets fr's record counts, adds to record_ms.
-// `record_g`: where the records of missed pixels are measured (the scanned G-buffer `g`
-// itself, or for GL frames the sampler's own view of the same pixels, record_points_for).
-template <class W>
-void scan_splat_buffer(const context& ctx, const camera& cam, gbuffer<float>& g, const gbuffer<float>& record_g,
-                       const cpu::splat_params& sp, float min_weight, std::vector<irradiance_record>& records,
-                       image_view<glm::vec4> splat, std::size_t max_new, frame_result& fr, double& record_ms) {
-    if (ctx.opt.scan == "batched") {
-        const auto stats = cpu::scan_cache_misses_batched<W>(g.view(), cam, sp, min_weight,
-                                                             record_batch_measurer(ctx, cam, record_g),
-                                                             record_committer(ctx, records), records, splat, ctx.batch,
-                                                             ctx.order, max_new);
-        take_scan_stats(stats, fr, record_ms);
-    } else {
-        fr.new_records = cpu::scan_cache_misses<W>(g.view(), cam, sp, min_weight,
-                                                   record_creator(ctx, cam, record_g, records, record_ms), records,
-                                                   splat, ctx.order, max_new);
-    }
-}
-
-// Whether two G-buffers see the same surface at a pixel: points within 1e-4 of the scene's
-// size and normals within 2.6 degrees (the error mask of GL frames uses the same test).
-bool same_surface(const gbuffer<float>& g, const gbuffer<float>& h, std::size_t x, std::size_t y, float scene_size) {
-    return std::isfinite(g.depth(x, y)) && std::isfinite(h.depth(x, y)) &&
-           glm::length(g.position(x, y) - h.position(x, y)) <= 1e-4f * scene_size &&
-           glm::dot(g.normal(x, y), h.normal(x, y)) >= 0.999f;
-}
-
-// CPU backends: splat-cpu (Algorithm 5 on the CPU) and octree / octree-lanes (the classical
-// two passes, the records evaluated one or four at a time).
-frame_result render_frame(const context& ctx, const camera& cam, gbuffer<float> g_in, float a,
-                          std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
-    const gbuffer<float>& g = g_in;
-    const options& o = ctx.opt;
-    const cpu::splat_params sp = splat_params_for(o, a);
-    const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
-    const auto gv = g_in.view();
-
-    double record_ms = 0;
-    frame_result fr;
-    fr.indirect = image<glm::vec3>(g.width(), g.height());
-    image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
-    const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
-    std::optional<image<glm::vec4>> wide;  // hole filling's wide splat
-    with_weighting(parse_weight(o.weight), [&](auto w) {
-        using W = decltype(w);
-        if (o.interp.starts_with("octree")) {
-            // Classical: the tree depends on a, so it is built for this frame's a.
-            const auto [lo, hi] = ctx.scene.bounds();
-            cpu::octree_cache<W> tree(lo, hi, sp);
-            {
-                auto t = timer.measure("splat_existing");  // (re)inserting existing records
-                for (const auto& r : records) tree.insert(r);
-            }
-            const auto t0 = clock_type::now();
-            // The classical fill: the same driver as the splat scan; --scan sequential makes it
-            // one record at a time (a batch of one guesses nothing).
-            cpu::scan_batch batch = ctx.batch;
-            if (o.scan == "sequential") batch.max_records = 1;
-            const glm::mat4 view = cam.view_matrix();
-            const auto stats = cpu::batched_scan(
-                g.width(), g.height(), ctx.order, max_new, batch,
-                [&](std::size_t x, std::size_t y) {
-                    return gv.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
-                },
-                record_batch_measurer(ctx, cam, g), record_committer(ctx, records), [&](const irradiance_record& rec) {
-                    records.push_back(rec);
-                    tree.insert(rec);
-                    const float zone = W::template influence_radius<float>(rec.radius, a);
-                    return cpu::guess_spacing(cpu::splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
-                });
-            take_scan_stats(stats, fr, record_ms);
-            timer.add_sample("scan", ms_since(t0) - record_ms);
-            timer.add_sample("compute_records", record_ms);
-            auto t = timer.measure("interpolate");
-            tree.render(gv, splat.view(), o.interp == "octree-lanes" ? cpu::octree_evaluation::lanes
-                                                                      : cpu::octree_evaluation::scalar);
-        } else {
-            {
-                auto t = timer.measure("splat_existing");
-                cpu::splat_records<W>(gv, cam, records, sp, splat.view());
-            }
-            const auto t0 = clock_type::now();
-            scan_splat_buffer<W>(ctx, cam, g_in, g_in, sp, min_weight, records, splat.view(), max_new, fr, record_ms);
-            timer.add_sample("scan", ms_since(t0) - record_ms);
-            timer.add_sample("compute_records", record_ms);
-            // Step 5: the image comes from splatting every record (on the GPU in the seed).
-            auto t = timer.measure("interpolate");
-            std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
-            cpu::splat_records<W>(gv, cam, records, sp, splat.view());
-            if (fill_holes) {
-                // A budget left pixels uncovered: the same records again with zones fill x wider.
-                cpu::splat_params wide_sp = sp;
-                wide_sp.a = a * o.fill_holes;
-                wide = image<glm::vec4>(g.width(), g.height(), glm::vec4(0.f));
-                cpu::splat_records<W>(gv, cam, records, wide_sp, wide->view());
-            }
-        }
-    });
-    {
-        auto t = timer.measure("normalize");
-        if (wide) cpu::normalize_splats(splat.view(), wide->view(), 1e-3f, fr.indirect.view());
-        else cpu::normalize_splats(splat.view(), fr.indirect.view());
-    }
-    fr.g = std::move(g_in);
-    return fr;
+cpu::irradiance_cache_options cache_options_for(const options& o, float a) {
+    cpu::irradiance_cache_options c;
+    c.splat.a = a;
+    c.splat.gradients = o.gradients;
+    c.splat.max_extrapolation = o.max_extrapolation;
+    c.splat.front_tolerance = o.front_tolerance;
+    c.min_weight = o.min_weight;
+    c.interpolation = o.interp == "octree"         ? cpu::cache_interpolation::octree
+                      : o.interp == "octree-lanes" ? cpu::cache_interpolation::octree_lanes
+                                                   : cpu::cache_interpolation::splat;
+    c.scan = o.scan == "sequential" ? cpu::scan_kind::sequential : cpu::scan_kind::batched;
+    c.batch.max_records = o.scan_batch;
+    const std::string order = !o.scan_order.empty() ? o.scan_order : (o.progressive > 0 ? "coarse-to-fine" : "linear");
+    c.order = order == "coarse-to-fine" ? cpu::scan_order::coarse_to_fine : cpu::scan_order::linear;
+    if (o.progressive > 0) c.max_new_records = o.progressive;
+    c.fill_holes = c.interpolation == cpu::cache_interpolation::splat ? o.fill_holes : 0.f;
+    c.neighbour_clamp = o.neighbour_clamp;
+    return c;
 }
 
 #ifdef BOUNCE_IC_WITH_GL
-// Everything the GL backend keeps across frames: context, mesh, passes, and how many
-// records the GPU copy of the cache holds.
-struct gl_backend {
-    gl::context gl_context;
+// What the GL frames keep: the context, the scene on the GPU, the renderer's own passes
+// (G-buffer, direct light) and the library's splatter; the raster record sampler.
+struct gl_frames {
+    gl::context context;
     gl::scene_mesh mesh;
     gl::gbuffer_pass gbuffer;
     gl::direct_light light;
-    gl::splat_pass splats;
-    gl::compose_pass compose;
-    std::size_t on_gpu = 0;
-    gl::splat_pass wide_splats;  // progressive hole filling: the same records, wider a
-    std::size_t wide_on_gpu = 0;
-
-    std::optional<gl::hemisphere_raster> raster;  // the record sampler, for --sampler raster
-
-    gl_backend(const io::scene& s, int shadow_resolution) : mesh(s), light(s, mesh, shadow_resolution) {}
+    gl::irradiance_splatter splatter;
+    std::optional<gl::hemisphere_raster> raster;
+    gl_frames(const io::scene& s, int shadow_resolution) : mesh(s), light(s, mesh, shadow_resolution) {}
 };
-
-// Where a GL frame's records are measured. The Embree sampler starts its rays at its own
-// hit of the pixel's camera ray, where that is the surface the raster saw: the rasterized
-// point is only within about 1e-6 of the triangle, and at a contact line (a gallery's
-// underside meeting a wall) that is enough to put the ray origin inside the touching solid,
-// whose record then sees a closed hemisphere. Elsewhere (silhouettes, where the two see
-// different surfaces), and for the raster sampler, the raster's own point is kept.
-gbuffer<float> record_points_for(const context& ctx, const camera& cam, const gbuffer<float>& g) {
-    gbuffer<float> out = g;
-    if (ctx.opt.sampler != "embree") return out;
-    const gbuffer<float> ray = embree::ray_cast_gbuffer(ctx.bvh, ctx.scene, cam, g.width(), g.height());
-    const float scene_size = glm::length(ctx.scene.bounds().second - ctx.scene.bounds().first);
-    for (std::size_t y = 0; y < g.height(); ++y)
-        for (std::size_t x = 0; x < g.width(); ++x)
-            if (same_surface(g, ray, x, y, scene_size)) {
-                out.position(x, y) = ray.position(x, y);
-                out.normal(x, y) = ray.normal(x, y);
-                out.depth(x, y) = ray.depth(x, y);
-            }
-    return out;
-}
-
-// Algorithm 5 as the seed runs it: G-buffer, direct light and splatting on the GPU, the
-// cache-miss scan on the CPU over the read-back splat buffer.
-frame_result render_frame_gl(const context& ctx, gl_backend& gb, const camera& cam, float a,
-                             std::vector<irradiance_record>& records, io::stage_timer& timer, std::size_t max_new) {
-    const options& o = ctx.opt;
-    const cpu::splat_params sp = splat_params_for(o, a);
-    const weighting_kind kind = parse_weight(o.weight);
-    const bool fill_holes = max_new != std::size_t(-1) && o.fill_holes > 0.f;
-    frame_result fr;
-    {  // step 1
-        auto t = timer.measure("gbuffer");
-        gb.gbuffer.render(gb.mesh, cam, o.width, o.height);
-        gl::finish();
-    }
-    const gl::gbuffer_textures tex = gl::textures_of(gb.gbuffer);
-    {
-        auto t = timer.measure("direct");
-        gb.light.render(tex);
-        gl::finish();
-    }
-    image<glm::vec4> splat(o.width, o.height);
-    {  // step 2: the records the GPU already holds
-        auto t = timer.measure("splat_existing");
-        if (gb.on_gpu < records.size()) gb.splats.append(std::span(records).subspan(gb.on_gpu));
-        gb.on_gpu = records.size();
-        gb.splats.clear(o.width, o.height);
-        gb.splats.splat(tex, cam, sp, kind);
-        gl::finish();
-    }
-    {  // step 3
-        auto t = timer.measure("readback");
-        fr.g = gb.gbuffer.read();
-        gb.splats.read_splat(splat.view());
-    }
-    const std::size_t before = records.size();
-    {  // step 4
-        double record_ms = 0;
-        const auto t0 = clock_type::now();
-        const float min_weight = o.min_weight > 0.f ? o.min_weight : a;
-        const auto t_points = clock_type::now();
-        const gbuffer<float> record_g = record_points_for(ctx, cam, fr.g);
-        record_ms += ms_since(t_points);
-        with_weighting(kind, [&](auto w) {
-            scan_splat_buffer<decltype(w)>(ctx, cam, fr.g, record_g, sp, min_weight, records, splat.view(), max_new, fr,
-                                           record_ms);
-        });
-        timer.add_sample("scan", ms_since(t0) - record_ms);
-        timer.add_sample("compute_records", record_ms);
-    }
-    {  // step 5: upload the new records and splat them on top of step 2's buffer
-        auto t = timer.measure("interpolate");
-        gb.splats.append(std::span(records).subspan(before));
-        gb.on_gpu = records.size();
-        gb.splats.splat(tex, cam, sp, kind, before);
-        if (fill_holes) {
-            // A budget left pixels uncovered: every record again with zones fill x wider.
-            if (gb.wide_on_gpu < records.size()) gb.wide_splats.append(std::span(records).subspan(gb.wide_on_gpu));
-            gb.wide_on_gpu = records.size();
-            gb.wide_splats.clear(o.width, o.height);
-            gl::splat_params wide_sp = sp;
-            wide_sp.a *= o.fill_holes;
-            gb.wide_splats.splat(tex, cam, wide_sp, kind);
-        }
-        gl::finish();
-    }
-    {
-        auto t = timer.measure("normalize");
-        fr.indirect = image<glm::vec3>(o.width, o.height);
-        fr.combined = image<glm::vec3>(o.width, o.height);
-        const gl::texture* wide = fill_holes ? &gb.wide_splats.splat_texture() : nullptr;
-        gb.compose.compose(gb.splats.splat_texture(), nullptr, wide, 1e-3f);
-        gb.compose.read(fr.indirect.view());
-        gb.compose.compose(gb.splats.splat_texture(), &gb.light.radiance(), wide, 1e-3f);
-        gb.compose.read(fr.combined->view());
-    }
-    return fr;
-}
 #endif
 
 image<float> coverage_mask(const gbuffer<float>& g) {
@@ -444,11 +171,12 @@ image<float> coverage_mask(const gbuffer<float>& g) {
 // surface as the ray-cast G-buffer the reference was computed on: elsewhere (a few
 // silhouette pixels) the two images show different surfaces and their difference is
 // not the cache's error.
-image<float> comparable_mask(const gbuffer<float>& g, const gbuffer<float>& ref_g, float scene_size) {
+image<float> comparable_mask(gbuffer<float> g, gbuffer<float> ref_g, float scene_size) {
     image<float> m = coverage_mask(g);
+    const gbuffer_view<float> gv = g.view(), rv = ref_g.view();
     for (std::size_t y = 0; y < g.height(); ++y)
         for (std::size_t x = 0; x < g.width(); ++x)
-            if (m(x, y) > 0.f && !same_surface(g, ref_g, x, y, scene_size)) m(x, y) = 0.f;
+            if (m(x, y) > 0.f && !same_surface(gv, rv, x, y, scene_size)) m(x, y) = 0.f;
     return m;
 }
 
@@ -480,7 +208,7 @@ struct camera_path {
     }
 };
 
-nlohmann::ordered_json error_json(const io::error_figures& e) {
+nlohmann::ordered_json error_json(const study::error_figures& e) {
     return {{"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}, {"sum_sq", e.sum_sq}, {"pixels", e.pixels}};
 }
 
@@ -491,12 +219,13 @@ embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64
     return s;
 }
 
-int run(const options& o) {
+template <class W>
+int run_with(const options& o) {
     if (o.falloff_kappa != 1.f && o.sampler != "raster")
         throw parameter_error("--falloff-kappa", "applies to --sampler raster only");
     if ((o.plane_turn != 0.0 || o.hashed_turn) && o.sampler != "raster")
         throw parameter_error("--plane-turn/--hashed-turn", "apply to --sampler raster only");
-    io::stage_timer setup;
+    study::stage_timer setup;
     const io::scene scene = io::load_scene_arg(o.scene);
     std::optional<embree::accel> bvh_storage;
     setup.time("bvh", [&] { bvh_storage.emplace(scene); });
@@ -506,23 +235,20 @@ int run(const options& o) {
     limits.min_pixels = o.min_pixels;
     limits.max_pixels = o.max_pixels;
     limits.gradient_limit = o.gradient_limit;
-    embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
-    context ctx{o, scene, bvh, integrator, std::ref(embree_sampler)};
-    ctx.batch.max_records = o.scan_batch;
-    const std::string scan_order = !o.scan_order.empty() ? o.scan_order : (o.progressive > 0 ? "coarse-to-fine" : "linear");
-    if (scan_order == "coarse-to-fine") ctx.order = cpu::coarse_to_fine_order(o.width, o.height);
-    cpu::neighbour_index clamp_index(scene.bounds().first, scene.bounds().second);
-    if (o.neighbour_clamp) ctx.clamp = &clamp_index;
-    std::vector<irradiance_record> records;
+    const embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
+    chosen_sampler sampler{std::cref(embree_sampler)};
+    cpu::irradiance_cache_options cache_options = cache_options_for(o, o.a);
+    const auto [lo, hi] = scene.bounds();
+    cpu::irradiance_cache<W> cache(lo, hi, cache_options);
 
 #ifdef BOUNCE_IC_WITH_GL
-    std::optional<gl_backend> gl_state;
+    std::optional<gl_frames> gl_state;
     if (o.interp == "splat-gl" || o.sampler == "raster")
         setup.time("gl_setup", [&] { gl_state.emplace(scene, o.shadow_resolution); });
     std::optional<gl::raster_record_sampler> raster_sampler;
     if (o.sampler == "raster") {
-        // Records from 64 x 64 planes of 126 degrees with border stretching (seed 8.4), or
-        // fall-off stretching with a fixed kappa (docs/hemisphere-sampling.md).
+        // Records from 64 x 64 planes of 126 degrees with border stretching (Gautron 2008,
+        // section 8.4), or fall-off stretching with a fixed kappa (docs/hemisphere-sampling.md).
         // One atlas per batch of the scan's guesses (16 planes unless --scan-batch says).
         const std::size_t planes = o.scan_batch > 0 ? o.scan_batch : 16;
         gl_state->raster.emplace(scene, gl_state->mesh, gl_state->light,
@@ -530,33 +256,91 @@ int run(const options& o) {
         raster_sampler.emplace(*gl_state->raster, limits,
                                o.falloff_kappa < 1.f ? plane_weighting::falloff : plane_weighting::stretch,
                                double(o.falloff_kappa));
-        ctx.sampler = [&](glm::vec3 p, glm::vec3 n, double fp) { return (*raster_sampler)(p, n, fp); };
-        ctx.batch_sampler = [&](std::span<const glm::vec3> p, std::span<const glm::vec3> n, std::span<const double> fp,
-                                std::span<std::optional<irradiance_record>> out) { (*raster_sampler)(p, n, fp, out); };
-        ctx.batch.max_records = planes;
+        sampler.measure = std::ref(*raster_sampler);
+        cache_options.batch.max_records = planes;
+        cache.set_options(cache_options);
     }
-    const bool gl_frames = o.interp == "splat-gl";
+    const bool gl_frames_on = o.interp == "splat-gl";
 #else
     if (o.sampler != "embree")
         throw parameter_error("--sampler", "'raster' needs the GL adapter, which this build does not have");
     if (o.interp == "splat-gl")
         throw parameter_error("--interp", "'splat-gl' needs the GL adapter, which this build does not have");
 #endif
-    // One frame for `cam` with the chosen backend; the G-buffer is part of its timing.
-    auto frame = [&](const camera& cam, float a, io::stage_timer& t, std::size_t max_new) -> frame_result {
+    // One frame for `cam` at accuracy `a` with the chosen backend; the G-buffer is part of
+    // its timing.
+    auto frame = [&](const camera& cam, float a, study::stage_timer& t) -> frame_result {
+        cache_options.splat.a = a;
+        cache.set_options(cache_options);
+        frame_result fr;
+        cpu::cache_frame_stats cs;
 #ifdef BOUNCE_IC_WITH_GL
-        if (gl_frames) return render_frame_gl(ctx, *gl_state, cam, a, records, t, max_new);
+        if (gl_frames_on) {
+            gl_frames& gs = *gl_state;
+            gl::irradiance_splatter_options so;
+            so.splat = cache_options.splat;
+            so.weighting = parse_weight(o.weight);
+            so.fill_holes = cache_options.fills_holes() ? cache_options.fill_holes : 0.f;
+            so.time_stages = true;
+            gs.splatter.set_options(so);
+            t.time("gbuffer", [&] {
+                gs.gbuffer.render(gs.mesh, cam, o.width, o.height);
+                gl::finish();
+            });
+            const gl::gbuffer_textures tex = gl::textures_of(gs.gbuffer);
+            t.time("direct", [&] {
+                gs.light.render(tex);
+                gl::finish();
+            });
+            double snap_ms = 0;
+            const auto st = gs.splatter.render(tex, cam, cache.records(), [&](gbuffer_view<float> g, image_view<glm::vec4> splat) {
+                if (o.sampler != "embree") {
+                    cs = cache.scan(g, cam, sampler, splat);
+                    return;
+                }
+                // The Embree sampler starts its rays at its own hits of the pixels.
+                const auto t0 = clock_type::now();
+                gbuffer<float> points = gs.splatter.scanned_gbuffer();
+                embree::snap_to_ray_hits(bvh, scene, cam, points.view());
+                snap_ms = ms_since(t0);
+                const gbuffer_view<float> where = points.view();
+                cs = cache.scan(g, cam, sampler, splat, &where);
+            });
+            t.add_sample("splat_existing", st.splat_existing_ms);
+            t.add_sample("readback", st.readback_ms);
+            t.add_sample("scan", cs.scan_ms);
+            t.add_sample("compute_records", cs.records_ms + snap_ms);
+            t.add_sample("interpolate", st.interpolate_ms);
+            t.time("normalize", [&] {
+                fr.indirect = image<glm::vec3>(o.width, o.height);
+                fr.combined = image<glm::vec3>(o.width, o.height);
+                gs.splatter.read_indirect(fr.indirect.view());
+                gl::read_texture(gs.splatter.compose(gs.light.radiance()), fr.combined->view());
+            });
+            fr.g = gs.splatter.scanned_gbuffer();
+        }
 #endif
-        gbuffer<float> g;
-        t.time("gbuffer", [&] { g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
-        return render_frame(ctx, cam, std::move(g), a, records, t, max_new);
+        if (!fr.g.width()) {
+            t.time("gbuffer", [&] { fr.g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height); });
+            fr.indirect = image<glm::vec3>(o.width, o.height);
+            cs = cache.render(fr.g.view(), cam, sampler, fr.indirect.view());
+            t.add_sample("splat_existing", cs.splat_existing_ms);
+            t.add_sample("scan", cs.scan_ms);
+            t.add_sample("compute_records", cs.records_ms);
+            t.add_sample("interpolate", cs.interpolate_ms);
+            t.add_sample("normalize", cs.normalize_ms);
+        }
+        fr.new_records = cs.new_records;
+        fr.measured = cs.measured;
+        fr.wasted = cs.wasted;
+        return fr;
     };
 
     const nlohmann::json cache_params = cache_parameters(o, scene);
-    if (!o.cache_in.empty()) records = io::load_records(o.cache_in, cache_params);
-    const std::size_t loaded = records.size();
+    if (!o.cache_in.empty()) cache.assign(study::load_records(o.cache_in, cache_params));
+    const std::size_t loaded = cache.records().size();
 
-    io::run_report report;
+    study::run_report report;
     report.technique = "ic_splatting";
     report.scene = scene.name;
     report.width = o.width;
@@ -572,7 +356,8 @@ int run(const options& o) {
                          {"front_tolerance", o.front_tolerance},
                          {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
                          {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
-                         {"scan", o.scan}, {"scan_batch", ctx.batch.max_records}, {"scan_order", scan_order},
+                         {"scan", o.scan}, {"scan_batch", cache_options.batch.max_records},
+                         {"scan_order", cache_options.order == cpu::scan_order::linear ? "linear" : "coarse-to-fine"},
                          {"embree_config", bvh.owner().config()}};
 
     auto reference_for = [&](const camera& cam) {
@@ -591,7 +376,7 @@ int run(const options& o) {
     };
 
     nlohmann::ordered_json extra = nlohmann::ordered_json::object();
-    io::stage_timer timer;
+    study::stage_timer timer;
 
     if (o.progressive > 0) {
         // Progressive mode: records are view-independent, so each frame of the camera path
@@ -600,22 +385,22 @@ int run(const options& o) {
         const camera_path path(bvh, scene.camera, o.frames);
         for (std::size_t f = 0; f < o.frames; ++f) {
             const camera cam = path.at(f);
-            io::stage_timer ft;
+            study::stage_timer ft;
             const auto t0 = clock_type::now();
-            const auto fr = frame(cam, o.a, ft, o.progressive);
+            const auto fr = frame(cam, o.a, ft);
             const double frame_ms = ms_since(t0);
             const auto ref = reference_for(cam);
-            const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask_for(fr.g, cam).view());
+            const auto err = study::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask_for(fr.g, cam).view());
             fmt::print("frame {:2}: {:5} records (+{:3}), {:8.1f} ms ({:5.2f} fps), indirect rel_rms {:.4f}\n", f,
-                       records.size(), fr.new_records, frame_ms, 1000.0 / frame_ms, err.rel_rms);
-            frames.push_back({{"frame", f}, {"records", records.size()}, {"new_records", fr.new_records},
+                       cache.records().size(), fr.new_records, frame_ms, 1000.0 / frame_ms, err.rel_rms);
+            frames.push_back({{"frame", f}, {"records", cache.records().size()}, {"new_records", fr.new_records},
                               {"ms", frame_ms}, {"fps", 1000.0 / frame_ms}, {"rel_rms", err.rel_rms}});
             for (const auto& s : ft.stages()) timer.add_sample(s, ft.median_ms(s));
             timer.add_sample("total", frame_ms);
         }
         extra["frames"] = frames;
         report.set_timings(timer);
-        report.set_count("records", records.size());
+        report.set_count("records", cache.records().size());
     } else {
         const camera& cam = scene.camera;
         const auto ref = reference_for(cam);
@@ -624,29 +409,26 @@ int run(const options& o) {
         nlohmann::ordered_json sweep = nlohmann::ordered_json::array();
         image<float> mask;
         for (float a : as) {
-            io::stage_timer at;
+            study::stage_timer at;
             // Each repeat starts from the same cache: what was loaded, or what earlier
             // sweep entries built (records are valid for every a).
-            const std::vector<irradiance_record> start = records;
+            const std::vector<irradiance_record> start = cache.records();
             for (int r = 0; r < o.repeat; ++r) {
-                records = start;
+                cache.assign(start);
 #ifdef BOUNCE_IC_WITH_GL
-                if (gl_frames) {  // the GPU copy restarts from the same cache
-                    gl_state->splats.upload(records);
-                    gl_state->on_gpu = records.size();
-                }
+                if (gl_state) gl_state->splatter.reset();  // the GPU copy restarts from the same cache
 #endif
                 const auto t0 = clock_type::now();
-                fr = frame(cam, a, at, std::size_t(-1));
+                fr = frame(cam, a, at);
                 at.add_sample("total", ms_since(t0));
             }
             mask = mask_for(fr.g, cam);
-            const auto err = io::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
+            const auto err = study::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
             fmt::print("a = {:.3f}: {:6} records (+{:5}), total {:9.1f} ms (interpolate {:8.2f}, records {:9.1f}), "
                        "indirect rel_rms {:.4f}\n",
-                       a, records.size(), fr.new_records, at.median_ms("total"), at.median_ms("interpolate"),
+                       a, cache.records().size(), fr.new_records, at.median_ms("total"), at.median_ms("interpolate"),
                        at.median_ms("compute_records"), err.rel_rms);
-            nlohmann::ordered_json entry = {{"a", a}, {"records", records.size()}, {"new_records", fr.new_records},
+            nlohmann::ordered_json entry = {{"a", a}, {"records", cache.records().size()}, {"new_records", fr.new_records},
                                             {"timings_ms", nlohmann::ordered_json::object()}, {"error", error_json(err)}};
             for (const auto& s : at.stages()) entry["timings_ms"][s] = at.median_ms(s);
             sweep.push_back(entry);
@@ -655,7 +437,7 @@ int run(const options& o) {
         }
         if (!o.a_sweep.empty()) extra["a_sweep"] = sweep;
         report.set_timings(timer);
-        report.set_count("records", records.size());
+        report.set_count("records", cache.records().size());
         if (fr.measured > 0) {
             // The batched scan's guesses: measured, and dropped because covered by then.
             report.set_count("records_measured", fr.measured);
@@ -672,7 +454,7 @@ int run(const options& o) {
                 const auto t0 = clock_type::now();
                 const auto ind = mci.indirect_image(fr.g.view());
                 const double ms = ms_since(t0);
-                const auto err = io::compare_luminance(ind.view(), ref.indirect.view(), mask.view());
+                const auto err = study::compare_luminance(ind.view(), ref.indirect.view(), mask.view());
                 fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f}\n", spp, ms, err.rel_rms);
                 mc.push_back({{"spp", spp}, {"ms", ms}, {"rel_rms", err.rel_rms}});
                 if (err.rel_rms <= target) {
@@ -731,9 +513,9 @@ int run(const options& o) {
         }
     }
 
-    if (!o.cache_out.empty()) io::save_records(o.cache_out, records, cache_params);
+    if (!o.cache_out.empty()) study::save_records(o.cache_out, cache.records(), cache_params);
     if (loaded) report.set_count("records_loaded", loaded);
-    fmt::print("{} records; total {:.1f} ms", records.size(), timer.median_ms("total"));
+    fmt::print("{} records; total {:.1f} ms", cache.records().size(), timer.median_ms("total"));
     if (report.error) fmt::print("; indirect rel_rms {:.4f}", report.error->rel_rms);
     fmt::print("\n");
     if (!o.json.empty()) {
@@ -743,6 +525,11 @@ int run(const options& o) {
         std::ofstream(o.json) << j.dump(2) << '\n';
     }
     return 0;
+}
+
+
+int run(const options& o) {
+    return with_weighting(parse_weight(o.weight), [&](auto w) { return run_with<decltype(w)>(o); });
 }
 
 }  // namespace

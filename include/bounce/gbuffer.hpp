@@ -4,8 +4,10 @@
 
 #include <bounce/image.hpp>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include <cmath>
 #include <limits>
 
 namespace bounce {
@@ -25,6 +27,17 @@ struct gbuffer_view {
         return depth(x, y) < std::numeric_limits<T>::infinity();
     }
 };
+
+/// Whether two G-buffers of one size see the same surface at (x, y): both covered, their
+/// points within 1e-4 `scale` (the scene's size) of each other and their normals within
+/// 2.6 degrees (dot >= 0.999). A raster and a ray-cast G-buffer differ at silhouettes, where
+/// they see different surfaces and their images are not comparable.
+template <class T>
+bool same_surface(const gbuffer_view<T>& a, const gbuffer_view<T>& b, std::size_t x, std::size_t y, T scale) {
+    return std::isfinite(a.depth(x, y)) && std::isfinite(b.depth(x, y)) &&
+           glm::length(a.position(x, y) - b.position(x, y)) <= T(1e-4) * scale &&
+           glm::dot(a.normal(x, y), b.normal(x, y)) >= T(0.999);
+}
 
 /// Owning storage behind a `gbuffer_view`.
 template <class T = float>

@@ -61,4 +61,18 @@ gbuffer<float> ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const
     return g;
 }
 
+void snap_to_ray_hits(const accel& bvh, const scene_view& scene, const bounce::camera& cam, gbuffer_view<float> g) {
+    gbuffer<float> ray = ray_cast_gbuffer(bvh, scene, cam, g.width(), g.height());
+    const auto [lo, hi] = scene.bounds();
+    const float scene_size = glm::length(hi - lo);
+    const gbuffer_view<float> rv = ray.view();
+    for (std::size_t y = 0; y < g.height(); ++y)
+        for (std::size_t x = 0; x < g.width(); ++x)
+            if (same_surface(g, rv, x, y, scene_size)) {
+                g.position(x, y) = rv.position(x, y);
+                g.normal(x, y) = rv.normal(x, y);
+                g.depth(x, y) = rv.depth(x, y);
+            }
+}
+
 }  // namespace bounce::embree

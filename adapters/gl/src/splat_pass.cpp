@@ -154,6 +154,24 @@ gbuffer_textures gbuffer_upload::textures() const {
     return {&*position_depth_, &*normal_, &*albedo_};
 }
 
+void read_gbuffer(const gbuffer_textures& g, gbuffer_view<float> out) {
+    g.validate();
+    const std::size_t w = g.width(), h = g.height();
+    const auto sized = [&](std::size_t ow, std::size_t oh) { return ow == w && oh == h; };
+    require(sized(out.position.width(), out.position.height()) && sized(out.normal.width(), out.normal.height()) &&
+                sized(out.albedo.width(), out.albedo.height()) && sized(out.depth.width(), out.depth.height()),
+            "out", "G-buffer views differ in size from the textures");
+    image<glm::vec4> position_depth(w, h);
+    read_texture(*g.position_depth, position_depth.view());
+    read_texture(*g.normal, out.normal);
+    read_texture(*g.albedo, out.albedo);
+    for (std::size_t y = 0; y < h; ++y)
+        for (std::size_t x = 0; x < w; ++x) {
+            out.position(x, y) = glm::vec3(position_depth(x, y));
+            out.depth(x, y) = position_depth(x, y).w;
+        }
+}
+
 void write_texture(const texture& t, image_view<const glm::vec4> image) {
     require_rgba32f(t, "t");
     require(image.width() == t.width() && image.height() == t.height(), "image", "size differs from the texture");
@@ -189,7 +207,7 @@ std::string splat_pass::vertex_source(weighting_kind weighting) {
     });
     kernels.add("sphere_ndc_bounds", sphere_ndc_bounds<glsl::f32, glsl::vec3>, "c", "r", "near_depth", "tan_half_fov_y",
                 "aspect", "box");
-    // The record's centre and radius arrive as per-instance attributes (the seed's vertex
+    // The record's centre and radius arrive as per-instance attributes (Gautron 2008's vertex
     // attributes; storage buffers in vertex shaders are optional in OpenGL 4.5), read from
     // the same buffer the fragment stage indexes.
     return std::string("#version 450 core\n") + R"(layout(location = 0) in vec4 record_position_inv_r;

@@ -26,4 +26,12 @@ void ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const bounce::c
 gbuffer<float> ray_cast_gbuffer(const accel& bvh, const scene_view& scene, const bounce::camera& cam,
                                 std::size_t width, std::size_t height);
 
+/// Replaces each pixel's position, normal and depth of `g` (a raster G-buffer, say) by the
+/// ray cast's through the same pixel centre where both see the same surface (same_surface
+/// with the scene's size). Record samplers that start rays at a pixel's point need this: a
+/// rasterized point is only within ~1e-6 of its triangle, and at a contact line (a ledge
+/// meeting a wall) that puts the origin inside the touching solid, whose record then sees a
+/// closed hemisphere. Silhouette pixels, where the two see different surfaces, keep g's.
+void snap_to_ray_hits(const accel& bvh, const scene_view& scene, const bounce::camera& cam, gbuffer_view<float> g);
+
 }  // namespace bounce::embree

@@ -4,19 +4,23 @@
 /// shaded with direct light and shadow rays (the reference integrator's radiance), then
 /// irradiance, gradients and radius from bounce/irradiance_gradients.hpp.
 ///
-/// Record samplers share one interface, so the renderer can swap them:
-///   std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint)
-/// (the GL single-plane rasterizer is the other one).
+/// It models bounce::record_sampler (record_sampler.hpp), as the GL single-plane rasterizer
+/// does, so a cache takes either; one record alone is
+///   std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint).
 
 #include <bounce/embree/reference.hpp>
 #include <bounce/irradiance_gradients.hpp>
 #include <bounce/irradiance_record.hpp>
+#include <bounce/record_sampler.hpp>
 #include <bounce/sampling.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <span>
+
+#include <tbb/parallel_for.h>
 
 namespace bounce::embree {
 
@@ -58,6 +62,17 @@ public:
         return rec;
     }
 
+    /// Records for points[k], normals[k], footprints[k] into out[k], the points on every
+    /// core (each record is a pure function of its point, so the order does not matter).
+    /// Throws parameter_error when the spans' sizes differ.
+    void operator()(std::span<const glm::vec3> points, std::span<const glm::vec3> normals,
+                    std::span<const double> footprints, std::span<std::optional<irradiance_record>> out) const {
+        require(normals.size() == points.size() && footprints.size() == points.size() && out.size() == points.size(),
+                "points", "points, normals, footprints and out must have one entry per record");
+        tbb::parallel_for(std::size_t(0), points.size(),
+                          [&](std::size_t k) { out[k] = (*this)(points[k], normals[k], footprints[k]); });
+    }
+
 private:
     const reference_integrator& integrator_;
     hemisphere_grid grid_;
@@ -70,5 +85,7 @@ private:
         return hash_floats({p.x, p.y, p.z, n.x, n.y, n.z});
     }
 };
+
+static_assert(bounce::record_sampler<const embree::record_sampler>);
 
 }  // namespace bounce::embree

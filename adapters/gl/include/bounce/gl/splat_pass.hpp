@@ -1,6 +1,6 @@
 #pragma once
 /// \file splat_pass.hpp
-/// Irradiance splatting on OpenGL (seed 000, section 8.1, Algorithms 1-4), and the
+/// Irradiance splatting on OpenGL (Gautron 2008, section 8.1, Algorithms 1-4), and the
 /// normalization and composition of Algorithm 5.
 ///
 /// One quad per record, instanced from a buffer of records (per-instance attributes for the
@@ -57,6 +57,11 @@ struct gbuffer_textures {
 
 /// The textures of `pass`'s last rendering. Throws parameter_error before any render.
 gbuffer_textures textures_of(const gbuffer_pass& pass);
+
+/// Reads the G-buffer textures `g` into `out` (row 0 at the top; every view of g's size):
+/// the CPU's view of a G-buffer a renderer drew. Throws parameter_error on bad textures or
+/// sizes.
+void read_gbuffer(const gbuffer_textures& g, gbuffer_view<float> out);
 
 /// A CPU G-buffer (e.g. a ray-cast one, or an analytic one in tests) uploaded as textures
 /// of gbuffer_pass's layout, rows flipped, so GL passes can read it.

@@ -1,0 +1,316 @@
+#pragma once
+/// \file irradiance_cache.hpp
+/// `cpu::irradiance_cache<Weight>`: irradiance caching by splatting as a library type
+/// (Gautron, "Hardware Implementation", SIGGRAPH 2008 course on irradiance caching, ch. 8,
+/// Algorithm 5), or the classical octree cache (Ward et al. 1988) behind the same interface.
+/// It owns the records, the scan policy (batched or sequential, scan order, a per-frame
+/// budget, hole filling) and neighbour clamping; a renderer calls `render` once per frame
+/// with its own G-buffer view, camera and record sampler.
+///
+/// A frame (`render`, the CPU backend):
+///   1. splat the records the cache holds into a splat buffer (octree: insert them);
+///   2. scan for cache misses, measuring a record at each with the sampler and splatting it
+///      at once (cpu::scan_cache_misses[_batched]);
+///   3. splat every record again into a clean buffer (the seed's step 5) and normalize.
+/// The GL backend (gl::irradiance_splatter) does steps 1 and 3 on the GPU and asks the cache
+/// for step 2 alone (`scan`) on the splat buffer it read back, so both backends share one
+/// scan and one record list.
+
+#include <bounce/camera.hpp>
+#include <bounce/cpu/batched_scan.hpp>
+#include <bounce/cpu/neighbour_index.hpp>
+#include <bounce/cpu/octree_cache.hpp>
+#include <bounce/cpu/splatting.hpp>
+#include <bounce/errors.hpp>
+#include <bounce/gbuffer.hpp>
+#include <bounce/image.hpp>
+#include <bounce/irradiance_record.hpp>
+#include <bounce/record_sampler.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+namespace bounce::cpu {
+
+/// How a cache interpolates its records into an image.
+enum class cache_interpolation {
+    splat,         ///< splatting (Algorithm 5): each record adds to the pixels of its zone
+    octree,        ///< classical: per pixel, the records an octree lookup finds, one at a time
+    octree_lanes,  ///< classical, the records evaluated four at a time (the splat's kernel)
+};
+
+/// How the cache-miss scan measures records.
+enum class scan_kind {
+    batched,     ///< guesses later misses and measures them together; same records as sequential
+    sequential,  ///< one record at a time, as the seed's Algorithm 5 reads
+};
+
+/// The order in which the scan visits pixels.
+enum class scan_order {
+    linear,          ///< row by row (the seed's order)
+    coarse_to_fine,  ///< a coarse grid first, then finer ones (coarse_to_fine_order): a budget spreads over the image
+};
+
+/// Everything a cache's frames depend on besides the G-buffer, camera and sampler.
+struct irradiance_cache_options {
+    splat_params splat{};  ///< a (accuracy, typical 0.1-0.4), gradients, extrapolation clamp, in-front test
+    /// Cache-miss threshold on a pixel's weight sum; 0: a itself (the seed's Eq. 8.8).
+    float min_weight = 0.f;
+    cache_interpolation interpolation = cache_interpolation::splat;
+    scan_kind scan = scan_kind::batched;
+    scan_batch batch{};  ///< records measured together by the batched scan (0: one per thread)
+    scan_order order = scan_order::linear;
+    /// New records per frame at most (progressive rendering); the default has no limit.
+    std::size_t max_new_records = std::numeric_limits<std::size_t>::max();
+    /// With a budget: pixels no record reaches are filled from a second splat whose zones
+    /// are this many times wider (hole_filled_splat); 0 leaves them black. Typical 4.
+    float fill_holes = 4.f;
+    /// Clamp each new record's radius to its neighbours': R_i <= R_j + |p_i - p_j|
+    /// (Krivanek et al. 2006's neighbour clamping).
+    bool neighbour_clamp = false;
+
+    /// The weight-sum threshold the scan uses.
+    float miss_threshold() const noexcept { return min_weight > 0.f ? min_weight : splat.a; }
+    /// Whether a frame fills holes (a budget and fill_holes > 0).
+    bool fills_holes() const noexcept {
+        return max_new_records != std::numeric_limits<std::size_t>::max() && fill_holes > 0.f;
+    }
+    /// Throws parameter_error naming the first bad field.
+    void validate() const {
+        splat.validate();
+        require(std::isfinite(min_weight) && min_weight >= 0.f, "min_weight", "must be a non-negative number (0: a)");
+        require(std::isfinite(fill_holes) && fill_holes >= 0.f, "fill_holes", "must be a non-negative number (0: off)");
+        require(max_new_records > 0, "max_new_records", "must be positive");
+        require(interpolation == cache_interpolation::splat || !fills_holes(), "fill_holes",
+                "applies to splatting only (set 0 for the octree)");
+    }
+};
+
+/// What one frame (or one scan) did, and how long each stage took (milliseconds, wall time).
+struct cache_frame_stats {
+    std::size_t new_records = 0;  ///< records the scan added
+    std::size_t measured = 0;     ///< records the batched scan measured (new + wasted + refused)
+    std::size_t wasted = 0;       ///< guesses dropped because covered by the time the scan got there
+    double splat_existing_ms = 0; ///< step 1: the records held before the frame (octree: inserting them)
+    double scan_ms = 0;           ///< step 2 without record computation
+    double records_ms = 0;        ///< step 2's record computation (the sampler)
+    double interpolate_ms = 0;    ///< step 3: the image from every record (octree: the lookups)
+    double normalize_ms = 0;      ///< sum / weight per pixel
+};
+
+template <class Weight>
+class irradiance_cache {
+public:
+    /// An empty cache for a scene inside [lo, hi] (its bounds: the octree and the neighbour
+    /// index are built over them; records outside still work, more slowly).
+    irradiance_cache(glm::vec3 lo, glm::vec3 hi, const irradiance_cache_options& options = {})
+        : lo_(lo), hi_(hi), options_(options), clamp_(lo, hi) {
+        options_.validate();
+    }
+
+    const irradiance_cache_options& options() const noexcept { return options_; }
+    /// New options for the next frames (records stay valid: they do not depend on them,
+    /// except through neighbour clamping, which applies to records added from then on).
+    void set_options(const irradiance_cache_options& options) {
+        options.validate();
+        options_ = options;
+    }
+
+    const std::vector<irradiance_record>& records() const noexcept { return records_; }
+    /// Replaces the records (a saved cache, or a restart from an earlier state).
+    void assign(std::vector<irradiance_record> records) {
+        records_ = std::move(records);
+        clamp_ = neighbour_index(lo_, hi_);
+    }
+
+    /// One frame: the indirect radiance rho/pi * E of every pixel of `g` seen by `cam` into
+    /// `indirect` (0 where no record reaches, or where g sees nothing), measuring the records
+    /// it misses with `sampler`. `record_points`, when given (same size as g), is where the
+    /// records of missed pixels are measured instead of g's own points (a sampler's more
+    /// exact hit of the same pixel). Throws parameter_error on mismatched sizes.
+    template <record_sampler Sampler>
+    cache_frame_stats render(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler,
+                             image_view<glm::vec3> indirect, const gbuffer_view<float>* record_points = nullptr) {
+        require(indirect.width() == g.width() && indirect.height() == g.height(), "indirect",
+                "size differs from the G-buffer");
+        cache_frame_stats stats;
+        image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
+        std::optional<image<glm::vec4>> wide;
+        const splat_params& sp = options_.splat;
+        if (options_.interpolation == cache_interpolation::splat) {
+            timed(stats.splat_existing_ms, [&] { splat_records<Weight>(g, cam, records_, sp, splat.view()); });
+            scan_into(g, cam, sampler, splat.view(), record_points, stats);
+            // Step 5: the image comes from splatting every record into a clean buffer.
+            timed(stats.interpolate_ms, [&] {
+                std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
+                splat_records<Weight>(g, cam, records_, sp, splat.view());
+                if (options_.fills_holes()) {
+                    splat_params wide_sp = sp;
+                    wide_sp.a = sp.a * options_.fill_holes;
+                    wide.emplace(g.width(), g.height(), glm::vec4(0.f));
+                    splat_records<Weight>(g, cam, records_, wide_sp, wide->view());
+                }
+            });
+        } else {
+            render_octree(g, cam, sampler, splat.view(), record_points, stats);
+        }
+        timed(stats.normalize_ms, [&] {
+            if (wide) normalize_splats(splat.view(), wide->view(), 1e-3f, indirect);
+            else normalize_splats(splat.view(), indirect);
+        });
+        return stats;
+    }
+
+    /// Step 2 alone, for a backend that splats elsewhere (gl::irradiance_splatter): scans
+    /// `splat`, which must hold every record of the cache splatted over `g`, adds a record at
+    /// each miss (and splats it into `splat`), and returns what it did (records_ms and
+    /// scan_ms set). Splatting only.
+    template <record_sampler Sampler>
+    cache_frame_stats scan(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler, image_view<glm::vec4> splat,
+                           const gbuffer_view<float>* record_points = nullptr) {
+        require(options_.interpolation == cache_interpolation::splat, "interpolation",
+                "a scan on a splat buffer needs splatting");
+        cache_frame_stats stats;
+        scan_into(g, cam, sampler, splat, record_points, stats);
+        return stats;
+    }
+
+private:
+    using clock = std::chrono::steady_clock;
+    template <class F>
+    static void timed(double& ms, F&& f) {
+        const auto t0 = clock::now();
+        f();
+        ms += std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+    }
+
+    std::span<const std::uint32_t> order_for(std::size_t width, std::size_t height) {
+        if (options_.order == scan_order::linear) return {};
+        if (order_size_ != std::pair{width, height}) {
+            order_ = coarse_to_fine_order(width, height);
+            order_size_ = {width, height};
+        }
+        return order_;
+    }
+
+    // Records for a batch of pixels: one call of the sampler on the points of `where`.
+    template <class Sampler>
+    auto batch_measurer(const gbuffer_view<float>& where, const camera& cam, Sampler& sampler) {
+        return [&where, &cam, &sampler](std::span<const pixel_xy> px, std::span<std::optional<irradiance_record>> out) {
+            std::vector<glm::vec3> p(px.size()), n(px.size());
+            std::vector<double> footprint(px.size());
+            for (std::size_t k = 0; k < px.size(); ++k) {
+                p[k] = where.position(px[k].x, px[k].y);
+                n[k] = where.normal(px[k].x, px[k].y);
+                footprint[k] = cam.pixel_footprint(where.depth(px[k].x, px[k].y), where.height());
+            }
+            sampler(std::span<const glm::vec3>(p), std::span<const glm::vec3>(n), std::span<const double>(footprint),
+                    out);
+        };
+    }
+
+    // What a new record owes to the records before it, in scan order: neighbour clamping.
+    auto committer() {
+        return [this](irradiance_record& rec) {
+            if (!options_.neighbour_clamp) return;
+            clamp_.sync(records_);
+            rec.radius = clamp_.clamped_radius(rec);
+        };
+    }
+
+    template <class Sampler>
+    void scan_into(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler, image_view<glm::vec4> splat,
+                   const gbuffer_view<float>* record_points, cache_frame_stats& stats) {
+        const gbuffer_view<float>& where = record_points ? *record_points : g;
+        require(where.width() == g.width() && where.height() == g.height(), "record_points",
+                "size differs from the G-buffer");
+        const auto t0 = clock::now();
+        const auto order = order_for(g.width(), g.height());
+        const float min_weight = options_.miss_threshold();
+        auto measure = batch_measurer(where, cam, sampler);
+        if (options_.scan == scan_kind::batched) {
+            const scan_stats s = scan_cache_misses_batched<Weight>(g, cam, options_.splat, min_weight, measure,
+                                                                   committer(), records_, splat, options_.batch, order,
+                                                                   options_.max_new_records);
+            stats.new_records += s.created;
+            stats.measured += s.measured;
+            stats.wasted += s.wasted;
+            stats.records_ms += s.measure_ms;
+            stats.scan_ms += ms_since(t0) - s.measure_ms;
+        } else {
+            double record_ms = 0;
+            auto commit = committer();
+            const auto create = [&](std::size_t x, std::size_t y) {
+                std::optional<irradiance_record> rec;
+                const pixel_xy px{x, y};
+                timed(record_ms, [&] { measure(std::span(&px, 1), std::span(&rec, 1)); });
+                if (rec) commit(*rec);
+                return rec;
+            };
+            stats.new_records += scan_cache_misses<Weight>(g, cam, options_.splat, min_weight, create, records_, splat,
+                                                           order, options_.max_new_records);
+            stats.records_ms += record_ms;
+            stats.scan_ms += ms_since(t0) - record_ms;
+        }
+    }
+
+    // The classical two passes: insert the records in an octree (built for this frame's a),
+    // fill it by the same scan driver (lookups as the miss test), then one lookup per pixel.
+    template <class Sampler>
+    void render_octree(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler, image_view<glm::vec4> out,
+                       const gbuffer_view<float>* record_points, cache_frame_stats& stats) {
+        const gbuffer_view<float>& where = record_points ? *record_points : g;
+        const splat_params& sp = options_.splat;
+        octree_cache<Weight> tree(lo_, hi_, sp);
+        timed(stats.splat_existing_ms, [&] {
+            for (const auto& r : records_) tree.insert(r);
+        });
+        const auto t0 = clock::now();
+        // A sequential scan is the batched driver with batches of one (it guesses nothing).
+        scan_batch batch = options_.batch;
+        if (options_.scan == scan_kind::sequential) batch.max_records = 1;
+        const float min_weight = options_.miss_threshold();
+        const glm::mat4 view = cam.view_matrix();
+        const scan_stats s = batched_scan(
+            g.width(), g.height(), order_for(g.width(), g.height()), options_.max_new_records, batch,
+            [&](std::size_t x, std::size_t y) {
+                return g.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
+            },
+            batch_measurer(where, cam, sampler), committer(), [&](const irradiance_record& rec) {
+                records_.push_back(rec);
+                tree.insert(rec);
+                const float zone = Weight::template influence_radius<float>(rec.radius, sp.a);
+                return guess_spacing(splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
+            });
+        stats.new_records += s.created;
+        stats.measured += s.measured;
+        stats.wasted += s.wasted;
+        stats.records_ms += s.measure_ms;
+        stats.scan_ms += ms_since(t0) - s.measure_ms;
+        timed(stats.interpolate_ms, [&] {
+            tree.render(g, out, options_.interpolation == cache_interpolation::octree_lanes ? octree_evaluation::lanes
+                                                                                           : octree_evaluation::scalar);
+        });
+    }
+
+    static double ms_since(clock::time_point t0) {
+        return std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+    }
+
+    glm::vec3 lo_, hi_;
+    irradiance_cache_options options_;
+    std::vector<irradiance_record> records_;
+    neighbour_index clamp_;
+    std::vector<std::uint32_t> order_;
+    std::pair<std::size_t, std::size_t> order_size_{0, 0};
+};
+
+}  // namespace bounce::cpu

@@ -1,0 +1,82 @@
+// The GPU stages of an irradiance-splatting frame around the caller's CPU scan.
+#include <bounce/gl/irradiance_splatter.hpp>
+#include <bounce/gl/objects.hpp>
+
+#include <cmath>
+#include <span>
+
+namespace bounce::gl {
+
+void irradiance_splatter_options::validate() const {
+    splat.validate();
+    require(std::isfinite(fill_holes) && fill_holes >= 0.f, "fill_holes", "must be a non-negative number (0: off)");
+}
+
+irradiance_splatter::irradiance_splatter(const irradiance_splatter_options& options) : options_(options) {
+    options_.validate();
+}
+
+void irradiance_splatter::set_options(const irradiance_splatter_options& options) {
+    options.validate();
+    options_ = options;
+}
+
+void irradiance_splatter::splat_existing(const gbuffer_textures& g, const camera& cam,
+                                         const std::vector<irradiance_record>& records, splatter_frame_stats& stats) {
+    g.validate();
+    const std::size_t w = g.width(), h = g.height();
+    require(on_gpu_ <= records.size(), "records", "fewer records than the GPU holds: call reset() after replacing them");
+    auto t0 = clock::now();
+    if (on_gpu_ == 0) splats_.upload(records);  // first frame, or after reset()
+    else if (on_gpu_ < records.size()) splats_.append(std::span(records).subspan(on_gpu_));
+    on_gpu_ = records.size();
+    splats_.clear(w, h);
+    splats_.splat(g, cam, options_.splat, options_.weighting);
+    if (options_.time_stages) finish();
+    stats.splat_existing_ms = ms_since(t0);
+
+    t0 = clock::now();
+    if (gbuffer_.width() != w || gbuffer_.height() != h) {
+        gbuffer_ = gbuffer<float>(w, h);
+        splat_ = image<glm::vec4>(w, h);
+    }
+    read_gbuffer(g, gbuffer_.view());
+    splats_.read_splat(splat_.view());
+    stats.readback_ms = ms_since(t0);
+}
+
+void irradiance_splatter::splat_new(const gbuffer_textures& g, const camera& cam,
+                                    const std::vector<irradiance_record>& records, std::size_t before,
+                                    splatter_frame_stats& stats) {
+    auto t0 = clock::now();
+    splats_.append(std::span(records).subspan(before));
+    on_gpu_ = records.size();
+    splats_.splat(g, cam, options_.splat, options_.weighting, before);
+    const bool fill = options_.fill_holes > 0.f;
+    if (fill) {
+        // Every record again with zones fill_holes x wider, for the pixels none reaches.
+        if (wide_on_gpu_ > records.size()) wide_on_gpu_ = 0;
+        if (wide_on_gpu_ == 0) wide_splats_.upload(records);
+        else if (wide_on_gpu_ < records.size()) wide_splats_.append(std::span(records).subspan(wide_on_gpu_));
+        wide_on_gpu_ = records.size();
+        wide_splats_.clear(g.width(), g.height());
+        splat_params wide = options_.splat;
+        wide.a *= options_.fill_holes;
+        wide_splats_.splat(g, cam, wide, options_.weighting);
+    }
+    if (options_.time_stages) finish();
+    stats.interpolate_ms = ms_since(t0);
+
+    t0 = clock::now();
+    compose_.compose(splats_.splat_texture(), nullptr, fill ? &wide_splats_.splat_texture() : nullptr, 1e-3f);
+    if (options_.time_stages) finish();
+    stats.normalize_ms = ms_since(t0);
+}
+
+const texture& irradiance_splatter::compose(const texture& direct) {
+    const bool fill = options_.fill_holes > 0.f;
+    compose_.compose(splats_.splat_texture(), &direct, fill ? &wide_splats_.splat_texture() : nullptr, 1e-3f);
+    return compose_.result();
+}
+
+}  // namespace bounce::gl
