@@ -98,6 +98,13 @@ struct lightmap_atlas {
     /// chart. block_first has blocks() + 1 entries.
     std::vector<std::uint32_t> block_first;
     int block_texels = 1;
+    /// Each block's rectangle in its chart's texel coordinates (x0, y0, width, height, in
+    /// texels of the base grid) and its grid of grid.x x grid.y texels: a base block's grid is
+    /// its rectangle's texels; adaptive subdivision (radiosity_subdivision.hpp) splits a block
+    /// into four quadrants with the same grid, so level L texels are 2^-L base texels wide.
+    std::vector<glm::vec4> block_rect;
+    std::vector<glm::uvec2> block_grid;
+    std::vector<std::uint8_t> block_level;  ///< 0 for base blocks
 
     /// Element at each atlas texel: the texel's own element, the nearest element of the same
     /// chart for padding texels and texels that miss the chart's triangles, -1 elsewhere.
@@ -131,15 +138,30 @@ struct lightmap_atlas {
         return uv;
     }
 
-    /// A per-element quantity laid out as the atlas: texel (x, y) holds values[element_at(x, y)],
-    /// `background` where no chart is. `values` has one entry per element.
+    /// A per-element quantity (per unit area, like a radiosity) laid out as the atlas: texel
+    /// (x, y) holds the area-weighted mean of `values` over the elements in the base texel of
+    /// element_at(x, y) (that element's own value unless its block was subdivided),
+    /// `background` where no chart is. `values` has one entry per element; T is a float or a
+    /// GLM vector of floats.
     template <class T>
     image<T> to_texels(std::span<const T> values, const T& background = T{}) const {
         require(values.size() == size(), "values", "needs one value per element");
-        image<T> out(std::max<std::uint32_t>(width, 1), std::max<std::uint32_t>(height, 1), background);
+        const std::size_t w = std::max<std::uint32_t>(width, 1), h = std::max<std::uint32_t>(height, 1);
+        std::vector<T> sum(w * h, T{});
+        std::vector<float> weight(w * h, 0.f);
+        for (std::size_t e = 0; e < size(); ++e) {
+            const std::size_t i = std::size_t(texel[e].y) * w + texel[e].x;
+            sum[i] += values[e] * area[e];
+            weight[i] += area[e];
+        }
+        image<T> out(w, h, background);
         for (std::uint32_t y = 0; y < height; ++y)
             for (std::uint32_t x = 0; x < width; ++x)
-                if (const std::int32_t e = element_at(x, y); e >= 0) out(x, y) = values[std::size_t(e)];
+                if (const std::int32_t e = element_at(x, y); e >= 0) {
+                    const std::size_t i = std::size_t(texel[std::size_t(e)].y) * w + texel[std::size_t(e)].x;
+                    // One element: its value exactly (no division round trip).
+                    out(x, y) = weight[i] == area[std::size_t(e)] ? values[std::size_t(e)] : sum[i] / weight[i];
+                }
         return out;
     }
 };
@@ -466,7 +488,13 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
                         atlas.texel.emplace_back(ch.atlas_x + i, ch.atlas_y + j);
                         atlas.element_at(ch.atlas_x + i, ch.atlas_y + j) = std::int32_t(atlas.size() - 1);
                     }
-                if (atlas.size() > first) atlas.block_first.push_back(first);
+                if (atlas.size() > first) {
+                    atlas.block_first.push_back(first);
+                    const std::uint32_t bw = std::min(b, ch.width - bx), bh = std::min(b, ch.height - by);
+                    atlas.block_rect.emplace_back(float(bx), float(by), float(bw), float(bh));
+                    atlas.block_grid.emplace_back(bw, bh);
+                    atlas.block_level.push_back(0);
+                }
             }
         ch.element_count = std::uint32_t(atlas.size()) - ch.first_element;
 

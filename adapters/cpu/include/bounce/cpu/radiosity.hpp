@@ -36,6 +36,7 @@
 #include <bounce/lightmap_atlas.hpp>
 #include <bounce/lights.hpp>
 #include <bounce/radiosity.hpp>
+#include <bounce/radiosity_subdivision.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <algorithm>
@@ -74,6 +75,7 @@ struct radiosity_timings {
     double visibility_ms = 0;    ///< begin_shot of the surface shots: item buffers, ray casts
     double choice_ms = 0;        ///< choosing shooters (reduction)
     double distribution_ms = 0;  ///< form factors and updates over the elements
+    double subdivision_ms = 0;   ///< adaptive subdivision: the test and the refined atlas
 };
 
 /// Where a solve stands after a step.
@@ -90,11 +92,12 @@ class progressive_radiosity {
 public:
     using vec = glm::vec<3, Real>;
 
-    /// Keeps a reference to `atlas` (which must outlive the solver) and the visibility (moved
-    /// in); `scene` is read only here (its lights). Throws parameter_error on bad options or an atlas not built from `scene`.
+    /// Copies `atlas` (subdivide() refines the copy) and keeps the visibility (moved in);
+    /// `scene` is read only here (its lights). Throws parameter_error on bad options or an
+    /// atlas not built from `scene`.
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, Visibility visibility,
                           radiosity_options options = {})
-        : atlas_(&atlas), visibility_(std::move(visibility)), options_(options) {
+        : atlas_(atlas), visibility_(std::move(visibility)), options_(options) {
         options.validate();
         scene.validate();
         require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
@@ -109,26 +112,7 @@ public:
             total_area_ += double(atlas.area[i]);
             albedo_area_ += glm::dvec3(atlas.albedo[i]) * double(atlas.area[i]);
         }
-        // Shooters: the atlas's blocks, or one per element.
-        if (options.shoot_blocks) first_.assign(atlas.block_first.begin(), atlas.block_first.end());
-        else {
-            first_.resize(n + 1);
-            std::iota(first_.begin(), first_.end(), std::uint32_t(0));
-        }
-        const std::size_t shooters = first_.size() - 1;
-        centre_.resize(shooters);
-        shooter_area_.resize(shooters);
-        power_.resize(shooters);
-        for (std::size_t k = 0; k < shooters; ++k) {
-            glm::dvec3 c(0);
-            double a = 0;
-            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
-                c += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
-                a += double(atlas.area[i]);
-            }
-            centre_[k] = glm::vec3(c / a);
-            shooter_area_[k] = Real(a);
-        }
+        build_shooters();
         const auto start = clock::now();
         for (const light& l : scene.lights) shoot_light(pack(l));
         timings_.lights_ms = ms_since(start);
@@ -189,7 +173,7 @@ public:
     glm::dvec3 escaped_power() const noexcept { return escaped_; }
     glm::dvec3 unshot_power() const {
         glm::dvec3 s(0);
-        for (std::size_t i = 0; i < unshot_.size(); ++i) s += glm::dvec3(unshot_[i]) * double(atlas_->area[i]);
+        for (std::size_t i = 0; i < unshot_.size(); ++i) s += glm::dvec3(unshot_[i]) * double(atlas_.area[i]);
         return s;
     }
 
@@ -210,7 +194,7 @@ public:
         std::vector<glm::vec3> out(radiosity_.size());
         const glm::vec3 amb = options_.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
         for (std::size_t i = 0; i < out.size(); ++i)
-            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(radiosity_[i]), atlas_->albedo[i], amb);
+            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(radiosity_[i]), atlas_.albedo[i], amb);
         return out;
     }
 
@@ -218,17 +202,69 @@ public:
     /// lightmap or texturing a view.
     image<glm::vec3> lightmap() const {
         const auto values = display_radiosity();
-        return atlas_->to_texels(std::span<const glm::vec3>(values));
+        return atlas_.to_texels(std::span<const glm::vec3>(values));
     }
 
     const radiosity_timings& timings() const noexcept { return timings_; }
     radiosity_progress progress() const noexcept { return {steps_, shots_, unshot_fraction()}; }
     std::size_t shooters() const noexcept { return power_.size(); }
-    const lightmap_atlas& atlas() const noexcept { return *atlas_; }
+    const lightmap_atlas& atlas() const noexcept { return atlas_; }
     Visibility& visibility() noexcept { return visibility_; }
+
+    /// Adaptive subdivision (radiosity_subdivision.hpp): splits the leaves whose radiosity
+    /// fails the test, gives each child element its parent's radiosity and unshot radiosity
+    /// (power is unchanged: children's areas add up to their parent's), and rebuilds the
+    /// shooters. `scene` is the scene the atlas was built from. Returns the leaves split.
+    /// The chapter runs this test after every reconstruction pass; calling it every step or
+    /// every few steps from the first shots on keeps most of the light at the finer level.
+    std::size_t subdivide(const scene_view& scene, const subdivision_options& options) {
+        const auto start = clock::now();
+        std::vector<glm::vec3> b(radiosity_.size());
+        for (std::size_t i = 0; i < b.size(); ++i) b[i] = glm::vec3(radiosity_[i]);
+        const auto split = blocks_to_subdivide(atlas_, std::span<const glm::vec3>(b), options);
+        if (!split.empty()) {
+            atlas_refinement r = refine_lightmap_atlas(scene, atlas_, split);
+            std::vector<vec> radiosity(r.parent.size()), unshot(r.parent.size());
+            for (std::size_t i = 0; i < r.parent.size(); ++i) {
+                radiosity[i] = radiosity_[r.parent[i]];
+                unshot[i] = unshot_[r.parent[i]];
+            }
+            atlas_ = std::move(r.atlas);
+            radiosity_ = std::move(radiosity);
+            unshot_ = std::move(unshot);
+            build_shooters();
+        }
+        timings_.subdivision_ms += ms_since(start);
+        return split.size();
+    }
 
 private:
     using clock = std::chrono::steady_clock;
+
+    // Shooters: the atlas's blocks, or one per element; their centres, areas and powers.
+    void build_shooters() {
+        const std::size_t n = atlas_.size();
+        if (options_.shoot_blocks) first_.assign(atlas_.block_first.begin(), atlas_.block_first.end());
+        else {
+            first_.resize(n + 1);
+            std::iota(first_.begin(), first_.end(), std::uint32_t(0));
+        }
+        const std::size_t shooters = first_.size() - 1;
+        centre_.resize(shooters);
+        shooter_area_.resize(shooters);
+        power_.resize(shooters);
+        for (std::size_t k = 0; k < shooters; ++k) {
+            glm::dvec3 c(0);
+            double a = 0;
+            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
+                c += glm::dvec3(atlas_.position[i]) * double(atlas_.area[i]);
+                a += double(atlas_.area[i]);
+            }
+            centre_[k] = glm::vec3(c / a);
+            shooter_area_[k] = Real(a);
+        }
+        refresh_powers();
+    }
     static double ms_since(clock::time_point t) {
         return std::chrono::duration<double, std::milli>(clock::now() - t).count();
     }
@@ -262,7 +298,7 @@ private:
         unshot_total_ = 0;
         for (std::size_t k = 0; k < power_.size(); ++k) {
             double p = 0;
-            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) p += channel_sum(unshot_[i]) * double(atlas_->area[i]);
+            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) p += channel_sum(unshot_[i]) * double(atlas_.area[i]);
             power_[k] = p;
             unshot_total_ += p;
         }
@@ -282,7 +318,7 @@ private:
                     double p = 0;
                     for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
                         receive(i, s);
-                        p += channel_sum(unshot_[i]) * double(atlas_->area[i]);
+                        p += channel_sum(unshot_[i]) * double(atlas_.area[i]);
                     }
                     power_[k] = p;
                     s.unshot += p;
@@ -301,7 +337,7 @@ private:
     }
 
     void shoot(std::uint32_t k) {
-        const lightmap_atlas& at = *atlas_;
+        const lightmap_atlas& at = atlas_;
         const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
         // The shooter's unshot radiosity, area-weighted over its elements; then zeroed, so
         // its elements' power (refreshed in the distribution) starts from 0.
@@ -346,7 +382,7 @@ private:
     // Direct light from one point, spot or directional light: each element's irradiance
     // E (lights.hpp) times visibility becomes incident power; rho E is its first radiosity.
     void shoot_light(const packed_light& l) {
-        const lightmap_atlas& at = *atlas_;
+        const lightmap_atlas& at = atlas_;
         const light_kind kind = l.kind();
         std::vector<shot_frame> frames;
         if (kind == light_kind::directional) frames.push_back({glm::vec3(0.f), l.direction(), true, shot_frame::none});
@@ -393,7 +429,7 @@ private:
         }
     }
 
-    const lightmap_atlas* atlas_;
+    lightmap_atlas atlas_;
     Visibility visibility_;
     radiosity_options options_;
     std::vector<vec> radiosity_, unshot_;

@@ -1,0 +1,160 @@
+// Adaptive subdivision: the second-difference test, conservative splitting of leaves, and
+// the solver carrying on after it.
+#include "radiosity_scenes.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/radiosity_subdivision.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <numeric>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+TEST_CASE("the second difference flags a step, not a linear ramp", "[radiosity][subdivision][kernel]") {
+    CHECK(radiosity_second_difference<double>(1, 2, 3, 1e-9) == 0.0);    // ramp
+    CHECK(radiosity_second_difference<double>(1, 1, 5, 1.0) == 1.0);     // step
+    CHECK(radiosity_second_difference<double>(2, 1, 2, 1.5) == 1.0);     // dip
+    CHECK(radiosity_second_difference<double>(2, 1, 2, 2.5) == 0.0);
+}
+
+TEST_CASE("splitting a leaf conserves each element's area and stays on its chart", "[radiosity][subdivision]") {
+    // Children's exact overlaps are rescaled to add up to their parent's area: to float
+    // rounding of each child's area (2^-24 relative, at most 4 per 2 x 2 split... per texel
+    // of the grid: children of one parent are at most 4).
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 1500, .block_texels = 4});
+    std::vector<std::uint32_t> all(atlas.blocks());
+    std::iota(all.begin(), all.end(), 0u);
+    const auto r = refine_lightmap_atlas(scene.view(), atlas, all);
+    const lightmap_atlas& fine = r.atlas;
+    CHECK(fine.size() >= 3 * atlas.size());
+    CHECK(fine.size() <= 4 * atlas.size());
+    CHECK(fine.blocks() >= atlas.blocks());
+    std::vector<double> sum(atlas.size(), 0.0);
+    for (std::size_t i = 0; i < fine.size(); ++i) {
+        const std::uint32_t p = r.parent[i];
+        sum[p] += fine.area[i];
+        CHECK(fine.chart[i] == atlas.chart[p]);
+        CHECK(fine.texel[i] == atlas.texel[p]);  // a child lies in its parent's base texel
+        const auto& ch = fine.charts[fine.chart[i]];
+        CHECK(std::abs(glm::dot(fine.position[i] - ch.origin, ch.normal)) < 1e-5f);
+    }
+    for (std::size_t e = 0; e < atlas.size(); ++e) CHECK(sum[e] == Approx(atlas.area[e]).epsilon(4 * 0x1p-24));
+    for (std::size_t k = 0; k < fine.blocks(); ++k) {
+        CHECK(fine.block_level[k] == 1);
+        for (std::uint32_t i = fine.block_first[k]; i < fine.block_first[k + 1]; ++i)
+            CHECK(fine.chart[i] == fine.chart[fine.block_first[k]]);
+    }
+    // Every atlas texel that pointed to an element points to one of its children.
+    for (std::uint32_t y = 0; y < atlas.height; ++y)
+        for (std::uint32_t x = 0; x < atlas.width; ++x) {
+            const std::int32_t before = atlas.element_at(x, y), after = fine.element_at(x, y);
+            CHECK((before < 0) == (after < 0));
+            if (after >= 0) CHECK(fine.chart[std::size_t(after)] == atlas.chart[std::size_t(before)]);
+        }
+    // Splitting again only the first block of the fine atlas reaches level 2 there.
+    const std::uint32_t first[] = {0};
+    const auto again = refine_lightmap_atlas(scene.view(), fine, first);
+    CHECK(again.atlas.block_level[0] == 2);
+    CHECK(again.atlas.blocks() >= fine.blocks() + 1);
+}
+
+TEST_CASE("the test splits the leaves a step crosses and leaves ramps alone", "[radiosity][subdivision]") {
+    // A floor of 16 x 16 texels in one 16 x 16 leaf... as four leaves of 8 x 8: a radiosity
+    // ramp along x flags nothing; a step at x = 0.3 of the floor flags the leaves it crosses.
+    owned_scene s;
+    const auto m = s.add_material(glm::vec3(0.5f));
+    s.add_quad({0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}, m);
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 256, .block_texels = 8});
+    REQUIRE(atlas.size() == 256);
+    REQUIRE(atlas.blocks() == 4);
+    std::vector<glm::vec3> ramp(atlas.size()), step(atlas.size());
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+        ramp[i] = glm::vec3(1.f + 3.f * atlas.position[i].x);
+        step[i] = glm::vec3(atlas.position[i].x < 0.3f ? 1.f : 4.f);
+    }
+    const subdivision_options o{.threshold = 0.25, .min_texels = 2, .max_level = 1};
+    CHECK(blocks_to_subdivide(atlas, std::span<const glm::vec3>(ramp), o).empty());
+    const auto split = blocks_to_subdivide(atlas, std::span<const glm::vec3>(step), o);
+    REQUIRE(split.size() == 2);  // the two leaves (of four) the line x = 0.3 crosses
+    for (const std::uint32_t k : split) {
+        bool low = false, high = false;
+        for (std::uint32_t i = atlas.block_first[k]; i < atlas.block_first[k + 1]; ++i) {
+            low = low || atlas.position[i].x < 0.3f;
+            high = high || atlas.position[i].x >= 0.3f;
+        }
+        CHECK((low && high));
+    }
+    // At max_level nothing splits any more.
+    const auto fine = refine_lightmap_atlas(s.view(), atlas, split).atlas;
+    std::vector<glm::vec3> fine_step(fine.size());
+    for (std::size_t i = 0; i < fine.size(); ++i) fine_step[i] = glm::vec3(fine.position[i].x < 0.3f ? 1.f : 4.f);
+    for (const std::uint32_t k : blocks_to_subdivide(fine, std::span<const glm::vec3>(fine_step), o))
+        CHECK(fine.block_level[k] == 0);
+}
+
+TEST_CASE("subdividing during a solve keeps the power balance and refines where the light changes",
+          "[radiosity][subdivision][solver]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 2000, .block_texels = 8});
+    cpu::progressive_radiosity solver(scene.view(), atlas,
+                                      cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 128}));
+    const subdivision_options o{.threshold = 0.25, .min_texels = 2, .max_level = 2};
+    std::size_t splits = 0;
+    for (int s = 0; s < 60; ++s) {
+        solver.step();
+        const glm::dvec3 before = solver.unshot_power();
+        std::vector<glm::vec3> b(solver.radiosity().begin(), solver.radiosity().end());
+        double power_before = 0;
+        for (std::size_t i = 0; i < b.size(); ++i) power_before += double(b[i].x) * solver.atlas().area[i];
+        splits += solver.subdivide(scene.view(), o);
+        // Children inherit per-area values over areas that add up to their parent's: power
+        // is unchanged to float rounding of the areas (2^-24 each, 4 allowed).
+        const glm::dvec3 after = solver.unshot_power();
+        CHECK(after.x == Approx(before.x).epsilon(4 * 0x1p-24));
+        double power_after = 0;
+        for (std::size_t i = 0; i < solver.radiosity().size(); ++i)
+            power_after += double(solver.radiosity()[i].x) * solver.atlas().area[i];
+        CHECK(power_after == Approx(power_before).epsilon(4 * 0x1p-24));
+        const glm::dvec3 balance = solver.absorbed_power() + solver.unshot_power() + solver.escaped_power();
+        CHECK(balance.x == Approx(solver.emitted_power().x).epsilon(4 * (s + 3) * 0x1p-24));
+    }
+    INFO(splits << " leaves split; " << solver.atlas().size() << " elements from " << atlas.size());
+    CHECK(splits > 0);
+    CHECK(solver.atlas().size() > atlas.size());
+    int deepest = 0;
+    for (const auto level : solver.atlas().block_level) deepest = std::max(deepest, int(level));
+    CHECK(deepest <= o.max_level);
+    // The lightmap still covers the atlas: every element's base texel holds the area-weighted
+    // mean of the elements in it.
+    const auto lm = solver.lightmap();
+    CHECK(lm.width() == atlas.width);
+    solver.solve(0.1);
+    CHECK(solver.unshot_fraction() <= 0.1);
+}
+
+TEST_CASE("bad subdivision input raises parameter_error naming it", "[radiosity][subdivision][errors]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
+    std::vector<glm::vec3> b(atlas.size(), glm::vec3(1.f));
+    const auto named = [&](const subdivision_options& o, const char* name) {
+        try {
+            blocks_to_subdivide(atlas, std::span<const glm::vec3>(b), o);
+            FAIL("no exception");
+        } catch (const parameter_error& e) {
+            CHECK(e.parameter() == name);
+        }
+    };
+    named({.threshold = 0}, "subdivision_options.threshold");
+    named({.min_texels = -1}, "subdivision_options.min_texels");
+    named({.max_level = 9}, "subdivision_options.max_level");
+    const std::uint32_t bad[] = {std::uint32_t(atlas.blocks())};
+    try {
+        refine_lightmap_atlas(scene.view(), atlas, bad);
+        FAIL("no exception");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "split");
+    }
+}
