@@ -15,6 +15,7 @@
 
 #include <bounce/gl/kernel_map.hpp>
 #include <bounce/radiosity.hpp>
+#include <bounce/radiosity_subdivision.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -193,4 +194,27 @@ TEST_CASE("the shooter frame and the ambient display agree on the GPU and the CP
     for (const auto& a : amb) cpu_amb.push_back(std::apply(radiosity_with_ambient<float, glm::vec3>, a));
     CHECK(worst_scaled(gl::map_kernel(radiosity_with_ambient<f32, vec3>, amb), cpu_amb, [](std::size_t) { return 6.0; }) <=
           tolerance);
+}
+
+TEST_CASE("the subdivision test's second difference agrees on the GPU and the CPU", "[glsl][radiosity]") {
+    // A flag, 0 or 1: it must agree exactly except where |b0 - 2 b1 + b2| lies within the
+    // rounding of the comparison (a few ulps of the terms) of the limit; inputs are drawn so
+    // that none does (limits on a grid of 1/8, radiosities on a grid of 1/4: the second
+    // difference is a multiple of 1/4 and never within 1/8 of a limit).
+    gl_test::shared_context();
+    pcg32 rng(35);
+    std::vector<std::tuple<float, float, float, float>> in;
+    for (int k = 0; k < random_count; ++k)
+        in.emplace_back(float(int(rng.next_float() * 40)) / 4, float(int(rng.next_float() * 40)) / 4,
+                        float(int(rng.next_float() * 40)) / 4, float(int(rng.next_float() * 80)) / 4 + 0.125f);
+    std::vector<float> cpu;
+    for (const auto& a : in) cpu.push_back(std::apply(radiosity_second_difference<float>, a));
+    const auto gpu = gl::map_kernel(radiosity_second_difference<f32>, in);
+    int ones = 0;
+    for (std::size_t e = 0; e < cpu.size(); ++e) {
+        REQUIRE(gpu[e] == cpu[e]);
+        ones += cpu[e] > 0 ? 1 : 0;
+    }
+    CHECK(ones > 100);
+    CHECK(ones < random_count - 100);
 }
