@@ -100,7 +100,6 @@ constexpr std::uint16_t float_to_half(float f) noexcept {
 }
 
 /// Which row-product code `cube_map_sh_projector` runs.
-/// Which row-product code `cube_map_sh_projector` runs.
 enum class sh_projection_path {
     automatic,  ///< AVX2 + FMA + F16C where the CPU has them, else portable
     portable,   ///< plain loops only (for comparison and testing)
@@ -316,10 +315,22 @@ private:
                 }
             }
             // Lane j of a period holds channel j mod 3 (periods start at a multiple of 3).
+            // Three local sums, not sums[... + j % 3]: that chains every addition through
+            // one memory location, which cost as much as a 16^2 face's products.
             for (std::size_t k = 0; k < count; ++k)
-                for (std::size_t i = 0; i < coefficients; ++i)
-                    for (std::size_t j = 0; j < acc_stride; ++j)
-                        sums[(k * coefficients + i) * 3 + j % 3] += double(acc[(k * coefficients + i) * acc_stride + j]);
+                for (std::size_t i = 0; i < coefficients; ++i) {
+                    const float* a = acc.data() + (k * coefficients + i) * acc_stride;
+                    double r = 0, g = 0, b = 0;
+                    for (std::size_t j = 0; j < acc_stride; j += 3) {
+                        r += double(a[j]);
+                        g += double(a[j + 1]);
+                        b += double(a[j + 2]);
+                    }
+                    double* sum = sums.data() + (k * coefficients + i) * 3;
+                    sum[0] += r;
+                    sum[1] += g;
+                    sum[2] += b;
+                }
         }
         for (std::size_t k = 0; k < count; ++k)
             for (std::size_t i = 0; i < coefficients; ++i)
