@@ -113,22 +113,42 @@ T interleave_tent_weight(T offset, T n) {
 /// One output pixel of a pass of the separable geometry-aware tent (Segovia et al. 2006
 /// step 6): `values` are the 2R + 1 pixels centred on it along the pass's axis; `edges[k]`
 /// is 1 where a discontinuity separates taps k and k + 1 (0 otherwise), so a tap counts
-/// only if no edge lies between it and the centre; the reached taps' tent weights
-/// (pattern width `n` <= R + 1 along this axis) are renormalized. The centre always counts.
-/// A compile-time radius R keeps the loop bounds constant for GLSL.
+/// only if no edge lies between it and the centre. The centre always counts; the pattern is
+/// `n` <= R + 1 wide along this axis, and a compile-time R keeps GLSL's loop bounds constant.
+///
+/// Renormalized per sub-buffer rather than per tap: every residue class mod n that is
+/// reached gets the same weight, its taps (offsets o and o - n) shared by their tent
+/// weights. Inside a surface this is the tent itself (each class already weighs 1/n); where
+/// an edge cuts the tent short it keeps the sub-buffers equal, so one sub-buffer's subset of
+/// lights does not outweigh the others (docs, section 6). With L taps reached on the left and
+/// Rr on the right (at most n - 1 each), right tap o shares its class with left tap n - o,
+/// reached when n - o <= L, so its class weight is (n - o) / n^2 + [n - o <= L] o / n^2;
+/// 1 + min(n - 1, L + Rr) classes are reached.
 template <int R, real T, vec3_of<T> V>
 V geometry_aware_tent(const std::array<V, 2 * R + 1>& values, const std::array<T, 2 * R>& edges, T n) {
-    V sum = values[R] * interleave_tent_weight<T>(T(0), n);
-    T weight = interleave_tent_weight<T>(T(0), n);
-    T reach_right = T(1), reach_left = T(1);
+    std::array<T, R + 1> reach_right, reach_left;  // [k]: tap +-k reached (k < n)
+    reach_right[0] = T(1);
+    reach_left[0] = T(1);
+    T count_right = T(0), count_left = T(0);
     for (int k = 1; k <= R; ++k) {
-        reach_right = reach_right * (T(1) - edges[std::size_t(R + k - 1)]);
-        reach_left = reach_left * (T(1) - edges[std::size_t(R - k)]);
-        const T w = interleave_tent_weight<T>(T(k), n);
-        sum = sum + values[std::size_t(R + k)] * (w * reach_right) + values[std::size_t(R - k)] * (w * reach_left);
-        weight = weight + w * (reach_right + reach_left);
+        const T in_tent = select(T(k) < n, T(1), T(0));
+        reach_right[std::size_t(k)] = reach_right[std::size_t(k - 1)] * (T(1) - edges[std::size_t(R + k - 1)]);
+        reach_left[std::size_t(k)] = reach_left[std::size_t(k - 1)] * (T(1) - edges[std::size_t(R - k)]);
+        count_right = count_right + reach_right[std::size_t(k)] * in_tent;
+        count_left = count_left + reach_left[std::size_t(k)] * in_tent;
     }
-    return sum / weight;
+    V sum = values[R];  // class 0: the centre alone, weight 1 within its class
+    const T inv_n2 = T(1) / (n * n);
+    for (int k = 1; k <= R; ++k) {
+        const T own = max(T(0), n - T(k)) * inv_n2;  // tent weight of taps +-k
+        const T partner = T(k) * inv_n2;             // tent weight of taps -+(n - k)
+        const T class_right = own + select(n - T(k) <= count_left, partner, T(0));
+        const T class_left = own + select(n - T(k) <= count_right, partner, T(0));
+        const T w_right = reach_right[std::size_t(k)] * own / max(class_right, inv_n2);
+        const T w_left = reach_left[std::size_t(k)] * own / max(class_left, inv_n2);
+        sum = sum + values[std::size_t(R + k)] * w_right + values[std::size_t(R - k)] * w_left;
+    }
+    return sum / (T(1) + min(n - T(1), count_left + count_right));
 }
 
 /// Whether two neighbouring G-buffer pixels lie on different surfaces (the discontinuity

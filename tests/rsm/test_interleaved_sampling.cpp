@@ -130,6 +130,36 @@ TEST_CASE("the geometry-aware tent keeps a constant, averages a pattern, and sto
     CHECK(geometry_aware_tent<R, float, glm::vec3>(v, edge, 4.f).x == Approx(1.f).epsilon(1e-6));
 }
 
+TEST_CASE("where an edge cuts the tent short, every sub-buffer it still reaches gets the same weight",
+          "[interleave]") {
+    constexpr int R = 7;
+    for (int n = 1; n <= R + 1; ++n)
+        for (int cut_left = 0; cut_left <= R; ++cut_left)
+            for (int cut_right = 0; cut_right <= R; ++cut_right) {
+                // Edges just beyond the cut_left-th tap on the left and cut_right-th on the right.
+                std::array<double, 2 * R> edges{};
+                if (cut_left < R) edges[std::size_t(R - cut_left - 1)] = 1;
+                if (cut_right < R) edges[std::size_t(R + cut_right)] = 1;
+                const int reached_left = std::min(cut_left, n - 1), reached_right = std::min(cut_right, n - 1);
+                const int classes = 1 + std::min(n - 1, reached_left + reached_right);
+                double total = 0;
+                for (int c = 0; c < n; ++c) {
+                    std::array<glm::dvec3, 2 * R + 1> v;
+                    bool reached = false;
+                    for (int o = -R; o <= R; ++o) {
+                        const bool in_class = ((o % n) + n) % n == c;
+                        v[std::size_t(o + R)] = glm::dvec3(in_class ? 1.0 : 0.0);
+                        reached = reached || (in_class && o >= -reached_left && o <= reached_right);
+                    }
+                    const double w = geometry_aware_tent<R, double, glm::dvec3>(v, edges, double(n)).x;
+                    INFO("n " << n << " cuts " << cut_left << ", " << cut_right << " class " << c);
+                    REQUIRE(w == Approx(reached ? 1.0 / classes : 0.0).margin(1e-12));
+                    total += w;
+                }
+                REQUIRE(total == Approx(1.0).epsilon(1e-12));
+            }
+}
+
 TEST_CASE("bad patterns and sizes raise parameter_error naming the parameter", "[interleave]") {
     CHECK_THROWS_AS(cpu::interleave_maps({0, 4}, 8, 8), parameter_error);
     CHECK_THROWS_AS(cpu::interleave_maps({4, 65}, 8, 8), parameter_error);

@@ -183,7 +183,8 @@ void tent_blur(image_view<const glm::vec3> in, image_view<const glm::vec2> edges
 /// The separable geometry-aware blur (step 6): a tent of radius n - 1 along x, then of
 /// radius m - 1 along y (interleave_tent_weight), each stopping at the first discontinuity
 /// on either side. Inside one surface every sub-buffer of the pattern gets weight 1/(n m),
-/// so the result averages the N M sub-buffers' estimates. Pixels that see no geometry are
+/// so the result averages the N M sub-buffers' estimates; where an edge cuts the tent short,
+/// every sub-buffer still reached gets the same weight (geometry_aware_tent). Pixels that see no geometry are
 /// copied. `scratch` holds the horizontal pass; all views are the image's size.
 inline void geometry_aware_blur(image_view<const glm::vec3> in, image_view<const glm::vec2> edges,
                                 image_view<const float> depth, const interleave_pattern& p,
