@@ -17,14 +17,15 @@
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
+#include <bounce/study/image_comparison.hpp>
 #include <bounce/study/reference_cache.hpp>
+#include <bounce/study/run_report.hpp>
 #include <bounce/cpu/plane_estimate.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/plane_camera.hpp>
 #include <bounce/plane_weights.hpp>
 #include <bounce/radial_profile.hpp>
 #include <bounce/io/image_io.hpp>
-#include <bounce/io/report.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/sampling.hpp>
 
@@ -95,14 +96,14 @@ std::vector<study_point> pick_points(const embree::accel& bvh, const io::scene& 
 
 double luminance(const glm::dvec3& c) { return rec709_luminance<double, glm::dvec3>(c); }
 
-// Relative RMS error of luminance (io::compare_luminance on K x 1 images).
+// Relative RMS error of luminance (study::compare_luminance on K x 1 images).
 double rel_rms(const std::vector<glm::dvec3>& E, const std::vector<glm::dvec3>& ref) {
     image<glm::vec3> x(E.size(), 1), r(ref.size(), 1);
     for (std::size_t k = 0; k < E.size(); ++k) {
         x(k, 0) = glm::vec3(E[k]);
         r(k, 0) = glm::vec3(ref[k]);
     }
-    return io::compare_luminance(x.view(), r.view()).rel_rms;
+    return study::compare_luminance(x.view(), r.view()).rel_rms;
 }
 
 // ---- the reference -----------------------------------------------------------------------
@@ -588,7 +589,7 @@ int main(int argc, char** argv) {
         }
 
         if (!json_path.empty()) {
-            io::run_report report;
+            study::run_report report;
             report.technique = "hemisphere_study";
             report.scene = scene.name;
             report.width = resolution;

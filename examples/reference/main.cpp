@@ -8,7 +8,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/io/image_io.hpp>
-#include <bounce/io/report.hpp>
+#include <bounce/study/run_report.hpp>
 #include <bounce/io/scene.hpp>
 
 #include <CLI/CLI.hpp>
@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
         settings.environment = {environment[0], environment[1], environment[2]};
         settings.seed = seed;
 
-        io::stage_timer timer;
+        study::stage_timer timer;
         const embree::device dev;  // BOUNCE_EMBREE_CONFIG, when set, pins its kernels (and keys the cache)
         std::optional<embree::accel> bvh;
         gbuffer<float> g;
@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
         for (std::size_t y = 0; y < height; ++y)
             for (std::size_t x = 0; x < width; ++x) covered += std::isfinite(g.depth(x, y)) ? 1 : 0;
         if (!json.empty()) {
-            io::run_report report;
+            study::run_report report;
             report.technique = "reference";
             report.scene = scene.name;
             report.width = width;

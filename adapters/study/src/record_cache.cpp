@@ -1,9 +1,9 @@
-#include <bounce/io/record_cache.hpp>
+#include <bounce/study/record_cache.hpp>
 
 #include <cmath>
 #include <fstream>
 
-namespace bounce::io {
+namespace bounce::study {
 
 cache_error::cache_error(std::filesystem::path file, const std::string& what)
     : bounce::error("bounce: cache '" + file.string() + "': " + what), file_(std::move(file)) {}
@@ -94,4 +94,4 @@ std::vector<irradiance_record> load_records(const std::filesystem::path& file, c
     return recs;
 }
 
-}  // namespace bounce::io
+}  // namespace bounce::study

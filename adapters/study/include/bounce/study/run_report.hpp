@@ -1,7 +1,7 @@
 #pragma once
-/// \file report.hpp
-/// The run report every example writes with `--json PATH` (design.md section 6), and the
-/// stage timer whose medians fill its `timings_ms`.
+/// \file run_report.hpp
+/// The run report every example writes with `--json PATH` (docs/architecture.md,
+/// "Measurement"); stage_timer.hpp's medians fill its `timings_ms`.
 ///
 /// The JSON object, keys in this order:
 /// ```
@@ -17,9 +17,9 @@
 /// (JSON has no infinity). Timings keep the order in which the stages first started.
 
 #include <bounce/errors.hpp>
-#include <bounce/io/image_io.hpp>
+#include <bounce/study/image_comparison.hpp>
+#include <bounce/study/stage_timer.hpp>
 
-#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -30,7 +30,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace bounce::io {
+namespace bounce::study {
 
 /// A report file that cannot be written; `file()` names it.
 struct report_error : bounce::error {
@@ -41,61 +41,7 @@ private:
     std::filesystem::path file_;
 };
 
-/// Wall-clock samples per named stage (std::chrono::steady_clock, milliseconds); the
-/// report takes their medians, which a single slow repeat (page faults, a shader compile)
-/// does not move.
-class stage_timer {
-public:
-    /// Times from construction to destruction (or `stop()`) and adds the sample to its stage.
-    class scope {
-    public:
-        scope(stage_timer& timer, std::string stage);
-        scope(scope&& other) noexcept;
-        scope(const scope&) = delete;
-        scope& operator=(const scope&) = delete;
-        scope& operator=(scope&&) = delete;
-        ~scope();
-        /// Ends the sample now; later calls and the destructor do nothing. Returns its ms.
-        double stop();
-
-    private:
-        stage_timer* timer_;
-        std::string stage_;
-        std::chrono::steady_clock::time_point start_;
-    };
-
-    /// Starts a sample of `stage` ("gbuffer", "interpolate", "total" ...) that ends when the
-    /// returned scope does.
-    [[nodiscard]] scope measure(std::string stage) { return scope(*this, std::move(stage)); }
-
-    /// Calls `f()`, adds its duration to `stage`, and returns what `f` returns.
-    template <class F>
-    decltype(auto) time(std::string_view stage, F&& f) {
-        scope s(*this, std::string(stage));
-        return std::forward<F>(f)();
-    }
-
-    /// Adds one sample of `ms` milliseconds (finite, >= 0) to `stage`.
-    /// Throws parameter_error otherwise or when `stage` is empty.
-    void add_sample(std::string_view stage, double ms);
-    /// The samples of `stage` in the order they were taken (empty if never timed).
-    std::vector<double> samples(std::string_view stage) const;
-    /// Median of the samples of `stage` (mean of the middle two for an even count).
-    /// Throws parameter_error when `stage` has no sample.
-    double median_ms(std::string_view stage) const;
-    /// Names of the stages with samples, in the order they were first started.
-    std::vector<std::string> stages() const;
-    /// The largest number of samples of any stage (the `--repeat` count in practice).
-    std::size_t repeats() const;
-    /// Forgets every sample.
-    void clear() noexcept { stages_.clear(); }
-
-private:
-    std::vector<double>& open_stage(std::string_view stage);
-    std::vector<std::pair<std::string, std::vector<double>>> stages_;
-};
-
-/// The measurement record of one run of one technique (design.md section 6).
+/// The measurement record of one run of one technique.
 struct run_report {
     std::string technique;  ///< the program, e.g. "ic_splatting", "reference"
     std::string scene;      ///< scene name: "cornell", "sponza" ...
@@ -123,4 +69,4 @@ struct run_report {
     void write(const std::filesystem::path& file) const;
 };
 
-}  // namespace bounce::io
+}  // namespace bounce::study

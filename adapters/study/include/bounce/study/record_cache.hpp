@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace bounce::io {
+namespace bounce::study {
 
 /// A cache file that cannot be read or written, is malformed, or was built with other
 /// parameters. `file()` names it.
@@ -37,4 +37,4 @@ void save_records(const std::filesystem::path& file, const std::vector<irradianc
 std::vector<irradiance_record> load_records(const std::filesystem::path& file,
                                             const nlohmann::json& expected_parameters);
 
-}  // namespace bounce::io
+}  // namespace bounce::study

@@ -1,7 +1,7 @@
-// The run report: the stage timer's medians, and the JSON object of design.md section 6.
-#include "scratch_folder.hpp"
+// The run report: the stage timer's medians, and the JSON object every example writes.
+#include "../io/scratch_folder.hpp"
 
-#include <bounce/io/report.hpp>
+#include <bounce/study/run_report.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -15,10 +15,10 @@
 using namespace bounce;
 using bounce::test::scratch_folder;
 
-TEST_CASE("the stage median is the middle sample, or the mean of the middle two", "[io][report][timer]") {
+TEST_CASE("the stage median is the middle sample, or the mean of the middle two", "[study][report][timer]") {
     pcg32 rng(41);
     const int n = GENERATE(range(1, 60));
-    io::stage_timer timer;
+    study::stage_timer timer;
     std::vector<double> xs;
     for (int i = 0; i < n; ++i) {
         xs.push_back(100.0 * rng.next_double());
@@ -36,8 +36,8 @@ TEST_CASE("the stage median is the middle sample, or the mean of the middle two"
     CHECK(2 * above >= n);
 }
 
-TEST_CASE("the stage timer records scopes and calls in first-timed order", "[io][report][timer]") {
-    io::stage_timer timer;
+TEST_CASE("the stage timer records scopes and calls in first-timed order", "[study][report][timer]") {
+    study::stage_timer timer;
     for (int r = 0; r < 3; ++r) {
         auto total = timer.measure("total");
         {
@@ -69,8 +69,8 @@ TEST_CASE("the stage timer records scopes and calls in first-timed order", "[io]
 }
 
 namespace {
-io::run_report sample_report() {
-    io::run_report r;
+study::run_report sample_report() {
+    study::run_report r;
     r.technique = "ic_splatting";
     r.scene = "cornell";
     r.width = 512;
@@ -78,11 +78,11 @@ io::run_report sample_report() {
     r.backend = "cpu";
     r.parameters["a"] = 0.15;
     r.parameters["weight"] = "ward";
-    io::stage_timer t;
+    study::stage_timer t;
     for (double ms : {3.0, 1.0, 2.0}) t.add_sample("gbuffer", ms);
     for (double ms : {10.0, 30.0, 20.0}) t.add_sample("total", ms);
     r.set_timings(t);
-    r.error = io::error_figures{0.041, 0.8, 12.5, 1000};
+    r.error = study::error_figures{0.041, 0.8, 12.5, 1000};
     r.set_count("records", 1834);
     r.set_count("vpls", 0);
     r.set_count("records", 1835);  // replaces
@@ -90,7 +90,7 @@ io::run_report sample_report() {
 }
 }  // namespace
 
-TEST_CASE("the run report is the object of design.md section 6", "[io][report]") {
+TEST_CASE("the run report is the object of design.md section 6", "[study][report]") {
     const auto j = sample_report().to_json();
     std::vector<std::string> keys;
     for (const auto& [k, v] : j.items()) keys.push_back(k);
@@ -111,7 +111,7 @@ TEST_CASE("the run report is the object of design.md section 6", "[io][report]")
 }
 
 TEST_CASE("the run report writes valid JSON, null for non-finite figures, and no error without a reference",
-          "[io][report]") {
+          "[study][report]") {
     scratch_folder dir;
     auto r = sample_report();
     r.error->rel_rms = std::numeric_limits<double>::infinity();
@@ -126,7 +126,7 @@ TEST_CASE("the run report writes valid JSON, null for non-finite figures, and no
 }
 
 TEST_CASE("an incomplete or clashing report is refused and an unwritable file raises report_error",
-          "[io][report][bad-input]") {
+          "[study][report][bad-input]") {
     auto r = sample_report();
     r.technique.clear();
     CHECK_THROWS_AS(r.to_json(), parameter_error);
@@ -146,7 +146,7 @@ TEST_CASE("an incomplete or clashing report is refused and an unwritable file ra
     try {
         sample_report().write(target);
         FAIL("wrote under a regular file");
-    } catch (const io::report_error& e) {
+    } catch (const study::report_error& e) {
         CHECK(e.file() == target);
     }
 }
