@@ -138,6 +138,59 @@ struct lightmap_atlas {
         return uv;
     }
 
+    /// to_texels at 2^level times the atlas resolution, for atlases refined by adaptive
+    /// subdivision (radiosity_subdivision.hpp): an element of level l fills the 2^(level - l)
+    /// square of fine texels its cell covers (elements deeper than `level` are averaged,
+    /// area-weighted); fine texels no element covers (a chart's slanted edge, padding) take
+    /// their base texel's to_texels value. level = 0 is to_texels.
+    template <class T>
+    image<T> to_fine_texels(std::span<const T> values, int level, const T& background = T{}) const {
+        require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
+        const image<T> base = to_texels(values, background);
+        if (level == 0) return base;
+        const std::size_t f = std::size_t(1) << level;
+        const std::size_t w = base.width() * f, h = base.height() * f;
+        std::vector<T> sum(w * h, T{});
+        std::vector<float> weight(w * h, 0.f);
+        std::vector<std::int64_t> single(w * h, -1);  // the one element of a fine texel, or -2 for several
+        for (std::size_t k = 0; k < blocks(); ++k) {
+            const int l = block_level.empty() ? 0 : int(block_level[k]);
+            const double cells = std::ldexp(1.0, l);  // cells per base texel
+            for (std::uint32_t e = block_first[k]; e < block_first[k + 1]; ++e) {
+                const lightmap_chart& ch = charts[chart[e]];
+                const glm::vec3 d = position[e] - ch.origin;
+                const glm::dvec2 c(glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u),
+                                   glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v));
+                // The element's cell, clamped into its base texel (its centroid lies inside).
+                const glm::dvec2 in_texel = glm::clamp(c * cells - glm::dvec2(texel[e] - glm::uvec2(ch.atlas_x, ch.atlas_y)) * cells,
+                                                       glm::dvec2(0.0), glm::dvec2(cells - 1e-9));
+                const glm::uvec2 cell(glm::floor(in_texel));
+                // Fine texels per cell: f / 2^l (>= 1), or one fine texel shared by 2^(l - level)^2 cells.
+                const std::size_t span = l <= level ? f >> l : 1;
+                const std::size_t x0 = texel[e].x * f + (l <= level ? cell.x * span : cell.x >> (l - level));
+                const std::size_t y0 = texel[e].y * f + (l <= level ? cell.y * span : cell.y >> (l - level));
+                for (std::size_t y = y0; y < y0 + span; ++y)
+                    for (std::size_t x = x0; x < x0 + span; ++x) {
+                        sum[y * w + x] += values[e] * area[e];
+                        weight[y * w + x] += area[e];
+                        single[y * w + x] = single[y * w + x] == -1 ? std::int64_t(e) : -2;
+                    }
+            }
+        }
+        image<T> out(w, h, background);
+        for (std::size_t y = 0; y < h; ++y)
+            for (std::size_t x = 0; x < w; ++x) {
+                const std::size_t bx = x / f, by = y / f;
+                const std::int32_t e = bx < width && by < height ? element_at(bx, by) : -1;
+                if (e < 0) continue;
+                // Only a texel's own fine texels come from its elements; padding copies its source texel.
+                const bool own = texel[std::size_t(e)].x == bx && texel[std::size_t(e)].y == by;
+                const std::int64_t one = single[y * w + x];
+                out(x, y) = !own || one == -1 ? base(bx, by) : one >= 0 ? values[std::size_t(one)] : sum[y * w + x] / weight[y * w + x];
+            }
+        return out;
+    }
+
     /// A per-element quantity (per unit area, like a radiosity) laid out as the atlas: texel
     /// (x, y) holds the area-weighted mean of `values` over the elements in the base texel of
     /// element_at(x, y) (that element's own value unless its block was subdivided),

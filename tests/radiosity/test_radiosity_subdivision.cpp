@@ -38,7 +38,6 @@ TEST_CASE("splitting a leaf conserves each element's area and stays on its chart
         sum[p] += fine.area[i];
         CHECK(fine.chart[i] == atlas.chart[p]);
         CHECK(fine.texel[i] == atlas.texel[p]);  // a child lies in its parent's base texel
-        const auto& ch = fine.charts[fine.chart[i]];
         CHECK(std::abs(glm::dot(fine.position[i] - ch.origin, ch.normal)) < 1e-5f);
     }
     for (std::size_t e = 0; e < atlas.size(); ++e) CHECK(sum[e] == Approx(atlas.area[e]).epsilon(4 * 0x1p-24));
@@ -59,6 +58,41 @@ TEST_CASE("splitting a leaf conserves each element's area and stays on its chart
     const auto again = refine_lightmap_atlas(scene.view(), fine, first);
     CHECK(again.atlas.block_level[0] == 2);
     CHECK(again.atlas.blocks() >= fine.blocks() + 1);
+}
+
+TEST_CASE("fine lightmaps show each subdivided element in the cells it covers", "[radiosity][subdivision]") {
+    // A closed box (rectangular charts: every texel whole) with every leaf split once: at
+    // level 1 each fine texel is exactly its child element's value; at level 0 each base texel
+    // is the area-weighted mean of its children; level 2 repeats level 1 in 2 x 2 squares.
+    const auto box = closed_box(1.f, 0.5f, 1.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 300, .block_texels = 4});
+    std::vector<std::uint32_t> all(atlas.blocks());
+    std::iota(all.begin(), all.end(), 0u);
+    const auto fine = refine_lightmap_atlas(box.view(), atlas, all).atlas;
+    std::vector<float> v(fine.size());
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = float(i % 97) + 1.f;
+    const auto one = fine.to_fine_texels(std::span<const float>(v), 1);
+    const auto two = fine.to_fine_texels(std::span<const float>(v), 2);
+    const auto zero = fine.to_fine_texels(std::span<const float>(v), 0);
+    std::vector<int> hits(one.width() * one.height(), 0);
+    for (std::size_t i = 0; i < fine.size(); ++i) {
+        const glm::vec2 c = fine.atlas_coords(fine.chart[i], fine.position[i]) * 2.f;  // level-1 coordinates
+        const std::size_t x = std::size_t(c.x), y = std::size_t(c.y);
+        CHECK(one(x, y) == v[i]);
+        ++hits[y * one.width() + x];
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) CHECK(two(2 * x + std::size_t(dx), 2 * y + std::size_t(dy)) == v[i]);
+    }
+    for (const int h : hits) CHECK(h <= 1);
+    for (std::size_t e = 0; e < atlas.size(); ++e) {
+        double s = 0, a = 0;
+        for (std::size_t i = 0; i < fine.size(); ++i)
+            if (fine.texel[i] == atlas.texel[e]) {
+                s += double(v[i]) * fine.area[i];
+                a += fine.area[i];
+            }
+        CHECK(zero(atlas.texel[e].x, atlas.texel[e].y) == Approx(s / a).epsilon(1e-6));
+    }
 }
 
 TEST_CASE("the test splits the leaves a step crosses and leaves ramps alone", "[radiosity][subdivision]") {

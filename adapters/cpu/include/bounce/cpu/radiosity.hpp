@@ -198,11 +198,12 @@ public:
         return out;
     }
 
-    /// display_radiosity laid out as the atlas (lightmap_atlas::to_texels), for writing a
-    /// lightmap or texturing a view.
-    image<glm::vec3> lightmap() const {
+    /// display_radiosity laid out as the atlas at 2^level times its resolution
+    /// (lightmap_atlas::to_fine_texels; level > 0 shows what adaptive subdivision added), for
+    /// writing a lightmap or texturing a view.
+    image<glm::vec3> lightmap(int level = 0) const {
         const auto values = display_radiosity();
-        return atlas_.to_texels(std::span<const glm::vec3>(values));
+        return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level);
     }
 
     const radiosity_timings& timings() const noexcept { return timings_; }
