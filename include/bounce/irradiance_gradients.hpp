@@ -15,7 +15,7 @@
 /// Conventions (derived in docs/irradiance-splatting.md, tested in tests/core):
 ///  - rotation gradient grad_r: for a normal turned by a small angle alpha about a unit
 ///    tangent axis t, E changes by alpha * dot(t, grad_r); the new normal n satisfies
-///    n_k x n = alpha t, hence E(n) ~ E_k + dot(n_k x n, grad_r) (seed Algorithm 4).
+///    n_k x n = alpha t, hence E(n) ~ E_k + dot(n_k x n, grad_r) (Gautron 2008, Algorithm 4).
 ///  - translation gradient grad_t: E(p) ~ E_k + dot(p - p_k, grad_t).
 
 #include <bounce/errors.hpp>

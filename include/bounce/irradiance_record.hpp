@@ -1,7 +1,7 @@
 #pragma once
 /// \file irradiance_record.hpp
 /// Irradiance records: what a record holds, how it extrapolates to a nearby point with its
-/// gradients (seed Algorithms 1 and 4), what it adds to the splat buffer, and how its
+/// gradients (Gautron 2008, Algorithms 1 and 4), what it adds to the splat buffer, and how its
 /// radius R is limited.
 
 #include <bounce/errors.hpp>
@@ -31,7 +31,7 @@ struct irradiance_record {
     float radius = 1.f;                         ///< R_k, world units, after every clamp
 };
 
-/// E_k(p) = E_k + (n_k x n) . grad_r + (p - p_k) . grad_t per channel (seed Algorithm 4),
+/// E_k(p) = E_k + (n_k x n) . grad_r + (p - p_k) . grad_t per channel (Gautron 2008, Algorithm 4),
 /// with the gradient term clamped to +-max_extrapolation * E_k per channel so that a record
 /// never extrapolates to negative or runaway irradiance far from where it was measured.
 /// Typical max_extrapolation: 1 (E_k(p) within [0, 2 E_k]).
@@ -67,7 +67,7 @@ auto record_in_front(const V& p, const V& n, const V& pk, const V& nk, T inv_r, 
     return dot(p - pk, n + nk) * inv_r < T(-2) * tolerance * a;
 }
 
-/// What record k adds to the splat buffer at a pixel (seed Algorithm 1): the weighted
+/// What record k adds to the splat buffer at a pixel (Gautron 2008, Algorithm 1): the weighted
 /// outgoing radiance w * (rho_d / pi) * E_k(p) in rgb and the weight w in the fourth
 /// component. `Weight` is a policy of weighting.hpp; `Gradients` is true to extrapolate
 /// with the record's gradients; `FrontTest` is true to apply record_in_front with
@@ -126,7 +126,7 @@ decltype(auto) with_kernel_flags(const splat_params& sp, F&& f) {
     return with_kernel_flags(sp.gradients, sp.front_test(), std::forward<F>(f));
 }
 
-/// Normalization of the splat buffer (seed Algorithm 5, last loop): sum / weight, black
+/// Normalization of the splat buffer (Gautron 2008, Algorithm 5, last loop): sum / weight, black
 /// where no record reached the pixel.
 template <real T, vec3_of<T> V>
 V normalized_splat(const V& sum, T weight) {

@@ -4,7 +4,7 @@
 /// to a surface point, without visibility (the caller multiplies by its shadow test:
 /// a shadow ray, a shadow map lookup).
 ///
-/// These are the only definitions of the light models of ../shared/scenes/README.md; the
+/// These are the only definitions of the light models of scene.json (docs/scenes.md); the
 /// reference integrator instantiates them with float/GLM and the GL passes print them as
 /// GLSL. Units: radiant intensity I in W/sr, radiance L in W/(m^2 sr), irradiance E in
 /// W/m^2, distances in scene units (metres by convention). RGB quantities are vectors of

@@ -1,10 +1,10 @@
 #pragma once
 /// \file splat_bounds.hpp
 /// The screen-space bounding box of a record's sphere of influence under a perspective
-/// camera (seed section 8.1: "determine the bounding box of I_k on the image plane").
+/// camera (Gautron 2008, section 8.1: "determine the bounding box of I_k on the image plane").
 ///
 /// Exact and conservative, including spheres that cross the near plane or contain the eye
-/// (where the seed's box of the sphere's silhouette square is wrong). Per axis, the sphere
+/// (where Gautron 2008's box of the sphere's silhouette square is wrong). Per axis, the sphere
 /// projects onto the plane spanned by that axis and the view axis as a disc; the slopes
 /// (lateral / depth) of the part of the disc in front of the near plane form an interval
 /// whose ends are either tangent points of lines through the eye or the ends of the chord

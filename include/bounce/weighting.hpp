@@ -1,6 +1,8 @@
 #pragma once
 /// \file weighting.hpp
-/// Weighting functions of irradiance caching, as policy types (seed 000, Eq. 8.2-8.4).
+/// Weighting functions of irradiance caching, as policy types (Ward et al. 1988; in the
+/// notation of Gautron 2008, "Hardware Implementation", ch. 8 of Krivanek et al., SIGGRAPH
+/// 2008 course Practical Global Illumination with Irradiance Caching, Eqs. 8.2-8.4).
 ///
 /// Each policy is a stateless type with
 ///  - `weight(p, n, pk, nk, inv_r, a)`: the weight of record k (position pk, unit normal nk,
@@ -12,7 +14,8 @@
 ///
 /// Two hazards every policy handles, because rounding makes both happen in practice:
 ///  - the singularity at p = pk, n = nk (1/0 in Ward's weight): the inverse weight is
-///    clamped to `inverse_weight_floor`, as the seed's shader clamps it to EPSILON;
+///    clamped to `inverse_weight_floor`, as Gautron 2008's shader (Algorithm 3) clamps it
+///    to EPSILON;
 ///  - n . nk slightly above or below 1 from rounding (unit vectors that are not quite unit):
 ///    the normal term allows for the rounding and clamps at 0, never NaN.
 
@@ -33,7 +36,7 @@ inline constexpr double inverse_weight_floor = 1e-4;
 /// ulps after normalize) have a dot product within ~5u of the exact one, u = 2^-24, so two
 /// copies of one normal can give 1 - n.nk = 6e-8 instead of 0. The square root turns that
 /// into 2.4e-4, above the inverse-weight floor: a record's weight at its own pixel would be
-/// 4089 on one backend and 9993 on another (seen between the CPU and GL splats on Sponza).
+/// 4089 on one backend and 9993 on another (docs/irradiance-splatting.md shows where).
 /// Below 8u = 2^-21 (0.056 degrees) normals count as equal.
 inline constexpr double normal_rounding = 0x1p-21;
 
@@ -44,7 +47,7 @@ T normal_divergence(const V& n, const V& nk) {
     return sqrt(max(T(0), T(1) - dot(n, nk) - T(normal_rounding)));
 }
 
-/// Ward et al. 1988 (seed Eq. 8.2 with the test 8.3): w = 1 / (|p - pk| / R_k + sqrt(1 - n.nk)),
+/// Ward et al. 1988 (Gautron 2008, Eq. 8.2 with the test 8.3): w = 1 / (|p - pk| / R_k + sqrt(1 - n.nk)),
 /// contributing where w >= 1/a. The zone of influence is the sphere of radius a R_k (Eq. 8.4).
 struct ward_weight {
     static constexpr const char* name = "ward";
@@ -62,7 +65,7 @@ struct ward_weight {
     static T influence_radius(T r, T a) { return a * r; }
 };
 
-/// The smoothed Ward weight (seed section 8.2): w - 1/a where w >= 1/a, so a record's
+/// The smoothed Ward weight (Gautron 2008, section 8.2): w - 1/a where w >= 1/a, so a record's
 /// contribution falls continuously to zero at the border of its zone and the circular seams
 /// of the plain test disappear. Same zone of influence as Ward's.
 struct ward_smooth_weight {
@@ -77,15 +80,17 @@ struct ward_smooth_weight {
     static T influence_radius(T r, T a) { return a * r; }
 };
 
-/// The seed's fragment-shader form (Algorithm 3): e1 = |p - pk|^2 / R_k^2,
+/// Ward's weight with an early rejection on squared terms, the fragment-shader form of
+/// Gautron 2008, Algorithm 3: e1 = |p - pk|^2 / R_k^2,
 /// e2 = c (1 - n.nk); reject early when e1 + e2 > a^2 (no square root needed: since
 /// (sqrt(e1) + sqrt(e2))^2 >= e1 + e2 the early test never rejects a contributing record),
 /// then w = 1 / (sqrt(e1) + sqrt(e2)) with the test w >= 1/a.
-/// The seed's shader uses c = 0.2 where Eq. 8.2 implies c = 1 (a slip noted in
-/// shared/seeds/README.md); `NormalScale` selects it: 1 (the default) reproduces Eq. 8.2
-/// exactly, 0.2 reproduces the shader.
+/// That shader uses c = 0.2 where Eq. 8.2 implies c = 1; `NormalScale` selects c: 1 (the
+/// default) reproduces Eq. 8.2 exactly, 1/5 the shader as printed (ward_scaled_normal_weight).
+/// Nothing here needs a GPU: the CPU runs it as well. `name` keeps the command-line and
+/// results spelling `ward-gpu`.
 template <int NormalScaleNumerator = 1, int NormalScaleDenominator = 1>
-struct gpu_ward_weight {
+struct ward_early_reject_weight {
     static constexpr const char* name = "ward-gpu";
     static constexpr double normal_scale = double(NormalScaleNumerator) / NormalScaleDenominator;
 
@@ -101,8 +106,9 @@ struct gpu_ward_weight {
     static T influence_radius(T r, T a) { return a * r; }
 };
 
-/// The seed shader's variant exactly as printed (normal term 0.2 (1 - n.nk)).
-using gpu_ward_shader_weight = gpu_ward_weight<1, 5>;
+/// Gautron 2008's Algorithm 3 exactly as printed: the normal term scaled to 0.2 (1 - n.nk)
+/// (command-line spelling `ward-gpu-shader`).
+using ward_scaled_normal_weight = ward_early_reject_weight<1, 5>;
 
 /// Tabellion and Lamorlette 2004: w = 1 - kappa max(|p - pk| / R_k, sqrt(1 - n.nk) /
 /// sqrt(1 - cos 10 deg)), kappa = 1/a, contributing where w > 0. R_k is the record's
@@ -123,7 +129,9 @@ struct tabellion_weight {
 };
 
 /// The weighting functions a program can choose at run time.
-enum class weighting_kind { ward, ward_smooth, ward_gpu, ward_gpu_shader, tabellion };
+/// Command-line spellings: ward, ward-smooth, ward-gpu (ward_early_reject), ward-gpu-shader
+/// (ward_scaled_normal), tabellion.
+enum class weighting_kind { ward, ward_smooth, ward_early_reject, ward_scaled_normal, tabellion };
 
 /// Calls `f(Policy{})` with the policy type for `k`, so run-time choices reach compile-time
 /// kernels: `with_weighting(k, [&](auto w) { splat<decltype(w)>(...); })`.
@@ -131,8 +139,8 @@ template <class F>
 decltype(auto) with_weighting(weighting_kind k, F&& f) {
     switch (k) {
         case weighting_kind::ward_smooth: return f(ward_smooth_weight{});
-        case weighting_kind::ward_gpu: return f(gpu_ward_weight<>{});
-        case weighting_kind::ward_gpu_shader: return f(gpu_ward_shader_weight{});
+        case weighting_kind::ward_early_reject: return f(ward_early_reject_weight<>{});
+        case weighting_kind::ward_scaled_normal: return f(ward_scaled_normal_weight{});
         case weighting_kind::tabellion: return f(tabellion_weight{});
         case weighting_kind::ward: break;
     }

@@ -54,7 +54,7 @@ float w_of(const query& q) {
 }  // namespace
 
 TEMPLATE_TEST_CASE("every weight is finite, non-negative and zero outside the zone of influence",
-                   "[weighting]", ward_weight, ward_smooth_weight, gpu_ward_weight<>, gpu_ward_shader_weight,
+                   "[weighting]", ward_weight, ward_smooth_weight, ward_early_reject_weight<>, ward_scaled_normal_weight,
                    tabellion_weight) {
     static const auto qs = queries();
     const auto i = GENERATE(range<std::size_t>(0, 407));
@@ -88,7 +88,7 @@ TEST_CASE("Ward's weight is 1/inverse weight, contributes exactly where w >= 1/a
     else CHECK(ws == 0.f);
     // The GPU form with the normal scale of Eq. 8.2 is the same function: its early
     // rejection e1 + e2 > a^2 never removes a contributing record.
-    const float wg = w_of<gpu_ward_weight<>>(q);
+    const float wg = w_of<ward_early_reject_weight<>>(q);
     if (std::abs(inv - q.a) > 1e-5 * q.a) CHECK(wg == Approx(w).epsilon(1e-5));
 }
 
@@ -104,7 +104,7 @@ TEST_CASE("equal normals give the capped weight at a record's own position, what
         const float cap = float(1 / inverse_weight_floor);
         REQUIRE(ward_weight::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap);
         REQUIRE(ward_smooth_weight::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap - 1.f / a);
-        REQUIRE(gpu_ward_weight<>::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap);
+        REQUIRE(ward_early_reject_weight<>::weight<float, glm::vec3>(p, n, p, nk, 1.f / r, a) == cap);
         REQUIRE(normal_divergence<float, glm::vec3>(n, nk) == 0.f);
         // In double the same holds, and a real divergence of 0.1 degrees still counts.
         REQUIRE(normal_divergence<double, glm::dvec3>(glm::dvec3(n), glm::normalize(glm::dvec3(nk))) == 0.0);

@@ -99,8 +99,8 @@ TEST_CASE("each lane of the four-lane splat kernel is bitwise the scalar float k
     const float front = seed % 3 == 0 ? 1.f : seed % 3 == 1 ? 0.f : 0.3f * rng.next_float();
     check_policy<ward_weight>(in, a, max_extrapolation, front);
     check_policy<ward_smooth_weight>(in, a, max_extrapolation, front);
-    check_policy<gpu_ward_weight<>>(in, a, max_extrapolation, front);
-    check_policy<gpu_ward_shader_weight>(in, a, max_extrapolation, front);
+    check_policy<ward_early_reject_weight<>>(in, a, max_extrapolation, front);
+    check_policy<ward_scaled_normal_weight>(in, a, max_extrapolation, front);
     check_policy<tabellion_weight>(in, a, max_extrapolation, front);
 }
 

@@ -237,7 +237,7 @@ TEST_CASE("octree lookups give the splat buffer's values on the same records", "
 }
 
 TEMPLATE_TEST_CASE("the octree's four-lane lookups equal its scalar lookups bit for bit", "[octree][cpu][lanes]",
-                   ward_weight, ward_smooth_weight, gpu_ward_shader_weight, tabellion_weight) {
+                   ward_weight, ward_smooth_weight, ward_scaled_normal_weight, tabellion_weight) {
     plane_view v(80, 60);
     pcg32 rng(std::uint64_t(GENERATE(1, 2, 3)));
     cpu::splat_params sp;

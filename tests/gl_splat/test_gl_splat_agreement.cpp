@@ -160,7 +160,7 @@ pixel_bounds bounds_for(const gbuffer_view<float>& gb, const std::vector<irradia
     pixel_bounds b{image<glm::vec4>(W, H, glm::vec4(0.f)), image<unsigned char>(W, H, 0)};
     const bool tabellion = kind == weighting_kind::tabellion;
     const bool jumps = !tabellion && kind != weighting_kind::ward_smooth;
-    const double normal_scale = kind == weighting_kind::ward_gpu_shader ? gpu_ward_shader_weight::normal_scale : 1.0;
+    const double normal_scale = kind == weighting_kind::ward_scaled_normal ? ward_scaled_normal_weight::normal_scale : 1.0;
     const double ulp = std::ldexp(1.0, -24), a = sp.a;
     const double tabellion_limit = std::sqrt(1.0 - std::cos(10.0 * std::numbers::pi / 180.0));
     for (std::size_t y = 0; y < H; ++y)
@@ -227,8 +227,8 @@ TEST_CASE("GL and CPU splat buffers agree for every weighting policy, with and w
     gl_test::shared_context();
     static plane_view v;
     static const auto recs = test_records(v);
-    const auto kind = GENERATE(weighting_kind::ward, weighting_kind::ward_smooth, weighting_kind::ward_gpu,
-                               weighting_kind::ward_gpu_shader, weighting_kind::tabellion);
+    const auto kind = GENERATE(weighting_kind::ward, weighting_kind::ward_smooth, weighting_kind::ward_early_reject,
+                               weighting_kind::ward_scaled_normal, weighting_kind::tabellion);
     const bool gradients = GENERATE(true, false);
     const float a = GENERATE(0.15f, 0.4f);
     // Ward's in-front test off, and on: the records sit up to 0.1 off the plane, so it cuts.

@@ -160,8 +160,8 @@ std::vector<direct_light::light_entry> direct_light::prepare(const scene_view& s
             // Seen from outside the scene's bounding sphere, the map spans the rectangle the
             // box's corners project to across the light (1% to spare, and 3 texels for the
             // PCF footprint as for spot maps). For a sun that is not along a diagonal this is
-            // well inside the sphere's disc: Sponza's texels shrink from 1.03 cm to 0.91 x
-            // 0.54 cm.
+            // well inside the sphere's disc, so the texels are smaller (docs/hemisphere-sampling.md
+            // measures it).
             const glm::vec3 centre = 0.5f * (lo + hi);
             const float r = std::max(0.505f * glm::length(hi - lo), 1e-3f);
             const glm::mat4 view = glm::lookAt(centre - 2.f * r * vector, centre, up_for(vector));

@@ -33,7 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::size_t max_obj_bytes = std::size_t(2) << 30;  // 2 GiB: far beyond Sponza's 7.6 MB
+constexpr std::size_t max_obj_bytes = std::size_t(2) << 30;  // 2 GiB: far beyond any mesh the docs use (7.6 MB)
 constexpr std::size_t max_mtl_bytes = std::size_t(64) << 20;
 // tinyobjloader's ear clipping costs up to O(n^3) for an n-gon; 256 keeps the worst face
 // below a millisecond and is far above what modelling tools write.

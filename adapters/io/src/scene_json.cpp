@@ -1,4 +1,4 @@
-// scene.json (../shared/scenes/README.md, docs/scenes.md) through nlohmann-json.
+// scene.json (docs/scenes.md) through nlohmann-json.
 //
 // Every fault names the file and the field as a path ("lights[0].intensity"); syntax errors
 // name the line. The whole JSON is checked before the OBJ is read, so a typo costs no

@@ -1,7 +1,7 @@
 #pragma once
 /// \file batched_scan.hpp
 /// The cache-miss scan with records measured ahead, in parallel, and the same result as the
-/// sequential scan (seed Algorithm 5, step 4).
+/// sequential scan (Gautron 2008, Algorithm 5, step 4).
 ///
 /// The sequential scan cannot run two records at once: each record is splatted before the
 /// next pixel is tested, so whether a later pixel is a miss depends on every record before

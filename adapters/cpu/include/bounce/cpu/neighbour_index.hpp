@@ -7,11 +7,12 @@
 /// expression is evaluated for every record that could lower the minimum, and a subtree is
 /// skipped only when box distance + smallest radius proves none of its records can.
 ///
-/// Why it matters: in detailed scenes (Sponza) a thin strip of bright indirect light (the
+/// Why it matters: in detailed scenes a thin strip of bright indirect light (the
 /// rim of an arch beside a crack, a contact) is found by one record with a tiny R, while
 /// records around it with R near 1 claim the strip's pixels and hide it. Clamping every
 /// later record against the small one lets the scan find the strip; the linear loop makes
-/// that O(N^2) per frame, which at 100,000 records costs more than the records.
+/// that O(N^2) per frame, which at 100,000 records costs more than the records
+/// (docs/irradiance-splatting.md shows such a strip and the cost).
 
 #include <bounce/errors.hpp>
 #include <bounce/irradiance_record.hpp>

@@ -1,6 +1,6 @@
 #pragma once
 /// \file splatting.hpp
-/// Irradiance splatting on the CPU (seed Algorithms 1 and 5): splat records onto a splat
+/// Irradiance splatting on the CPU (Gautron 2008, Algorithms 1 and 5): splat records onto a splat
 /// buffer, scan it for cache misses, normalize and compose.
 ///
 /// The splat buffer holds (sum of w * rho_d/pi * E_k(p) in rgb, sum of w) per pixel as
@@ -163,7 +163,7 @@ inline void splat_into(const gbuffer_view<float>& gb, const irradiance_record& r
 }
 }  // namespace detail
 
-/// Splats one record (seed Algorithm 1) onto `out`, sequentially. Used by the cache-miss
+/// Splats one record (Gautron 2008, Algorithm 1) onto `out`, sequentially. Used by the cache-miss
 /// scan, where each new record must be visible to the next pixel at once. Returns the
 /// pixel rectangle it touched (empty when the zone is off screen).
 template <class Weight>
@@ -235,13 +235,13 @@ inline std::vector<std::uint32_t> coarse_to_fine_order(std::size_t width, std::s
     return order;
 }
 
-/// The cache-miss scan (seed Algorithm 5, step 4): visits covered pixels in `order` (row
+/// The cache-miss scan (Gautron 2008, Algorithm 5, step 4): visits covered pixels in `order` (row
 /// by row when empty; any permutation of pixel indices y * width + x otherwise), and where
 /// the accumulated weight is below `min_weight` asks `create(x, y)` for a record
 /// (std::optional<irradiance_record>; nullopt skips the pixel), appends it to `records` and
 /// splats it at once so later pixels see it. Stops after `max_new` records (progressive
 /// mode). Returns the number of records created.
-/// The seed tests the weight sum against a itself (Eq. 8.8); pass `min_weight = a` for that.
+/// Gautron 2008 tests the weight sum against a itself (Eq. 8.8); pass `min_weight = a` for that.
 template <class Weight, class Create>
 std::size_t scan_cache_misses(const gbuffer_view<float>& gb, const camera& cam, const splat_params& sp,
                               float min_weight, Create&& create, std::vector<irradiance_record>& records,
@@ -277,7 +277,7 @@ void for_each_pixel(std::size_t width, std::size_t height, F&& f) {
 }
 }  // namespace detail
 
-/// Normalization (seed Algorithm 5, last loop): indirect radiance = sum / weight, 0 where
+/// Normalization (Gautron 2008, Algorithm 5, last loop): indirect radiance = sum / weight, 0 where
 /// no record reached the pixel.
 inline void normalize_splats(image_view<const glm::vec4> splat, image_view<glm::vec3> indirect) {
     require(splat.width() == indirect.width() && splat.height() == indirect.height(), "indirect",

@@ -1,7 +1,7 @@
 #pragma once
 /// \file hemisphere_raster.hpp
-/// Hemisphere sampling by rasterization onto one plane per record (seed 000, section 8.4),
-/// many records per batch in an atlas of planes, with the two summations the seed weighs:
+/// Hemisphere sampling by rasterization onto one plane per record (Gautron 2008, section 8.4),
+/// many records per batch in an atlas of planes, with the two summations Gautron 2008 weighs:
 /// read-back through pixel buffer objects and a CPU sum (cpu::estimate_plane), or a reduction on
 /// the GPU (a compute shader running the emitted plane_pixel_terms kernel).
 ///

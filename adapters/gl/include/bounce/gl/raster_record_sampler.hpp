@@ -1,6 +1,6 @@
 #pragma once
 /// \file raster_record_sampler.hpp
-/// Irradiance records by single-plane rasterization (seed section 8.4): the record sampler
+/// Irradiance records by single-plane rasterization (Gautron 2008, section 8.4): the record sampler
 /// interface of embree::record_sampler,
 ///   std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint),
 /// over gl::hemisphere_raster with border-stretching weights and the GPU reduction.
