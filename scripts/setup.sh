@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake ninja-build pkg-config git
   libglm-dev libembree-dev libtbb-dev
-  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri
+  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev
   catch2 libopenimageio-dev openimageio-tools libtinyobjloader-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   python3 python3-matplotlib
 )

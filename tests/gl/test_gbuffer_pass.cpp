@@ -8,9 +8,8 @@
 
 #include <bounce/gl/gbuffer_pass.hpp>
 
-#define GL_GLEXT_PROTOTYPES
-#include <GL/glcorearb.h>
 
+#include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)
 #include <catch2/catch.hpp>
 #include <glm/glm.hpp>
 

@@ -41,9 +41,8 @@
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/sampling.hpp>
 
-#define GL_GLEXT_PROTOTYPES
-#include <GL/glcorearb.h>
 
+#include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)
 #include <catch2/catch.hpp>
 
 #include <cmath>

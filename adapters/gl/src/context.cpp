@@ -2,10 +2,9 @@
 // Mesa's surfaceless platform; the first that yields a context wins.
 #include <bounce/gl/context.hpp>
 
-#define GL_GLEXT_PROTOTYPES
+#include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
-#include <GL/glcorearb.h>
 
 #include <cstring>
 #include <string_view>

@@ -1,8 +1,8 @@
 #pragma once
 // Save-and-restore of the context state a pass changes, so the adapter works inside a
 // renderer's own context without disturbing it (private to the adapter).
-#define GL_GLEXT_PROTOTYPES
-#include <GL/glcorearb.h>
+
+#include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)
 
 #include <array>
 #include <vector>
