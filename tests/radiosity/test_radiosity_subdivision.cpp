@@ -38,6 +38,7 @@ TEST_CASE("splitting a leaf conserves each element's area and stays on its chart
         sum[p] += fine.area[i];
         CHECK(fine.chart[i] == atlas.chart[p]);
         CHECK(fine.texel[i] == atlas.texel[p]);  // a child lies in its parent's base texel
+        const auto& ch = fine.charts[fine.chart[i]];
         CHECK(std::abs(glm::dot(fine.position[i] - ch.origin, ch.normal)) < 1e-5f);
     }
     for (std::size_t e = 0; e < atlas.size(); ++e) CHECK(sum[e] == Approx(atlas.area[e]).epsilon(4 * 0x1p-24));
