@@ -7,17 +7,19 @@
 /// c_i = sum over texels of table_i(texel) f(texel).
 ///
 /// How the product is laid out for the memory system:
-/// - The table is stored per face row and coefficient with each weight repeated for the r,
-///   g and b floats of its texel, so a row of packed RGB texels multiplies the table row
-///   float by float (no de-interleaving); float j of a row belongs to channel j mod 3, and
-///   three 8-float accumulators per coefficient cover the period of 24 floats (8 texels).
+/// - A block of rows of each map is first split into r, g and b planes (two blends and a
+///   permutation per 8 texels on AVX2), so each weight of the table is loaded once and used
+///   for three channels: per 8 texels 9 weight loads, 3 plane loads and 27 fused
+///   multiply-adds, the minimum for 9 coefficients x 3 channels. (A table with each weight
+///   repeated per channel, multiplying the interleaved texels directly, loads 3 times the
+///   bytes and was 10-20% slower.)
 /// - Maps are taken in groups (one TBB task each); the group walks the faces a few rows at
 ///   a time and projects those rows of every map in the group while the rows' table
-///   (4 x 9 x 192 floats = 28 KB for L = 3, size 64) stays in L1/L2. The table (2.7 MB at
-///   that size) is thus read from memory once per group, not once per map. Packed rows
-///   (stride = width) and the table's per-coefficient rows are contiguous, so a block is one
-///   long run for the vector loop rather than short rows.
-/// - On x86-64 with AVX2, FMA and F16C (checked at run time) the row products use 256-bit
+///   (16 x 9 x 64 floats = 37 KB for L = 3, size 64) stays in L1/L2 (blocks of 16 rows
+///   measured 1.0-1.2 Gtexel per CPU-second, 4 rows 0.7-0.8, 64 rows 0.8-0.9). The table
+///   (0.9 MB at that size) is thus read from memory once per group, not once per map. The table's rows of
+///   one coefficient are contiguous, so a block is one long run for the vector loop.
+/// - On x86-64 with AVX2, FMA and F16C (checked at run time) the products use 256-bit
 ///   fused multiply-adds, three coefficients at a time (nine accumulators in registers);
 ///   elsewhere a portable loop the compiler vectorizes for the baseline ISA. (A 512-bit
 ///   variant with all 27 accumulators in registers was slower on the AMD EPYC this was
@@ -112,7 +114,7 @@ template <int L>
 class cube_map_sh_projector {
 public:
     static constexpr std::size_t coefficients = sh_count(L);
-    static constexpr std::size_t rows_per_block = 4;  ///< face rows projected per table block
+    static constexpr std::size_t rows_per_block = 16;  ///< face rows projected per table block
     static constexpr std::size_t maps_per_task = 16;  ///< maps one TBB task projects together
 
     /// Tables for size x size faces (typical: 64; 1 to 4096). Throws parameter_error naming
@@ -121,22 +123,22 @@ public:
         : size_(size), avx2_(path == sh_projection_path::automatic && cpu_has_avx2_fma()) {
         static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "texel rows are read as packed floats");
         require(size >= 1 && size <= 4096, "size", "cube-map size must be 1 to 4096 texels");
-        const std::size_t row = 3 * size_;
-        table_.assign(6 * size_ * coefficients * row, 0.f);
+        // 8 floats of padding: a block whose texel count is not a multiple of 8 reads up
+        // to 7 weights past its end, multiplied by the zero padding of the planar texels.
+        table_.assign(6 * coefficients * size_ * size_ + 8, 0.f);
         for (int f = 0; f < 6; ++f)
             for (std::size_t y = 0; y < size_; ++y)
                 for (std::size_t x = 0; x < size_; ++x) {
                     const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face(f), size_, x, y));
                     const double dw = cube_texel_solid_angle(size_, x, y);
-                    for (std::size_t i = 0; i < coefficients; ++i)
-                        for (std::size_t c = 0; c < 3; ++c) table_[table_row(std::size_t(f), y, i) + 3 * x + c] = float(basis[i] * dw);
+                    for (std::size_t i = 0; i < coefficients; ++i) table_[table_row(std::size_t(f), y, i) + x] = float(basis[i] * dw);
                 }
     }
 
     std::size_t size() const noexcept { return size_; }
     /// The row product that runs: "avx2" or "portable".
     const char* path_name() const noexcept { return avx2_ ? "avx2" : "portable"; }
-    /// Bytes of the tables (4 x 3 x 6 size^2 L^2).
+    /// Bytes of the table (4 x 6 size^2 L^2).
     std::size_t table_bytes() const noexcept { return table_.size() * sizeof(float); }
 
     /// SH coefficients of every map of `maps` into `out` (one per map), in parallel over
@@ -174,8 +176,8 @@ public:
     }
 
 private:
-    static constexpr std::size_t lanes = 24;       // floats per accumulator period: 8 texels x 3 channels
-    static constexpr std::size_t acc_stride = 24;  // accumulator floats per coefficient
+    // Accumulators per coefficient: 8 lanes of red, 8 of green, 8 of blue.
+    static constexpr std::size_t acc_stride = 24;
 
     static bool cpu_has_avx2_fma() noexcept {
 #if BOUNCE_SH_PROJECTION_AVX2
@@ -185,104 +187,108 @@ private:
 #endif
     }
 
-
-    // Table layout [face][coefficient][row][3 size]: one coefficient's rows follow each
-    // other, so a block of packed rows multiplies one contiguous run of the table.
+    // Table layout [face][coefficient][row][size]: one coefficient's rows follow each
+    // other, so a block of rows is one contiguous run of weights.
     std::size_t table_row(std::size_t face, std::size_t y, std::size_t i) const noexcept {
-        return ((face * coefficients + i) * size_ + y) * 3 * size_;
-    }
-    // Rows of a view with stride == width are contiguous: a block of them is one run.
-    template <class Texel>
-    std::size_t rows_per_run(const image_view<const Texel>& v, std::size_t y0, std::size_t y1) const noexcept {
-        return v.stride() == size_ ? y1 - y0 : 1;
+        return ((face * coefficients + i) * size_ + y) * size_;
     }
 
-    // acc[i * 24 + j] += sum over steps s of table_i[24 s + j] * row[24 s + j], for the
-    // rows [y0, y1) of one face; a partial last step fills lanes 0 .. tail - 1.
+    // The block's texels as three planes (r, g, b), each `stride` floats apart, zero-padded
+    // to a multiple of 8 texels.
     template <class Texel>
-    void accumulate_portable(const image_view<const Texel>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
-                             float* acc) const {
-        const std::size_t run = rows_per_run(face_view, y0, y1), floats = 3 * size_ * run;
-        std::vector<float> converted;
-        if constexpr (std::is_same_v<Texel, half_rgb>) converted.resize(floats);
-        for (std::size_t y = y0; y < y1; y += run) {
-            const float* row = nullptr;
+    static void deinterleave_portable(const Texel* src, std::size_t texels, float* r, float* g, float* b) {
+        for (std::size_t x = 0; x < texels; ++x) {
             if constexpr (std::is_same_v<Texel, half_rgb>) {
-                const half_rgb* h = &face_view(0, y);
-                for (std::size_t x = 0; x < size_ * run; ++x)
-                    for (std::size_t c = 0; c < 3; ++c) converted[3 * x + c] = half_to_float(h[x].bits[c]);
-                row = converted.data();
+                r[x] = half_to_float(src[x].bits[0]);
+                g[x] = half_to_float(src[x].bits[1]);
+                b[x] = half_to_float(src[x].bits[2]);
             } else {
-                row = &face_view(0, y).x;
+                r[x] = src[x].x;
+                g[x] = src[x].y;
+                b[x] = src[x].z;
             }
-            for (std::size_t i = 0; i < coefficients; ++i) {
-                const float* t = table_.data() + table_row(face, y, i);
-                float* a = acc + i * acc_stride;
-                std::size_t s = 0;
-                for (; s + lanes <= floats; s += lanes)
-                    for (std::size_t j = 0; j < lanes; ++j) a[j] += t[s + j] * row[s + j];
-                for (std::size_t j = 0; s + j < floats; ++j) a[j] += t[s + j] * row[s + j];
-            }
+        }
+    }
+
+    // acc[i][c][lane] += sum over x = lane (mod 8) of w_i[x] plane_c[x] over `padded` texels.
+    void accumulate_portable(const float* planes, std::size_t stride, std::size_t padded, std::size_t face, std::size_t y0,
+                             float* acc) const {
+        for (std::size_t i = 0; i < coefficients; ++i) {
+            const float* w = table_.data() + table_row(face, y0, i);
+            // Local accumulators: through `acc` the compiler must assume they alias the
+            // table and the planes, and would load and store them every step.
+            float a[acc_stride];
+            std::copy_n(acc + i * acc_stride, acc_stride, a);
+            for (std::size_t x = 0; x < padded; x += 8)
+                for (std::size_t c = 0; c < 3; ++c)
+                    for (std::size_t lane = 0; lane < 8; ++lane) a[8 * c + lane] += w[x + lane] * planes[c * stride + x + lane];
+            std::copy_n(a, acc_stride, acc + i * acc_stride);
         }
     }
 
 #if BOUNCE_SH_PROJECTION_AVX2
-    // The same sums with 256-bit FMAs, G coefficients (3 G accumulators) at a time; half
-    // texels are widened to float in registers.
-    template <class Texel>
-    __attribute__((target("avx2,fma,f16c"))) static __m256 load8(const Texel* row, std::size_t s) {
-        if constexpr (std::is_same_v<Texel, half_rgb>)
-            return _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(reinterpret_cast<const std::uint16_t*>(row) + s)));
-        else
-            return _mm256_loadu_ps(&row->x + s);
+    // Eight interleaved RGB texels (three vectors) into r, g, b vectors: two blends pick
+    // each channel's lanes, one permutation puts them in texel order.
+    __attribute__((target("avx2,fma,f16c"))) static void deinterleave8(__m256 a, __m256 b, __m256 c, float* r, float* g,
+                                                                       float* bl) {
+        const __m256 rr = _mm256_blend_ps(_mm256_blend_ps(a, b, 0b10010010), c, 0b00100100);
+        const __m256 gg = _mm256_blend_ps(_mm256_blend_ps(a, b, 0b00100100), c, 0b01001001);
+        const __m256 bb = _mm256_blend_ps(_mm256_blend_ps(a, b, 0b01001001), c, 0b10010010);
+        _mm256_storeu_ps(r, _mm256_permutevar8x32_ps(rr, _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5)));
+        _mm256_storeu_ps(g, _mm256_permutevar8x32_ps(gg, _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6)));
+        _mm256_storeu_ps(bl, _mm256_permutevar8x32_ps(bb, _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7)));
     }
 
-    template <std::size_t G, class Texel>
-    __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const image_view<const Texel>& face_view,
-                                                                         std::size_t face, std::size_t y0, std::size_t y1,
-                                                                         std::size_t first, float* acc) const {
-        const std::size_t run = rows_per_run(face_view, y0, y1), floats = 3 * size_ * run;
-        __m256 a[G][3];
-        for (std::size_t g = 0; g < G; ++g)
-            for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_loadu_ps(acc + (first + g) * acc_stride + 8 * v);
-        for (std::size_t y = y0; y < y1; y += run) {
-            const Texel* row = &face_view(0, y);
-            const float* t[G];
-            for (std::size_t g = 0; g < G; ++g) t[g] = table_.data() + table_row(face, y, first + g);
-            std::size_t s = 0;
-            for (; s + lanes <= floats; s += lanes) {
-                const __m256 d0 = load8(row, s), d1 = load8(row, s + 8), d2 = load8(row, s + 16);
-                for (std::size_t g = 0; g < G; ++g) {
-                    a[g][0] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s), d0, a[g][0]);
-                    a[g][1] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s + 8), d1, a[g][1]);
-                    a[g][2] = _mm256_fmadd_ps(_mm256_loadu_ps(t[g] + s + 16), d2, a[g][2]);
-                }
+    template <class Texel>
+    __attribute__((target("avx2,fma,f16c"))) static void deinterleave_avx2(const Texel* src, std::size_t texels, float* r,
+                                                                           float* g, float* b) {
+        std::size_t x = 0;
+        for (; x + 8 <= texels; x += 8) {
+            if constexpr (std::is_same_v<Texel, half_rgb>) {
+                const auto* h = reinterpret_cast<const __m128i*>(src + x);
+                deinterleave8(_mm256_cvtph_ps(_mm_loadu_si128(h)), _mm256_cvtph_ps(_mm_loadu_si128(h + 1)),
+                              _mm256_cvtph_ps(_mm_loadu_si128(h + 2)), r + x, g + x, b + x);
+            } else {
+                const float* f = &src[x].x;
+                deinterleave8(_mm256_loadu_ps(f), _mm256_loadu_ps(f + 8), _mm256_loadu_ps(f + 16), r + x, g + x, b + x);
             }
-            if (s < floats) {  // a partial period: the remaining floats into lanes 0 .. floats - s - 1
-                alignas(32) float tail[G][lanes] = {};
-                for (std::size_t j = 0; s + j < floats; ++j) {
-                    float value = 0;
-                    if constexpr (std::is_same_v<Texel, half_rgb>) value = half_to_float(row[(s + j) / 3].bits[(s + j) % 3]);
-                    else value = (&row->x)[s + j];
-                    for (std::size_t g = 0; g < G; ++g) tail[g][j] = t[g][s + j] * value;
-                }
-                for (std::size_t g = 0; g < G; ++g)
-                    for (std::size_t v = 0; v < 3; ++v) a[g][v] = _mm256_add_ps(a[g][v], _mm256_load_ps(tail[g] + 8 * v));
+        }
+        deinterleave_portable(src + x, texels - x, r + x, g + x, b + x);
+    }
+
+    // The products with 256-bit FMAs, G coefficients at a time: 3 G accumulators, the three
+    // planes and one weight vector in registers (13 of 16 for G = 3).
+    template <std::size_t G>
+    __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const float* planes, std::size_t stride,
+                                                                         std::size_t padded, std::size_t face, std::size_t y0,
+                                                                         std::size_t first, float* acc) const {
+        __m256 a[G][3];
+        const float* w[G];
+        for (std::size_t g = 0; g < G; ++g) {
+            w[g] = table_.data() + table_row(face, y0, first + g);
+            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm256_loadu_ps(acc + (first + g) * acc_stride + 8 * c);
+        }
+        for (std::size_t x = 0; x < padded; x += 8) {
+            const __m256 r = _mm256_loadu_ps(planes + x), gr = _mm256_loadu_ps(planes + stride + x),
+                         b = _mm256_loadu_ps(planes + 2 * stride + x);
+            for (std::size_t g = 0; g < G; ++g) {
+                const __m256 weight = _mm256_loadu_ps(w[g] + x);
+                a[g][0] = _mm256_fmadd_ps(weight, r, a[g][0]);
+                a[g][1] = _mm256_fmadd_ps(weight, gr, a[g][1]);
+                a[g][2] = _mm256_fmadd_ps(weight, b, a[g][2]);
             }
         }
         for (std::size_t g = 0; g < G; ++g)
-            for (std::size_t v = 0; v < 3; ++v) _mm256_storeu_ps(acc + (first + g) * acc_stride + 8 * v, a[g][v]);
+            for (std::size_t c = 0; c < 3; ++c) _mm256_storeu_ps(acc + (first + g) * acc_stride + 8 * c, a[g][c]);
     }
 
-    template <class Texel>
-    void accumulate_avx2(const image_view<const Texel>& face_view, std::size_t face, std::size_t y0, std::size_t y1,
+    void accumulate_avx2(const float* planes, std::size_t stride, std::size_t padded, std::size_t face, std::size_t y0,
                          float* acc) const {
         std::size_t i = 0;
-        for (; i + 3 <= coefficients; i += 3) accumulate_group_avx2<3>(face_view, face, y0, y1, i, acc);
-        if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(face_view, face, y0, y1, i, acc);
-        if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(face_view, face, y0, y1, i, acc);
+        for (; i + 3 <= coefficients; i += 3) accumulate_group_avx2<3>(planes, stride, padded, face, y0, i, acc);
+        if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(planes, stride, padded, face, y0, i, acc);
+        if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(planes, stride, padded, face, y0, i, acc);
     }
-
 #endif
 
     template <class Texel>
@@ -291,10 +297,18 @@ private:
         const std::size_t count = end - begin;
         std::vector<float> acc(count * coefficients * acc_stride);
         std::vector<double> sums(count * coefficients * 3, 0.0);
+        // One block's texels as planes, padded to whole vectors with zeros.
+        const std::size_t stride = (rows_per_block * size_ + 7) / 8 * 8;
+        std::vector<float> planes(3 * stride, 0.f);
         for (std::size_t face = 0; face < 6; ++face) {
             std::fill(acc.begin(), acc.end(), 0.f);
             for (std::size_t y0 = 0; y0 < size_; y0 += rows_per_block) {
-                const std::size_t y1 = std::min(size_, y0 + rows_per_block);
+                const std::size_t y1 = std::min(size_, y0 + rows_per_block), texels = (y1 - y0) * size_;
+                const std::size_t padded = (texels + 7) / 8 * 8;
+                // A face's last block can be shorter than the others: zero its padding, which
+                // still holds texels of the block before.
+                for (std::size_t c = 0; c < 3; ++c)
+                    std::fill(planes.begin() + std::ptrdiff_t(c * stride + texels), planes.begin() + std::ptrdiff_t(c * stride + padded), 0.f);
                 for (std::size_t k = 0; k < count; ++k) {
                     const auto& face_view = maps[begin + k].faces[face];
                     float* a = acc.data() + k * coefficients * acc_stride;
@@ -305,31 +319,38 @@ private:
                             const char* next = reinterpret_cast<const char*>(&maps[begin + k + 1].faces[face](0, y));
                             for (std::size_t b = 0; b < sizeof(Texel) * size_; b += 64) __builtin_prefetch(next + b);
                         }
+                    // Packed rows (stride = width) are one run; otherwise row by row.
+                    const std::size_t run = face_view.stride() == size_ ? y1 - y0 : 1;
+                    for (std::size_t y = y0; y < y1; y += run) {
+                        const std::size_t at = (y - y0) * size_;
+                        float* r = planes.data() + at;
+#if BOUNCE_SH_PROJECTION_AVX2
+                        if (avx2_) {
+                            deinterleave_avx2(&face_view(0, y), run * size_, r, r + stride, r + 2 * stride);
+                            continue;
+                        }
+#endif
+                        deinterleave_portable(&face_view(0, y), run * size_, r, r + stride, r + 2 * stride);
+                    }
 #if BOUNCE_SH_PROJECTION_AVX2
                     if (avx2_) {
-                        accumulate_avx2(face_view, face, y0, y1, a);
+                        accumulate_avx2(planes.data(), stride, padded, face, y0, a);
                         continue;
                     }
 #endif
-                    accumulate_portable(face_view, face, y0, y1, a);
+                    accumulate_portable(planes.data(), stride, padded, face, y0, a);
                 }
             }
-            // Lane j of a period holds channel j mod 3 (periods start at a multiple of 3).
-            // Three local sums, not sums[... + j % 3]: that chains every addition through
-            // one memory location, which cost as much as a 16^2 face's products.
+            // Lanes [8c, 8c + 8) hold channel c.
             for (std::size_t k = 0; k < count; ++k)
                 for (std::size_t i = 0; i < coefficients; ++i) {
                     const float* a = acc.data() + (k * coefficients + i) * acc_stride;
-                    double r = 0, g = 0, b = 0;
-                    for (std::size_t j = 0; j < acc_stride; j += 3) {
-                        r += double(a[j]);
-                        g += double(a[j + 1]);
-                        b += double(a[j + 2]);
-                    }
                     double* sum = sums.data() + (k * coefficients + i) * 3;
-                    sum[0] += r;
-                    sum[1] += g;
-                    sum[2] += b;
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        double s = 0;
+                        for (std::size_t lane = 0; lane < 8; ++lane) s += double(a[8 * c + lane]);
+                        sum[c] += s;
+                    }
                 }
         }
         for (std::size_t k = 0; k < count; ++k)
