@@ -1,6 +1,8 @@
 // The raster G-buffer (OpenGL) and the ray-cast one (Embree) see the same surfaces through
 // the same pixel centres: they agree pixel by pixel except along silhouettes, where a
 // rasterizer's coverage rule and a ray's hit can pick different sides of an edge.
+#include "../skip.hpp"
+
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/gl/context.hpp>
@@ -61,7 +63,7 @@ TEST_CASE("raster and ray-cast G-buffers of the Cornell box agree on at least 99
 TEST_CASE("raster and ray-cast G-buffers of Sponza agree on at least 99% of pixels", "[gbuffer][gl][embree]") {
     const auto file = io::scenes_dir() / "sponza" / "scene.json";
     if (!std::filesystem::exists(file)) {
-        WARN("skipped: " << file << " not found (set BOUNCE_SCENES)");
+        bounce::test::skip(file.string() + " not found (set BOUNCE_SCENES)");
         return;
     }
     const auto a = compare(io::load_scene(file), 128, 96);
