@@ -11,7 +11,8 @@
 ///   1. splat the records the cache holds into a splat buffer (octree: insert them);
 ///   2. scan for cache misses, measuring a record at each with the sampler and splatting it
 ///      at once (cpu::scan_cache_misses[_batched]);
-///   3. splat every record again into a clean buffer (the seed's step 5) and normalize.
+///   3. splat every record again into a clean buffer (Gautron 2008, Algorithm 5, step 5)
+///      and normalize.
 /// The GL backend (gl::irradiance_splatter) does steps 1 and 3 on the GPU and asks the cache
 /// for step 2 alone (`scan`) on the splat buffer it read back, so both backends share one
 /// scan and one record list.
@@ -50,19 +51,19 @@ enum class cache_interpolation {
 /// How the cache-miss scan measures records.
 enum class scan_kind {
     batched,     ///< guesses later misses and measures them together; same records as sequential
-    sequential,  ///< one record at a time, as the seed's Algorithm 5 reads
+    sequential,  ///< one record at a time, as Gautron 2008's Algorithm 5 reads
 };
 
 /// The order in which the scan visits pixels.
 enum class scan_order {
-    linear,          ///< row by row (the seed's order)
+    linear,          ///< row by row (Gautron 2008's order)
     coarse_to_fine,  ///< a coarse grid first, then finer ones (coarse_to_fine_order): a budget spreads over the image
 };
 
 /// Everything a cache's frames depend on besides the G-buffer, camera and sampler.
 struct irradiance_cache_options {
     splat_params splat{};  ///< a (accuracy, typical 0.1-0.4), gradients, extrapolation clamp, in-front test
-    /// Cache-miss threshold on a pixel's weight sum; 0: a itself (the seed's Eq. 8.8).
+    /// Cache-miss threshold on a pixel's weight sum; 0: a itself (Gautron 2008, Eq. 8.8).
     float min_weight = 0.f;
     cache_interpolation interpolation = cache_interpolation::splat;
     scan_kind scan = scan_kind::batched;
