@@ -2,7 +2,7 @@
 """How far any choice of fall-off factor could take border stretching, from the per-point
 CSV of hemisphere_study (--points-csv, ray-cast sampler):
 
-    build/bin/hemisphere_study --scene ../shared/scenes/sponza/scene.json --points 10000 \\
+    build/bin/hemisphere_study --scene sponza --points 10000 \\
         --no-raster --points-csv build/points.csv
     /usr/bin/python3 docs/studies/hemisphere_band_oracle.py build/points.csv
 
