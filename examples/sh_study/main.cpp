@@ -11,6 +11,7 @@
 #include "../common/cli_number_checks.hpp"
 
 #include <bounce/cpu/sh_projection.hpp>
+#include <bounce/sh_gradients.hpp>
 #include <bounce/sh_irradiance.hpp>
 #include <bounce/sh_lights.hpp>
 #include <bounce/sh_projection.hpp>
@@ -228,6 +229,46 @@ json accuracy_table(const environment& env, std::size_t cube_size, std::index_se
     return json::array({accuracy_for_order<int(I) + 2>(env, raster)...});
 }
 
+// ---- gradients ---------------------------------------------------------------------------
+
+// Oat's extrapolation I + grad I . d against the probe re-projected at p + d, for a sphere
+// light of radius 0.5 m whose centre is 3 m above the probe (order 2). Errors are the largest
+// irradiance difference over 4096 normals, relative to the peak irradiance at p + d, for the
+// stale probe (no gradient) and the extrapolated one.
+json gradient_table() {
+    constexpr int L = 3;
+    const glm::dvec3 q(0, 0, 3);
+    const double radius = 0.5, step = 0.1;
+    auto probe_at = [&](const glm::dvec3& p) {
+        const glm::dvec3 d = q - p;
+        const double sin_alpha = radius / glm::length(d);
+        return sh_project_cone_light<L, glm::dvec3>(d, std::sqrt(1 - sin_alpha * sin_alpha), glm::dvec3(1.0));
+    };
+    const glm::dvec3 p(0.0);
+    const auto stale = probe_at(p);
+    const auto g = sh_translational_gradient<L, glm::dvec3>(probe_at, p, step);
+    json rows = json::array();
+    for (const glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(0, 0, 1)})
+        for (const double distance : {0.25, 0.5, 1.0}) {
+            const glm::dvec3 d = dir * distance;
+            const auto exact = probe_at(p + d), extrapolated = sh_extrapolate<L, glm::dvec3>(stale, g, d);
+            double peak = 0, err_stale = 0, err_extrapolated = 0;
+            for (std::size_t j = 0; j < 4096; ++j) {
+                const glm::dvec3 n = spherical_fibonacci_direction(j, 4096);
+                const double e = sh_irradiance<L, double, glm::dvec3>(exact, n).x;
+                peak = std::max(peak, e);
+                err_stale = std::max(err_stale, std::abs(sh_irradiance<L, double, glm::dvec3>(stale, n).x - e));
+                err_extrapolated = std::max(err_extrapolated, std::abs(sh_irradiance<L, double, glm::dvec3>(extrapolated, n).x - e));
+            }
+            rows.push_back({{"direction", dir.x > 0 ? "sideways" : "towards the light"},
+                            {"distance_m", distance},
+                            {"step_m", step},
+                            {"stale_max_rel", err_stale / peak},
+                            {"extrapolated_max_rel", err_extrapolated / peak}});
+        }
+    return rows;
+}
+
 // ---- timing ------------------------------------------------------------------------------
 
 // Wall-clock and process CPU time of one run. On a shared machine the wall clock includes
@@ -413,6 +454,12 @@ int main(int argc, char** argv) {
         }
     }
 
+    const json gradients = gradient_table();
+    fmt::print("gradients: sphere light r = 0.5 m, 3 m above the probe, order 2, step 0.1 m; max irradiance error / peak\n");
+    for (const auto& r : gradients)
+        fmt::print("  {:<18} d = {:.2f} m: stale probe {:.4f}, extrapolated {:.4f}\n", r["direction"].get<std::string>(),
+                   r["distance_m"].get<double>(), r["stale_max_rel"].get<double>(), r["extrapolated_max_rel"].get<double>());
+
     if (!json_path.empty()) {
         json report = {
             {"technique", "sh"},
@@ -439,6 +486,7 @@ int main(int argc, char** argv) {
                             {"half_projection_texels_per_cpu_s", per_s(texels, half_run.cpu_ms)}}},
             {"load_average", {{"before", load_before}, {"after", load_after}}},
             {"error", accuracy},
+            {"gradients", gradients},
             {"provenance", {{"cpu", cpu_model()}, {"cores", std::thread::hardware_concurrency()}, {"date", utc_now()},
                             {"commit", source_commit()}}},
         };
