@@ -144,3 +144,11 @@ TEST_CASE("sh_extrapolate (Oat's I + grad I . d) agrees on the GPU and the CPU",
             }
     }
 }
+
+TEST_CASE("the irradiance kernel prints as one GLSL function of nine radiance vectors and a normal", "[glsl][sh]") {
+    const std::string src = glsl::emit("sh_irradiance", sh_irradiance<L, f32, vec3>, "radiance", "n");
+    CHECK(src.rfind("vec3 sh_irradiance(vec3 radiance[9], vec3 n) {\n", 0) == 0);
+    // Bands with A_l = 0 print nothing; no trigonometry reaches the shader.
+    CHECK(src.find("sin(") == std::string::npos);
+    CHECK(src.find("cos(") == std::string::npos);
+}
