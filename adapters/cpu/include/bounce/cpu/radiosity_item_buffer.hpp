@@ -376,6 +376,9 @@ private:
             for (int m = 0; m < 3; ++m)
                 l[std::size_t(m)] =
                     to_shooter_frame<float, glm::vec3>(corners_[k][std::size_t(m)], shot_.position, t_, b_, shot_.axis);
+            // Wholly behind the shooter's plane (both projections clip at this height): unseen.
+            const float z_min = 1e-6f * diagonal_;
+            if (l[0].z < z_min && l[1].z < z_min && l[2].z < z_min) continue;
             local_.push_back(l);
             local_chart_.push_back(triangle_chart_[k]);
             // Its plane n . x = d in the shooter's frame, d >= 0.
