@@ -71,7 +71,8 @@ std::array<C, sh_count(L)> sh_extrapolate(const std::array<C, sh_count(L)>& c, c
     return out;
 }
 
-/// `sh_extrapolate` with a gradient from `sh_translational_gradient`.
+/// `sh_extrapolate` with a gradient from `sh_translational_gradient`, in double precision
+/// (`C` is double or glm::dvec3: GLM does not multiply a float vector by a double).
 template <int L, class C>
 sh_coefficients<L, C> sh_extrapolate(const sh_coefficients<L, C>& c, const sh_gradient<L, C>& g, const glm::dvec3& d) {
     return sh_extrapolate<L, double, glm::dvec3, C>(c, g.x, g.y, g.z, d);
