@@ -416,7 +416,7 @@ void direct_light::render(const gbuffer_textures& g) {
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     glUseProgram(radiance_program_.id());
     glBindVertexArray(empty_vao_.id());
-    const GLuint textures[3] = {g.position_depth->id(), g.normal->id(), g.albedo->id()};
+    const GLuint textures[3] = {g.position_depth.id, g.normal.id, g.albedo.id};
     for (GLuint u = 0; u < 3; ++u) {
         glBindTextureUnit(u, textures[u]);
         glBindSampler(u, 0);

@@ -235,14 +235,39 @@ texture::texture(texel_format format, std::size_t width, std::size_t height)
     check_error("glTextureStorage2D");
 }
 
-std::vector<float> texture::read_floats() const {
-    const bool single = format_ == texel_format::r32f || format_ == texel_format::depth32f;
-    const GLenum fmt = format_ == texel_format::depth32f ? GL_DEPTH_COMPONENT : single ? GL_RED : GL_RGBA;
-    std::vector<float> texels(width_ * height_ * (single ? 1 : 4));
+std::vector<float> texture::read_floats() const { return texture_ref(*this).read_floats(); }
+
+std::vector<float> texture_ref::read_floats() const {
+    const bool single = format == texel_format::r32f || format == texel_format::depth32f;
+    const GLenum fmt = format == texel_format::depth32f ? GL_DEPTH_COMPONENT : single ? GL_RED : GL_RGBA;
+    std::vector<float> texels(width * height * (single ? 1 : 4));
     const detail::pack_state pack;
-    glGetTextureImage(id(), 0, fmt, GL_FLOAT, GLsizei(texels.size() * sizeof(float)), texels.data());
+    glGetTextureImage(id, 0, fmt, GL_FLOAT, GLsizei(texels.size() * sizeof(float)), texels.data());
     check_error("glGetTextureImage");
     return texels;
+}
+
+texture_ref texture_ref::of(object_id id, const char* name) {
+    require_context();
+    if (!glIsTexture(id)) throw parameter_error(name, "is not a texture name");
+    GLint w = 0, h = 0, internal = 0;
+    glGetTextureLevelParameteriv(id, 0, GL_TEXTURE_WIDTH, &w);
+    glGetTextureLevelParameteriv(id, 0, GL_TEXTURE_HEIGHT, &h);
+    glGetTextureLevelParameteriv(id, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    check_error("glGetTextureLevelParameteriv");
+    texture_ref r;
+    r.id = id;
+    r.width = std::size_t(std::max(w, 0));
+    r.height = std::size_t(std::max(h, 0));
+    switch (internal) {
+        case GL_RGBA32F: r.format = texel_format::rgba32f; break;
+        case GL_R32F: r.format = texel_format::r32f; break;
+        case GL_RGBA8: r.format = texel_format::rgba8; break;
+        case GL_DEPTH_COMPONENT32F: r.format = texel_format::depth32f; break;
+        default: throw parameter_error(name, "has an internal format bounce does not read (RGBA32F, R32F, RGBA8, DEPTH32F)");
+    }
+    if (r.width == 0 || r.height == 0) throw parameter_error(name, "has no storage (zero size)");
+    return r;
 }
 
 framebuffer::framebuffer() {

@@ -75,8 +75,8 @@ gpu_record pack(const irradiance_record& r, std::size_t index) {
     return g;
 }
 
-void require_rgba32f(const texture& t, const char* name) {
-    require(t.format() == texel_format::rgba32f, name, "must be an RGBA32F texture");
+void require_rgba32f(const texture_ref& t, const char* name) {
+    require(t.format == texel_format::rgba32f, name, "must be an RGBA32F texture");
 }
 
 // Rows of `image` in GL order (row 0 at the bottom), tightly packed.
@@ -108,17 +108,17 @@ void main() {
 // ---- G-buffer textures ------------------------------------------------------------------
 
 void gbuffer_textures::validate() const {
-    require(position_depth && normal && albedo, "gbuffer", "a G-buffer texture is missing");
-    require(position_depth->format() == texel_format::rgba32f && normal->format() == texel_format::rgba32f &&
-                albedo->format() == texel_format::rgba32f,
+    require(position_depth.id != 0 && normal.id != 0 && albedo.id != 0, "gbuffer", "a G-buffer texture is missing");
+    require(position_depth.format == texel_format::rgba32f && normal.format == texel_format::rgba32f &&
+                albedo.format == texel_format::rgba32f,
             "gbuffer", "G-buffer textures must be RGBA32F");
-    require(normal->width() == width() && albedo->width() == width() && normal->height() == height() &&
-                albedo->height() == height(),
+    require(width() > 0 && height() > 0, "gbuffer", "G-buffer textures have no size");
+    require(normal.width == width() && albedo.width == width() && normal.height == height() && albedo.height == height(),
             "gbuffer", "G-buffer textures differ in size");
 }
 
 gbuffer_textures textures_of(const gbuffer_pass& pass) {
-    return {&pass.position_depth(), &pass.normal(), &pass.albedo()};
+    return {pass.position_depth(), pass.normal(), pass.albedo()};
 }
 
 void gbuffer_upload::upload(const gbuffer_view<float>& g) {
@@ -151,7 +151,7 @@ void gbuffer_upload::upload(const gbuffer_view<float>& g) {
 
 gbuffer_textures gbuffer_upload::textures() const {
     require(position_depth_.has_value(), "gbuffer_upload", "nothing uploaded yet");
-    return {&*position_depth_, &*normal_, &*albedo_};
+    return {*position_depth_, *normal_, *albedo_};
 }
 
 void read_gbuffer(const gbuffer_textures& g, gbuffer_view<float> out) {
@@ -162,9 +162,9 @@ void read_gbuffer(const gbuffer_textures& g, gbuffer_view<float> out) {
                 sized(out.albedo.width(), out.albedo.height()) && sized(out.depth.width(), out.depth.height()),
             "out", "G-buffer views differ in size from the textures");
     image<glm::vec4> position_depth(w, h);
-    read_texture(*g.position_depth, position_depth.view());
-    read_texture(*g.normal, out.normal);
-    read_texture(*g.albedo, out.albedo);
+    read_texture(g.position_depth, position_depth.view());
+    read_texture(g.normal, out.normal);
+    read_texture(g.albedo, out.albedo);
     for (std::size_t y = 0; y < h; ++y)
         for (std::size_t x = 0; x < w; ++x) {
             out.position(x, y) = glm::vec3(position_depth(x, y));
@@ -181,9 +181,9 @@ void write_texture(const texture& t, image_view<const glm::vec4> image) {
 namespace {
 // RGBA32F texels into the first Pixel::length() channels of `out`, rows flipped to top first.
 template <class Pixel>
-void read_texels(const texture& t, image_view<Pixel> out) {
+void read_texels(const texture_ref& t, image_view<Pixel> out) {
     require_rgba32f(t, "t");
-    require(out.width() == t.width() && out.height() == t.height(), "out", "size differs from the texture");
+    require(out.width() == t.width && out.height() == t.height, "out", "size differs from the texture");
     const auto f = t.read_floats();
     for (std::size_t y = 0; y < out.height(); ++y)
         for (std::size_t x = 0; x < out.width(); ++x) {
@@ -193,9 +193,9 @@ void read_texels(const texture& t, image_view<Pixel> out) {
 }
 }  // namespace
 
-void read_texture(const texture& t, image_view<glm::vec4> out) { read_texels(t, out); }
+void read_texture(const texture_ref& t, image_view<glm::vec4> out) { read_texels(t, out); }
 
-void read_texture(const texture& t, image_view<glm::vec3> out) { read_texels(t, out); }
+void read_texture(const texture_ref& t, image_view<glm::vec3> out) { read_texels(t, out); }
 
 // ---- splat_pass -------------------------------------------------------------------------
 
@@ -402,7 +402,7 @@ void splat_pass::splat(const gbuffer_textures& g, const camera& cam, const splat
     glVertexArrayVertexBuffer(record_vao_.id(), 0, records_->id(), 0, sizeof(gpu_record));
     glBindVertexArray(record_vao_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, records_->id());
-    const GLuint textures[3] = {g.position_depth->id(), g.normal->id(), g.albedo->id()};
+    const GLuint textures[3] = {g.position_depth.id, g.normal.id, g.albedo.id};
     for (GLuint u = 0; u < 3; ++u) {
         glBindTextureUnit(u, textures[u]);
         glBindSampler(u, 0);

@@ -157,6 +157,25 @@ private:
     std::size_t width_, height_;
 };
 
+/// A texture by name, owned by whoever made it (a renderer's own G-buffer target, or a
+/// bounce::gl::texture): passes read it and never delete it. It must outlive the use.
+struct texture_ref {
+    object_id id = 0;
+    texel_format format = texel_format::rgba32f;
+    std::size_t width = 0, height = 0;
+
+    texture_ref() = default;
+    /// A bounce texture.
+    texture_ref(const texture& t) noexcept  // NOLINT: implicit, so bounce textures pass as they are
+        : id(t.id()), format(t.format()), width(t.width()), height(t.height()) {}
+    /// A texture the caller made: its size and internal format are read from GL (a context
+    /// must be current). Throws parameter_error naming `name` when `id` is not a 2D texture
+    /// or its format is none of texel_format's.
+    static texture_ref of(object_id id, const char* name = "texture");
+    /// The texels as floats, in GL order, as texture::read_floats.
+    std::vector<float> read_floats() const;
+};
+
 /// A framebuffer object with textures attached.
 class framebuffer {
 public:

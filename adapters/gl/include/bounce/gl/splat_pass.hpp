@@ -40,16 +40,15 @@
 namespace bounce::gl {
 
 /// The three G-buffer textures a pass reads, in gbuffer_pass's layout (RGBA32F, GL row
-/// order): position (xyz) and depth (w, +infinity where no geometry), unit normal (xyz),
-/// diffuse reflectance (rgb). Borrowed: the textures must outlive the use.
+/// order): position (xyz) and depth along the view axis (w, +infinity where no geometry),
+/// unit normal facing the camera (xyz), diffuse reflectance (rgb). Borrowed: bounce
+/// textures or a renderer's own (texture_ref::of(name)); they must outlive the use.
 struct gbuffer_textures {
-    const texture* position_depth = nullptr;
-    const texture* normal = nullptr;
-    const texture* albedo = nullptr;
+    texture_ref position_depth, normal, albedo;
 
     /// Size in pixels (0 when position_depth is not set).
-    std::size_t width() const noexcept { return position_depth ? position_depth->width() : 0; }
-    std::size_t height() const noexcept { return position_depth ? position_depth->height() : 0; }
+    std::size_t width() const noexcept { return position_depth.width; }
+    std::size_t height() const noexcept { return position_depth.height; }
     /// Throws parameter_error (parameter "gbuffer") unless all three are set, RGBA32F and
     /// of one size.
     void validate() const;
@@ -85,9 +84,9 @@ private:
 void write_texture(const texture& t, image_view<const glm::vec4> image);
 /// Copies the RGBA32F texture `t` into `out` (row 0 at the top). Throws parameter_error on
 /// a size or format mismatch.
-void read_texture(const texture& t, image_view<glm::vec4> out);
+void read_texture(const texture_ref& t, image_view<glm::vec4> out);
 /// Copies the rgb of the RGBA32F texture `t` into `out` (row 0 at the top).
-void read_texture(const texture& t, image_view<glm::vec3> out);
+void read_texture(const texture_ref& t, image_view<glm::vec3> out);
 
 /// Parameters shared by every splat of a frame (irradiance_record.hpp).
 using bounce::splat_params;
