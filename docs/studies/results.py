@@ -13,8 +13,8 @@ study scripts add each run with
 
 which replaces a run of the same name (keeping the order of the others) and records the
 machine it ran on: CPU model and logical cores from /proc/cpuinfo, the GL renderer
-(`--gl-renderer`, else $BOUNCE_GL_RENDERER, else the renderer `eglinfo -B` names, else
-null), and the Embree ISA (the run's pinned `embree_config`, else the widest of AVX-512,
+(`--gl-renderer`, else the report's own `gl_renderer`, which programs that ran GL write,
+else $BOUNCE_GL_RENDERER, else the renderer `eglinfo -B` names, else null), and the Embree ISA (the run's pinned `embree_config`, else the widest of AVX-512,
 AVX2, SSE4.2 the CPU has: Embree's own choice). Scripts that read the file
 (docs/make_report.py, docs/plot_hemisphere_sampling.py, docs/studies/hemisphere_turn_table.py)
 use `load(path)` or read the JSON directly.
@@ -53,9 +53,11 @@ def embree_isa(flags, config):
     return "sse2"
 
 
-def gl_renderer(given):
+def gl_renderer(given, report):
     if given:
         return given
+    if report.get("gl_renderer"):
+        return report["gl_renderer"]
     if os.environ.get("BOUNCE_GL_RENDERER"):
         return os.environ["BOUNCE_GL_RENDERER"]
     if shutil.which("eglinfo"):
@@ -107,7 +109,7 @@ def add(path, study, name, report, renderer=None, commit=None, date=None):
     date = date or datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
     config = report.get("parameters", {}).get("embree_config", "")
     provenance = {"commit": commit, "date": date, "cpu": model, "cores": cores,
-                  "gl_renderer": gl_renderer(renderer), "embree_isa": embree_isa(flags, config)}
+                  "gl_renderer": gl_renderer(renderer, report), "embree_isa": embree_isa(flags, config)}
     run = {"name": name, "provenance": provenance}
     run.update({k: v for k, v in report.items() if k not in ("name", "provenance")})
     runs = results["runs"]
@@ -127,12 +129,13 @@ def main(argv):
     a.add_argument("results", help="docs/results/<study>.json")
     a.add_argument("name", help="the run's name, unique in the study")
     a.add_argument("report", help="the --json report the run wrote")
-    a.add_argument("--study", help="study name when the file is new (default: the file's stem)")
+    a.add_argument("--study", help="study name (default: the file's, or its stem when the file is new)")
     a.add_argument("--gl-renderer", help="GL renderer string of the run's context")
     args = parser.parse_args(argv)
     with open(args.report) as f:
         report = json.load(f)
-    study = args.study or os.path.splitext(os.path.basename(args.results))[0]
+    study = args.study or (load(args.results)["study"] if os.path.exists(args.results)
+                           else os.path.splitext(os.path.basename(args.results))[0])
     add(args.results, study, args.name, report, renderer=args.gl_renderer)
 
 

@@ -609,6 +609,9 @@ int main(int argc, char** argv) {
             report.parameters["shadow_slope_bias"] = shadows.slope_bias;
 #endif
             report.parameters["reference_spp_per_half"] = reference.spp;
+#ifdef BOUNCE_STUDY_WITH_GL
+            if (context && !no_raster) report.gl_renderer = context->renderer();
+#endif
             report.set_count("records", points);
             json j = report.to_json();
             j["timings_ms"] = json::object();

@@ -90,7 +90,7 @@ study::run_report sample_report() {
 }
 }  // namespace
 
-TEST_CASE("the run report is the object of design.md section 6", "[study][report]") {
+TEST_CASE("the run report is the object every example writes", "[study][report]") {
     const auto j = sample_report().to_json();
     std::vector<std::string> keys;
     for (const auto& [k, v] : j.items()) keys.push_back(k);
@@ -108,6 +108,19 @@ TEST_CASE("the run report is the object of design.md section 6", "[study][report
     CHECK(j["error"]["sum_sq"] == 12.5);
     CHECK(j["records"] == 1835);
     CHECK(j["vpls"] == 0);
+}
+
+TEST_CASE("a run that used GL names its renderer after the backend; one without GL does not", "[study][report]") {
+    auto r = sample_report();
+    CHECK_FALSE(r.to_json().contains("gl_renderer"));
+    r.gl_renderer = "llvmpipe (LLVM 15.0.6, 256 bits)";
+    const auto j = r.to_json();
+    std::vector<std::string> keys;
+    for (const auto& [k, v] : j.items()) keys.push_back(k);
+    REQUIRE(keys.size() > 5);
+    CHECK(keys[4] == "backend");
+    CHECK(keys[5] == "gl_renderer");
+    CHECK(j["gl_renderer"] == "llvmpipe (LLVM 15.0.6, 256 bits)");
 }
 
 TEST_CASE("the run report writes valid JSON, null for non-finite figures, and no error without a reference",

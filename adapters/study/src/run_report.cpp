@@ -42,6 +42,7 @@ ojson run_report::to_json() const {
     j["width"] = width;
     j["height"] = height;
     j["backend"] = backend;
+    if (!gl_renderer.empty()) j["gl_renderer"] = gl_renderer;
     j["parameters"] = parameters;
     j["repeat"] = repeat;
     ojson t = ojson::object();

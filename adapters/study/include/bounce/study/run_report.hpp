@@ -6,7 +6,7 @@
 /// The JSON object, keys in this order:
 /// ```
 /// { "technique": "ic_splatting", "scene": "cornell", "width": 512, "height": 512,
-///   "backend": "cpu",
+///   "backend": "cpu", "gl_renderer": "llvmpipe (LLVM 15.0.6, 256 bits)",  // when GL ran
 ///   "parameters": { "a": 0.15, "weight": "ward", ... },     // whatever the run was given
 ///   "repeat": 5,                                            // samples per stage
 ///   "timings_ms": { "gbuffer": 3.1, "interpolate": 8.2, ..., "total": 40.2 },  // medians
@@ -48,6 +48,10 @@ struct run_report {
     std::size_t width = 0;  ///< image width in pixels
     std::size_t height = 0; ///< image height in pixels
     std::string backend;    ///< "cpu", "gl", "embree" ...
+    /// The GL renderer string of the run's context (gl::context::renderer(), e.g.
+    /// "llvmpipe (LLVM 15.0.6, 256 bits)"), part of the run's provenance; written as
+    /// `gl_renderer` after `backend` when not empty (runs without GL leave it empty).
+    std::string gl_renderer;
     /// The run's parameters as given, e.g. `parameters["a"] = 0.15`.
     nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
     /// Per stage, the median in milliseconds over the repeats (see set_timings).
