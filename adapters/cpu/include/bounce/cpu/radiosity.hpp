@@ -62,10 +62,14 @@ struct radiosity_options {
     bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
     int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16)
     bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
+    double near_field = 2;         ///< a block shoots as its elements to receivers nearer than this
+                                   ///< many times its side (sqrt of its area); 0: always one disc (typical: 2)
 
     void validate() const {
         require(shooters_per_step >= 1 && shooters_per_step <= 4096, "radiosity_options.shooters_per_step",
                 "must lie in [1, 4096]");
+        require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
+                "must be finite and non-negative");
     }
 };
 
@@ -341,10 +345,13 @@ private:
         const lightmap_atlas& at = atlas_;
         const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
         // The shooter's unshot radiosity, area-weighted over its elements; then zeroed, so
-        // its elements' power (refreshed in the distribution) starts from 0.
+        // its elements' power (refreshed in the distribution) starts from 0. Its elements are
+        // kept for the near field.
         glm::dvec3 power(0);
+        near_.clear();
         for (std::uint32_t i = i0; i < i1; ++i) {
             power += glm::dvec3(unshot_[i]) * double(at.area[i]);
+            near_.push_back({vec(at.position[i]), Real(at.area[i]), unshot_[i]});
             unshot_[i] = vec(0);
         }
         const Real area = shooter_area_[k];
@@ -353,6 +360,11 @@ private:
         const glm::vec3 ns_f = at.normal[i0];
         const vec ns = vec(ns_f);
         const std::uint32_t chart = at.chart[i0];
+        // Receivers nearer than twice the block's side see it as its elements, not one disc:
+        // one disc of area A_s gives F = A_s cos cos / (pi d^2 + A_s), which falls short of the
+        // sum over its parts by O(A_s / d^2) (the + A_s term), and at a block's own scale that
+        // loses power at every concave corner (docs/radiosity.md, section 6).
+        const Real near_d2 = near_.size() > 1 ? Real(options_.near_field) * Real(options_.near_field) * area : Real(0);
 
         auto start = clock::now();
         visibility_.begin_shot(shot_frame{centre_[k], ns_f, false, chart});
@@ -361,16 +373,31 @@ private:
         start = clock::now();
         const Visibility& vis = visibility_;
         const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
+            if (at.chart[i] == chart) return;  // coplanar with the shooter: F = 0
             const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
-            const Real f = disc_form_factor<Real, vec>(pr, nr, ps, ns, area);
-            if (!(f > Real(0))) return;
+            const vec rho = vec(at.albedo[i]);
+            const vec r = ps - pr;
+            vec gain(0);
+            glm::dvec3 incident(0);  // sum of dB_j F_{r->j}, before visibility
+            if (!(dot(r, r) < near_d2)) {
+                const Real f = disc_form_factor<Real, vec>(pr, nr, ps, ns, area);
+                if (!(f > Real(0))) return;
+                incident = glm::dvec3(db) * double(f);
+                gain = shot_radiosity<Real, vec>(pr, nr, rho, ps, ns, area, db, Real(1));
+            } else {
+                for (const near_element& e : near_) {
+                    const Real f = disc_form_factor<Real, vec>(pr, nr, e.position, ns, e.area);
+                    incident += glm::dvec3(e.unshot) * double(f);
+                    gain += shot_radiosity<Real, vec>(pr, nr, rho, e.position, ns, e.area, e.unshot, Real(1));
+                }
+                if (!(incident.x > 0 || incident.y > 0 || incident.z > 0)) return;
+            }
             const Real v = Real(vis.visible(at.position[i], at.chart[i]));
             if (!(v > Real(0))) return;
-            const vec rho = vec(at.albedo[i]);
-            const vec gain = shot_radiosity<Real, vec>(pr, nr, rho, ps, ns, area, db, v);
+            gain *= v;
             radiosity_[i] += gain;
             unshot_[i] += gain;
-            const glm::dvec3 intercepted = glm::dvec3(db) * (double(f) * double(v) * double(at.area[i]));
+            const glm::dvec3 intercepted = incident * (double(v) * double(at.area[i]));
             s.intercepted += intercepted;
             s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
         });
@@ -439,6 +466,12 @@ private:
     std::vector<Real> shooter_area_;
     std::vector<double> power_;
     std::vector<chunk_sums> sums_;
+    struct near_element {
+        vec position;
+        Real area;
+        vec unshot;
+    };
+    std::vector<near_element> near_;
     double unshot_total_ = 0, total_area_ = 0;
     glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, albedo_area_{0};
     radiosity_timings timings_;
