@@ -27,10 +27,11 @@ void report(const char* name, const scene_view& scene, const lightmap_atlas& atl
     solver.solve(fraction);
     const double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const auto& t = solver.timings();
-    std::printf("%-34s elements %6zu shooters %6zu shots %6zu unshot %.4f total %8.1f ms (lights %.1f, visibility %.1f, "
-                "choice %.1f, distribution %.1f)\n",
-                name, atlas.size(), solver.shooters(), solver.progress().shots, solver.unshot_fraction(), total,
-                t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms);
+    std::printf("%-34s elements %6zu shooters %6zu shots %6zu unshot %.4f escaped %.4f total %8.1f ms (lights %.1f, "
+                "visibility %.1f, choice %.1f, distribution %.1f)\n",
+                name, atlas.size(), solver.shooters(), solver.progress().shots, solver.unshot_fraction(),
+                solver.escaped_power().x / solver.emitted_power().x, total, t.lights_ms, t.visibility_ms, t.choice_ms,
+                t.distribution_ms);
     CHECK(solver.unshot_fraction() <= fraction);
 }
 
@@ -61,6 +62,32 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% convergence"
             }
             report("all visible (no occlusion)", scene.view(), atlas, cpu::all_visible{}, {}, 0.1);
         }
+    }
+}
+
+TEST_CASE("study: adaptive subdivision in the Cornell box", "[radiosity][study]") {
+    // The chapter's leaves are 16 x 16 textures; here base leaves of 16 x 16 (about 2,500
+    // elements) and of 8 x 8 texels, subdivided after each of the first 200 steps (the chapter
+    // tests after every reconstruction pass) down to level 2, then solved to 90%.
+    const auto scene = cornell_box();
+    for (int block : {16, 8}) {
+        const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 2500, .block_texels = block});
+        const auto t0 = std::chrono::steady_clock::now();
+        cpu::progressive_radiosity solver(scene.view(), atlas,
+                                          cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 128}));
+        std::size_t splits = 0;
+        for (int s = 0; s < 200 && solver.step(); ++s)
+            splits += solver.subdivide(scene.view(), {.threshold = 0.25, .min_texels = 2, .max_level = 2});
+        solver.solve(0.1);
+        const double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        std::size_t per_level[3] = {0, 0, 0};
+        const auto& a = solver.atlas();
+        for (std::size_t k = 0; k < a.blocks(); ++k) per_level[a.block_level[k]] += a.block_first[k + 1] - a.block_first[k];
+        std::printf("subdivision, leaves %dx%d: %zu -> %zu elements (level 0/1/2: %zu/%zu/%zu), %zu splits, %zu shots, "
+                    "unshot %.3f, %.0f ms (subdivision %.0f ms)\n",
+                    block, block, atlas.size(), a.size(), per_level[0], per_level[1], per_level[2], splits,
+                    solver.progress().shots, solver.unshot_fraction(), total, solver.timings().subdivision_ms);
+        CHECK(solver.unshot_fraction() <= 0.1);
     }
 }
 
