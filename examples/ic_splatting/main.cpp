@@ -12,6 +12,8 @@
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
+#include <bounce/study/equal_error.hpp>
+#include <bounce/study/frame_comparison.hpp>
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/study/image_comparison.hpp>
@@ -32,7 +34,6 @@
 #include <CLI/CLI.hpp>
 #include "../common/cli_number_checks.hpp"
 #include <fmt/core.h>
-#include <glm/gtc/quaternion.hpp>
 
 #include <chrono>
 #include <functional>
@@ -159,54 +160,6 @@ struct gl_frames {
     gl_frames(const io::scene& s, int shadow_resolution) : mesh(s), light(s, mesh, shadow_resolution) {}
 };
 #endif
-
-image<float> coverage_mask(const gbuffer<float>& g) {
-    image<float> m(g.width(), g.height(), 0.f);
-    for (std::size_t y = 0; y < g.height(); ++y)
-        for (std::size_t x = 0; x < g.width(); ++x) m(x, y) = std::isfinite(g.depth(x, y)) ? 1.f : 0.f;
-    return m;
-}
-
-// The pixels where a frame's G-buffer (the raster one, for the GL backend) sees the same
-// surface as the ray-cast G-buffer the reference was computed on: elsewhere (a few
-// silhouette pixels) the two images show different surfaces and their difference is
-// not the cache's error.
-image<float> comparable_mask(gbuffer<float> g, gbuffer<float> ref_g, float scene_size) {
-    image<float> m = coverage_mask(g);
-    const gbuffer_view<float> gv = g.view(), rv = ref_g.view();
-    for (std::size_t y = 0; y < g.height(); ++y)
-        for (std::size_t x = 0; x < g.width(); ++x)
-            if (m(x, y) > 0.f && !same_surface(gv, rv, x, y, scene_size)) m(x, y) = 0.f;
-    return m;
-}
-
-// The progressive mode's camera path: from the scene's camera, a walk forward along the
-// view axis (a tenth of the way to the target, and never more than half the way to the first
-// surface on the axis) while the view pans from -10 to +10 degrees about the up axis, so the
-// eye stays in the open space it starts in. (An orbit about the target, the first path, swung
-// Sponza's eye 3 m sideways through the colonnade: frames saw one column face from
-// centimetres away, and their errors told nothing about the cache.)
-struct camera_path {
-    camera base;
-    glm::vec3 forward;
-    float walk;  // world units the eye moves over the whole path
-    std::size_t frames;
-
-    camera_path(const embree::accel& bvh, const camera& start, std::size_t frame_count)
-        : base(start), forward(start.forward()), frames(frame_count) {
-        const embree::hit first = bvh.intersect({base.position, forward});  // t = inf on a miss
-        walk = std::min(0.1f * glm::length(base.look_at - base.position), 0.5f * first.t);
-    }
-
-    camera at(std::size_t f) const {
-        const float t = float(f) / float(std::max<std::size_t>(1, frames - 1));
-        camera cam = base;
-        cam.position = base.position + t * walk * forward;
-        const glm::quat pan = glm::angleAxis(glm::radians(20.f) * (t - 0.5f), glm::normalize(base.up));
-        cam.look_at = cam.position + pan * (base.look_at - cam.position);
-        return cam;
-    }
-};
 
 nlohmann::ordered_json error_json(const study::error_figures& e) {
     return {{"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}, {"sum_sq", e.sum_sq}, {"pixels", e.pixels}};
@@ -370,9 +323,10 @@ int run_with(const options& o) {
 
     // Error is measured where the frame's G-buffer sees what the reference saw.
     const float scene_size = glm::length(scene.bounds().second - scene.bounds().first);
-    auto mask_for = [&](const gbuffer<float>& g, const camera& cam) {
-        if (o.interp != "splat-gl") return coverage_mask(g);
-        return comparable_mask(g, embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height), scene_size);
+    auto mask_for = [&](gbuffer<float> g, const camera& cam) {
+        if (o.interp != "splat-gl") return study::coverage_mask(g.view());
+        auto ray = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height);
+        return study::comparable_mask(g.view(), ray.view(), scene_size);
     };
 
     nlohmann::ordered_json extra = nlohmann::ordered_json::object();
@@ -382,7 +336,7 @@ int run_with(const options& o) {
         // Progressive mode: records are view-independent, so each frame of the camera path
         // reuses the cache and adds at most N records.
         nlohmann::ordered_json frames = nlohmann::ordered_json::array();
-        const camera_path path(bvh, scene.camera, o.frames);
+        const study::camera_path path(bvh, scene.camera, o.frames);
         for (std::size_t f = 0; f < o.frames; ++f) {
             const camera cam = path.at(f);
             study::stage_timer ft;
@@ -445,52 +399,18 @@ int run_with(const options& o) {
         }
 
         if (o.mc_compare) {
-            // Brute-force Monte Carlo indirect light at doubling sample counts (an independent
-            // seed), until its error reaches this run's: the time it needs at equal error.
-            nlohmann::ordered_json mc = nlohmann::ordered_json::array();
-            const double target = report.error->rel_rms;
-            for (std::uint32_t spp = 1; spp <= o.ref_spp / 2; spp *= 2) {
-                const embree::reference_integrator mci(bvh, scene, reference_settings_for(spp, 99));
-                const auto t0 = clock_type::now();
-                const auto ind = mci.indirect_image(fr.g.view());
-                const double ms = ms_since(t0);
-                const auto err = study::compare_luminance(ind.view(), ref.indirect.view(), mask.view());
-                fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f}\n", spp, ms, err.rel_rms);
-                mc.push_back({{"spp", spp}, {"ms", ms}, {"rel_rms", err.rel_rms}});
-                if (err.rel_rms <= target) {
-                    // The sample count that reaches the target exactly, interpolating the last
-                    // two points in log-log (error ~ spp^-1/2 away from the reference's floor),
-                    // and its time (proportional to spp): doubling alone would overstate it.
-                    double equal_spp = spp, equal_ms = ms;
-                    if (mc.size() >= 2) {
-                        const auto& prev = mc[mc.size() - 2];
-                        const double s1 = prev["spp"].get<double>(), e1 = prev["rel_rms"].get<double>();
-                        const double t = (std::log(target) - std::log(e1)) / (std::log(err.rel_rms) - std::log(e1));
-                        equal_spp = std::exp(std::log(s1) + t * (std::log(double(spp)) - std::log(s1)));
-                        equal_ms = ms * equal_spp / spp;
-                    }
-                    const double speedup = equal_ms / timer.median_ms("total");
-                    extra["mc_equal_error"] = {{"spp", equal_spp}, {"ms", equal_ms}, {"rel_rms", target},
-                                               {"measured_spp", spp}, {"measured_ms", ms},
-                                               {"measured_rel_rms", err.rel_rms}, {"speedup", speedup}};
-                    fmt::print("at equal error Monte Carlo needs ~{:.0f} spp, {:.1f} ms: {:.1f}x the cache's {:.1f} ms\n",
-                               equal_spp, equal_ms, speedup, timer.median_ms("total"));
-                    break;
-                }
-            }
-            if (!extra.contains("mc_equal_error") && !mc.empty()) {
-                // Monte Carlo did not reach the cache's error below half the reference's
-                // samples (beyond that it would be measured against its own kind of noise):
-                // its last time is a lower bound on the time it needs.
-                const double ms = mc.back()["ms"].get<double>();
-                extra["mc_equal_error"] = {{"rel_rms", target}, {"lower_bound", true},
-                                           {"measured_spp", mc.back()["spp"]}, {"measured_ms", ms},
-                                           {"measured_rel_rms", mc.back()["rel_rms"]},
-                                           {"speedup", ms / timer.median_ms("total")}};
-                fmt::print("Monte Carlo stays above the cache's error up to {} spp ({:.1f} ms): at least {:.1f}x the cache's time\n",
-                           mc.back()["spp"].get<int>(), ms, ms / timer.median_ms("total"));
-            }
-            extra["mc_sweep"] = mc;
+            // Brute-force Monte Carlo at doubling sample counts until it reaches this run's
+            // error (up to half the reference's samples: beyond, it would meet its own noise).
+            const double ms = timer.median_ms("total");
+            const auto mc = study::monte_carlo_at_equal_error(
+                bvh, scene, fr.g.view(), ref.indirect.view(), mask.view(), report.error->rel_rms, o.ref_spp / 2,
+                [](const study::monte_carlo_step& s) {
+                    fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f}\n", s.spp, s.ms, s.rel_rms);
+                });
+            extra["mc_equal_error"] = mc.equal_error_json(ms);
+            extra["mc_sweep"] = mc.sweep_json();
+            fmt::print("at equal error Monte Carlo needs {}{:.0f} spp, {:.1f} ms: {}{:.1f}x the cache's {:.1f} ms\n",
+                       mc.reached ? "~" : "more than ", mc.spp, mc.ms, mc.reached ? "" : "at least ", mc.ms / ms, ms);
         }
 
         if (!o.out.empty() || !o.exr.empty()) {
