@@ -62,8 +62,9 @@ struct radiosity_options {
     bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
     int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16)
     bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
-    double near_field = 2;         ///< a block shoots as its elements to receivers nearer than this
-                                   ///< many times its side (sqrt of its area); 0: always one disc (typical: 2)
+    double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
+                                   ///< times its side (sqrt of its area), else as its quadrants,
+                                   ///< recursively; 0: always one disc (typical: 2-4)
 
     void validate() const {
         require(shooters_per_step >= 1 && shooters_per_step <= 4096, "radiosity_options.shooters_per_step",
@@ -348,23 +349,14 @@ private:
         // its elements' power (refreshed in the distribution) starts from 0. Its elements are
         // kept for the near field.
         glm::dvec3 power(0);
-        near_.clear();
-        for (std::uint32_t i = i0; i < i1; ++i) {
-            power += glm::dvec3(unshot_[i]) * double(at.area[i]);
-            near_.push_back({vec(at.position[i]), Real(at.area[i]), unshot_[i]});
-            unshot_[i] = vec(0);
-        }
-        const Real area = shooter_area_[k];
-        const vec db = vec(power / double(area));
-        const vec ps = vec(centre_[k]);
+        for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot_[i]) * double(at.area[i]);
+        build_near_tree(k);
+        for (std::uint32_t i = i0; i < i1; ++i) unshot_[i] = vec(0);
         const glm::vec3 ns_f = at.normal[i0];
         const vec ns = vec(ns_f);
         const std::uint32_t chart = at.chart[i0];
-        // Receivers nearer than twice the block's side see it as its elements, not one disc:
-        // one disc of area A_s gives F = A_s cos cos / (pi d^2 + A_s), which falls short of the
-        // sum over its parts by O(A_s / d^2) (the + A_s term), and at a block's own scale that
-        // loses power at every concave corner (docs/radiosity.md, section 6).
-        const Real near_d2 = near_.size() > 1 ? Real(options_.near_field) * Real(options_.near_field) * area : Real(0);
+        const std::uint32_t root = std::uint32_t(near_.size() - 1);
+        const Real near2 = Real(options_.near_field) * Real(options_.near_field);
 
         auto start = clock::now();
         visibility_.begin_shot(shot_frame{centre_[k], ns_f, false, chart});
@@ -376,22 +368,26 @@ private:
             if (at.chart[i] == chart) return;  // coplanar with the shooter: F = 0
             const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
             const vec rho = vec(at.albedo[i]);
-            const vec r = ps - pr;
             vec gain(0);
-            glm::dvec3 incident(0);  // sum of dB_j F_{r->j}, before visibility
-            if (!(dot(r, r) < near_d2)) {
-                const Real f = disc_form_factor<Real, vec>(pr, nr, ps, ns, area);
-                if (!(f > Real(0))) return;
-                incident = glm::dvec3(db) * double(f);
-                gain = shot_radiosity<Real, vec>(pr, nr, rho, ps, ns, area, db, Real(1));
-            } else {
-                for (const near_element& e : near_) {
-                    const Real f = disc_form_factor<Real, vec>(pr, nr, e.position, ns, e.area);
-                    incident += glm::dvec3(e.unshot) * double(f);
-                    gain += shot_radiosity<Real, vec>(pr, nr, rho, e.position, ns, e.area, e.unshot, Real(1));
+            glm::dvec3 incident(0);  // sum of dB_j F_{r->j} over the discs used, before visibility
+            // The block as one disc where the receiver is farther than near_field times its
+            // side, else as its four quadrants, recursively, down to elements.
+            std::array<std::uint32_t, 64> stack;
+            std::size_t top = 0;
+            stack[top++] = root;
+            while (top > 0) {
+                const near_node& node = near_[stack[--top]];
+                const vec r = node.position - pr;
+                if (node.child_count == 0 || !(dot(r, r) < near2 * node.area)) {
+                    const Real f = disc_form_factor<Real, vec>(pr, nr, node.position, ns, node.area);
+                    if (!(f > Real(0))) continue;
+                    incident += glm::dvec3(node.unshot) * double(f);
+                    gain += shot_radiosity<Real, vec>(pr, nr, rho, node.position, ns, node.area, node.unshot, Real(1));
+                } else {
+                    for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = node.first_child + c;
                 }
-                if (!(incident.x > 0 || incident.y > 0 || incident.z > 0)) return;
             }
+            if (!(incident.x > 0 || incident.y > 0 || incident.z > 0)) return;
             const Real v = Real(vis.visible(at.position[i], at.chart[i]));
             if (!(v > Real(0))) return;
             gain *= v;
@@ -466,12 +462,69 @@ private:
     std::vector<Real> shooter_area_;
     std::vector<double> power_;
     std::vector<chunk_sums> sums_;
-    struct near_element {
+    // The shooter's near-field tree: its elements, then groups of 2 x 2, 4 x 4 ... cells of
+    // its grid (the chapter's mipmap pyramid of the residual texture), the whole block last.
+    // A node's unshot radiosity is the area-weighted mean of its elements', so every level
+    // carries the same power.
+    struct near_node {
         vec position;
         Real area;
         vec unshot;
+        std::uint32_t first_child = 0, child_count = 0;
     };
-    std::vector<near_element> near_;
+    std::vector<near_node> near_;
+
+    void build_near_tree(std::uint32_t k) {
+        const lightmap_atlas& at = atlas_;
+        const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
+        near_.clear();
+        struct pending {
+            glm::uvec2 cell;
+            glm::dvec3 moment, power;
+            double area;
+            std::uint32_t first_child, child_count;
+        };
+        std::vector<pending> level, next;
+        glm::vec4 rect(0.f, 0.f, 1.f, 1.f);
+        glm::uvec2 grid(1u);
+        if (options_.shoot_blocks) {
+            rect = at.block_rect[k];
+            grid = at.block_grid[k];
+        }
+        const lightmap_chart& ch = at.charts[at.chart[i0]];
+        for (std::uint32_t i = i0; i < i1; ++i) {
+            const glm::vec3 d = at.position[i] - ch.origin;
+            const glm::vec2 g((glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u) - rect.x) / (rect.z / float(grid.x)),
+                              (glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v) - rect.y) / (rect.w / float(grid.y)));
+            const glm::uvec2 cell(std::uint32_t(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1)),
+                                  std::uint32_t(std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1)));
+            const double a = double(at.area[i]);
+            level.push_back({cell, glm::dvec3(at.position[i]) * a, glm::dvec3(unshot_[i]) * a, a, 0, 0});
+        }
+        const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
+        while (true) {
+            // Siblings next to each other, then this level's nodes appended.
+            std::stable_sort(level.begin(), level.end(), [&](const pending& a, const pending& b) {
+                return key(a.cell / 2u) < key(b.cell / 2u);
+            });
+            const std::uint32_t base = std::uint32_t(near_.size());
+            for (const pending& p : level)
+                near_.push_back({vec(p.moment / p.area), Real(p.area), vec(p.power / p.area), p.first_child, p.child_count});
+            if (level.size() == 1) break;
+            next.clear();
+            for (std::size_t j = 0; j < level.size(); ++j) {
+                const glm::uvec2 parent = level[j].cell / 2u;
+                if (next.empty() || key(next.back().cell) != key(parent))
+                    next.push_back({parent, glm::dvec3(0), glm::dvec3(0), 0.0, base + std::uint32_t(j), 0});
+                pending& q = next.back();
+                q.moment += level[j].moment;
+                q.power += level[j].power;
+                q.area += level[j].area;
+                ++q.child_count;
+            }
+            level.swap(next);
+        }
+    }
     double unshot_total_ = 0, total_area_ = 0;
     glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, albedo_area_{0};
     radiosity_timings timings_;
