@@ -11,6 +11,7 @@
 // multiply-adds) is off by about 2 k ulp of its terms; 1e-5 is that for k up to 40, more
 // than any kernel here has. The hemicube's face numbers come from comparisons of the same
 // float values on both sides and must agree exactly.
+#include "../gl/agreement_inputs.hpp"
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/kernel_map.hpp>
@@ -31,36 +32,10 @@ using glsl::vec2;
 using glsl::vec3;
 
 namespace {
+using namespace bounce::gl_test;
 constexpr double tolerance = 1e-5;
 constexpr int random_count = 5000;
 
-glm::vec3 random_unit(pcg32& rng) {
-    const float z = 2 * rng.next_float() - 1, phi = 6.2831853f * rng.next_float();
-    const float r = std::sqrt(std::max(0.f, 1 - z * z));
-    return glm::normalize(glm::vec3(r * std::cos(phi), r * std::sin(phi), z));
-}
-glm::vec3 random_upper(pcg32& rng) {
-    glm::vec3 v = random_unit(rng);
-    v.z = std::abs(v.z);
-    return v;
-}
-
-template <class R, class Scale>
-double worst_scaled(const std::vector<R>& gpu, const std::vector<R>& cpu, Scale scale) {
-    REQUIRE(gpu.size() == cpu.size());
-    double worst = 0;
-    for (std::size_t e = 0; e < cpu.size(); ++e) {
-        const auto diff = [&](double g, double c) {
-            REQUIRE(std::isfinite(g));
-            REQUIRE(std::isfinite(c));
-            worst = std::max(worst, std::abs(g - c) / scale(e));
-        };
-        if constexpr (std::is_same_v<R, float>) diff(gpu[e], cpu[e]);
-        else
-            for (int c = 0; c < R::length(); ++c) diff(gpu[e][c], cpu[e][c]);
-    }
-    return worst;
-}
 const auto unit_scale = [](std::size_t) { return 1.0; };
 }  // namespace
 

@@ -12,6 +12,7 @@
 // 2 k ulp (ulp = 1.2e-7) for k up to 40 operations, more than any kernel here has.
 // Index maps are integers and must agree exactly (interleaved_sampling.hpp: exact for
 // sizes below 2^14 and patterns up to 64 wide).
+#include "../gl/agreement_inputs.hpp"
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/kernel_map.hpp>
@@ -31,36 +32,9 @@ using glsl::f32;
 using glsl::vec3;
 
 namespace {
+using namespace bounce::gl_test;
 constexpr double tolerance = 1e-5;
 constexpr int random_count = 5000;
-
-glm::vec3 random_unit(pcg32& rng) {
-    const float z = 2 * rng.next_float() - 1, phi = 6.2831853f * rng.next_float();
-    const float r = std::sqrt(std::max(0.f, 1 - z * z));
-    return glm::normalize(glm::vec3(r * std::cos(phi), r * std::sin(phi), z));
-}
-glm::vec3 random_point(pcg32& rng, float extent) {
-    return glm::vec3(rng.next_float() * 2 - 1, rng.next_float() * 2 - 1, rng.next_float() * 2 - 1) * extent;
-}
-
-// Largest |gpu - cpu| / scale over all elements and components.
-template <class R, class Scale>
-double worst_scaled(const std::vector<R>& gpu, const std::vector<R>& cpu, Scale scale) {
-    REQUIRE(gpu.size() == cpu.size());
-    double worst = 0;
-    for (std::size_t e = 0; e < cpu.size(); ++e) {
-        const auto diff = [&](double g, double c) {
-            REQUIRE(std::isfinite(g));
-            REQUIRE(std::isfinite(c));
-            worst = std::max(worst, std::abs(g - c) / scale(e));
-        };
-        if constexpr (std::is_same_v<R, float>)
-            diff(gpu[e], cpu[e]);
-        else
-            for (int c = 0; c < R::length(); ++c) diff(gpu[e][c], cpu[e][c]);
-    }
-    return worst;
-}
 }  // namespace
 
 TEST_CASE("pixel_light_irradiance agrees on the GPU and the CPU, hard cases included", "[glsl][rsm]") {
