@@ -258,6 +258,26 @@ inline void clipped_triangle_moments(const std::array<glm::dvec2, 3>& tri, doubl
     }
 }
 
+/// Calls add(cell, area, moment) for each cell of a width x height grid that triangle `q`
+/// overlaps (grid coordinates: cell (i, j), index j * width + i, is [i, i + 1] x [j, j + 1]),
+/// with the exact overlap's area and first moment, in grid coordinates.
+template <class Add>
+void for_each_cell_overlap(const std::array<glm::dvec2, 3>& q, std::uint32_t width, std::uint32_t height, Add&& add) {
+    const glm::dvec2 mn = glm::min(q[0], glm::min(q[1], q[2])), mx = glm::max(q[0], glm::max(q[1], q[2]));
+    const int i0 = std::max(0, int(std::floor(mn.x))), i1 = std::min(int(width) - 1, int(std::floor(mx.x)));
+    const int j0 = std::max(0, int(std::floor(mn.y))), j1 = std::min(int(height) - 1, int(std::floor(mx.y)));
+    for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+            std::array<glm::dvec2, 3> local;
+            for (int m = 0; m < 3; ++m) local[std::size_t(m)] = q[std::size_t(m)] - glm::dvec2(i, j);
+            double a;
+            glm::dvec2 mom;
+            clipped_triangle_moments(local, a, mom);
+            if (a <= 0) continue;
+            add(std::size_t(j) * width + std::size_t(i), a, mom + a * glm::dvec2(i, j));
+        }
+}
+
 inline glm::dvec3 to_d(const glm::vec3& v) { return glm::dvec3(v); }
 
 }  // namespace detail
@@ -442,21 +462,10 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
                     const glm::dvec3 d = detail::to_d(scene.positions[scene.triangles[t][m]]) - ex.origin;
                     q[std::size_t(m)] = {glm::dot(d, ex.u) / su, glm::dot(d, ex.v) / sv};
                 }
-                const glm::dvec2 mn = glm::min(q[0], glm::min(q[1], q[2])), mx = glm::max(q[0], glm::max(q[1], q[2]));
-                const int i0 = std::max(0, int(std::floor(mn.x))), i1 = std::min(int(ch.width) - 1, int(std::floor(mx.x)));
-                const int j0 = std::max(0, int(std::floor(mn.y))), j1 = std::min(int(ch.height) - 1, int(std::floor(mx.y)));
-                for (int j = j0; j <= j1; ++j)
-                    for (int i = i0; i <= i1; ++i) {
-                        std::array<glm::dvec2, 3> local;
-                        for (int m = 0; m < 3; ++m) local[std::size_t(m)] = q[std::size_t(m)] - glm::dvec2(i, j);
-                        double a;
-                        glm::dvec2 mom;
-                        detail::clipped_triangle_moments(local, a, mom);
-                        if (a <= 0) continue;
-                        texel_sum& ts = s[std::size_t(j) * ch.width + std::size_t(i)];
-                        ts.area += a;
-                        ts.moment += mom + a * glm::dvec2(i, j);
-                    }
+                detail::for_each_cell_overlap(q, ch.width, ch.height, [&](std::size_t cell, double a, glm::dvec2 moment) {
+                    s[cell].area += a;
+                    s[cell].moment += moment;
+                });
             }
             // Slivers below 1e-6 of a texel are dropped: they carry no measurable power and
             // their centroids are ill-conditioned.

@@ -84,21 +84,10 @@ inline std::vector<grid_overlap> grid_overlaps(const scene_view& scene, const li
             const glm::dvec3 d = glm::dvec3(scene.positions[scene.triangles[t][m]]) - origin;
             q[std::size_t(m)] = (glm::dvec2(glm::dot(d, au) / uu, glm::dot(d, av) / vv) - glm::dvec2(rect)) / cell;
         }
-        const glm::dvec2 mn = glm::min(q[0], glm::min(q[1], q[2])), mx = glm::max(q[0], glm::max(q[1], q[2]));
-        const int i0 = std::max(0, int(std::floor(mn.x))), i1 = std::min(int(grid.x) - 1, int(std::floor(mx.x)));
-        const int j0 = std::max(0, int(std::floor(mn.y))), j1 = std::min(int(grid.y) - 1, int(std::floor(mx.y)));
-        for (int j = j0; j <= j1; ++j)
-            for (int i = i0; i <= i1; ++i) {
-                std::array<glm::dvec2, 3> local;
-                for (int m = 0; m < 3; ++m) local[std::size_t(m)] = q[std::size_t(m)] - glm::dvec2(i, j);
-                double a;
-                glm::dvec2 mom;
-                clipped_triangle_moments(local, a, mom);
-                if (a <= 0) continue;
-                grid_overlap& o = out[std::size_t(j) * grid.x + std::size_t(i)];
-                o.area += a;
-                o.moment += mom + a * glm::dvec2(i, j);
-            }
+        for_each_cell_overlap(q, grid.x, grid.y, [&](std::size_t cell, double a, glm::dvec2 moment) {
+            out[cell].area += a;
+            out[cell].moment += moment;
+        });
     }
     // To base texels: areas scale by the cell's area, centroids map back to chart coordinates.
     for (grid_overlap& o : out) {
