@@ -207,6 +207,7 @@ namespace {
 GLenum internal_format(texel_format f) {
     switch (f) {
         case texel_format::rgba32f: return GL_RGBA32F;
+        case texel_format::rgb32f: return GL_RGB32F;
         case texel_format::r32f: return GL_R32F;
         case texel_format::rgba8: return GL_RGBA8;
         case texel_format::depth32f: return GL_DEPTH_COMPONENT32F;
@@ -261,10 +262,11 @@ texture_ref texture_ref::of(object_id id, const char* name) {
     r.height = std::size_t(std::max(h, 0));
     switch (internal) {
         case GL_RGBA32F: r.format = texel_format::rgba32f; break;
+        case GL_RGB32F: r.format = texel_format::rgb32f; break;
         case GL_R32F: r.format = texel_format::r32f; break;
         case GL_RGBA8: r.format = texel_format::rgba8; break;
         case GL_DEPTH_COMPONENT32F: r.format = texel_format::depth32f; break;
-        default: throw parameter_error(name, "has an internal format bounce does not read (RGBA32F, R32F, RGBA8, DEPTH32F)");
+        default: throw parameter_error(name, "has an internal format bounce does not read (RGBA32F, RGB32F, R32F, RGBA8, DEPTH32F)");
     }
     if (r.width == 0 || r.height == 0) throw parameter_error(name, "has no storage (zero size)");
     return r;

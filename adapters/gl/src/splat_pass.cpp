@@ -12,6 +12,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <initializer_list>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -109,9 +110,15 @@ void main() {
 
 void gbuffer_textures::validate() const {
     require(position_depth.id != 0 && normal.id != 0 && albedo.id != 0, "gbuffer", "a G-buffer texture is missing");
-    require(position_depth.format == texel_format::rgba32f && normal.format == texel_format::rgba32f &&
-                albedo.format == texel_format::rgba32f,
-            "gbuffer", "G-buffer textures must be RGBA32F");
+    const auto is = [](const texture_ref& t, std::initializer_list<texel_format> allowed) {
+        return std::find(allowed.begin(), allowed.end(), t.format) != allowed.end();
+    };
+    require(position_depth.format == texel_format::rgba32f, "gbuffer",
+            "position and depth must be an RGBA32F texture (depth in w)");
+    require(is(normal, {texel_format::rgba32f, texel_format::rgb32f}), "gbuffer",
+            "the normal texture must be RGBA32F or RGB32F");
+    require(is(albedo, {texel_format::rgba32f, texel_format::rgb32f, texel_format::rgba8}), "gbuffer",
+            "the albedo texture must be RGBA32F, RGB32F or RGBA8");
     require(width() > 0 && height() > 0, "gbuffer", "G-buffer textures have no size");
     require(normal.width == width() && albedo.width == width() && normal.height == height() && albedo.height == height(),
             "gbuffer", "G-buffer textures differ in size");
@@ -182,7 +189,8 @@ namespace {
 // RGBA32F texels into the first Pixel::length() channels of `out`, rows flipped to top first.
 template <class Pixel>
 void read_texels(const texture_ref& t, image_view<Pixel> out) {
-    require_rgba32f(t, "t");
+    require(t.format == texel_format::rgba32f || t.format == texel_format::rgb32f || t.format == texel_format::rgba8, "t",
+            "must be an RGBA32F, RGB32F or RGBA8 texture");
     require(out.width() == t.width && out.height() == t.height, "out", "size differs from the texture");
     const auto f = t.read_floats();
     for (std::size_t y = 0; y < out.height(); ++y)

@@ -133,6 +133,7 @@ private:
 
 enum class texel_format {
     rgba32f,  ///< four floats (GL_RGBA32F)
+    rgb32f,   ///< three floats (GL_RGB32F); read back and sampled with alpha 1
     r32f,     ///< one float (GL_R32F)
     rgba8,    ///< four unsigned normalized bytes (GL_RGBA8)
     depth32f  ///< float depth (GL_DEPTH_COMPONENT32F)
@@ -169,8 +170,8 @@ struct texture_ref {
     texture_ref(const texture& t) noexcept  // NOLINT: implicit, so bounce textures pass as they are
         : id(t.id()), format(t.format()), width(t.width()), height(t.height()) {}
     /// A texture the caller made: its size and internal format are read from GL (a context
-    /// must be current). Throws parameter_error naming `name` when `id` is not a 2D texture
-    /// or its format is none of texel_format's.
+    /// must be current). Throws parameter_error naming `name` when `id` is not a texture
+    /// name, has no storage, or its format is none of texel_format's.
     static texture_ref of(object_id id, const char* name = "texture");
     /// The texels as floats, in GL order, as texture::read_floats.
     std::vector<float> read_floats() const;

@@ -39,9 +39,10 @@
 
 namespace bounce::gl {
 
-/// The three G-buffer textures a pass reads, in gbuffer_pass's layout (RGBA32F, GL row
-/// order): position (xyz) and depth along the view axis (w, +infinity where no geometry),
-/// unit normal facing the camera (xyz), diffuse reflectance (rgb). Borrowed: bounce
+/// The three G-buffer textures a pass reads (GL row order): position (xyz) and depth along
+/// the view axis (w, +infinity where no geometry) in an RGBA32F texture; the unit normal
+/// facing the camera (xyz) in RGBA32F or RGB32F; the diffuse reflectance (rgb) in RGBA32F,
+/// RGB32F or RGBA8 (normalized). gbuffer_pass writes all three as RGBA32F. Borrowed: bounce
 /// textures or a renderer's own (texture_ref::of(name)); they must outlive the use.
 struct gbuffer_textures {
     texture_ref position_depth, normal, albedo;
@@ -49,8 +50,8 @@ struct gbuffer_textures {
     /// Size in pixels (0 when position_depth is not set).
     std::size_t width() const noexcept { return position_depth.width; }
     std::size_t height() const noexcept { return position_depth.height; }
-    /// Throws parameter_error (parameter "gbuffer") unless all three are set, RGBA32F and
-    /// of one size.
+    /// Throws parameter_error (parameter "gbuffer") unless all three are set, of the formats
+    /// above and of one size.
     void validate() const;
 };
 
