@@ -1,0 +1,159 @@
+#pragma once
+// ic_splatting's options: what the command line sets, how it is spelled and checked, and the
+// library settings it makes (the program's main.cpp runs and reports).
+#include <bounce/cpu/irradiance_cache.hpp>
+#include <bounce/errors.hpp>
+#include <bounce/weighting.hpp>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include "../common/cli_number_checks.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace bounce::examples {
+
+struct options {
+    std::string scene = "cornell";
+    std::size_t width = 512, height = 512;
+    float a = 0.15f;
+    std::string weight = "ward-smooth";
+    bool gradients = true;
+    std::string sampler = "embree";
+    float falloff_kappa = 1.f;  // raster sampler: fall-off stretching's band factor (1: border stretching)
+    double plane_turn = 0.0;    // raster sampler: plane_camera::turn_deg
+    bool hashed_turn = false;   // raster sampler: plane_camera::hashed_turn
+    int shadow_resolution = 2048;  // GL: texels per side of the shadow maps (raster records, GL frames' direct light)
+    std::string interp = "splat-cpu";
+    std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
+    float fill_holes = 4.f;       // progressive: wide splat's a / a (0: leave holes black)
+    std::size_t frames = 8;
+    std::vector<float> a_sweep;
+    std::uint32_t record_samples = 1024, ref_spp = 1024;
+    float min_pixels = 1.5f, max_pixels = 64.f;
+    bool neighbour_clamp = false;
+    std::string scan = "batched";
+    std::string scan_order;  // linear | coarse-to-fine; empty: linear, coarse-to-fine when progressive
+    std::size_t scan_batch = 0;
+    bool gradient_limit = true;
+    float max_extrapolation = 1.f;
+    float front_tolerance = 1.f;
+    float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
+    int repeat = 1;
+    bool mc_compare = false;
+    std::filesystem::path json, out, exr, indirect_out, indirect_exr, cache_in, cache_out;
+};
+
+inline weighting_kind parse_weight(const std::string& w) {
+    if (w == "ward") return weighting_kind::ward;
+    if (w == "ward-smooth") return weighting_kind::ward_smooth;
+    if (w == "ward-gpu") return weighting_kind::ward_early_reject;
+    if (w == "ward-gpu-shader") return weighting_kind::ward_scaled_normal;
+    if (w == "tabellion") return weighting_kind::tabellion;
+    throw parameter_error("--weight", "unknown weighting function '" + w + "'");
+}
+
+/// The cache settings the options ask for, at accuracy `a`.
+inline cpu::irradiance_cache_options cache_options_for(const options& o, float a) {
+    cpu::irradiance_cache_options c;
+    c.splat.a = a;
+    c.splat.gradients = o.gradients;
+    c.splat.max_extrapolation = o.max_extrapolation;
+    c.splat.front_tolerance = o.front_tolerance;
+    c.min_weight = o.min_weight;
+    c.interpolation = o.interp == "octree"         ? cpu::cache_interpolation::octree
+                      : o.interp == "octree-lanes" ? cpu::cache_interpolation::octree_lanes
+                                                   : cpu::cache_interpolation::splat;
+    c.scan = o.scan == "sequential" ? cpu::scan_kind::sequential : cpu::scan_kind::batched;
+    c.batch.max_records = o.scan_batch;
+    const std::string order = !o.scan_order.empty() ? o.scan_order : (o.progressive > 0 ? "coarse-to-fine" : "linear");
+    c.order = order == "coarse-to-fine" ? cpu::scan_order::coarse_to_fine : cpu::scan_order::linear;
+    if (o.progressive > 0) c.max_new_records = o.progressive;
+    c.fill_holes = c.interpolation == cpu::cache_interpolation::splat ? o.fill_holes : 0.f;
+    c.neighbour_clamp = o.neighbour_clamp;
+    return c;
+}
+
+// The parameters records depend on (not a: records are valid for every a). falloff_kappa
+// and the plane's turn keep their defaults unless the raster sampler takes them (run()
+// refuses them with the Embree sampler).
+inline nlohmann::json cache_parameters(const options& o, const std::string& scene) {
+    return {{"scene", scene},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
+            {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
+            {"shadow_resolution", o.sampler == "raster" ? o.shadow_resolution : 0},  // the raster's records see the maps
+            {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
+            {"gradient_limit", o.gradient_limit}, {"height", o.height}};
+}
+
+/// Declares every option on `app`, writing into `o` (and `gradients`: "on" or "off").
+inline void add_options(CLI::App& app, options& o, std::string& gradients) {
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")->capture_default_str();
+    app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--weight", o.weight, "ward | ward-smooth | ward-gpu | ward-gpu-shader | tabellion")
+        ->check(CLI::IsMember({"ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion"}))->capture_default_str();
+    app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+    app.add_option("--sampler", o.sampler, "record sampler: embree | raster")->check(CLI::IsMember({"embree", "raster"}))->capture_default_str();
+    app.add_option("--falloff-kappa", o.falloff_kappa,
+                   "raster sampler: fall-off stretching with this band factor (hemisphere_study's falloff_kappa for the "
+                   "scene); 1: border stretching")
+        ->check(examples::unit_interval)
+        ->capture_default_str();
+    app.add_option("--plane-turn", o.plane_turn,
+                   "raster sampler: turn of every plane about its normal from orthonormal_basis(n), degrees in [0, 90)")
+        ->check(examples::quarter_turn_deg)
+        ->capture_default_str();
+    app.add_flag("--hashed-turn", o.hashed_turn,
+                 "raster sampler: also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
+    app.add_option("--shadow-resolution", o.shadow_resolution,
+                   "GL: texels per side of the shadow maps (raster sampler's records, splat-gl's direct light)")
+        ->check(CLI::Range(64, 8192))
+        ->capture_default_str();
+    app.add_option("--interp", o.interp,
+                   "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
+        ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();
+    app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)");
+    app.add_option("--fill-holes", o.fill_holes,
+                   "progressive: fill pixels no zone reaches from a splat with a this many times wider (0: off)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
+    app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--a-sweep", o.a_sweep, "comma-separated a values rendered from one growing cache")
+        ->delimiter(',')
+        ->check(examples::finite_positive);
+    app.add_option("--record-samples", o.record_samples, "hemisphere rays per record")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
+    app.add_option("--ref-spp", o.ref_spp, "reference integrator samples per pixel")->check(CLI::Range(1u, 1u << 20))->capture_default_str();
+    app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(examples::finite_non_negative)->capture_default_str();
+    app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
+        ->check(CLI::IsMember({"batched", "sequential"}))
+        ->capture_default_str();
+    app.add_option("--scan-order", o.scan_order,
+                   "cache-miss scan order: linear | coarse-to-fine (default: linear; coarse-to-fine when progressive)")
+        ->check(CLI::IsMember({"linear", "coarse-to-fine"}));
+    app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread; 16 planes per atlas for --sampler raster)")
+        ->check(CLI::Range(0, 4096))
+        ->capture_default_str();
+    app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
+    app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
+    app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(examples::finite_non_negative)->capture_default_str();
+    app.add_option("--front-tolerance", o.front_tolerance,
+                   "skip records whose tangent plane the point lies this fraction of the zone behind (Ward's in-front test; 1: off)")
+        ->check(examples::unit_interval)->capture_default_str();
+    app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(examples::finite_non_negative);
+    app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
+    app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");
+    app.add_option("--json", o.json, "write the run report here");
+    app.add_option("--out", o.out, "write the final image (direct + indirect) as PNG");
+    app.add_option("--exr", o.exr, "write the final image as EXR");
+    app.add_option("--indirect-out", o.indirect_out, "write the indirect image beside the reference's as PNG");
+    app.add_option("--indirect-exr", o.indirect_exr, "write the indirect image alone as EXR (linear, for error maps)");
+    app.add_option("--cache-in", o.cache_in, "start from the records saved in this file");
+    app.add_option("--cache-out", o.cache_out, "save the records to this file");
+}
+
+}  // namespace bounce::examples
