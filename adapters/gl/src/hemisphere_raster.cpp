@@ -1,5 +1,6 @@
 // The raster hemisphere sampler: an atlas of record planes drawn by one instanced draw per
-// batch, read back through pixel buffer objects, or reduced by a compute shader. The
+// batch (or by the caller's callback, once per record), read back through pixel buffer
+// objects, or reduced by a compute shader. The
 // shaders are plumbing; the per-texel maths are emitted kernels (surface.hpp's
 // facing_normal, lights.hpp's lambertian_radiance, plane_pixel.hpp's plane_hit_distance and
 // plane_pixel_terms) and gl::direct_light's direct_irradiance.
@@ -149,23 +150,54 @@ glm::mat4 plane_view(const glm::vec3& eye, const glm::vec3& t, const glm::vec3& 
     return v;
 }
 
-// Clip distances and their enables, saved and restored (raster_state leaves them alone).
+// Every clip distance's enable (GL_MAX_CLIP_DISTANCES of them), saved and restored
+// (raster_state leaves them alone). All of them, not the built-in drawer's four: the
+// callback path turns them all off, since a caller's shader that does not write an enabled
+// gl_ClipDistance[i] leaves its clipping undefined.
 class clip_distance_state {
 public:
     clip_distance_state() {
-        for (int i = 0; i < 4; ++i) enabled_[std::size_t(i)] = glIsEnabled(GLenum(GL_CLIP_DISTANCE0 + i));
+        GLint count = 0;
+        glGetIntegerv(GL_MAX_CLIP_DISTANCES, &count);
+        enabled_.resize(std::size_t(std::max(count, 0)));
+        for (std::size_t i = 0; i < enabled_.size(); ++i) enabled_[i] = glIsEnabled(GLenum(GL_CLIP_DISTANCE0 + i));
     }
     ~clip_distance_state() {
-        for (int i = 0; i < 4; ++i)
-            if (enabled_[std::size_t(i)]) glEnable(GLenum(GL_CLIP_DISTANCE0 + i));
+        for (std::size_t i = 0; i < enabled_.size(); ++i)
+            if (enabled_[i]) glEnable(GLenum(GL_CLIP_DISTANCE0 + i));
             else glDisable(GLenum(GL_CLIP_DISTANCE0 + i));
     }
     clip_distance_state(const clip_distance_state&) = delete;
     clip_distance_state& operator=(const clip_distance_state&) = delete;
 
 private:
-    std::array<GLboolean, 4> enabled_{};
+    std::vector<GLboolean> enabled_;
 };
+
+// The state plane_drawer's contract promises before each call (hemisphere_raster.hpp): the
+// tile as viewport and scissor box, reversed depth, and every capability that would change
+// what a draw writes off. Set in full before every call, so what one record's callback
+// changes cannot leak into the next record's tile.
+constexpr std::array<GLenum, 11> callback_caps_off = {
+    GL_BLEND,       GL_CULL_FACE,          GL_STENCIL_TEST,  GL_RASTERIZER_DISCARD,         GL_DEPTH_CLAMP,
+    GL_POLYGON_OFFSET_FILL, GL_SAMPLE_ALPHA_TO_COVERAGE, GL_SAMPLE_COVERAGE, GL_COLOR_LOGIC_OP,
+    GL_PRIMITIVE_RESTART,   GL_PRIMITIVE_RESTART_FIXED_INDEX};
+
+void set_plane_draw_state(GLuint fbo, const plane_draw::rect& tile, std::size_t clip_distances) {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+    glViewport(tile.x, tile.y, tile.width, tile.height);
+    glScissor(tile.x, tile.y, tile.width, tile.height);
+    glEnable(GL_SCISSOR_TEST);
+    glEnable(GL_DEPTH_TEST);
+    for (const GLenum cap : callback_caps_off) glDisable(cap);
+    for (std::size_t i = 0; i < clip_distances; ++i) glDisable(GLenum(GL_CLIP_DISTANCE0 + i));
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glDepthRange(0.0, 1.0);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+}
 
 }  // namespace
 
@@ -208,10 +240,24 @@ std::size_t checked_atlas_side(std::size_t tiles, const hemisphere_raster_option
 
 hemisphere_raster::hemisphere_raster(const scene_view& scene, const scene_mesh& mesh, const direct_light& light,
                                      const hemisphere_raster_options& options)
-    : mesh_(mesh), light_(light), options_(options), columns_(columns_for(options)),
-      rows_((options.batch + columns_ - 1) / columns_), vertex_source_(vertex_shader()),
-      fragment_source_(fragment_shader(light)), reduce_source_(reduce_shader()),
-      raster_program_(vertex_source_, fragment_source_), reduce_program_(program::compute(reduce_source_)),
+    : hemisphere_raster(scene, &mesh, &light, plane_drawer{}, options) {}
+
+namespace {
+plane_drawer checked_drawer(plane_drawer draw) {
+    require(bool(draw), "draw", "an empty plane_drawer draws nothing: pass a callable");
+    return draw;
+}
+}  // namespace
+
+hemisphere_raster::hemisphere_raster(const scene_view& scene, plane_drawer draw, const hemisphere_raster_options& options)
+    : hemisphere_raster(scene, nullptr, nullptr, checked_drawer(std::move(draw)), options) {}
+
+hemisphere_raster::hemisphere_raster(const scene_view& scene, const scene_mesh* mesh, const direct_light* light,
+                                     plane_drawer draw, const hemisphere_raster_options& options)
+    : mesh_(mesh), light_(light), draw_(std::move(draw)), options_(options), columns_(columns_for(options)),
+      rows_((options.batch + columns_ - 1) / columns_), vertex_source_(mesh ? vertex_shader() : std::string()),
+      fragment_source_(light ? fragment_shader(*light) : std::string()), reduce_source_(reduce_shader()),
+      reduce_program_(program::compute(reduce_source_)),
       atlas_(texel_format::rgba32f, checked_atlas_side(columns_, options), rows_ * options.camera.resolution),
       depth_(texel_format::depth32f, columns_ * options.camera.resolution, rows_ * options.camera.resolution),
       records_(options.batch * (16 + 8) * sizeof(float)), sums_(options.batch * sums_per_record * sizeof(float)) {
@@ -227,7 +273,10 @@ hemisphere_raster::hemisphere_raster(const scene_view& scene, const scene_mesh& 
     fbo_.check_complete();
     const std::size_t bytes = atlas_.width() * atlas_.height() * 4 * sizeof(float);
     for (auto& p : pbo_) p.emplace(bytes);
-    raster_program_.set(0, unsigned(std::max<std::size_t>(mesh.triangle_count(), 1)));
+    if (mesh_) {
+        raster_program_.emplace(vertex_source_, fragment_source_);
+        raster_program_->set(0, unsigned(std::max<std::size_t>(mesh_->triangle_count(), 1)));
+    }
     reduce_program_.set(0, unsigned(options_.camera.resolution));
     reduce_program_.set(1, unsigned(columns_));
 }
@@ -239,55 +288,88 @@ void hemisphere_raster::render(std::span<const glm::vec3> positions, std::span<c
     require(!positions.empty() && positions.size() <= capacity(), "positions", "between 1 and capacity() records");
     const std::uint32_t N = options_.camera.resolution;
     const glm::mat4 projection = plane_projection(options_.camera.half_extent(), offset_ / 100.f);
-    std::vector<float> packed(positions.size() * 24);
-    const float W = float(atlas_.width()), H = float(atlas_.height());
+    std::vector<plane_draw> draws(positions.size());
     for (std::size_t k = 0; k < positions.size(); ++k) {
         const glm::vec3 p = positions[k], n = normals[k];
         require(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "positions", "non-finite position");
         require(std::abs(glm::length(n) - 1.f) <= 1e-3f, "normals", "normal is not unit length");
         const auto tb = options_.camera.frame(p, n);
-        const glm::vec3 eye = p + offset_ * n;
-        const glm::mat4 vp = projection * plane_view(eye, tb[0], tb[1], n);
-        std::memcpy(&packed[k * 24], &vp[0][0], 16 * sizeof(float));
-        // Tile (c, r) spans texels [c N, (c + 1) N) x [r N, (r + 1) N) of the W x H atlas.
-        const float c = float(k % columns_), r = float(k / columns_);
-        packed[k * 24 + 16] = float(N) / W;
-        packed[k * 24 + 17] = float(N) / H;
-        packed[k * 24 + 18] = (2.f * c + 1.f) * float(N) / W - 1.f;
-        packed[k * 24 + 19] = (2.f * r + 1.f) * float(N) / H - 1.f;
-        packed[k * 24 + 20] = eye.x;
-        packed[k * 24 + 21] = eye.y;
-        packed[k * 24 + 22] = eye.z;
-        packed[k * 24 + 23] = 0.f;
+        plane_draw& d = draws[k];
+        d.record = k;
+        d.position = p;
+        d.normal = n;
+        d.eye = p + offset_ * n;
+        d.view = plane_view(d.eye, tb[0], tb[1], n);
+        d.projection = projection;
+        d.view_projection = projection * d.view;
+        // Tile (c, r) spans texels [c N, (c + 1) N) x [r N, (r + 1) N) of the atlas.
+        d.tile = {std::int32_t((k % columns_) * N), std::int32_t((k / columns_) * N), std::int32_t(N), std::int32_t(N)};
     }
-    records_.write(0, packed.data(), packed.size() * sizeof(float));
 
-    const detail::raster_state raster;
+    const detail::raster_state raster;  // scissor test off: the clears below reach every tile
     const detail::blend_offset_state blend;
+    const detail::scissor_box_state scissor;
     const clip_distance_state clips;
     const detail::program_and_storage_state bindings({0u, 1u});
-    const detail::texture_unit_state units(1, GLuint(std::max<std::size_t>(light_.texture_units(), 1)));
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_.id());
-    glViewport(0, 0, GLsizei(atlas_.width()), GLsizei(atlas_.height()));
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glDepthFunc(GL_GREATER);
-    for (int i = 0; i < 4; ++i) glEnable(GLenum(GL_CLIP_DISTANCE0 + i));
+    rendered_ = 0;  // the atlas is about to change: nothing to read until this batch is drawn
     const float background[4] = {options_.environment.x, options_.environment.y, options_.environment.z,
                                  std::numeric_limits<float>::infinity()};
     const float far_depth = 0.f;  // reversed depth: 0 is infinitely far
     glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 0, background);
     glClearNamedFramebufferfv(fbo_.id(), GL_DEPTH, 0, &far_depth);
-    if (mesh_.triangle_count() > 0) {
-        glUseProgram(raster_program_.id());
-        light_.bind(raster_program_, 1);
-        glBindVertexArray(mesh_.vertices().id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh_.albedo_per_triangle().id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, records_.id());
-        glDrawElementsInstanced(GL_TRIANGLES, GLsizei(3 * mesh_.triangle_count()), GL_UNSIGNED_INT, nullptr,
-                                GLsizei(positions.size()));
+    if (draw_) draw_callback(draws);
+    else {
+        std::vector<float> packed(draws.size() * 24);
+        const float W = float(atlas_.width()), H = float(atlas_.height());
+        for (const plane_draw& d : draws) {
+            float* r = &packed[d.record * 24];
+            std::memcpy(r, &d.view_projection[0][0], 16 * sizeof(float));
+            // The tile's place in the atlas as an affine map of NDC: ndc' = ndc * scale + offset.
+            r[16] = float(N) / W;
+            r[17] = float(N) / H;
+            r[18] = (2.f * float(d.tile.x) + float(N)) / W - 1.f;
+            r[19] = (2.f * float(d.tile.y) + float(N)) / H - 1.f;
+            r[20] = d.eye.x;
+            r[21] = d.eye.y;
+            r[22] = d.eye.z;
+            r[23] = 0.f;
+        }
+        records_.write(0, packed.data(), packed.size() * sizeof(float));
+        draw_built_in(draws.size());
     }
     check_error("hemisphere_raster::render");
     rendered_ = positions.size();
+}
+
+// One instanced draw for the whole batch: instance k reads record k and clips itself to its
+// tile, so the atlas is one viewport and the scene's state is set once.
+void hemisphere_raster::draw_built_in(std::size_t records) {
+    if (mesh_->triangle_count() == 0) return;
+    const detail::texture_unit_state units(1, GLuint(std::max<std::size_t>(light_->texture_units(), 1)));
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_.id());
+    glViewport(0, 0, GLsizei(atlas_.width()), GLsizei(atlas_.height()));
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glDepthFunc(GL_GREATER);
+    for (int i = 0; i < 4; ++i) glEnable(GLenum(GL_CLIP_DISTANCE0 + i));
+    glUseProgram(raster_program_->id());
+    light_->bind(*raster_program_, 1);
+    glBindVertexArray(mesh_->vertices().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh_->albedo_per_triangle().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, records_.id());
+    glDrawElementsInstanced(GL_TRIANGLES, GLsizei(3 * mesh_->triangle_count()), GL_UNSIGNED_INT, nullptr,
+                            GLsizei(records));
+}
+
+// One call per record, as lightmapper.h renders its user's scene once per hemisphere view:
+// the viewport and the scissor box keep each call in its tile (the caller's shader has no
+// clip distances to do it), and the state is set again before every call.
+void hemisphere_raster::draw_callback(std::span<const plane_draw> draws) {
+    GLint clip_count = 0;
+    glGetIntegerv(GL_MAX_CLIP_DISTANCES, &clip_count);
+    for (const plane_draw& d : draws) {
+        set_plane_draw_state(fbo_.id(), d.tile, std::size_t(std::max(clip_count, 0)));
+        draw_(d);
+    }
 }
 
 void hemisphere_raster::start_read() {

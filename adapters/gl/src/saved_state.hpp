@@ -133,6 +133,19 @@ private:
     std::array<GLint, 2> polygon_mode_{GL_FILL, GL_FILL};
 };
 
+/// The scissor box, which raster_state leaves alone (it saves the scissor test's enable,
+/// not the rectangle): saved as found, restored on destruction; nothing is set here.
+class scissor_box_state {
+public:
+    scissor_box_state() { glGetIntegerv(GL_SCISSOR_BOX, box_.data()); }
+    ~scissor_box_state() { glScissor(box_[0], box_[1], box_[2], box_[3]); }
+    scissor_box_state(const scissor_box_state&) = delete;
+    scissor_box_state& operator=(const scissor_box_state&) = delete;
+
+private:
+    std::array<GLint, 4> box_{};
+};
+
 /// Pixel-unpack state set to tightly packed client memory (no unpack buffer) for uploads.
 class unpack_state {
 public:
