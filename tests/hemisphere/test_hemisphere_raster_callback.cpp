@@ -10,6 +10,7 @@
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
+#include <bounce/gl/raster_record_sampler.hpp>
 #include <bounce/cpu/plane_estimate.hpp>
 #include <bounce/plane_camera.hpp>
 #include <bounce/plane_weights.hpp>
@@ -223,6 +224,48 @@ TEST_CASE("a callback drawing the half-lit ceiling gives the built-in drawer's p
         // The CPU sum of the read-back plane agrees with the reduction (the same plane).
         const auto cpu = cpu::estimate_plane(stretch, got.view(k));
         CHECK(records[k].irradiance.x == Approx(cpu.irradiance.x).epsilon(1e-5));
+    }
+}
+
+TEST_CASE("the raster record sampler makes the same records over a callback raster as over the built-in one",
+          "[hemisphere][gl][callback][record]") {
+    gl_test::shared_context();
+    const float H = 1.5f, x_edge = 0.4f, kd = 0.75f, E_perp = 2.f;
+    const double L = double(kd / float(pi) * E_perp);
+    const auto options = raster_options(32, 126.0, 4, 1e-3f);
+    const test::owned_scene scene = half_lit_ceiling_scene(H, x_edge, kd, E_perp);
+    const gl::scene_mesh mesh(scene);
+    const gl::direct_light light(scene, mesh, 512);
+    gl::hemisphere_raster built_in(scene, mesh, light, options);
+    const ceiling_drawer drawer(scene, E_perp);
+    gl::hemisphere_raster callback(scene, [&drawer](const gl::plane_draw& d) { drawer(d); }, options);
+    gl::raster_record_sampler from_built_in(built_in, radius_limits{}), from_callback(callback, radius_limits{});
+    pcg32 rng(23);
+    std::vector<glm::vec3> p, n;
+    std::vector<double> footprint;
+    for (int k = 0; k < 9; ++k) {  // batches of 4, 4 and 1
+        const float z = float(4 * rng.next_double() - 2);
+        p.emplace_back(float(4 * rng.next_double() - 2), 0.f, z);
+        n.emplace_back(0.f, 1.f, 0.f);
+        footprint.push_back(1e-3);
+    }
+    std::vector<std::optional<irradiance_record>> a(p.size()), b(p.size());
+    from_built_in(p, n, footprint, a);
+    from_callback(p, n, footprint, b);
+    for (std::size_t k = 0; k < p.size(); ++k) {
+        REQUIRE((a[k] && b[k]));
+        // The planes differ only in texels the edge crosses, by at most L each (first test
+        // case), and a band takes its border pixel's radiance: the records differ by at most
+        // L times the weights of the mixed cells, bands included, plus the float sums (1e-5
+        // relative each). The radius is the harmonic mean distance (clamped alike on both):
+        // a weighted harmonic mean of distances each within 2e-4 relative of the other
+        // drawer's is within 2e-4 of its mean, plus the float sums: 3e-4.
+        const auto hc = hemisphere_test::ceiling_seen_from(options.camera, p[k], H, options.offset, x_edge, L);
+        const auto bound = ceiling_test::mixed_cells(options.camera, hc, true);
+        CAPTURE(k, a[k]->irradiance.x, b[k]->irradiance.x, bound.E);
+        CHECK(std::abs(double(a[k]->irradiance.x - b[k]->irradiance.x)) <= L * bound.E + 2e-5 * hc.E());
+        CHECK(double(glm::length(a[k]->rotation[0] - b[k]->rotation[0])) <= L * bound.rotation + 2e-5 * hc.E());
+        CHECK(b[k]->radius == Approx(a[k]->radius).epsilon(3e-4));
     }
 }
 
