@@ -117,7 +117,8 @@ struct plane_draw {
 ///   GL_CLIP_DISTANCEi off; polygon mode GL_FILL.
 /// The callback draws with `d.view_projection` (or `d.projection` times its own equal view)
 /// unchanged: the reductions read texel (i, j) of the tile as the direction of plane pixel
-/// (i, j), and depth 0 as "nothing". The y flip reverses every triangle's winding in the
+/// (i, j), and only this depth convention keeps the nearest surface under GL_GREATER
+/// against the cleared 0 (a texel nothing covers keeps (environment, +infinity)). The y flip reverses every triangle's winding in the
 /// window: a callback that culls faces must cull GL_FRONT where an unflipped camera culls
 /// GL_BACK (or set glFrontFace(GL_CW)). Each fragment must write
 /// to colour output 0 `vec4(L, r)`: L the radiance (rgb, W/(m^2 sr)) leaving the visible
