@@ -35,6 +35,7 @@
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/objects.hpp>
+#include <bounce/gl/raster_record_sampler.hpp>
 #endif
 
 #include <CLI/CLI.hpp>
@@ -281,11 +282,15 @@ struct raster_result {
     estimates cpu;              // PBO read-back + CPU sums (cpu::estimate_plane)
     double gpu_seconds = 0;     // render + GPU reduction (stretch table), all records
     double cpu_gpu_difference = 0;  // max relative difference of E_stretch between the two sums
+    double running_seconds = 0;     // the record sampler's running fall-off mode, all records
+    double running_cpu_gpu_difference = 0;  // max relative difference of its E from the CPU sums' running fall-off
 };
 
 // The raster sampler over all points in batches: render batch b, start its read-back, and
 // sum batch b - 1 on the CPU while the GPU works (double-buffered PBOs). Then the same
-// batches again with the GPU reduction instead of the read-back.
+// batches through gl::raster_record_sampler's running fall-off mode, whose kappa per batch
+// is the running profile's (the CPU sums take it, so that every weighting is summed the same
+// way), and again with the GPU reduction of the stretch table instead of the read-back.
 raster_result raster(const io::scene& scene, const gl_scene& g, const std::vector<study_point>& pts,
                      const plane_camera& cam, std::size_t batch) {
     const tables t(cam);
@@ -298,7 +303,6 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
     out.cpu.stretch.resize(pts.size());
     out.cpu.running_kappa.resize(pts.size());
     out.cpu.coverage_scale = t.coverage_scale();
-    radial_profile profile(cam);
     std::vector<glm::vec3> positions, normals;
     const auto load = [&](std::size_t first) { batch_points(pts, first, batch, positions, normals); };
     const auto sum = [&](std::size_t first) {
@@ -307,8 +311,6 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
             out.cpu.stretch[first + k] = cpu::estimate_plane(t.stretch, planes.view(k)).irradiance;
             out.cpu.plane[first + k] = cpu::estimate_plane(t.plane, planes.view(k)).irradiance;
         });
-        for (std::size_t k = 0; k < planes.size(); ++k) profile.add(planes.radiance[k].view());
-        std::fill_n(out.cpu.running_kappa.begin() + std::ptrdiff_t(first), planes.size(), profile.falloff_factor());
     };
     const auto t0 = clock_type::now();
     std::optional<std::size_t> previous;
@@ -321,7 +323,21 @@ raster_result raster(const io::scene& scene, const gl_scene& g, const std::vecto
     }
     if (previous) sum(*previous);
     out.cpu.seconds = seconds_since(t0);
-    out.cpu.kappa = profile.falloff_factor();
+
+    // The running profile as a renderer has it: every batch summed on the GPU with the kappa
+    // of all planes rendered so far, its own batch included (gl::falloff_mode::running).
+    gl::raster_record_sampler running(r, radius_limits{}, {plane_weighting::falloff, gl::falloff_mode::running});
+    batch_points(pts, 0, pts.size(), positions, normals);
+    std::vector<hemisphere_estimate> running_est(pts.size());
+    const auto t2 = clock_type::now();
+    running.estimate(positions, normals, running_est, out.cpu.running_kappa);
+    out.running_seconds = seconds_since(t2);
+    out.cpu.kappa = running.falloff_kappa();  // after the last batch: pooled over the run
+    const auto running_cpu = out.cpu.falloff(out.cpu.running_kappa);
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+        const double c = luminance(running_cpu[k]), d = std::abs(luminance(running_est[k].irradiance) - c);
+        out.running_cpu_gpu_difference = std::max(out.running_cpu_gpu_difference, c > 0 ? d / c : d);
+    }
 
     r.set_weights(t.stretch);
     std::vector<glm::dvec3> gpu(pts.size());
@@ -513,9 +529,14 @@ int main(int argc, char** argv) {
             records_per_s["raster"] = double(main_pts.size()) / r.cpu.seconds;
             records_per_s["raster_gpu_sum"] = double(main_pts.size()) / r.gpu_seconds;
             extra["raster_cpu_gpu_max_relative_difference"] = r.cpu_gpu_difference;
+            records_per_s["raster_falloff_running"] = double(main_pts.size()) / r.running_seconds;
+            extra["raster_running_cpu_gpu_max_relative_difference"] = r.running_cpu_gpu_difference;
             print_row("raster (CPU sum)", e, double(main_pts.size()) / r.cpu.seconds);
             fmt::print("  raster (GPU sum)  {:8.1f} records/s; CPU and GPU sums differ by at most {:.2e} (relative)\n",
                        double(main_pts.size()) / r.gpu_seconds, r.cpu_gpu_difference);
+            fmt::print("  raster (running)  {:8.1f} records/s (record sampler, running fall-off: read-back, profile, GPU "
+                       "sum); its sums differ from the CPU's by at most {:.2e} (relative)\n",
+                       double(main_pts.size()) / r.running_seconds, r.running_cpu_gpu_difference);
             if (texel_points > 0) {
                 const auto tp = first(pts, std::min(texel_points, pts.size()));
                 const double d = plane_texel_difference(ref, scene, *gls, tp, cam, std::min(batch, tp.size()));
