@@ -7,9 +7,11 @@
 ///
 /// The cache asks in batches: the batched cache-miss scan guesses several misses ahead and
 /// measures them together (a GPU sampler renders a batch in one atlas; a ray tracer traces it
-/// on every core). A record must be a pure function of its point, normal and footprint (seed
-/// the sampler by the point, not by a call counter), which is what lets the scan measure
-/// ahead and keep the result of the one-record-at-a-time scan bit for bit.
+/// on every core). When a record is a pure function of its point, normal and footprint (the
+/// sampler seeded by the point, not by a call counter), the scan can measure ahead and keep
+/// the result of the one-record-at-a-time scan bit for bit. A sampler that learns as it goes
+/// (the raster sampler's running fall-off profile) is still a record sampler, but that
+/// equality no longer holds for it.
 
 #include <bounce/irradiance_record.hpp>
 
