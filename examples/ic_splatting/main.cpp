@@ -228,6 +228,9 @@ int run_with(const options& o) {
     report.width = o.width;
     report.height = o.height;
     report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
+#ifdef BOUNCE_IC_WITH_GL
+    if (gl_state) report.gl_renderer = gl_state->context.renderer();
+#endif
     report.parameters = {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
                          {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
                          {"shadow_resolution", o.shadow_resolution},
