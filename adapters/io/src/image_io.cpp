@@ -1,5 +1,6 @@
 // Images through OpenImageIO: files and tone mapping for people.
 #include <bounce/io/image_io.hpp>
+#include <bounce/io/detail/imagebuf_view.hpp>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -22,26 +23,13 @@ image_error::image_error(fs::path file, const std::string& what)
 
 namespace {
 
+using detail::require_writable_size;
+using detail::to_imagebuf;
+
 // OIIO reports through geterror(); an empty message still deserves a word.
 std::string oiio_message(std::string m) {
     while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
     return m.empty() ? "OpenImageIO failed without a message" : m;
-}
-
-// A float ImageBuf holding a copy of a view (whatever its row stride).
-template <class T>
-OIIO::ImageBuf to_imagebuf(image_view<const T> v, int channels) {
-    OIIO::ImageSpec spec(int(v.width()), int(v.height()), channels, OIIO::TypeDesc::FLOAT);
-    OIIO::ImageBuf buf(spec, OIIO::InitializePixels::No);
-    buf.set_pixels(OIIO::ROI(0, int(v.width()), 0, int(v.height()), 0, 1, 0, channels), OIIO::TypeDesc::FLOAT,
-                   v.data(), sizeof(T), OIIO::stride_t(v.stride() * sizeof(T)));
-    return buf;
-}
-
-void require_writable_size(std::size_t w, std::size_t h) {
-    require(w > 0 && h > 0, "image", "empty image");
-    require(w <= std::size_t(std::numeric_limits<int>::max()) && h <= std::size_t(std::numeric_limits<int>::max()),
-            "image", "too large for OpenImageIO");
 }
 
 template <class T>

@@ -1,5 +1,6 @@
 // Error figures of an image against its reference, through OpenImageIO's compare.
 #include <bounce/study/image_comparison.hpp>
+#include <bounce/io/detail/imagebuf_view.hpp>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -9,25 +10,8 @@
 
 namespace bounce::study {
 
-namespace {
-
-// A float ImageBuf holding a copy of a view (whatever its row stride).
-template <class T>
-OIIO::ImageBuf to_imagebuf(image_view<const T> v, int channels) {
-    OIIO::ImageSpec spec(int(v.width()), int(v.height()), channels, OIIO::TypeDesc::FLOAT);
-    OIIO::ImageBuf buf(spec, OIIO::InitializePixels::No);
-    buf.set_pixels(OIIO::ROI(0, int(v.width()), 0, int(v.height()), 0, 1, 0, channels), OIIO::TypeDesc::FLOAT,
-                   v.data(), sizeof(T), OIIO::stride_t(v.stride() * sizeof(T)));
-    return buf;
-}
-
-void require_writable_size(std::size_t w, std::size_t h) {
-    require(w > 0 && h > 0, "image", "empty image");
-    require(w <= std::size_t(std::numeric_limits<int>::max()) && h <= std::size_t(std::numeric_limits<int>::max()),
-            "image", "too large for OpenImageIO");
-}
-
-}  // namespace
+using io::detail::require_writable_size;
+using io::detail::to_imagebuf;
 
 error_figures compare_luminance(image_view<const glm::vec3> x, image_view<const glm::vec3> ref,
                                 image_view<const float> mask) {
