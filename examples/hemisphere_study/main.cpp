@@ -1,4 +1,4 @@
-// hemisphere_study: single-plane hemisphere sampling (seed 000, section 8.4, Table 8.1)
+// hemisphere_study: single-plane hemisphere sampling (Gautron 2008, section 8.4, Table 8.1)
 // against a full-hemisphere Monte Carlo reference, on K random visible points of a scene.
 //
 //   build/bin/hemisphere_study --scene ../shared/scenes/sponza/scene.json --resolution 64

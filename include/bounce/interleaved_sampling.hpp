@@ -8,7 +8,7 @@
 /// footprint covers the pattern.
 ///
 /// The index maps are arithmetic, for any size (W and H need not be multiples of N and M),
-/// so no lookup textures are needed (the thesis, seed 002 section 4.1.3, keeps four of them,
+/// so no lookup textures are needed (Hahn 2012, section 4.1.3, keeps four of them,
 /// 15 MB at 1280x768, one set per resolution). Along one axis with size W = q N + r
 /// (0 <= r < N), sub-buffer i holds the q + [i < r] pixels x = i, i + N, ... and starts at
 /// column i q + min(i, r) of the split buffer; the split buffer is W x H, the sub-buffers
@@ -22,7 +22,7 @@
 /// Energy: each light (VPL, gather sample) reaches one sub-buffer of N M, so its weight is
 /// multiplied by N M (`interleaved_weight_scale`): then the expected value of every pixel,
 /// over a uniformly random relabelling of the sub-buffers, is the non-interleaved value
-/// (docs/rsm-sii-interleaved.md, section 5). The thesis (seed 002 section 5.2) splatted each
+/// (docs/rsm-sii-interleaved.md, section 5). The thesis (Hahn 2012, section 5.2) splatted each
 /// VPL into one sub-buffer at weight 1 and lost 1 - 1/(N M) of the energy.
 
 #include <bounce/errors.hpp>
@@ -223,7 +223,7 @@ inline sub_buffer_rect sub_buffer_of(const interleave_pattern& p, int i, int j, 
             std::size_t(interleave_sub_buffer_extent<double>(j, h, m))};
 }
 
-/// How lights are dealt to the sub-buffers (seed 002 sections 4.1.3 and 5.2).
+/// How lights are dealt to the sub-buffers (Hahn 2012, sections 4.1.3 and 5.2).
 enum class light_assignment {
     interleaved,  ///< light k to sub-buffer k mod (N M): each gets every (N M)-th light
     blocked,      ///< consecutive runs of ceil(K / (N M)) lights to each sub-buffer

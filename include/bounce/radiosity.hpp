@@ -1,7 +1,7 @@
 #pragma once
 /// \file radiosity.hpp
 /// Kernels of progressive refinement radiosity on textures (Coombe and Harris 2005, GPU Gems 2
-/// ch. 39, seed 003): the oriented-disc form factor and the radiosity a shot adds to a
+/// ch. 39): the oriented-disc form factor and the radiosity a shot adds to a
 /// receiver (its Listing 39-4), the hemispherical (stereographic) projection of the visibility
 /// pass (its Listing 39-2) with its inverse and separate depth, and the hemicube's
 /// direction -> face and texel map (Cohen and Greenberg 1985), so a GL backend can use either.

@@ -61,7 +61,7 @@ struct vpl {
 /// The importance of a texel's flux: its Rec. 709 luminance (W, luminance-weighted).
 inline float flux_importance(const glm::vec3& flux) noexcept { return rec709_luminance<float, glm::vec3>(flux); }
 
-/// VPLs at the centres of a `grid_x` x `grid_y` grid of cells over the map (seed 002
+/// VPLs at the centres of a `grid_x` x `grid_y` grid of cells over the map (Hahn 2012
 /// section 4.1.2, "a regular grid of sample positions"): each stands for the
 /// width x height / (grid_x grid_y) texels of its cell. Texels with zero flux give no VPL
 /// (they light nothing), so fewer than grid_x grid_y may come back.

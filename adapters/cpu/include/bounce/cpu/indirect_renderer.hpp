@@ -33,7 +33,7 @@ enum class indirect_technique {
 };
 
 enum class vpl_selection {
-    grid,          ///< texels on a regular grid (seed 002 section 4.1.2)
+    grid,          ///< texels on a regular grid (Hahn 2012, section 4.1.2)
     flux_warping,  ///< hierarchical importance warping on the flux (DS06 section 3.3)
 };
 

@@ -39,7 +39,7 @@ struct sii_params {
     float cutoff = 0.f;
     int tile = 32;  ///< tile side in pixels of the split buffer (typical: 16-64)
     /// Interleaved VPLs carry N M times their flux (interleaved_weight_scale). false
-    /// reproduces the thesis's splat at weight 1 (seed 002 section 5.2) for comparison: the
+    /// reproduces the thesis's splat at weight 1 (Hahn 2012, section 5.2) for comparison: the
     /// image then holds 1/(N M) of the energy.
     bool energy_correct = true;
 
