@@ -44,16 +44,16 @@ struct scene_view {
     /// vertices and triangles (32-bit indices on every backend). Degenerate (zero-area)
     /// triangles are allowed: backends give them no hits and no light.
     void validate_mesh() const {
-        const auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+        using detail::finite3;
         const std::size_t nv = positions.size(), nt = triangles.size();
         for (std::size_t i = 0; i < nv; ++i)
-            if (!finite(positions[i]))
+            if (!finite3(positions[i]))
                 throw parameter_error("scene.positions", "vertex " + std::to_string(i) + " is not finite");
         if (!normals.empty() && normals.size() != nv)
             throw parameter_error("scene.normals", "has " + std::to_string(normals.size()) + " entries for " +
                                                        std::to_string(nv) + " positions");
         for (std::size_t i = 0; i < normals.size(); ++i)
-            if (!finite(normals[i]))
+            if (!finite3(normals[i]))
                 throw parameter_error("scene.normals", "normal " + std::to_string(i) + " is not finite");
         constexpr std::size_t limit = std::numeric_limits<std::uint32_t>::max();
         if (nt >= limit || nv >= limit)
@@ -73,11 +73,10 @@ struct scene_view {
                                                                std::to_string(material_of[t]) + " of " +
                                                                std::to_string(materials.size()));
         for (std::size_t m = 0; m < materials.size(); ++m) {
-            const auto bad = [&](const glm::vec3& v) { return !(finite(v) && v.x >= 0.f && v.y >= 0.f && v.z >= 0.f); };
-            if (bad(materials[m].albedo))
+            if (!detail::non_negative3(materials[m].albedo))
                 throw parameter_error("scene.materials", "material " + std::to_string(m) +
                                                              " has a negative or non-finite albedo");
-            if (bad(materials[m].emission))
+            if (!detail::non_negative3(materials[m].emission))
                 throw parameter_error("scene.materials", "material " + std::to_string(m) +
                                                              " has a negative or non-finite emission");
         }
