@@ -56,15 +56,8 @@ double ms_since(clock_type::time_point t0) {
 }
 
 // The record sampler the options chose, behind one type (it models bounce::record_sampler).
-struct chosen_sampler {
-    std::function<void(std::span<const glm::vec3>, std::span<const glm::vec3>, std::span<const double>,
-                       std::span<std::optional<irradiance_record>>)>
-        measure;
-    void operator()(std::span<const glm::vec3> p, std::span<const glm::vec3> n, std::span<const double> footprint,
-                    std::span<std::optional<irradiance_record>> out) {
-        measure(p, n, footprint, out);
-    }
-};
+using chosen_sampler = std::function<void(std::span<const glm::vec3>, std::span<const glm::vec3>,
+                                          std::span<const double>, std::span<std::optional<irradiance_record>>)>;
 
 // What one frame gives the report: what it saw, its indirect image, the GL backend's
 // composed image, and the scan's counts.
@@ -74,7 +67,6 @@ struct frame_result {
     std::optional<image<glm::vec3>> combined;
     std::size_t new_records = 0, measured = 0, wasted = 0;
 };
-
 
 #ifdef BOUNCE_IC_WITH_GL
 // What the GL frames keep: the context, the scene on the GPU, the renderer's own passes
@@ -118,7 +110,7 @@ int run_with(const options& o) {
     limits.max_pixels = o.max_pixels;
     limits.gradient_limit = o.gradient_limit;
     const embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
-    chosen_sampler sampler{std::cref(embree_sampler)};
+    chosen_sampler sampler = std::cref(embree_sampler);
     cpu::irradiance_cache_options cache_options = cache_options_for(o, o.a);
     const auto [lo, hi] = scene.bounds();
     cpu::irradiance_cache<W> cache(lo, hi, cache_options);
@@ -138,7 +130,7 @@ int run_with(const options& o) {
         raster_sampler.emplace(*gl_state->raster, limits,
                                o.falloff_kappa < 1.f ? plane_weighting::falloff : plane_weighting::stretch,
                                double(o.falloff_kappa));
-        sampler.measure = std::ref(*raster_sampler);
+        sampler = std::ref(*raster_sampler);
         cache_options.batch.max_records = planes;
         cache.set_options(cache_options);
     }
