@@ -1,6 +1,8 @@
 // Properties of the real spherical-harmonics basis: Sloan's closed forms for bands 0-2,
 // orthonormality on the sphere, finite and exact values at the poles, and the addition
 // theorem (rotation invariance of each band).
+#include "../sh/sphere_quadrature.hpp"
+
 #include <bounce/sampling.hpp>
 #include <bounce/sh_basis.hpp>
 
@@ -31,38 +33,8 @@ std::vector<glm::dvec3> test_directions() {
     return ds;
 }
 
-// Legendre polynomial P_l(x) by Bonnet's recurrence, independent of the kernel.
-double legendre(int l, double x) {
-    double p0 = 1, p1 = x;
-    if (l == 0) return p0;
-    for (int k = 2; k <= l; ++k) {
-        const double p2 = ((2 * k - 1) * x * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-    }
-    return p1;
-}
-
-// Gauss-Legendre nodes and weights on [-1, 1] (Newton's method on P_n from the
-// Tricomi initial guesses): exact for polynomials of degree <= 2n - 1.
-void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
-    x.resize(std::size_t(n));
-    w.resize(std::size_t(n));
-    for (int i = 0; i < n; ++i) {
-        double t = std::cos(pi * (i + 0.75) / (n + 0.5)), dp = 0;
-        for (int it = 0; it < 100; ++it) {
-            const double p = legendre(n, t), q = legendre(n - 1, t);
-            dp = n * (t * p - q) / (t * t - 1);
-            const double step = p / dp;
-            t -= step;
-            if (std::abs(step) < 1e-16) break;
-        }
-        const double p = legendre(n, t), q = legendre(n - 1, t);
-        dp = n * (t * p - q) / (t * t - 1);
-        x[std::size_t(i)] = t;
-        w[std::size_t(i)] = 2 / ((1 - t * t) * dp * dp);
-    }
-}
+using sh_test::gauss_legendre;
+using sh_test::legendre;
 
 }  // namespace
 

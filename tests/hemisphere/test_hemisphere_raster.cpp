@@ -5,6 +5,7 @@
 #include "../core/half_lit_ceiling.hpp"
 #include "../gl/shared_context.hpp"
 #include "half_lit_ceiling_scene.hpp"
+#include "raster_options.hpp"
 
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
@@ -91,15 +92,6 @@ struct gl_ceiling {
         : scene(half_lit_ceiling_scene(H, x_edge, kd, E_perp)), mesh(scene), light(scene, mesh, shadow_resolution),
           raster(scene, mesh, light, options) {}
 };
-
-gl::hemisphere_raster_options raster_options(std::uint32_t N, double aperture, std::size_t batch, float offset,
-                                              double turn = 0, bool hashed_turn = false) {
-    gl::hemisphere_raster_options o;
-    o.camera = {N, aperture, turn, hashed_turn};
-    o.batch = batch;
-    o.offset = offset;
-    return o;
-}
 
 }  // namespace
 

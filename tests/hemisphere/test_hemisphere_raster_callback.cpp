@@ -6,6 +6,7 @@
 #include "../core/half_lit_ceiling.hpp"
 #include "../gl/shared_context.hpp"
 #include "half_lit_ceiling_scene.hpp"
+#include "raster_options.hpp"
 
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
@@ -35,15 +36,6 @@ namespace {
 
 constexpr double pi = std::numbers::pi;
 constexpr float inf = std::numeric_limits<float>::infinity();
-
-gl::hemisphere_raster_options raster_options(std::uint32_t N, double aperture, std::size_t batch, float offset,
-                                              double turn = 0, bool hashed_turn = false) {
-    gl::hemisphere_raster_options o;
-    o.camera = {N, aperture, turn, hashed_turn};
-    o.batch = batch;
-    o.offset = offset;
-    return o;
-}
 
 // A renderer's own draw of the half-lit ceiling: its own vertex buffer (position and albedo
 // per vertex, no index buffer, nothing of bounce's scene_mesh) and its own program. The
