@@ -1,0 +1,92 @@
+#pragma once
+/// \file probe_baker.hpp
+/// Irradiance-volume probes ray-cast with Embree: a `bounce::probe_source` for
+/// `irradiance_volume::build`.
+///
+/// A probe at p casts `rays` rays from p along a spherical Fibonacci set of directions
+/// (Gonzalez, "Measurement of areas on a sphere using Fibonacci and latitude-longitude
+/// lattices", Mathematical Geosciences 2010: near-equal areas, each ray standing for
+/// 4 pi / rays sr), takes the radiance each brings from the reference integrator
+/// (`reference_integrator::incoming_radiance`: Kd / pi times the direct irradiance at the
+/// first hit, the environment on a miss; so the volume holds one-bounce indirect light, the
+/// same light the reference's `indirect_irradiance` integrates) and projects it onto SH
+/// bands 0..2 with `sh_project_monte_carlo` (density 1 / (4 pi)). Every probe uses the same
+/// directions, so the central differences of the gradients carry no Monte Carlo noise of
+/// their own, only the directional discretization, which is the same at p +- h.
+///
+/// - Harmonic mean distance: rays / sum_j 1 / d_j over the hits (misses add 0).
+/// - Inside geometry: a probe whose rays hit the back of triangles (the side opposite
+///   their counter-clockwise normal) in more than `inside_fraction` of the cases is
+///   flagged inside; it gets no gradient.
+/// - Gradients (sh_translational_gradient): central differences of six re-projected
+///   probes at p +- h e_k with h = min(gradient_step, nearest_fraction * the nearest hit
+///   distance), so that a displaced probe does not cross the surface nearest to it
+///   (sh_gradients.hpp explains the step's two errors).
+
+#include <bounce/embree/accel.hpp>
+#include <bounce/embree/reference.hpp>
+#include <bounce/irradiance_volume.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace bounce::embree {
+
+/// Parameters of the probe baker (unit and typical value with each).
+struct probe_baker_settings {
+    /// Rays per probe (and per displaced probe of a gradient). Typical: 256-1024.
+    std::uint32_t rays = 512;
+    /// Largest central-difference step h of the gradients (world units); 0: no gradients
+    /// (6 fewer probes' worth of rays each). Typical: a tenth of the finest cell edge.
+    float gradient_step = 0.f;
+    /// The step is also at most this fraction of the distance to the nearest hit.
+    /// Typical: 0.5.
+    float nearest_fraction = 0.5f;
+    /// Fraction of back-facing hits above which a probe is inside geometry. Typical: 0.5.
+    float inside_fraction = 0.5f;
+    /// Base seed of the area-light samples at the hits (unused without emitters).
+    std::uint64_t seed = 1;
+    /// Called with (probes done, probes in the batch) as probes finish, serialized, from a
+    /// worker thread; may be empty.
+    std::function<void(std::size_t done, std::size_t total)> progress;
+};
+
+/// Bakes probes over one scene with the reference integrator's light. Holds references
+/// to the integrator (and through it the BVH and scene): they must outlive it. Safe to
+/// call from many threads.
+class probe_baker {
+public:
+    /// Throws parameter_error naming the setting: rays = 0, a negative or non-finite
+    /// gradient_step, nearest_fraction outside (0, 1], inside_fraction outside [0, 1].
+    probe_baker(const reference_integrator& light, const accel& bvh, const scene_view& scene,
+                probe_baker_settings settings = {});
+
+    const probe_baker_settings& settings() const noexcept { return settings_; }
+    /// The unit ray directions every probe uses.
+    const std::vector<glm::dvec3>& directions() const noexcept { return directions_; }
+
+    /// One probe at `position` (finite; throws parameter_error naming "position").
+    irradiance_probe bake(glm::vec3 position) const;
+    /// Probes at every position, in parallel (TBB), reporting progress.
+    void bake(std::span<const glm::vec3> positions, std::span<irradiance_probe> out) const;
+    /// `bake` of a batch: makes the baker a bounce::probe_source.
+    void operator()(std::span<const glm::vec3> positions, std::span<irradiance_probe> out) const {
+        bake(positions, out);
+    }
+
+private:
+    struct cast;
+    irradiance_probe::coefficients project(glm::vec3 position, std::uint64_t seed, cast* details) const;
+
+    const reference_integrator& light_;
+    const accel& bvh_;
+    scene_view scene_;
+    probe_baker_settings settings_;
+    std::vector<glm::dvec3> directions_;
+};
+
+}  // namespace bounce::embree

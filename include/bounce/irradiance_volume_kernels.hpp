@@ -1,0 +1,97 @@
+#pragma once
+/// \file irradiance_volume_kernels.hpp
+/// The per-point math of an irradiance-volume lookup (Oat, "Irradiance Volumes for
+/// Real-time Rendering", ShaderX5 section 6.1, 2006), written once as kernels: the CPU
+/// lookup (irradiance_volume.hpp) instantiates them with float and glm::vec3, the GL
+/// adapter prints them as GLSL (gl/irradiance_volume.hpp). What is left outside them is
+/// plumbing: reading nodes and probes from buffers and the loops over them.
+///
+/// Probes hold the SH coefficients (bands 0..2, RGB) of the incoming radiance at a point
+/// and, optionally, their translational gradients (sh_gradients.hpp).
+
+#include <bounce/concepts.hpp>
+#include <bounce/sh_gradients.hpp>
+#include <bounce/sh_irradiance.hpp>
+#include <bounce/vocabulary.hpp>
+
+#include <array>
+#include <cstddef>
+#include <utility>
+
+namespace bounce {
+
+/// SH bands of an irradiance-volume probe: 3 (order 2, 9 coefficients per channel), all
+/// that irradiance needs (Ramamoorthi and Hanrahan 2001).
+inline constexpr int irradiance_volume_bands = 3;
+/// Coefficients per channel of a probe.
+inline constexpr std::size_t irradiance_volume_coefficients = sh_count(irradiance_volume_bands);
+
+/// The child of an octree cell holding `p`: 0..7 with bit 0 set for p.x >= centre.x, bit 1
+/// for y, bit 2 for z (a point on a splitting plane belongs to the upper child). Returned
+/// as a number so that the same kernel runs in GLSL, where the caller converts it to int.
+template <real T, vec3_of<T> V>
+T octree_octant(const V& p, const V& centre) {
+    return select(p.x >= centre.x, T(1), T(0)) + select(p.y >= centre.y, T(2), T(0)) +
+           select(p.z >= centre.z, T(4), T(0));
+}
+
+/// Trilinear weights of the 8 corners of the box [lo, lo + size] at `p` (clamped into the
+/// box), corner k at lo + size * (k & 1, (k >> 1) & 1, (k >> 2) & 1). They sum to 1 and
+/// reproduce any linear function of position exactly.
+template <real T, vec3_of<T> V>
+std::array<T, 8> trilinear_weights(const V& p, const V& lo, const V& size) {
+    const V t = clamp((p - lo) / size, T(0), T(1));
+    const T x[2] = {T(1) - t.x, t.x}, y[2] = {T(1) - t.y, t.y}, z[2] = {T(1) - t.z, t.z};
+    std::array<T, 8> w{x[0], x[0], x[0], x[0], x[0], x[0], x[0], x[0]};
+    for (int k = 0; k < 8; ++k) w[std::size_t(k)] = x[k & 1] * y[(k >> 1) & 1] * z[(k >> 2) & 1];
+    return w;
+}
+
+/// Irradiance (W/m^2, RGB) at a surface with unit normal `n` at offset `d` from a probe
+/// with radiance coefficients `c` and gradients (`gx`, `gy`, `gz`): Oat's first-order
+/// extrapolation I'_i = I_i + grad I_i . d (sh_extrapolate), then the clamped-cosine
+/// convolution (sh_irradiance). With d = 0 it is the probe's own irradiance.
+template <int L, real T, vec3_of<T> V>
+V probe_irradiance(const std::array<V, sh_count(L)>& c, const std::array<V, sh_count(L)>& gx,
+                   const std::array<V, sh_count(L)>& gy, const std::array<V, sh_count(L)>& gz, const V& d, const V& n) {
+    return sh_irradiance<L, T, V>(sh_extrapolate<L, T, V, V>(c, gx, gy, gz, d), n);
+}
+
+/// One probe's term of the distance-weighted average (Oat 2006, "Interpolating between
+/// probes"): w = valid (1 / max(|p - s| / scale, min_distance))^b, added with the probe's
+/// irradiance at p, extrapolated by the gradients scaled by `gradient_scale` (1: on, 0:
+/// off). `scale` (world units) only normalizes distances so that w stays in float range:
+/// every term of one lookup uses the same scale, which cancels in the average.
+/// `min_distance` (relative to scale, typical 1e-4) caps the weight at a probe, so the
+/// average there is that probe's value to within (min_distance)^b of the others' weights.
+/// `valid` is 1 for a usable probe and 0 for one inside geometry. Returns the new
+/// (sum of w E, sum of w).
+template <int L, real T, vec3_of<T> V>
+std::pair<V, T> weighted_probe_accumulate(const V& sum, const T& weight_sum, const V& p, const V& n, const V& s,
+                                          const T& valid, const T& b, const T& scale, const T& min_distance,
+                                          const T& gradient_scale, const std::array<V, sh_count(L)>& c,
+                                          const std::array<V, sh_count(L)>& gx, const std::array<V, sh_count(L)>& gy,
+                                          const std::array<V, sh_count(L)>& gz) {
+    const V d = p - s;
+    const T r = max(length(d) / scale, min_distance);
+    const T w = valid * pow(T(1) / r, b);
+    const V e = probe_irradiance<L, T, V>(c, gx, gy, gz, d * gradient_scale, n);
+    return {sum + e * w, weight_sum + w};
+}
+
+/// One corner's term of a trilinear lookup: weight times valid, added with the probe's own
+/// irradiance (no extrapolation). Returns the new (sum of w E, sum of w).
+template <int L, real T, vec3_of<T> V>
+std::pair<V, T> trilinear_probe_accumulate(const V& sum, const T& weight_sum, const V& n, const T& weight,
+                                           const T& valid, const std::array<V, sh_count(L)>& c) {
+    const T w = weight * valid;
+    return {sum + sh_irradiance<L, T, V>(c, n) * w, weight_sum + w};
+}
+
+/// The average sum / weight_sum, and 0 where no probe contributed (weight_sum = 0).
+template <real T, vec3_of<T> V>
+V probe_average(const V& sum, const T& weight_sum) {
+    return sum * select(weight_sum > T(0), T(1) / max(weight_sum, T(1e-30)), T(0));
+}
+
+}  // namespace bounce
