@@ -1,0 +1,716 @@
+// One-bounce indirect irradiance from reflective shadow maps on OpenGL: the interleaved
+// split and gather (Segovia et al. 2006), the RSM gather (Dachsbacher and Stamminger 2005)
+// as a fragment pass, SII (Dachsbacher and Stamminger 2006) as instanced quads with
+// additive blending, the discontinuity buffer and the separable geometry-aware tent. The
+// shaders are plumbing (fetches, loops over storage buffers, row flips, writes); the index
+// maps, disc centre, pixel-light irradiance, discontinuity test and tent are the emitted
+// kernels of rsm.hpp and interleaved_sampling.hpp.
+#include <bounce/gl/indirect_renderer.hpp>
+#include <bounce/glsl/emit.hpp>
+#include <bounce/rsm.hpp>
+#include <bounce/sampling.hpp>
+#include <bounce/splat_bounds.hpp>
+
+#include "saved_state.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <glm/glm.hpp>
+
+namespace bounce::gl {
+
+// ---- options ----------------------------------------------------------------------------
+
+void pixel_light_params::validate() const {
+    require(std::isfinite(offset) && offset >= 0.f, "offset", "must be finite and >= 0");
+    require(std::isfinite(min_distance2) && min_distance2 >= 0.f, "min_distance2", "must be finite and >= 0");
+}
+
+void discontinuity_params::validate() const {
+    require(std::isfinite(relative_depth) && relative_depth >= 0.f, "relative_depth", "must be finite and >= 0");
+    require(std::isfinite(cos_normal) && cos_normal >= -1.f && cos_normal <= 1.f, "cos_normal", "must lie in [-1, 1]");
+}
+
+void indirect_options::validate() const {
+    require(count > 0 && count <= (std::size_t(1) << 24), "count", "must lie in [1, 2^24]");
+    pattern.validate();
+    require(shift >= 0 && shift < pattern.cells(), "shift", "must lie in [0, N M)");
+    discontinuity.validate();
+    require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
+    light.validate();
+    require(std::isfinite(sii_cutoff) && sii_cutoff >= 0.f, "sii_cutoff", "must be finite and >= 0");
+    require(low_resolution == 1, "low_resolution",
+            "must be 1: the GL renderer gathers at full resolution (no upsampling pass)");
+}
+
+void rsm_textures::validate(const char* name) const {
+    require(position.id != 0 && normal.id != 0 && flux.id != 0, name, "a map texture is missing");
+    require(position.format == texel_format::rgba32f && normal.format == texel_format::rgba32f &&
+                flux.format == texel_format::rgba32f,
+            name, "position, normal and flux must be RGBA32F textures");
+    require(flux.width > 0 && flux.height > 0, name, "the map has no size");
+    require(position.width == flux.width && position.height == flux.height && normal.width == flux.width &&
+                normal.height == flux.height,
+            name, "position, normal and flux maps differ in size");
+}
+
+rsm_images::rsm_images(const rsm_textures& t)
+    : position(t.width(), t.height()),
+      normal(t.width(), t.height()),
+      flux(t.width(), t.height()),
+      light_view_projection(t.light_view_projection) {
+    t.validate();
+    read_texture(t.position, position.view());
+    read_texture(t.normal, normal.view());
+    read_texture(t.flux, flux.view());
+}
+
+// ---- CPU-side choices, the CPU renderer's ------------------------------------------------
+
+std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count, std::uint64_t seed,
+                                        disc_weighting weighting) {
+    require(count > 0, "count", "must be positive");
+    require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
+    require(texel_count > 0, "texel_count", "must be positive");
+    pcg32 rng(seed);
+    const glm::dvec2 shift(rng.next_double(), rng.next_double());
+    std::vector<glm::vec3> out(count);
+    for (std::size_t k = 0; k < count; ++k) {
+        const glm::dvec2 xi = halton2(k, shift);
+        out[k] = weighting == disc_weighting::unbiased
+                     ? rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count))
+                     : rsm_disc_sample_xi1_squared<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count),
+                                                                       double(count));
+    }
+    for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
+    return out;
+}
+
+std::vector<vpl> select_vpls(std::span<const rsm_view> maps, const indirect_options& options) {
+    std::vector<vpl> out;
+    std::vector<double> totals;
+    double sum = 0;
+    for (const auto& m : maps) {
+        totals.push_back(flux_warping(m).total());
+        sum += totals.back();
+    }
+    for (std::size_t i = 0; i < maps.size(); ++i) {
+        if (!(totals[i] > 0)) continue;
+        // VPLs shared between maps in proportion to their flux, so each carries about the
+        // same flux whichever map it comes from.
+        const auto share = std::max<std::size_t>(1, std::size_t(std::llround(double(options.count) * totals[i] / sum)));
+        std::vector<vpl> more;
+        if (options.selection == vpl_selection::flux_warping) {
+            more = vpls_by_flux_warping(maps[i], share, options.seed + i);
+        } else {
+            const double aspect = double(maps[i].width()) / double(maps[i].height());
+            const auto gx = std::max<std::size_t>(1, std::size_t(std::llround(std::sqrt(double(share) * aspect))));
+            const auto gy = std::max<std::size_t>(1, (share + gx - 1) / gx);
+            more = vpls_on_grid(maps[i], gx, gy);
+        }
+        out.insert(out.end(), more.begin(), more.end());
+    }
+    return out;
+}
+
+namespace {
+
+// A pixel rectangle, inclusive, rows counted from the top.
+struct pixel_box {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    bool empty() const noexcept { return x0 > x1 || y0 > y1; }
+};
+
+// The pixels whose centres a sphere can cover, widened by 1/8 pixel: the rectangle
+// cpu::splat_rect computes (cpu/splatting.hpp), from the same kernel and the same rounding.
+pixel_box sphere_pixels(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float radius,
+                        std::size_t width, std::size_t height) {
+    const glm::vec3 c = glm::vec3(view * glm::vec4(centre, 1.f));
+    const auto b =
+        sphere_ndc_bounds<float, glm::vec3>(c, radius, cam.near_plane, cam.tan_half_fov(), float(width) / float(height));
+    if (!(b[0] <= b[2]) || b[0] >= 2.f) return {};
+    auto px = [&](float ndc) { return double(ndc + 1.f) * 0.5 * double(width); };
+    auto py = [&](float ndc) { return double(1.f - ndc) * 0.5 * double(height); };
+    constexpr double m = 0.125;
+    pixel_box r;
+    r.x0 = int(std::max(0.0, std::ceil(px(b[0]) - 0.5 - m)));
+    r.x1 = int(std::min(double(width) - 1, std::floor(px(b[2]) - 0.5 + m)));
+    r.y0 = int(std::max(0.0, std::ceil(py(b[3]) - 0.5 - m)));
+    r.y1 = int(std::min(double(height) - 1, std::floor(py(b[1]) - 0.5 + m)));
+    return r;
+}
+
+// Image columns [lo, hi] that belong to sub-buffer i of an n-wide pattern (x = i + a n) as
+// split-buffer columns: a in [ceil((lo - i) / n), floor((hi - i) / n)], from the sub-buffer's
+// origin (as cpu::splat_vpls).
+void local_span(int lo, int hi, int i, int n, std::size_t extent, std::size_t origin, int& a, int& b) {
+    a = lo <= i ? 0 : (lo - i + n - 1) / n;
+    b = hi < i ? -1 : std::min((hi - i) / n, int(extent) - 1);
+    a += int(origin);
+    b += int(origin);
+}
+
+constexpr const char* fullscreen_vertex = R"(#version 450 core
+void main() {
+    vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
+    gl_Position = vec4(corner - 1.0, 0.0, 1.0);
+}
+)";
+
+// Shared declarations: the frame's size and pattern, GL rows to rows from the top, the
+// background test (depth +infinity, gbuffer_view::covered).
+constexpr const char* common_glsl = R"(layout(location = 0) uniform vec2 frame_size;
+layout(location = 1) uniform vec2 frame_pattern;
+int top_row(int row) { return int(frame_size.y) - 1 - row; }
+ivec2 texel_of(int x, int row_from_top) { return ivec2(x, int(frame_size.y) - 1 - row_from_top); }
+bool covered(float depth) { return depth < uintBitsToFloat(0x7f800000u); }
+)";
+
+std::string index_kernels() {
+    glsl::function_set k;
+    k.add("interleave_gather_coordinate", interleave_gather_coordinate<glsl::f32>, "u", "size", "n", "result");
+    k.add("interleave_split_coordinate", interleave_split_coordinate<glsl::f32>, "x", "size", "n");
+    return k.source();
+}
+
+// Split: split-buffer pixel (u, v) holds image pixel gather_coordinate(u, v) (its inverse
+// map is split_coordinate), position-depth and normal into two targets.
+std::string split_fragment() {
+    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D source_position_depth;
+layout(binding = 1) uniform sampler2D source_normal;
+layout(location = 0) out vec4 split_position_depth;
+layout(location = 1) out vec4 split_normal;
+
+)" + index_kernels() + R"(
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    float gx[2], gy[2];
+    interleave_gather_coordinate(float(g.x), frame_size.x, frame_pattern.x, gx);
+    interleave_gather_coordinate(float(top_row(g.y)), frame_size.y, frame_pattern.y, gy);
+    ivec2 source = texel_of(int(gx[0]), int(gy[0]));
+    split_position_depth = texelFetch(source_position_depth, source, 0);
+    split_normal = vec4(texelFetch(source_normal, source, 0).xyz, 0.0);
+}
+)";
+}
+
+// Gather: image pixel (x, y) takes split-buffer pixel split_coordinate(x, y).
+std::string gather_fragment() {
+    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D split_image;
+layout(location = 0) out vec4 image;
+
+)" + index_kernels() + R"(
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    float u = interleave_split_coordinate(float(g.x), frame_size.x, frame_pattern.x);
+    float v = interleave_split_coordinate(float(top_row(g.y)), frame_size.y, frame_pattern.y);
+    image = vec4(texelFetch(split_image, texel_of(int(u), int(v)), 0).rgb, 0.0);
+}
+)";
+}
+
+// The RSM gather over a (split) G-buffer from one map: the pixel's sub-buffer s reads the
+// run [group_begin[s], group_begin[s + 1]) of the grouped pattern (cpu::rsm_gather's order).
+std::string gather_rsm_fragment() {
+    glsl::function_set k;
+    k.add("interleave_gather_coordinate", interleave_gather_coordinate<glsl::f32>, "u", "size", "n", "result");
+    k.add("rsm_disc_centre", rsm_disc_centre<glsl::f32, glsl::vec2>, "clip_x", "clip_y", "clip_w");
+    k.add("pixel_light_irradiance", pixel_light_irradiance<glsl::f32, glsl::vec3>, "x", "n", "xp", "np", "flux",
+          "offset", "min_distance2");
+    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
+layout(binding = 1) uniform sampler2D gbuffer_normal;
+layout(binding = 2) uniform sampler2D map_position;
+layout(binding = 3) uniform sampler2D map_normal;
+layout(binding = 4) uniform sampler2D map_flux;
+layout(std430, binding = 0) readonly buffer bounce_disc { vec4 disc[]; };
+layout(std430, binding = 1) readonly buffer bounce_groups { uint group_begin[]; };
+layout(location = 2) uniform mat4 light_view_projection;
+layout(location = 3) uniform vec2 map_size;
+layout(location = 4) uniform float weight_scale;
+layout(location = 5) uniform float offset;
+layout(location = 6) uniform float min_distance2;
+layout(location = 0) out vec4 irradiance;
+
+)" + k.source() + R"(
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    vec4 position_depth = texelFetch(gbuffer_position_depth, g, 0);
+    if (!covered(position_depth.w)) {
+        irradiance = vec4(0.0);
+        return;
+    }
+    float gx[2], gy[2];
+    interleave_gather_coordinate(float(g.x), frame_size.x, frame_pattern.x, gx);
+    interleave_gather_coordinate(float(top_row(g.y)), frame_size.y, frame_pattern.y, gy);
+    int s = int(gy[1]) * int(frame_pattern.x) + int(gx[1]);
+    vec3 x = position_depth.xyz;
+    vec3 n = texelFetch(gbuffer_normal, g, 0).xyz;
+    // The matrix product in glm's order, unfused, so the disc centre rounds as on the CPU.
+    precise vec4 clip = (light_view_projection[0] * x.x + light_view_projection[1] * x.y) +
+                        (light_view_projection[2] * x.z + light_view_projection[3]);
+    vec2 centre = rsm_disc_centre(clip.x, clip.y, clip.w);
+    vec3 e = vec3(0.0);
+    for (uint k = group_begin[s]; k < group_begin[s + 1]; ++k) {
+        vec4 sample_k = disc[k];
+        precise float tu = (centre.x + sample_k.x) * map_size.x;
+        precise float tv = (centre.y + sample_k.y) * map_size.y;
+        if (!(tu >= 0.0 && tu < map_size.x && tv >= 0.0 && tv < map_size.y)) continue;
+        ivec2 t = ivec2(int(tu), int(map_size.y) - 1 - int(tv));
+        vec3 flux = texelFetch(map_flux, t, 0).rgb;
+        if (flux == vec3(0.0)) continue;
+        e += pixel_light_irradiance(x, n, texelFetch(map_position, t, 0).xyz, texelFetch(map_normal, t, 0).xyz,
+                                    flux * (sample_k.z * weight_scale), offset, min_distance2);
+    }
+    irradiance = vec4(e, 0.0);
+}
+)";
+}
+
+// SII: one quad per VPL on its split-buffer rectangle (pixel edges, rows from the top).
+constexpr const char* splat_vertex = R"(#version 450 core
+layout(location = 0) in vec4 rect;
+layout(location = 0) uniform vec2 frame_size;
+flat out int vpl_index;
+void main() {
+    vpl_index = gl_InstanceID;
+    float x = (gl_VertexID & 1) != 0 ? rect.z + 1.0 : rect.x;
+    float y = (gl_VertexID & 2) != 0 ? rect.w + 1.0 : rect.y;
+    gl_Position = vec4(2.0 * x / frame_size.x - 1.0, 1.0 - 2.0 * y / frame_size.y, 0.0, 1.0);
+}
+)";
+
+std::string splat_fragment() {
+    glsl::function_set k;
+    k.add("pixel_light_irradiance", pixel_light_irradiance<glsl::f32, glsl::vec3>, "x", "n", "xp", "np", "flux",
+          "offset", "min_distance2");
+    return std::string("#version 450 core\n") + R"(struct bounce_vpl {
+    vec4 position;
+    vec4 normal;
+    vec4 flux;
+};
+layout(std430, binding = 0) readonly buffer bounce_vpls { bounce_vpl vpls[]; };
+layout(binding = 0) uniform sampler2D gbuffer_position_depth;
+layout(binding = 1) uniform sampler2D gbuffer_normal;
+layout(location = 5) uniform float offset;
+layout(location = 6) uniform float min_distance2;
+flat in int vpl_index;
+layout(location = 0) out vec4 irradiance;
+
+)" + k.source() + R"(
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    vec4 position_depth = texelFetch(gbuffer_position_depth, g, 0);
+    if (!(position_depth.w < uintBitsToFloat(0x7f800000u))) discard;
+    bounce_vpl l = vpls[vpl_index];
+    irradiance = vec4(pixel_light_irradiance(position_depth.xyz, texelFetch(gbuffer_normal, g, 0).xyz, l.position.xyz,
+                                             l.normal.xyz, l.flux.xyz, offset, min_distance2), 0.0);
+}
+)";
+}
+
+// The discontinuity buffer: x = edge towards the right neighbour, y = towards the one below
+// (rows from the top); borders and background count as edges (cpu::discontinuity_buffer).
+std::string discontinuity_fragment() {
+    glsl::function_set k;
+    k.add("geometry_discontinuity", geometry_discontinuity<glsl::f32, glsl::vec3>, "depth_a", "n_a", "depth_b", "n_b",
+          "relative_depth", "cos_normal");
+    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
+layout(binding = 1) uniform sampler2D gbuffer_normal;
+layout(location = 2) uniform float relative_depth;
+layout(location = 3) uniform float cos_normal;
+layout(location = 0) out vec4 edges;
+
+)" + k.source() + R"(
+float edge(ivec2 a, ivec2 b) {
+    float da = texelFetch(gbuffer_position_depth, a, 0).w, db = texelFetch(gbuffer_position_depth, b, 0).w;
+    if (!covered(da) || !covered(db)) return 1.0;
+    return geometry_discontinuity(da, texelFetch(gbuffer_normal, a, 0).xyz, db, texelFetch(gbuffer_normal, b, 0).xyz,
+                                  relative_depth, cos_normal);
+}
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    int y = top_row(g.y);
+    float right = g.x + 1 < int(frame_size.x) ? edge(g, ivec2(g.x + 1, g.y)) : 1.0;
+    float below = y + 1 < int(frame_size.y) ? edge(g, ivec2(g.x, g.y - 1)) : 1.0;
+    edges = vec4(right, below, 0.0, 0.0);
+}
+)";
+}
+
+// One pass of the geometry-aware tent with compile-time radius R along x or y (rows from
+// the top), clamped at the borders as cpu::geometry_aware_blur.
+std::string tent_fragment(int radius, bool vertical) {
+    glsl::function_set k;
+    const auto add = [&]<int R>() {
+        k.add("geometry_aware_tent", geometry_aware_tent<R, glsl::f32, glsl::vec3>, "values", "edges", "n");
+    };
+    switch (radius) {
+        case 1: add.operator()<1>(); break;
+        case 3: add.operator()<3>(); break;
+        case 7: add.operator()<7>(); break;
+        case 15: add.operator()<15>(); break;
+        case 31: add.operator()<31>(); break;
+        default: add.operator()<63>(); break;
+    }
+    const std::string r = std::to_string(radius);
+    return std::string("#version 450 core\n") + common_glsl + "const int R = " + r + ";\nconst bool vertical = " +
+           (vertical ? "true" : "false") + R"(;
+layout(binding = 0) uniform sampler2D blur_input;
+layout(binding = 1) uniform sampler2D edge_buffer;
+layout(binding = 2) uniform sampler2D gbuffer_position_depth;
+layout(location = 2) uniform float pattern_width;
+layout(location = 0) out vec4 blurred;
+
+)" + k.source() + R"(
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    if (!covered(texelFetch(gbuffer_position_depth, g, 0).w)) {
+        blurred = vec4(texelFetch(blur_input, g, 0).rgb, 0.0);
+        return;
+    }
+    int x = g.x, y = top_row(g.y);
+    int along = vertical ? y : x;
+    int size = vertical ? int(frame_size.y) : int(frame_size.x);
+    vec3 values[2 * R + 1];
+    float cuts[2 * R];
+    for (int k = 0; k <= 2 * R; ++k) {
+        int t = along - R + k;
+        bool inside = t >= 0 && t < size;
+        int at = inside ? t : along;
+        ivec2 texel = vertical ? texel_of(x, at) : texel_of(at, y);
+        values[k] = texelFetch(blur_input, texel, 0).rgb;
+        if (k < 2 * R) {
+            vec2 e = texelFetch(edge_buffer, texel, 0).xy;
+            cuts[k] = inside && t + 1 < size ? (vertical ? e.y : e.x) : 1.0;
+        }
+    }
+    blurred = vec4(geometry_aware_tent(values, cuts, pattern_width), 0.0);
+}
+)";
+}
+
+int tent_radius(const interleave_pattern& p) {
+    const int reach = std::max(p.n, p.m) - 1;
+    for (int r : {1, 3, 7, 15, 31})
+        if (reach <= r) return r;
+    return 63;
+}
+
+// Uniform locations of common_glsl and the passes.
+enum location : int {
+    loc_size = 0,
+    loc_pattern = 1,
+    loc_light_view_projection = 2,
+    loc_relative_depth = 2,
+    loc_pattern_width = 2,
+    loc_map_size = 3,
+    loc_cos_normal = 3,
+    loc_weight_scale = 4,
+    loc_offset = 5,
+    loc_min_distance2 = 6,
+};
+
+// One VPL as the splat shader reads it (std430).
+struct gpu_vpl {
+    glm::vec4 position, normal, flux;
+};
+
+}  // namespace
+
+// ---- the passes -------------------------------------------------------------------------
+
+struct indirect_renderer::passes {
+    program split{fullscreen_vertex, split_fragment()};
+    program gather{fullscreen_vertex, gather_fragment()};
+    program gather_rsm{fullscreen_vertex, gather_rsm_fragment()};
+    program splat{splat_vertex, splat_fragment()};
+    program discontinuity{fullscreen_vertex, discontinuity_fragment()};
+    std::optional<program> tent_x, tent_y;
+    int tent_r = 0;
+    framebuffer fbo;
+    vertex_array empty_vao, rect_vao;
+    // Scratch of one size (interleaved frames): split G-buffer, split result, gathered
+    // result, horizontal tent, discontinuity buffer.
+    std::optional<texture> split_position_depth, split_normal, split_out, gathered, scratch, edges;
+    std::size_t width = 0, height = 0;
+    // The disc pattern (grouped) and its group starts, kept while unchanged.
+    std::optional<buffer> disc, groups;
+    std::size_t disc_count = 0, disc_texels = 0;
+    std::optional<buffer> vpls, rects;
+
+    passes() {
+        const GLuint vao = rect_vao.id();
+        glVertexArrayAttribFormat(vao, 0, 4, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(vao, 0, 0);
+        glEnableVertexArrayAttrib(vao, 0);
+        glVertexArrayBindingDivisor(vao, 0, 1);
+        check_error("indirect_renderer vertex array");
+    }
+
+    void ensure_scratch(std::size_t w, std::size_t h) {
+        if (split_out && width == w && height == h) return;
+        split_position_depth.emplace(texel_format::rgba32f, w, h);
+        split_normal.emplace(texel_format::rgba32f, w, h);
+        split_out.emplace(texel_format::rgba32f, w, h);
+        gathered.emplace(texel_format::rgba32f, w, h);
+        scratch.emplace(texel_format::rgba32f, w, h);
+        edges.emplace(texel_format::rgba32f, w, h);
+        width = w;
+        height = h;
+    }
+
+    void ensure_tent(int r) {
+        if (tent_r == r) return;
+        tent_x.emplace(fullscreen_vertex, tent_fragment(r, false));
+        tent_y.emplace(fullscreen_vertex, tent_fragment(r, true));
+        tent_r = r;
+    }
+
+    // Binds `targets` as the colour attachments, the viewport to their size.
+    void target(std::initializer_list<object_id> targets, std::size_t w, std::size_t h) {
+        GLenum buffers[4];
+        GLuint i = 0;
+        for (object_id t : targets) {
+            glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0 + i, t, 0);
+            buffers[i] = GL_COLOR_ATTACHMENT0 + i;
+            ++i;
+        }
+        for (GLuint j = i; j < 4; ++j) glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0 + j, 0, 0);
+        glNamedFramebufferDrawBuffers(fbo.id(), GLsizei(i), buffers);
+        fbo.check_complete();
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo.id());
+        glViewport(0, 0, GLsizei(w), GLsizei(h));
+    }
+
+    void release_targets() {
+        for (GLuint j = 0; j < 4; ++j) glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0 + j, 0, 0);
+    }
+
+    static void textures(std::initializer_list<object_id> ids) {
+        GLuint unit = 0;
+        for (object_id t : ids) {
+            glBindTextureUnit(unit, t);
+            glBindSampler(unit, 0);
+            ++unit;
+        }
+    }
+
+    static void frame_uniforms(const program& p, std::size_t w, std::size_t h, const interleave_pattern& pattern) {
+        p.set(loc_size, glm::vec2(float(w), float(h)));
+        p.set(loc_pattern, glm::vec2(float(pattern.n), float(pattern.m)));
+    }
+
+    void fullscreen(const program& p) {
+        glUseProgram(p.id());
+        glBindVertexArray(empty_vao.id());
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
+};
+
+indirect_renderer::indirect_renderer(const indirect_options& options) : options_(options) {
+    options_.validate();
+    passes_ = std::make_unique<passes>();
+}
+
+indirect_renderer::~indirect_renderer() = default;
+
+double indirect_renderer::lap(clock::time_point& t) const {
+    if (options_.time_stages) finish();
+    const auto now = clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+    t = now;
+    return ms;
+}
+
+indirect_timings indirect_renderer::render(const gbuffer_textures& g, const camera& cam,
+                                           std::span<const rsm_textures> maps, const texture_ref& irradiance) {
+    g.validate();
+    cam.validate();
+    require(irradiance.id != 0 && irradiance.format == texel_format::rgba32f, "irradiance",
+            "must be an RGBA32F texture");
+    require(irradiance.width == g.width() && irradiance.height == g.height(), "irradiance",
+            "size differs from the G-buffer");
+    for (const auto& m : maps) m.validate("maps");
+    if (options_.technique == indirect_technique::rsm_gather)
+        for (const auto& m : maps)
+            require(m.width() == maps[0].width() && m.height() == maps[0].height(), "maps",
+                    "must all have one size (the disc pattern's weights hold its texel count)");
+
+    passes& p = *passes_;
+    const interleave_pattern& pattern = options_.pattern;
+    const bool interleaved = pattern.cells() > 1;
+    const std::size_t w = g.width(), h = g.height();
+    indirect_timings t;
+
+    const detail::raster_state raster;
+    const detail::blend_offset_state blend;
+    const detail::program_and_storage_state bindings({0u, 1u});
+    const detail::texture_unit_state units(0, 6);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glDisable(GL_DITHER);
+
+    auto start = clock::now();
+    gbuffer_textures shaded = g;
+    object_id shaded_out = irradiance.id;
+    if (interleaved) {
+        p.ensure_scratch(w, h);
+        p.target({p.split_position_depth->id(), p.split_normal->id()}, w, h);
+        passes::textures({g.position_depth.id, g.normal.id});
+        passes::frame_uniforms(p.split, w, h, pattern);
+        p.fullscreen(p.split);
+        shaded.position_depth = *p.split_position_depth;
+        shaded.normal = *p.split_normal;
+        shaded_out = p.split_out->id();
+    }
+    check_error("indirect_renderer split");
+    t.split_ms = lap(start);
+
+    // Shade the sub-buffers.
+    const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+    glClearTexImage(shaded_out, 0, GL_RGBA, GL_FLOAT, zero);
+    const float scale =
+        options_.energy_correct ? interleaved_weight_scale<float>(float(pattern.n), float(pattern.m)) : 1.f;
+    if (options_.technique == indirect_technique::rsm_gather) {
+        t.vpls = options_.count;
+        if (!maps.empty()) {
+            const std::size_t texels = maps[0].width() * maps[0].height();
+            if (!p.disc || p.disc_count != options_.count || p.disc_texels != texels) {
+                const auto full =
+                    rsm_disc_pattern(options_.count, options_.r_max, texels, options_.seed, options_.disc);
+                const light_groups groups =
+                    assign_lights(full.size(), pattern.cells(), light_assignment::interleaved, {}, options_.shift);
+                std::vector<glm::vec4> grouped(full.size());
+                for (std::size_t k = 0; k < full.size(); ++k) grouped[k] = glm::vec4(full[groups.order[k]], 0.f);
+                p.disc.emplace(std::span<const glm::vec4>(grouped));
+                p.groups.emplace(std::span<const std::uint32_t>(groups.begin));
+                p.disc_count = options_.count;
+                p.disc_texels = texels;
+            }
+            p.target({shaded_out}, w, h);
+            glEnable(GL_BLEND);
+            glBlendEquation(GL_FUNC_ADD);
+            glBlendFunc(GL_ONE, GL_ONE);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, p.disc->id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, p.groups->id());
+            const program& prog = p.gather_rsm;
+            passes::frame_uniforms(prog, w, h, pattern);
+            prog.set(loc_weight_scale, scale);
+            prog.set(loc_offset, options_.light.offset);
+            prog.set(loc_min_distance2, options_.light.min_distance2);
+            for (const auto& m : maps) {
+                passes::textures({shaded.position_depth.id, shaded.normal.id, m.position.id, m.normal.id, m.flux.id});
+                prog.set(loc_light_view_projection, m.light_view_projection);
+                prog.set(loc_map_size, glm::vec2(float(m.width()), float(m.height())));
+                p.fullscreen(prog);
+            }
+            glDisable(GL_BLEND);
+        }
+    } else {
+        // VPLs from the read-back maps, as the CPU renderer selects them.
+        std::vector<rsm_images> images;
+        images.reserve(maps.size());
+        for (const auto& m : maps) images.emplace_back(m);
+        std::vector<rsm_view> views;
+        for (const auto& im : images) views.push_back(im.view());
+        const std::vector<vpl> all = select_vpls(views, options_);
+        t.vpls = all.size();
+        std::vector<glm::vec3> positions;
+        if (options_.assignment == light_assignment::similarity)
+            for (const auto& l : all) positions.push_back(l.position);
+        const light_groups groups =
+            assign_lights(all.size(), pattern.cells(), options_.assignment, positions, options_.shift);
+        // Each VPL's rectangle in the split buffer (cpu::splat_vpls), in group order.
+        const glm::mat4 view = cam.view_matrix();
+        splatted_.clear();
+        std::vector<gpu_vpl> packed;
+        std::vector<glm::vec4> rects;
+        for (int s = 0; s < pattern.cells(); ++s) {
+            const int i = s % pattern.n, j = s / pattern.n;
+            const sub_buffer_rect sub = sub_buffer_of(pattern, i, j, w, h);
+            for (std::uint32_t k = groups.begin[std::size_t(s)]; k < groups.begin[std::size_t(s) + 1]; ++k) {
+                const vpl& l = all[groups.order[k]];
+                const vpl scaled{l.position, l.normal, l.flux * scale};
+                splatted_.push_back(scaled);
+                pixel_box r{0, 0, int(w) - 1, int(h) - 1};
+                if (options_.sii_cutoff > 0.f) {
+                    const float flux_max = std::max(std::max(l.flux.x, l.flux.y), l.flux.z);
+                    const auto [centre, radius] = pixel_light_bounding_sphere<float, glm::vec3>(
+                        l.position, l.normal, flux_max, options_.sii_cutoff / float(all.size()), options_.light.offset);
+                    r = sphere_pixels(cam, view, centre, radius, w, h);
+                }
+                if (r.empty() || sub.width == 0 || sub.height == 0) continue;
+                pixel_box q;
+                local_span(r.x0, r.x1, i, pattern.n, sub.width, sub.x0, q.x0, q.x1);
+                local_span(r.y0, r.y1, j, pattern.m, sub.height, sub.y0, q.y0, q.y1);
+                if (q.empty()) continue;
+                packed.push_back({glm::vec4(scaled.position, 0.f), glm::vec4(scaled.normal, 0.f),
+                                  glm::vec4(scaled.flux, 0.f)});
+                rects.emplace_back(float(q.x0), float(q.y0), float(q.x1), float(q.y1));
+            }
+        }
+        if (!packed.empty()) {
+            p.vpls.emplace(std::span<const gpu_vpl>(packed));
+            p.rects.emplace(std::span<const glm::vec4>(rects));
+            p.target({shaded_out}, w, h);
+            glEnable(GL_BLEND);
+            glBlendEquation(GL_FUNC_ADD);
+            glBlendFunc(GL_ONE, GL_ONE);
+            passes::textures({shaded.position_depth.id, shaded.normal.id});
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, p.vpls->id());
+            const program& prog = p.splat;
+            prog.set(loc_size, glm::vec2(float(w), float(h)));
+            prog.set(loc_offset, options_.light.offset);
+            prog.set(loc_min_distance2, options_.light.min_distance2);
+            glUseProgram(prog.id());
+            glVertexArrayVertexBuffer(p.rect_vao.id(), 0, p.rects->id(), 0, sizeof(glm::vec4));
+            glBindVertexArray(p.rect_vao.id());
+            glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(packed.size()));
+            glDisable(GL_BLEND);
+        }
+    }
+    check_error("indirect_renderer shade");
+    t.shade_ms = lap(start);
+
+    if (interleaved) {
+        const object_id gathered = options_.blur ? p.gathered->id() : irradiance.id;
+        p.target({gathered}, w, h);
+        passes::textures({p.split_out->id()});
+        passes::frame_uniforms(p.gather, w, h, pattern);
+        p.fullscreen(p.gather);
+        check_error("indirect_renderer gather");
+        t.gather_ms = lap(start);
+        if (options_.blur) {
+            p.target({p.edges->id()}, w, h);
+            passes::textures({g.position_depth.id, g.normal.id});
+            passes::frame_uniforms(p.discontinuity, w, h, pattern);
+            p.discontinuity.set(loc_relative_depth, options_.discontinuity.relative_depth);
+            p.discontinuity.set(loc_cos_normal, options_.discontinuity.cos_normal);
+            p.fullscreen(p.discontinuity);
+
+            p.ensure_tent(tent_radius(pattern));
+            p.target({p.scratch->id()}, w, h);
+            passes::textures({p.gathered->id(), p.edges->id(), g.position_depth.id});
+            passes::frame_uniforms(*p.tent_x, w, h, pattern);
+            p.tent_x->set(loc_pattern_width, float(pattern.n));
+            p.fullscreen(*p.tent_x);
+
+            p.target({irradiance.id}, w, h);
+            passes::textures({p.scratch->id(), p.edges->id(), g.position_depth.id});
+            passes::frame_uniforms(*p.tent_y, w, h, pattern);
+            p.tent_y->set(loc_pattern_width, float(pattern.m));
+            p.fullscreen(*p.tent_y);
+            check_error("indirect_renderer blur");
+            t.blur_ms = lap(start);
+        }
+    }
+    p.release_targets();
+    check_error("indirect_renderer::render");
+    return t;
+}
+
+}  // namespace bounce::gl

@@ -1,0 +1,341 @@
+// gl::indirect_renderer against cpu::indirect_renderer on the same G-buffer, the same
+// reflective shadow map and the same options: the RSM gather and SII, without and with
+// interleaving (patterns 2x2, 4x4 and 3x2 on an image whose size is no multiple of them),
+// blur on, SII with and without the splat cutoff; the CPU-side choices (disc pattern, VPLs)
+// equal bit for bit; bad input refused by name; the caller's GL state kept.
+//
+// Tolerance. Every pixel is a sum of non-negative terms (pixel-light irradiances), added in
+// the same order on both backends, then (interleaved, blurred) a convex combination of such
+// sums with weights from the same kernel. Each term's GLSL value is within 1e-5 of its own
+// size of the CPU's (tests/rsm/test_rsm_glsl_agreement.cpp: about 2 k ulp for the k <= 40
+// operations of the kernel); a sum of non-negative terms keeps the largest relative error of
+// its terms plus the float rounding of the additions, which is the same on both sides up to
+// the propagated term errors; the tent's weights are ratios of small integers computed in
+// a few operations (1e-6). So |gl - cpu| <= 1e-4 |cpu| per pixel and channel holds with a
+// margin of about 10. What could break it: a disc sample whose texel index rounds to a
+// different texel on the GPU (tu within an ulp of an integer); the shader computes the disc
+// centre unfused, in the CPU's order, so that does not happen on these inputs.
+#include "../gl/shared_context.hpp"
+#include "../rsm/corner_scene.hpp"
+
+#include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/gl/indirect_renderer.hpp>
+#include <bounce/gl/splat_pass.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+using namespace bounce;
+using rsm_test::corner_scene;
+
+namespace {
+
+cpu::indirect_options cpu_options(const gl::indirect_options& o) {
+    cpu::indirect_options c;
+    c.technique = o.technique == gl::indirect_technique::rsm_gather ? cpu::indirect_technique::rsm_gather
+                                                                     : cpu::indirect_technique::sii;
+    c.count = o.count;
+    c.pattern = o.pattern;
+    c.assignment = o.assignment;
+    c.shift = o.shift;
+    c.blur = o.blur;
+    c.energy_correct = o.energy_correct;
+    c.discontinuity.relative_depth = o.discontinuity.relative_depth;
+    c.discontinuity.cos_normal = o.discontinuity.cos_normal;
+    c.selection = o.selection == gl::vpl_selection::grid ? cpu::vpl_selection::grid : cpu::vpl_selection::flux_warping;
+    c.r_max = o.r_max;
+    c.disc = o.disc == gl::disc_weighting::unbiased ? cpu::disc_weighting::unbiased : cpu::disc_weighting::xi1_squared;
+    c.light.offset = o.light.offset;
+    c.light.min_distance2 = o.light.min_distance2;
+    c.sii_cutoff = o.sii_cutoff;
+    c.seed = o.seed;
+    return c;
+}
+
+// An RGBA32F texture holding `img` (row 0 at the top), alpha `a`.
+gl::texture upload(const image<glm::vec3>& img) {
+    gl::texture t(gl::texel_format::rgba32f, img.width(), img.height());
+    image<glm::vec4> padded(img.width(), img.height());
+    for (std::size_t y = 0; y < img.height(); ++y)
+        for (std::size_t x = 0; x < img.width(); ++x) padded(x, y) = glm::vec4(img(x, y), 0.f);
+    gl::write_texture(t, padded.view());
+    return t;
+}
+
+// The scene's map as textures, kept alive with the refs.
+struct map_textures {
+    gl::texture position, normal, flux;
+    gl::rsm_textures refs;
+    explicit map_textures(const corner_scene& s)
+        : position(upload(s.map_position)), normal(upload(s.map_normal)), flux(upload(s.map_flux)) {
+        refs = {position, normal, flux, s.light_view_projection};
+    }
+};
+
+struct comparison {
+    double worst_relative = 0;  // max over pixels and channels of |gl - cpu| / |cpu| (cpu > 0)
+    double worst_zero = 0;      // max |gl| where the CPU has exactly 0
+    double mean = 0;            // mean of the CPU's channel x over covered pixels
+};
+
+comparison compare(const corner_scene& s, const image<glm::vec3>& gl_img, const image<glm::vec3>& cpu_img) {
+    comparison c;
+    std::size_t n = 0;
+    for (std::size_t y = 0; y < s.gb.height(); ++y)
+        for (std::size_t x = 0; x < s.gb.width(); ++x) {
+            if (s.gb.depth(x, y) < std::numeric_limits<float>::infinity()) {
+                c.mean += cpu_img(x, y).x;
+                ++n;
+            }
+            for (int k = 0; k < 3; ++k) {
+                const double a = gl_img(x, y)[k], b = cpu_img(x, y)[k];
+                if (b == 0) c.worst_zero = std::max(c.worst_zero, std::abs(a));
+                else c.worst_relative = std::max(c.worst_relative, std::abs(a - b) / std::abs(b));
+            }
+        }
+    c.mean /= double(std::max<std::size_t>(n, 1));
+    return c;
+}
+
+struct frame {
+    image<glm::vec3> gl_img, cpu_img;
+    gl::indirect_timings timings;
+};
+
+frame render_both(const corner_scene& s, const gl::indirect_options& o) {
+    gl::gbuffer_upload gb(const_cast<gbuffer<float>&>(s.gb).view());
+    map_textures map(s);
+    gl::texture out(gl::texel_format::rgba32f, s.gb.width(), s.gb.height());
+    gl::indirect_renderer renderer(o);
+    const gl::rsm_textures maps[] = {map.refs};
+    frame f;
+    f.timings = renderer.render(gb.textures(), s.cam, maps, out);
+    f.gl_img = image<glm::vec3>(s.gb.width(), s.gb.height());
+    gl::read_texture(out, f.gl_img.view());
+
+    cpu::indirect_renderer cpu_renderer(cpu_options(o));
+    f.cpu_img = image<glm::vec3>(s.gb.width(), s.gb.height());
+    const rsm_view cpu_maps[] = {s.map()};
+    auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
+    cpu_renderer.render(gbv, s.cam, cpu_maps, f.cpu_img.view());
+    return f;
+}
+
+void check_agreement(const corner_scene& s, const gl::indirect_options& o) {
+    const frame f = render_both(s, o);
+    const comparison c = compare(s, f.gl_img, f.cpu_img);
+    INFO("pattern " << o.pattern.n << "x" << o.pattern.m << ", worst relative " << c.worst_relative
+                    << ", worst where the CPU has 0: " << c.worst_zero << ", mean " << c.mean);
+    CHECK(c.mean > 0);  // the frame lit something
+    CHECK(c.worst_relative <= 1e-4);
+    CHECK(c.worst_zero <= 1e-4 * c.mean);
+}
+
+}  // namespace
+
+TEST_CASE("GL RSM gather equals the CPU's, plain and interleaved with blur", "[gl][rsm]") {
+    gl_test::shared_context();
+    const corner_scene s(61, 47);  // no multiple of 2, 3 or 4
+    gl::indirect_options o;
+    o.technique = gl::indirect_technique::rsm_gather;
+    o.count = 256;
+    for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{2, 2}, interleave_pattern{4, 4},
+                                       interleave_pattern{3, 2}}) {
+        o.pattern = p;
+        check_agreement(s, o);
+    }
+    SECTION("with the singularity remedies, DS05's weights and a shift") {
+        o.pattern = {2, 2};
+        o.light.offset = 0.01f;
+        o.light.min_distance2 = 1e-4f;
+        o.disc = gl::disc_weighting::xi1_squared;
+        o.shift = 3;
+        check_agreement(s, o);
+    }
+}
+
+TEST_CASE("GL SII equals the CPU's, plain and interleaved with blur, with and without the cutoff", "[gl][rsm]") {
+    gl_test::shared_context();
+    const corner_scene s(61, 47);
+    gl::indirect_options o;
+    o.technique = gl::indirect_technique::sii;
+    o.count = 128;
+    // The corner map's VPLs carry about 0.02 W each: a cutoff of 1 W/m^2 over 128 VPLs bounds
+    // each splat by a sphere of radius 0.4 m in a 2 m scene, so the rectangles matter.
+    for (const float cutoff : {0.f, 1.f}) {
+        o.sii_cutoff = cutoff;
+        for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{2, 2},
+                                           interleave_pattern{4, 4}, interleave_pattern{3, 2}}) {
+            o.pattern = p;
+            check_agreement(s, o);
+        }
+    }
+    SECTION("the cutoff changes the image (the rectangles were exercised)") {
+        o.pattern = {2, 2};
+        o.sii_cutoff = 0.f;
+        const frame whole = render_both(s, o);
+        o.sii_cutoff = 1.f;
+        const frame cut = render_both(s, o);
+        const comparison c = compare(s, cut.gl_img, whole.gl_img);
+        CHECK(c.worst_relative > 1e-2);
+    }
+    SECTION("grid VPLs, similarity assignment, weight 1 (the thesis's)") {
+        o.pattern = {2, 2};
+        o.selection = gl::vpl_selection::grid;
+        o.assignment = light_assignment::similarity;
+        o.energy_correct = false;
+        check_agreement(s, o);
+    }
+}
+
+TEST_CASE("GL interleaving without blur is the split, shaded and gathered image of the CPU", "[gl][rsm]") {
+    gl_test::shared_context();
+    const corner_scene s(37, 29);
+    gl::indirect_options o;
+    o.technique = gl::indirect_technique::sii;
+    o.count = 64;
+    o.blur = false;
+    o.pattern = {4, 3};
+    check_agreement(s, o);
+}
+
+TEST_CASE("the GL renderer's disc pattern and VPLs are the CPU's, bit for bit", "[gl][rsm]") {
+    const auto a = gl::rsm_disc_pattern(400, 1.5f, 1024, 7, gl::disc_weighting::unbiased);
+    const auto b = cpu::rsm_disc_pattern(400, 1.5f, 1024, 7, cpu::disc_weighting::unbiased);
+    CHECK(a == b);
+    const auto c = gl::rsm_disc_pattern(100, 0.3f, 64, 2, gl::disc_weighting::xi1_squared);
+    const auto d = cpu::rsm_disc_pattern(100, 0.3f, 64, 2, cpu::disc_weighting::xi1_squared);
+    CHECK(c == d);
+
+    const corner_scene s(8, 8);
+    const rsm_view maps[] = {s.map()};
+    gl::indirect_options o;
+    o.count = 300;
+    o.seed = 5;
+    const auto v = gl::select_vpls(maps, o);
+    const auto w = vpls_by_flux_warping(s.map(), 300, 5);
+    REQUIRE(v.size() == w.size());
+    for (std::size_t k = 0; k < v.size(); ++k) {
+        CHECK(v[k].position == w[k].position);
+        CHECK(v[k].flux == w[k].flux);
+    }
+}
+
+TEST_CASE("the GL indirect renderer refuses bad input by name", "[gl][rsm]") {
+    gl_test::shared_context();
+    const corner_scene s(16, 12, 8);
+    gl::gbuffer_upload gb(const_cast<gbuffer<float>&>(s.gb).view());
+    map_textures map(s);
+    gl::texture out(gl::texel_format::rgba32f, 16, 12);
+    const gl::rsm_textures maps[] = {map.refs};
+    const auto throws_naming = [](auto&& f, const std::string& name) {
+        try {
+            f();
+            FAIL("no exception");
+        } catch (const parameter_error& e) {
+            CHECK(std::string(e.what()).find(name) != std::string::npos);
+        }
+    };
+    gl::indirect_renderer r;
+    SECTION("output of another size") {
+        gl::texture small(gl::texel_format::rgba32f, 15, 12);
+        throws_naming([&] { r.render(gb.textures(), s.cam, maps, small); }, "irradiance");
+    }
+    SECTION("output of another format") {
+        gl::texture r32(gl::texel_format::r32f, 16, 12);
+        throws_naming([&] { r.render(gb.textures(), s.cam, maps, r32); }, "irradiance");
+    }
+    SECTION("a map with a texture of another size or format, or none") {
+        gl::texture odd(gl::texel_format::rgba32f, 8, 7);
+        gl::rsm_textures bad = map.refs;
+        bad.normal = odd;
+        const gl::rsm_textures bad_maps[] = {bad};
+        throws_naming([&] { r.render(gb.textures(), s.cam, bad_maps, out); }, "maps");
+        gl::texture r32(gl::texel_format::r32f, 8, 8);
+        bad.normal = r32;
+        const gl::rsm_textures bad_format[] = {bad};
+        throws_naming([&] { r.render(gb.textures(), s.cam, bad_format, out); }, "maps");
+        bad.normal = gl::texture_ref{};
+        const gl::rsm_textures missing[] = {bad};
+        throws_naming([&] { r.render(gb.textures(), s.cam, missing, out); }, "maps");
+    }
+    SECTION("a zero-sized G-buffer") {
+        gl::gbuffer_textures empty = gb.textures();
+        empty.position_depth.width = 0;
+        throws_naming([&] { r.render(empty, s.cam, maps, out); }, "gbuffer");
+    }
+    SECTION("zero-sized textures cannot be made") {
+        throws_naming([] { gl::texture t(gl::texel_format::rgba32f, 0, 4); }, "");
+    }
+    SECTION("maps of two sizes for the gather") {
+        gl::indirect_options o;
+        o.technique = gl::indirect_technique::rsm_gather;
+        gl::indirect_renderer gather(o);
+        const corner_scene other(16, 12, 4);
+        map_textures small(other);
+        const gl::rsm_textures two[] = {map.refs, small.refs};
+        throws_naming([&] { gather.render(gb.textures(), s.cam, two, out); }, "maps");
+    }
+    SECTION("options") {
+        gl::indirect_options o;
+        o.low_resolution = 2;
+        throws_naming([&] { gl::indirect_renderer x(o); }, "low_resolution");
+        o = {};
+        o.pattern = {0, 4};
+        throws_naming([&] { gl::indirect_renderer x(o); }, "pattern.n");
+        o = {};
+        o.shift = 16;
+        throws_naming([&] { gl::indirect_renderer x(o); }, "shift");
+        o = {};
+        o.light.offset = -1.f;
+        throws_naming([&] { gl::indirect_renderer x(o); }, "offset");
+    }
+}
+
+TEST_CASE("the GL indirect renderer keeps the caller's GL state", "[gl][rsm]") {
+    gl_test::shared_context();
+    const corner_scene s(16, 12, 8);
+    gl::gbuffer_upload gb(const_cast<gbuffer<float>&>(s.gb).view());
+    map_textures map(s);
+    gl::texture out(gl::texel_format::rgba32f, 16, 12);
+    const gl::rsm_textures maps[] = {map.refs};
+    gl::framebuffer fb;
+    gl::texture colour(gl::texel_format::rgba32f, 5, 5);
+    fb.attach_color(0, colour);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fb.id());
+    glViewport(1, 2, 3, 4);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glBindTextureUnit(3, colour.id());
+    for (const auto technique : {gl::indirect_technique::sii, gl::indirect_technique::rsm_gather}) {
+        gl::indirect_options o;
+        o.technique = technique;
+        o.count = 16;
+        gl::indirect_renderer r(o);
+        r.render(gb.textures(), s.cam, maps, out);
+        GLint fbo = 0, viewport[4] = {}, src = 0, unit3 = 0, program = 0;
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
+        glGetIntegerv(GL_VIEWPORT, viewport);
+        glGetIntegerv(GL_BLEND_SRC_RGB, &src);
+        glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+        glActiveTexture(GL_TEXTURE3);
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, &unit3);
+        glActiveTexture(GL_TEXTURE0);
+        CHECK(GLuint(fbo) == fb.id());
+        CHECK((viewport[0] == 1 && viewport[1] == 2 && viewport[2] == 3 && viewport[3] == 4));
+        CHECK(glIsEnabled(GL_BLEND) == GL_TRUE);
+        CHECK(src == GL_SRC_ALPHA);
+        CHECK(program == 0);
+        CHECK(GLuint(unit3) == colour.id());
+    }
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glDisable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ZERO);
+    glBindTextureUnit(3, 0);
+}
