@@ -1,0 +1,132 @@
+#pragma once
+// rsm_sii's options: what the command line sets, how it is spelled and checked, and the
+// library settings (cpu::indirect_options) they make. main.cpp runs and reports.
+#include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/errors.hpp>
+
+#include <CLI/CLI.hpp>
+#include "../common/cli_number_checks.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace bounce::examples {
+
+struct options {
+    std::string technique = "sii";     // rsm (the gather, DS05) | sii (splatting, DS06)
+    std::size_t vpls = 1024;           // SII: VPLs; RSM: disc samples per pixel and map
+    std::string pattern = "4x4";       // N x M interleave pattern; 1x1: none
+    std::string assign = "interleaved";
+    std::string backend = "cpu";
+    std::string scene = "cornell";
+    std::size_t width = 512, height = 384;
+    std::size_t rsm_resolution = 256;  // texels per side of each map (cube face)
+    std::string selection = "warping"; // SII VPLs: warping (DS06 section 3.3) | grid
+    float r_max = 1.5f;                // RSM gather disc radius, map units
+    float clamp = -1.f;                // d^2 clamped at clamp^2 (m); < 0: 0.5% of the scene's diagonal
+    float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
+    bool blur = true;
+    bool thesis_weights = false;       // interleaved lights at weight 1 (Hahn 2012), not N M
+    std::uint64_t seed = 1;
+    std::uint32_t ref_spp = 1024;      // rays per pixel of both references
+    int repeat = 1;
+    bool study = false;
+    std::filesystem::path json, out, indirect_out;
+};
+
+/// "NxM" -> pattern; throws parameter_error naming --pattern.
+inline interleave_pattern parse_pattern(const std::string& s) {
+    const auto x = s.find('x');
+    int n = 0, m = 0;
+    try {
+        if (x == std::string::npos) throw std::invalid_argument(s);
+        std::size_t used_n = 0, used_m = 0;
+        n = std::stoi(s.substr(0, x), &used_n);
+        m = std::stoi(s.substr(x + 1), &used_m);
+        if (used_n != x || used_m != s.size() - x - 1) throw std::invalid_argument(s);
+    } catch (const std::exception&) {
+        throw parameter_error("--pattern", "'" + s + "' is not of the form NxM (e.g. 4x4)");
+    }
+    interleave_pattern p{n, m};
+    try {
+        p.validate();
+    } catch (const parameter_error&) {
+        throw parameter_error("--pattern", "'" + s + "': N and M must lie in [1, 64]");
+    }
+    return p;
+}
+
+inline light_assignment parse_assign(const std::string& s) {
+    if (s == "interleaved") return light_assignment::interleaved;
+    if (s == "blocked") return light_assignment::blocked;
+    if (s == "similar") return light_assignment::similarity;
+    throw parameter_error("--assign", "unknown assignment '" + s + "'");
+}
+
+/// The renderer's options for a run of `technique` with `count` lights and `pattern`.
+inline cpu::indirect_options indirect_options_for(const options& o, const std::string& technique, std::size_t count,
+                                                  interleave_pattern pattern, float clamp_distance) {
+    cpu::indirect_options c;
+    c.technique = technique == "rsm" ? cpu::indirect_technique::rsm_gather : cpu::indirect_technique::sii;
+    c.count = count;
+    c.pattern = pattern;
+    c.assignment = parse_assign(o.assign);
+    c.blur = o.blur;
+    c.energy_correct = !o.thesis_weights;
+    c.selection = o.selection == "grid" ? cpu::vpl_selection::grid : cpu::vpl_selection::flux_warping;
+    c.r_max = o.r_max;
+    c.light.offset = o.offset;
+    c.light.min_distance2 = clamp_distance * clamp_distance;
+    c.seed = o.seed;
+    c.validate();
+    return c;
+}
+
+inline void add_options(CLI::App& app, options& o) {
+    app.add_option("--technique", o.technique, "rsm (the RSM gather, DS05) | sii (splatting indirect illumination, DS06)")
+        ->check(CLI::IsMember({"rsm", "sii"}))
+        ->capture_default_str();
+    app.add_option("--vpls", o.vpls, "SII: VPLs per frame; RSM: disc samples per pixel and map")
+        ->check(CLI::Range(std::size_t(1), std::size_t(1) << 24))
+        ->capture_default_str();
+    app.add_option("--pattern", o.pattern, "interleave pattern NxM: 1x1 (none), 2x2, 2x4, 4x4, 8x8 ...")->capture_default_str();
+    app.add_option("--assign", o.assign, "VPLs to sub-buffers: interleaved | blocked | similar")
+        ->check(CLI::IsMember({"interleaved", "blocked", "similar"}))
+        ->capture_default_str();
+    app.add_option("--backend", o.backend, "cpu | gl")->check(CLI::IsMember({"cpu", "gl"}))->capture_default_str();
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
+        ->capture_default_str();
+    app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--rsm-resolution", o.rsm_resolution, "texels per side of each reflective shadow map (cube face)")
+        ->check(CLI::Range(1, 8192))
+        ->capture_default_str();
+    app.add_option("--selection", o.selection, "SII's VPLs: warping (importance on the flux) | grid")
+        ->check(CLI::IsMember({"warping", "grid"}))
+        ->capture_default_str();
+    app.add_option("--r-max", o.r_max, "RSM gather disc radius in map units, (0, 2]; 1.5 reaches the whole map")
+        ->check(examples::detail::number_in(0, 2, true, "a radius"))
+        ->capture_default_str();
+    app.add_option("--clamp", o.clamp,
+                   "sender-receiver distance below which 1/d^2 is clamped (scene units); default 0.5% of the scene's diagonal");
+    app.add_option("--offset", o.offset, "senders moved this far along -n_p (scene units; DS05's remedy)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
+    app.add_flag("!--no-blur", o.blur, "skip the geometry-aware blur after interleaving");
+    app.add_flag("--thesis-weights", o.thesis_weights,
+                 "interleaved lights at weight 1 as in Hahn 2012 (loses 1 - 1/(N M) of the energy), not N M");
+    app.add_option("--seed", o.seed, "seed of the VPLs and of the disc pattern")->capture_default_str();
+    app.add_option("--ref-spp", o.ref_spp, "rays per pixel of the references (with and without indirect visibility)")
+        ->check(CLI::Range(2u, 1u << 20))
+        ->capture_default_str();
+    app.add_option("--repeat", o.repeat, "renders per run (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
+    app.add_flag("--study", o.study,
+                 "run Hahn 2012's grid (VPLs 64..1024 x patterns none, 2x2, 2x4, 4x4, 8x8, both techniques) and more, "
+                 "into the --json file");
+    app.add_option("--json", o.json, "write the run report (or the study's) here");
+    app.add_option("--out", o.out, "write direct + indirect radiance as PNG");
+    app.add_option("--indirect-out", o.indirect_out, "write the indirect radiance beside the unoccluded reference's as PNG");
+}
+
+}  // namespace bounce::examples
