@@ -1,0 +1,162 @@
+#pragma once
+/// \file radiosity.hpp
+/// Progressive refinement radiosity on the GPU (Cohen et al. 1988, on textures as Coombe and
+/// Harris 2005 do it, GPU Gems 2 ch. 39): `gl::progressive_radiosity`, the GL backend of the
+/// solver cpu::progressive_radiosity (adapters/cpu), with the same steps, options and answers
+/// (docs/radiosity-gl.md).
+///
+/// Elements are the texels of the lightmap atlas (include/bounce/lightmap_atlas.hpp): the
+/// radiosity and the unshot ("residual") radiosity are RGBA32F textures of the atlas's size,
+/// element e at texel atlas.texel[e]. One step:
+///  1. the shooter chosen by the last reduction (the largest unshot power sum dB A, channels
+///     summed, ties to the lowest index, as on the CPU) is shot: its texels' unshot radiosity
+///     (at most block_texels^2 texels) is read back to build its near-field quadtree and then
+///     cleared;
+///  2. visibility: the scene's triangles, in the shooter's frame, clipped above its plane and
+///     tessellated on the CPU with the sagitta rule of cpu::item_buffer_visibility, are drawn
+///     by GL in the stereographic projection (stereographic_item_coords, emitted from
+///     radiosity.hpp) into an item buffer holding chart id, triangle id and the exact depth at
+///     each pixel centre (item_plane_depth), depth tested on a separate depth attachment;
+///  3. a compute pass over the atlas texels evaluates, per receiving element, the shot from
+///     the shooter's near-field nodes (disc_form_factor and shot_radiosity, emitted), looks
+///     its pixel up with item_buffer_sees (the CPU's concave-corner rule) and adds the result
+///     to the radiosity and unshot textures, writing the power it intercepted;
+///  4. a compute reduction (per shooter, then per work group, then one group) finds the next
+///     shooter, the total unshot power and the shot's intercepted and absorbed power, in
+///     double: the convergence fraction is known after every step.
+/// Point and spot lights are shot first, in the constructor, as the CPU solver does (their
+/// direct irradiance from lights.hpp times visibility from the light, a hemisphere at a time).
+///
+/// Not here (the CPU solver has them): directional lights, the hemicube (the options offer
+/// stereographic or no occlusion), several shooters per step, adaptive subdivision.
+///
+/// Every pass works in the context current on the calling thread, on textures and buffers the
+/// solver owns, and restores the context state it touches (program, framebuffers, viewport,
+/// raster state, the storage-buffer and image bindings it uses). Construct, use and destroy
+/// it with the same context current.
+
+#include <bounce/gl/errors.hpp>
+#include <bounce/gl/objects.hpp>
+#include <bounce/image.hpp>
+#include <bounce/lightmap_atlas.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace bounce::gl {
+
+/// How visibility is found for each shot.
+enum class radiosity_visibility {
+    stereographic,  ///< item buffer in the stereographic projection (Coombe and Harris 2005)
+    none            ///< every element sees every shooter (open scenes, tests, the unoccluded bound)
+};
+
+/// Options of gl::progressive_radiosity: the shooting options of cpu::radiosity_options and
+/// the item-buffer options of cpu::item_buffer_visibility::options, with the same meanings
+/// and defaults (mirrored here: the GL adapter does not include the CPU adapter).
+struct radiosity_options {
+    bool shoot_blocks = true;  ///< substructuring: shoot per atlas block (true) or per element
+    bool ambient = false;      ///< display_radiosity adds the ambient term (Cohen et al. 1988)
+    double near_field = 4;     ///< a block shoots as one disc to receivers farther than this many
+                               ///< times its side, else as its quadrants, recursively; 0: one disc
+                               ///< (typical: 2-4)
+    radiosity_visibility visibility = radiosity_visibility::stereographic;
+    int resolution = 256;            ///< item buffer side, pixels (typical: 128-512)
+    float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
+    int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges
+
+    /// Throws parameter_error naming the option ("radiosity_options.resolution" ...).
+    void validate() const;
+};
+
+/// Time spent per stage since construction, milliseconds, each stage ended by glFinish (so
+/// the figures are the GPU's time, not the driver's queueing).
+struct radiosity_timings {
+    double lights_ms = 0;        ///< point and spot lights, their visibility included (construction)
+    double visibility_ms = 0;    ///< reading the shooter back, tessellating and drawing the item buffer
+    double choice_ms = 0;        ///< the reduction that picks the next shooter and sums powers
+    double distribution_ms = 0;  ///< form factors and updates over the atlas texels
+};
+
+/// Where a solve stands after a step.
+struct radiosity_progress {
+    std::size_t steps = 0, shots = 0;
+    double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
+};
+
+/// The GL solver. Move-only; owns its GL objects (create, use and destroy it with one context
+/// current).
+class progressive_radiosity {
+public:
+    /// Uploads `atlas` (copied: base blocks only, as build_lightmap_atlas makes them; a
+    /// subdivided atlas is refused) and the scene's triangles, compiles the passes, shoots the
+    /// point and spot lights and runs the first reduction. `scene` is read only here. Throws
+    /// parameter_error on bad options, an atlas not built from `scene`, a subdivided atlas,
+    /// blocks wider than 16 texels, or a directional light; gl_error when GL cannot run it.
+    progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, radiosity_options options = {});
+    ~progressive_radiosity();
+    progressive_radiosity(progressive_radiosity&&) noexcept;
+    progressive_radiosity& operator=(progressive_radiosity&&) noexcept;
+    progressive_radiosity(const progressive_radiosity&) = delete;
+    progressive_radiosity& operator=(const progressive_radiosity&) = delete;
+
+    /// One step: shoot the shooter with the largest unshot power. Returns false (and does
+    /// nothing) when no unshot power is left.
+    bool step();
+    /// Steps until the unshot fraction is at most `fraction` (in [0, 1)) or nothing is left to
+    /// shoot, calling `progress` after each step (return false from it to stop early).
+    /// Returns the steps taken.
+    std::size_t solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress = {});
+
+    /// Unshot power / emitted power, channels summed (from the last reduction); 0 for a
+    /// scene that emits nothing.
+    double unshot_fraction() const noexcept;
+    radiosity_progress progress() const noexcept;
+    /// The shooter the next step will shoot (the last reduction's choice) and its unshot
+    /// power (W, channels summed); power 0 when nothing is left.
+    std::uint32_t next_shooter() const noexcept;
+    double next_shooter_power() const noexcept;
+    /// Number of shooters (blocks, or elements without shoot_blocks); shooter k is the
+    /// elements [shooter_first(k), shooter_first(k + 1)).
+    std::size_t shooters() const noexcept;
+    std::uint32_t shooter_first(std::size_t k) const;
+
+    /// Power per channel, W, as cpu::progressive_radiosity keeps them: emitted (surfaces and
+    /// the direct light that reached elements), absorbed, escaped, and unshot (read back and
+    /// summed in double).
+    glm::dvec3 emitted_power() const noexcept;
+    glm::dvec3 absorbed_power() const noexcept;
+    glm::dvec3 escaped_power() const noexcept;
+    glm::dvec3 unshot_power() const;
+
+    /// Radiosity B and unshot radiosity per element (read back), W/m^2 per channel.
+    std::vector<glm::vec3> radiosity() const;
+    std::vector<glm::vec3> unshot() const;
+    /// The ambient radiosity (Cohen et al. 1988) and B plus rho times it when the options ask.
+    glm::dvec3 ambient() const;
+    std::vector<glm::vec3> display_radiosity() const;
+    /// display_radiosity laid out as the atlas (lightmap_atlas::to_texels, padding filled).
+    image<glm::vec3> lightmap() const;
+    /// The solver's radiosity and unshot textures (RGBA32F, atlas size, element texels only;
+    /// padding texels hold 0), for a renderer to sample; valid while the solver lives.
+    texture_ref radiosity_texture() const noexcept;
+    texture_ref unshot_texture() const noexcept;
+
+    const radiosity_timings& timings() const noexcept;
+    const lightmap_atlas& atlas() const noexcept;
+    const radiosity_options& options() const noexcept;
+    /// Pieces drawn into the item buffer in the last shot (tessellation included).
+    std::size_t drawn_triangles() const noexcept;
+
+private:
+    struct state;
+    std::unique_ptr<state> s_;
+};
+
+}  // namespace bounce::gl

@@ -1,0 +1,953 @@
+// gl::progressive_radiosity: the GL backend of progressive refinement radiosity (Cohen et al.
+// 1988; Coombe and Harris 2005). See radiosity.hpp for the steps and docs/radiosity-gl.md.
+#include <bounce/gl/radiosity.hpp>
+
+#include <bounce/gl/radiosity_kernels.hpp>
+#include <bounce/glsl/emit.hpp>
+#include <bounce/light.hpp>
+#include <bounce/lights.hpp>
+#include <bounce/radiosity.hpp>
+#include <bounce/sampling.hpp>
+
+#include "saved_state.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <utility>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+namespace bounce::gl {
+
+void radiosity_options::validate() const {
+    require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
+            "must be finite and non-negative");
+    require(resolution >= 8 && resolution <= 8192, "radiosity_options.resolution", "must lie in [8, 8192]");
+    require(tolerance_px > 0.f && std::isfinite(tolerance_px), "radiosity_options.tolerance_px", "must be positive");
+    require(max_tessellation_depth >= 0 && max_tessellation_depth <= 16, "radiosity_options.max_tessellation_depth",
+            "must lie in [0, 16]");
+    require(visibility == radiosity_visibility::stereographic || visibility == radiosity_visibility::none,
+            "radiosity_options.visibility", "is not a known method");
+}
+
+namespace {
+
+using clock_type = std::chrono::steady_clock;
+double ms_since(clock_type::time_point t) { return std::chrono::duration<double, std::milli>(clock_type::now() - t).count(); }
+
+// Storage-buffer bindings and image units the passes use.
+constexpr GLuint texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
+                 partial_binding = 5;
+constexpr GLuint radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
+constexpr int reduce_group = 256;
+// Doubles per reduction entry: best power, best index, total unshot, intercepted rgb,
+// absorbed rgb, padding.
+constexpr std::size_t partial_doubles = 10;
+
+// The bindings the passes change beyond raster_state: program, the storage buffers and image
+// units above; restored on destruction.
+class binding_state {
+public:
+    binding_state() {
+        glGetIntegerv(GL_CURRENT_PROGRAM, &program_);
+        glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
+        for (GLuint i = 0; i < storage_.size(); ++i) {
+            glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &storage_[i].buffer);
+            glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, i, &storage_[i].start);
+            glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, i, &storage_[i].size);
+        }
+        for (GLuint i = 0; i < images_.size(); ++i) {
+            image& m = images_[i];
+            glGetIntegeri_v(GL_IMAGE_BINDING_NAME, i, &m.name);
+            glGetIntegeri_v(GL_IMAGE_BINDING_LEVEL, i, &m.level);
+            glGetIntegeri_v(GL_IMAGE_BINDING_LAYERED, i, &m.layered);
+            glGetIntegeri_v(GL_IMAGE_BINDING_LAYER, i, &m.layer);
+            glGetIntegeri_v(GL_IMAGE_BINDING_ACCESS, i, &m.access);
+            glGetIntegeri_v(GL_IMAGE_BINDING_FORMAT, i, &m.format);
+        }
+    }
+    ~binding_state() {
+        for (GLuint i = 0; i < images_.size(); ++i) {
+            const image& m = images_[i];
+            glBindImageTexture(i, GLuint(m.name), m.level, GLboolean(m.layered), m.layer, GLenum(m.access),
+                               GLenum(m.format));
+        }
+        for (GLuint i = 0; i < storage_.size(); ++i) {
+            const auto& b = storage_[i];
+            if (b.size > 0) glBindBufferRange(GL_SHADER_STORAGE_BUFFER, i, GLuint(b.buffer), b.start, b.size);
+            else glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(b.buffer));
+        }
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(generic_));
+        glUseProgram(GLuint(program_));
+    }
+    binding_state(const binding_state&) = delete;
+    binding_state& operator=(const binding_state&) = delete;
+
+private:
+    struct storage {
+        GLint buffer = 0;
+        GLint64 start = 0, size = 0;
+    };
+    struct image {
+        GLint name = 0, level = 0, layered = 0, layer = 0, access = GL_READ_ONLY, format = GL_RGBA32F;
+    };
+    GLint program_ = 0, generic_ = 0;
+    std::array<storage, 6> storage_{};
+    std::array<image, 4> images_{};
+};
+
+// ---- the CPU side of the item buffer: clipping and the sagitta tessellation ------------------
+// The same geometry as cpu::item_buffer_visibility (docs/radiosity.md section 3), restated here
+// because the GL adapter does not include the CPU adapter.
+
+// A convex polygon clipped in place to dot(p, plane) >= offset; an edge's intersection is
+// computed from its endpoints in a canonical order, so a shared edge clips alike from both sides.
+void clip_polygon(std::vector<glm::vec3>& poly, glm::vec3 plane, float offset, std::vector<glm::vec3>& scratch) {
+    scratch.clear();
+    const std::size_t n = poly.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 a = poly[i], b = poly[(i + 1) % n];
+        const float da = glm::dot(a, plane) - offset, db = glm::dot(b, plane) - offset;
+        if (da >= 0.f) scratch.push_back(a);
+        if ((da >= 0.f) != (db >= 0.f)) {
+            const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
+            const glm::vec3 p = swap ? b : a, q = swap ? a : b;
+            const float dp = swap ? db : da, dq = swap ? da : db;
+            scratch.push_back(p + (q - p) * (dp / (dp - dq)));
+        }
+    }
+    poly.swap(scratch);
+}
+
+// The midpoint of a and b taken in a canonical order (a shared edge splits alike).
+glm::vec3 canonical_midpoint(glm::vec3 a, glm::vec3 b) {
+    const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
+    return swap ? b + (a - b) * 0.5f : a + (b - a) * 0.5f;
+}
+
+// One vertex of the item buffer's vertex stream: shooter-frame position, chart, triangle.
+struct item_vertex {
+    glm::vec3 local;
+    float chart, triangle;
+};
+
+// std430 layouts shared with the shaders.
+struct texel_attributes {
+    glm::vec4 position_area{0.f};  // world position, area (0: not an element's texel)
+    glm::vec4 normal_chart{0.f};   // unit normal, chart
+    glm::vec4 albedo{0.f};         // rho, unused
+};
+struct gpu_node {
+    glm::vec4 position_area;
+    glm::vec4 unshot;
+    std::array<std::int32_t, 4> meta;  // parent (-1: root), leaf (1/0)
+};
+
+std::string version_header() { return "#version 450 core\n"; }
+
+}  // namespace
+
+struct progressive_radiosity::state {
+    lightmap_atlas atlas;
+    radiosity_options options;
+    std::uint32_t width = 0, height = 0;
+    // Shooters.
+    std::vector<std::uint32_t> first;
+    std::vector<glm::vec3> centre;
+    std::vector<glm::uvec4> rect;  // texel bounding box of each shooter's elements: x, y, w, h
+    // Scene triangles with a chart: corners, chart, world plane (unit n, n . x).
+    std::vector<std::array<glm::vec3, 3>> corners;
+    std::vector<std::uint32_t> triangle_chart;
+    std::vector<glm::vec4> world_plane;
+    float diagonal = 1.f;
+    glm::vec3 lo{0.f}, hi{0.f};
+    int max_nodes = 1;
+    double total_area = 0;
+    glm::dvec3 albedo_area{0.0};
+
+    // GL objects.
+    texture radiosity, unshot, intercepted, item_color, item_depth;
+    framebuffer item_fbo;
+    vertex_array item_vao;
+    buffer texels, nodes, planes, first_buffer, element_texel, partials;
+    std::unique_ptr<buffer> vertices;
+    std::size_t vertex_capacity = 0;
+    std::unique_ptr<program> item_program, distribute_program, light_program, reduce_program, finish_program;
+    std::size_t reduce_groups = 1;
+
+    // Per shot, CPU side.
+    glm::vec3 shot_position{0.f}, shot_axis{0.f, 0.f, 1.f}, t{1, 0, 0}, b{0, 1, 0};
+    float shot_chart = -2.f;
+    std::vector<glm::vec4> local_plane;
+    std::vector<item_vertex> pieces;
+    std::vector<gpu_node> near;
+    std::size_t drawn = 0;
+
+    // Bookkeeping (double, per channel), from the reductions.
+    glm::dvec3 emitted{0.0}, absorbed{0.0}, escaped{0.0};
+    double unshot_total = 0;
+    std::uint32_t next = 0;
+    double next_power = 0;
+    std::size_t steps = 0, shots = 0;
+    radiosity_timings timings;
+
+    state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o);
+    void compile();
+    struct reduction {
+        glm::dvec3 intercepted{0.0}, absorbed{0.0};
+    };
+    reduction reduce();
+    void draw_item_buffer();
+    void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
+    void shoot(std::uint32_t k);
+    void shoot_light(const packed_light& l);
+    std::vector<glm::vec3> read_elements(const texture& t) const;
+    void bind_common() const;
+};
+
+progressive_radiosity::state::state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o)
+    : atlas(a),
+      options(o),
+      width(std::max<std::uint32_t>(a.width, 1)),
+      height(std::max<std::uint32_t>(a.height, 1)),
+      radiosity(texel_format::rgba32f, width, height),
+      unshot(texel_format::rgba32f, width, height),
+      intercepted(texel_format::rgba32f, width, height),
+      item_color(texel_format::rgba32f, std::size_t(o.resolution), std::size_t(o.resolution)),
+      item_depth(texel_format::depth32f, std::size_t(o.resolution), std::size_t(o.resolution)),
+      texels(std::size_t(width) * height * sizeof(texel_attributes)),
+      nodes(std::size_t(1) * sizeof(gpu_node)),
+      planes(std::max<std::size_t>(scene.triangles.size(), 1) * sizeof(glm::vec4)),
+      first_buffer((a.size() + 1) * sizeof(std::uint32_t)),
+      element_texel(std::max<std::size_t>(a.size(), 1) * sizeof(std::uint32_t)),
+      partials(sizeof(double)) {
+    const std::size_t n = atlas.size();
+    // Element attributes per texel, and the initial radiosity and unshot radiosity E.
+    std::vector<texel_attributes> attributes(std::size_t(width) * height);
+    std::vector<glm::vec4> initial(std::size_t(width) * height, glm::vec4(0.f));
+    std::vector<std::uint32_t> packed(std::max<std::size_t>(n, 1), 0u);
+    glm::dvec3 emitted_surfaces(0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::uvec2 tx = atlas.texel[i];
+        const std::size_t at = std::size_t(tx.y) * width + tx.x;
+        attributes[at] = {glm::vec4(atlas.position[i], atlas.area[i]), glm::vec4(atlas.normal[i], float(atlas.chart[i])),
+                          glm::vec4(atlas.albedo[i], 0.f)};
+        initial[at] = glm::vec4(atlas.emission[i], 0.f);
+        packed[i] = tx.x | (tx.y << 16);
+        emitted_surfaces += glm::dvec3(atlas.emission[i]) * double(atlas.area[i]);
+        total_area += double(atlas.area[i]);
+        albedo_area += glm::dvec3(atlas.albedo[i]) * double(atlas.area[i]);
+    }
+    emitted = emitted_surfaces;
+    texels.write(0, attributes.data(), attributes.size() * sizeof(texel_attributes));
+    element_texel.write(0, packed.data(), packed.size() * sizeof(std::uint32_t));
+    {
+        detail::unpack_state unpack;
+        for (const texture* tex : {&radiosity, &unshot})
+            glTextureSubImage2D(tex->id(), 0, 0, 0, GLsizei(width), GLsizei(height), GL_RGBA, GL_FLOAT, initial.data());
+        const glm::vec4 zero(0.f);
+        glClearTexImage(intercepted.id(), 0, GL_RGBA, GL_FLOAT, &zero);
+        check_error("uploading the radiosity textures");
+    }
+
+    // Shooters: blocks or elements, their centres and texel rectangles.
+    if (options.shoot_blocks) first.assign(atlas.block_first.begin(), atlas.block_first.end());
+    else {
+        first.resize(n + 1);
+        std::iota(first.begin(), first.end(), std::uint32_t(0));
+    }
+    const std::size_t shooters = first.size() - 1;
+    centre.resize(shooters);
+    rect.resize(shooters);
+    for (std::size_t k = 0; k < shooters; ++k) {
+        glm::dvec3 c(0.0);
+        double area = 0;
+        glm::uvec2 mn(std::numeric_limits<std::uint32_t>::max()), mx(0u);
+        for (std::uint32_t i = first[k]; i < first[k + 1]; ++i) {
+            c += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
+            area += double(atlas.area[i]);
+            mn = glm::min(mn, atlas.texel[i]);
+            mx = glm::max(mx, atlas.texel[i]);
+        }
+        centre[k] = glm::vec3(c / area);
+        rect[k] = glm::uvec4(mn, mx - mn + 1u);
+    }
+    std::vector<std::uint32_t> first_padded(first);
+    first_buffer = buffer(first_padded.size() * sizeof(std::uint32_t), first_padded.data());
+    reduce_groups = (shooters + reduce_group - 1) / reduce_group;
+    partials = buffer((reduce_groups + 1) * partial_doubles * sizeof(double));
+    // The near-field tree of a block of b x b texels: b^2 + (b/2)^2 + ... nodes at most.
+    if (options.shoot_blocks) {
+        int b = atlas.block_texels, count = 0;
+        for (;;) {
+            count += b * b;
+            if (b == 1) break;
+            b = (b + 1) / 2;
+        }
+        max_nodes = count;
+    }
+    nodes = buffer(std::size_t(max_nodes) * sizeof(gpu_node));
+
+    // Triangles that have a chart.
+    for (std::size_t tri = 0; tri < scene.triangles.size(); ++tri) {
+        if (atlas.chart_of_triangle[tri] == lightmap_atlas::none) continue;
+        const auto& ix = scene.triangles[tri];
+        corners.push_back({scene.positions[ix.x], scene.positions[ix.y], scene.positions[ix.z]});
+        triangle_chart.push_back(atlas.chart_of_triangle[tri]);
+        const glm::dvec3 p0(corners.back()[0]), p1(corners.back()[1]), p2(corners.back()[2]);
+        const glm::dvec3 nn = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+        world_plane.emplace_back(glm::vec3(nn), float(glm::dot(nn, p0)));
+    }
+    const auto [blo, bhi] = scene.bounds();
+    lo = blo;
+    hi = bhi;
+    diagonal = std::max(glm::length(hi - lo), 1e-30f);
+    local_plane.assign(std::max<std::size_t>(corners.size(), 1), glm::vec4(0.f, 0.f, 1.f, 0.f));
+
+    item_fbo.attach_color(0, item_color);
+    item_fbo.attach_depth(item_depth);
+    item_fbo.set_draw_buffers(1);
+    item_fbo.check_complete();
+    compile();
+}
+
+void progressive_radiosity::state::compile() {
+    using glsl::f32;
+    using glsl::vec2;
+    using glsl::vec3;
+    glsl::function_set fs;
+    fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
+    fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
+    fs.add("radiosity_item_sees", item_buffer_sees<f32, vec3>, "element", "element_chart", "shown_chart",
+           "plane_normal", "plane_offset", "shown_depth", "diagonal");
+    const std::string lookup_functions = fs.source();
+
+    // Item buffer: the pieces projected by the emitted stereographic map; depth exact at each
+    // pixel centre along its direction (stereographic_direction, emitted).
+    glsl::function_set vs_fs;
+    vs_fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
+    const std::string vertex = version_header() + vs_fs.source() + R"(
+layout(location = 0) in vec3 piece_corner;
+layout(location = 1) in vec2 ids;
+layout(location = 0) noperspective out float radial;
+layout(location = 1) flat out vec2 item_ids;
+void main() {
+    vec2 uv = radiosity_item_coords(piece_corner);
+    gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
+    radial = length(piece_corner);
+    item_ids = ids;
+}
+)";
+    glsl::function_set fr_fs;
+    fr_fs.add("radiosity_pixel_direction", stereographic_direction<f32, vec3, vec2>, "q");
+    fr_fs.add("radiosity_plane_depth", item_plane_depth<f32, vec3>, "plane_normal", "plane_offset", "w", "interpolated");
+    const std::string fragment = version_header() + fr_fs.source() + R"(
+layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
+layout(location = 0) uniform float resolution;
+layout(location = 1) uniform float depth_scale;
+layout(location = 0) noperspective in float radial;
+layout(location = 1) flat in vec2 item_ids;
+layout(location = 0) out vec4 item;
+void main() {
+    vec3 w = radiosity_pixel_direction(gl_FragCoord.xy / resolution * 2.0 - 1.0);
+    vec4 plane = local_plane[int(item_ids.y)];
+    float depth = radiosity_plane_depth(plane.xyz, plane.w, w, radial);
+    gl_FragDepth = depth / depth_scale;
+    item = vec4(item_ids, depth, 1.0);
+}
+)";
+    item_program = std::make_unique<program>(vertex, fragment);
+
+    const std::string common = R"(
+struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
+layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
+layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
+layout(rgba32f, binding = 0) uniform image2D radiosity_image;
+layout(rgba32f, binding = 1) uniform image2D unshot_image;
+layout(rgba32f, binding = 2) uniform writeonly image2D intercepted_image;
+layout(rgba32f, binding = 3) uniform readonly image2D item_image;
+layout(location = 0) uniform int atlas_width;
+layout(location = 1) uniform int atlas_height;
+layout(location = 2) uniform vec3 shot_position;
+layout(location = 3) uniform vec3 shot_t;
+layout(location = 4) uniform vec3 shot_b;
+layout(location = 5) uniform vec3 shot_n;
+layout(location = 6) uniform float shot_chart;
+layout(location = 7) uniform int occlusion;
+layout(location = 8) uniform float resolution;
+layout(location = 9) uniform float diagonal;
+// Visibility of the element at world position p (chart `chart`) from the shot.
+float shot_visibility(vec3 p, float chart) {
+    if (occlusion == 0) return 1.0;
+    vec3 l = radiosity_to_shooter_frame(p, shot_position, shot_t, shot_b, shot_n);
+    vec2 uv = radiosity_item_coords(l);
+    int res = int(resolution);
+    ivec2 pixel = clamp(ivec2(floor(uv * resolution)), ivec2(0), ivec2(res - 1));
+    vec4 item = imageLoad(item_image, pixel);
+    vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
+    return radiosity_item_sees(l, chart, item.x, plane.xyz, plane.w, item.z, diagonal);
+}
+void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
+    imageStore(radiosity_image, xy, imageLoad(radiosity_image, xy) + vec4(gain, 0.0));
+    imageStore(unshot_image, xy, imageLoad(unshot_image, xy) + vec4(gain, 0.0));
+    imageStore(intercepted_image, xy, vec4(intercepted, 0.0));
+}
+)";
+
+    glsl::function_set dist_fs;
+    dist_fs.add("radiosity_form_factor", disc_form_factor<f32, vec3>, "receiver_position", "receiver_normal",
+                "shooter_position", "shooter_normal", "shooter_area");
+    dist_fs.add("radiosity_shot", shot_radiosity<f32, vec3>, "receiver_position", "receiver_normal", "receiver_albedo",
+                "shooter_position", "shooter_normal", "shooter_area", "shooter_unshot", "visibility");
+    dist_fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
+    const std::string distribute = version_header() + "layout(local_size_x = 8, local_size_y = 8) in;\n" +
+                                   lookup_functions + dist_fs.source() + common +
+                                   "const int max_nodes = " + std::to_string(max_nodes) + ";\n" + R"(
+struct near_node { vec4 position_area; vec4 unshot; ivec4 meta; };
+layout(std430, binding = 1) readonly buffer nodes_block { near_node node[]; };
+layout(location = 10) uniform int node_count;
+layout(location = 11) uniform float near2;
+void main() {
+    ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
+    if (xy.x >= atlas_width || xy.y >= atlas_height) return;
+    texel_attributes a = texel[xy.y * atlas_width + xy.x];
+    if (!(a.position_area.w > 0.0)) return;
+    if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    vec3 pr = a.position_area.xyz, nr = a.normal_chart.xyz, rho = a.albedo.rgb;
+    vec3 gain = vec3(0.0), incident = vec3(0.0);
+    // Parents follow their children in the node array, the root last: walking it backwards
+    // visits a node after its parent. A node is used as one disc when its parent was opened
+    // and it is a leaf or far; it is opened when its parent was and it is near.
+    bool opened[max_nodes];
+    for (int j = node_count - 1; j >= 0; --j) {
+        near_node nd = node[j];
+        bool parent_open = nd.meta.x < 0 || opened[nd.meta.x];
+        bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
+        bool leaf = nd.meta.y != 0;
+        opened[j] = parent_open && near_node_ && !leaf;
+        if (parent_open && (leaf || !near_node_)) {
+            float f = radiosity_form_factor(pr, nr, nd.position_area.xyz, shot_n, nd.position_area.w);
+            if (f > 0.0) {
+                incident += nd.unshot.xyz * f;
+                gain += radiosity_shot(pr, nr, rho, nd.position_area.xyz, shot_n, nd.position_area.w, nd.unshot.xyz, 1.0);
+            }
+        }
+    }
+    if (!(incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    float v = shot_visibility(pr, a.normal_chart.w);
+    if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    receive(xy, gain * v, incident * (v * a.position_area.w));
+}
+)";
+    distribute_program = std::make_unique<program>(program::compute(distribute));
+
+    glsl::function_set light_fs;
+    light_fs.add("radiosity_point_irradiance", point_light_irradiance<f32, vec3>, "p", "n", "light_position",
+                 "intensity");
+    light_fs.add("radiosity_spot_irradiance", spot_light_irradiance<f32, vec3>, "p", "n", "light_position", "axis",
+                 "intensity", "cos_cone", "cosine_falloff");
+    const std::string light = version_header() + "layout(local_size_x = 8, local_size_y = 8) in;\n" +
+                              lookup_functions + light_fs.source() + common + R"(
+layout(location = 10) uniform int spot;
+layout(location = 11) uniform vec3 light_axis;
+layout(location = 12) uniform vec3 intensity;
+layout(location = 13) uniform float cos_cone;
+layout(location = 14) uniform float cosine_falloff;
+layout(location = 15) uniform int strict_side;
+void main() {
+    ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
+    if (xy.x >= atlas_width || xy.y >= atlas_height) return;
+    texel_attributes a = texel[xy.y * atlas_width + xy.x];
+    if (!(a.position_area.w > 0.0)) return;
+    if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    vec3 p = a.position_area.xyz, n = a.normal_chart.xyz;
+    // Each element belongs to one hemisphere of the light: z >= 0 of the first, z > 0 of the second.
+    float z = dot(p - shot_position, shot_n);
+    bool side = strict_side != 0 ? z > 0.0 : z >= 0.0;
+    vec3 e = spot != 0 ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
+                       : radiosity_point_irradiance(p, n, shot_position, intensity);
+    if (!side || !(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    float v = shot_visibility(p, a.normal_chart.w);
+    if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    receive(xy, a.albedo.rgb * (e * v), e * (v * a.position_area.w));
+}
+)";
+    light_program = std::make_unique<program>(program::compute(light));
+
+    // Reduction: per shooter its unshot power (channel sums times area, in double, in element
+    // order: the CPU solver's sum), with its elements' intercepted and absorbed power; then
+    // the largest power (ties to the lowest index) and the sums per work group; then one group.
+    const std::string reduce_common = version_header() + "layout(local_size_x = " + std::to_string(reduce_group) +
+                                      ") in;\n" + R"(
+const int entry = 10;
+layout(std430, binding = 5) buffer partial_block { double partial[]; };
+shared double s[256 * 9];
+void store_shared(uint i, double power, double index, double total, dvec3 ic, dvec3 ab) {
+    s[i * 9u] = power; s[i * 9u + 1u] = index; s[i * 9u + 2u] = total;
+    s[i * 9u + 3u] = ic.x; s[i * 9u + 4u] = ic.y; s[i * 9u + 5u] = ic.z;
+    s[i * 9u + 6u] = ab.x; s[i * 9u + 7u] = ab.y; s[i * 9u + 8u] = ab.z;
+}
+// Combines entry i with entry j: the larger power (ties: lower index) and the sums.
+void combine(uint i, uint j) {
+    bool take = s[j * 9u] > s[i * 9u] || (s[j * 9u] == s[i * 9u] && s[j * 9u + 1u] < s[i * 9u + 1u]);
+    if (take) { s[i * 9u] = s[j * 9u]; s[i * 9u + 1u] = s[j * 9u + 1u]; }
+    for (uint c = 2u; c < 9u; ++c) s[i * 9u + c] += s[j * 9u + c];
+}
+void reduce_and_write(uint out_index) {
+    uint i = gl_LocalInvocationID.x;
+    for (uint stride = 128u; stride > 0u; stride >>= 1u) {
+        barrier();
+        if (i < stride) combine(i, i + stride);
+    }
+    barrier();
+    if (i == 0u)
+        for (uint c = 0u; c < 9u; ++c) partial[out_index * uint(entry) + c] = s[c];
+}
+)";
+    const std::string reduce = reduce_common + R"(
+struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
+layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
+layout(std430, binding = 3) readonly buffer first_block { uint shooter_first[]; };
+layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
+layout(rgba32f, binding = 1) uniform readonly image2D unshot_image;
+layout(rgba32f, binding = 2) uniform readonly image2D intercepted_image;
+layout(location = 0) uniform int atlas_width;
+layout(location = 1) uniform uint shooter_count;
+void main() {
+    uint k = gl_GlobalInvocationID.x;
+    double power = -1.0, total = 0.0;
+    dvec3 ic = dvec3(0.0), ab = dvec3(0.0);
+    if (k < shooter_count) {
+        power = 0.0;
+        for (uint e = shooter_first[k]; e < shooter_first[k + 1u]; ++e) {
+            uint code = element_texel[e];
+            ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
+            texel_attributes a = texel[xy.y * atlas_width + xy.x];
+            vec4 u = imageLoad(unshot_image, xy);
+            power += (double(u.r) + double(u.g) + double(u.b)) * double(a.position_area.w);
+            dvec3 got = dvec3(imageLoad(intercepted_image, xy).rgb);
+            ic += got;
+            ab += (dvec3(1.0) - dvec3(a.albedo.rgb)) * got;
+        }
+        total = power;
+    }
+    store_shared(gl_LocalInvocationID.x, power, double(k), total, ic, ab);
+    reduce_and_write(gl_WorkGroupID.x + 1u);
+}
+)";
+    reduce_program = std::make_unique<program>(program::compute(reduce));
+    const std::string finish = reduce_common + R"(
+layout(location = 0) uniform uint group_count;
+void main() {
+    uint i = gl_LocalInvocationID.x;
+    store_shared(i, -1.0, 4294967295.0, 0.0, dvec3(0.0), dvec3(0.0));
+    for (uint g = i; g < group_count; g += 256u) {
+        uint at = (g + 1u) * uint(entry);
+        double p = partial[at], x = partial[at + 1u];
+        bool take = p > s[i * 9u] || (p == s[i * 9u] && x < s[i * 9u + 1u]);
+        if (take) { s[i * 9u] = p; s[i * 9u + 1u] = x; }
+        for (uint c = 2u; c < 9u; ++c) s[i * 9u + c] += partial[at + c];
+    }
+    reduce_and_write(0u);
+}
+)";
+    finish_program = std::make_unique<program>(program::compute(finish));
+}
+
+void progressive_radiosity::state::bind_common() const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, texels.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, nodes_binding, nodes.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, planes_binding, planes.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, first_binding, first_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, element_binding, element_texel.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, partial_binding, partials.id());
+    glBindImageTexture(radiosity_unit, radiosity.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(unshot_unit, unshot.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(intercepted_unit, intercepted.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(item_unit, item_color.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+}
+
+progressive_radiosity::state::reduction progressive_radiosity::state::reduce() {
+    const auto start = clock_type::now();
+    {
+        binding_state saved;
+        bind_common();
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        glUseProgram(reduce_program->id());
+        reduce_program->set(0, int(width));
+        reduce_program->set(1, unsigned(first.size() - 1));
+        glDispatchCompute(GLuint(reduce_groups), 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glUseProgram(finish_program->id());
+        finish_program->set(0, unsigned(reduce_groups));
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        check_error("progressive_radiosity: the shooter reduction");
+    }
+    std::array<double, partial_doubles> r{};
+    partials.read(0, r.data(), sizeof(double) * 9);
+    next_power = std::max(0.0, r[0]);
+    next = std::uint32_t(std::clamp(r[1], 0.0, double(first.size() - 2)));
+    unshot_total = r[2];
+    timings.choice_ms += ms_since(start);
+    return {{r[3], r[4], r[5]}, {r[6], r[7], r[8]}};
+}
+
+void progressive_radiosity::state::set_shot(glm::vec3 position, glm::vec3 axis, float chart) {
+    shot_position = position;
+    shot_axis = axis;
+    shot_chart = chart;
+    const auto tb = orthonormal_basis<float, glm::vec3>(axis);
+    t = tb[0];
+    b = tb[1];
+}
+
+void progressive_radiosity::state::draw_item_buffer() {
+    // The triangles in the shooter's frame, clipped above its plane and tessellated until no
+    // projected edge bends more than tolerance_px from its chord (cpu::item_buffer_visibility).
+    pieces.clear();
+    const float res = float(options.resolution);
+    const float z_min = 1e-6f * diagonal;
+    const auto pixel = [&](glm::vec3 l) { return stereographic_item_coords<float, glm::vec3, glm::vec2>(l) * res; };
+    std::vector<glm::vec3> poly, scratch;
+    struct pending {
+        glm::vec3 a, b, c;
+        int depth;
+    };
+    std::vector<pending> stack;
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+        if (float(triangle_chart[k]) == shot_chart) continue;
+        std::array<glm::vec3, 3> l;
+        for (int m = 0; m < 3; ++m)
+            l[std::size_t(m)] = to_shooter_frame<float, glm::vec3>(corners[k][std::size_t(m)], shot_position, t, b, shot_axis);
+        if (l[0].z < z_min && l[1].z < z_min && l[2].z < z_min) continue;
+        const glm::vec3 nl(glm::dot(glm::vec3(world_plane[k]), t), glm::dot(glm::vec3(world_plane[k]), b),
+                           glm::dot(glm::vec3(world_plane[k]), shot_axis));
+        const float d = glm::dot(nl, l[0]);
+        local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
+        poly.assign(l.begin(), l.end());
+        clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
+        const float chart = float(triangle_chart[k]), id = float(k);
+        for (std::size_t f = 1; f + 1 < poly.size(); ++f) {
+            // Depth first, children in the CPU's order, so the pieces come out in its order.
+            stack.assign(1, pending{poly[0], poly[f], poly[f + 1], 0});
+            while (!stack.empty()) {
+                const pending p = stack.back();
+                stack.pop_back();
+                const glm::vec2 pa = pixel(p.a), pb = pixel(p.b), pc = pixel(p.c);
+                const glm::vec3 ab = canonical_midpoint(p.a, p.b), bc = canonical_midpoint(p.b, p.c),
+                                ca = canonical_midpoint(p.c, p.a);
+                const float s = std::max({glm::length(pixel(ab) - 0.5f * (pa + pb)),
+                                          glm::length(pixel(bc) - 0.5f * (pb + pc)),
+                                          glm::length(pixel(ca) - 0.5f * (pc + pa))});
+                if (!(s > options.tolerance_px) || p.depth >= options.max_tessellation_depth) {
+                    pieces.push_back({p.a, chart, id});
+                    pieces.push_back({p.b, chart, id});
+                    pieces.push_back({p.c, chart, id});
+                    continue;
+                }
+                stack.push_back({ab, bc, ca, p.depth + 1});
+                stack.push_back({ca, bc, p.c, p.depth + 1});
+                stack.push_back({ab, p.b, bc, p.depth + 1});
+                stack.push_back({p.a, ab, ca, p.depth + 1});
+            }
+        }
+    }
+    drawn = pieces.size() / 3;
+    planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));
+    if (pieces.size() > vertex_capacity) {
+        vertex_capacity = std::max<std::size_t>(pieces.size() * 2, 1024);
+        vertices = std::make_unique<buffer>(vertex_capacity * sizeof(item_vertex));
+        glVertexArrayVertexBuffer(item_vao.id(), 0, vertices->id(), 0, GLsizei(sizeof(item_vertex)));
+        glEnableVertexArrayAttrib(item_vao.id(), 0);
+        glEnableVertexArrayAttrib(item_vao.id(), 1);
+        glVertexArrayAttribFormat(item_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribFormat(item_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
+        glVertexArrayAttribBinding(item_vao.id(), 0, 0);
+        glVertexArrayAttribBinding(item_vao.id(), 1, 0);
+    }
+    if (!pieces.empty()) vertices->write(0, pieces.data(), pieces.size() * sizeof(item_vertex));
+
+    // The farthest the scene can be from the shooter: the depth attachment's scale.
+    float far_distance = 0.f;
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        far_distance = std::max(far_distance, glm::length(corner - shot_position));
+    }
+    detail::raster_state raster;
+    binding_state saved;
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(item_fbo.id(), GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(item_fbo.id(), GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
+    glViewport(0, 0, options.resolution, options.resolution);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, planes_binding, planes.id());
+    glUseProgram(item_program->id());
+    item_program->set(0, res);
+    item_program->set(1, far_distance * 1.01f + 1e-6f * diagonal);
+    glBindVertexArray(item_vao.id());
+    if (!pieces.empty()) glDrawArrays(GL_TRIANGLES, 0, GLsizei(pieces.size()));
+    check_error("progressive_radiosity: drawing the item buffer");
+}
+
+std::vector<glm::vec3> progressive_radiosity::state::read_elements(const texture& tex) const {
+    const std::vector<float> all = tex.read_floats();
+    std::vector<glm::vec3> out(atlas.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        const std::size_t at = 4 * (std::size_t(atlas.texel[i].y) * width + atlas.texel[i].x);
+        out[i] = glm::vec3(all[at], all[at + 1], all[at + 2]);
+    }
+    return out;
+}
+
+void progressive_radiosity::state::shoot(std::uint32_t k) {
+    auto start = clock_type::now();
+    const std::uint32_t i0 = first[k], i1 = first[k + 1];
+    // The shooter's texels, read back: its power and its near-field tree (the CPU solver's
+    // build_near_tree: elements, then 2 x 2 groups of its grid cells, ..., the block last);
+    // then cleared.
+    const glm::uvec4 r = rect[k];
+    std::vector<glm::vec4> texels_back(std::size_t(r.z) * r.w);
+    {
+        detail::pack_state pack;
+        glGetTextureSubImage(unshot.id(), 0, GLint(r.x), GLint(r.y), 0, GLsizei(r.z), GLsizei(r.w), 1, GL_RGBA, GL_FLOAT,
+                             GLsizei(texels_back.size() * sizeof(glm::vec4)), texels_back.data());
+        const glm::vec4 zero(0.f);
+        glClearTexSubImage(unshot.id(), 0, GLint(r.x), GLint(r.y), 0, GLsizei(r.z), GLsizei(r.w), 1, GL_RGBA, GL_FLOAT,
+                           &zero);
+        check_error("progressive_radiosity: reading the shooter back");
+    }
+    glm::dvec3 power(0.0);
+    struct node_sum {
+        glm::uvec2 cell;
+        glm::dvec3 moment, power;
+        double area;
+        std::int32_t first_child, child_count;
+    };
+    std::vector<node_sum> level, up;
+    glm::vec4 block_rect(0.f, 0.f, 1.f, 1.f);
+    glm::uvec2 grid(1u);
+    if (options.shoot_blocks) {
+        block_rect = atlas.block_rect[k];
+        grid = atlas.block_grid[k];
+    }
+    const lightmap_chart& ch = atlas.charts[atlas.chart[i0]];
+    for (std::uint32_t i = i0; i < i1; ++i) {
+        const glm::uvec2 tx = atlas.texel[i] - glm::uvec2(r.x, r.y);
+        const glm::vec3 u(texels_back[std::size_t(tx.y) * r.z + tx.x]);
+        const double a = double(atlas.area[i]);
+        power += glm::dvec3(u) * a;
+        const glm::vec3 d = atlas.position[i] - ch.origin;
+        const glm::vec2 g((glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u) - block_rect.x) /
+                              (block_rect.z / float(grid.x)),
+                          (glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v) - block_rect.y) /
+                              (block_rect.w / float(grid.y)));
+        const glm::uvec2 cell(std::uint32_t(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1)),
+                              std::uint32_t(std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1)));
+        level.push_back({cell, glm::dvec3(atlas.position[i]) * a, glm::dvec3(u) * a, a, 0, 0});
+    }
+    near.clear();
+    std::vector<std::int32_t> parent;
+    const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
+    for (;;) {
+        std::stable_sort(level.begin(), level.end(),
+                         [&](const node_sum& x, const node_sum& y) { return key(x.cell / 2u) < key(y.cell / 2u); });
+        const std::int32_t base = std::int32_t(near.size());
+        for (const node_sum& p : level) {
+            near.push_back({glm::vec4(glm::vec3(p.moment / p.area), float(p.area)), glm::vec4(glm::vec3(p.power / p.area), 0.f),
+                            {-1, p.child_count == 0 ? 1 : 0, 0, 0}});
+            for (std::int32_t c = 0; c < p.child_count; ++c) near[std::size_t(p.first_child + c)].meta[0] = std::int32_t(near.size() - 1);
+        }
+        if (level.size() == 1) break;
+        up.clear();
+        for (std::size_t j = 0; j < level.size(); ++j) {
+            const glm::uvec2 pc = level[j].cell / 2u;
+            if (up.empty() || key(up.back().cell) != key(pc))
+                up.push_back({pc, glm::dvec3(0.0), glm::dvec3(0.0), 0.0, base + std::int32_t(j), 0});
+            node_sum& q = up.back();
+            q.moment += level[j].moment;
+            q.power += level[j].power;
+            q.area += level[j].area;
+            ++q.child_count;
+        }
+        level.swap(up);
+    }
+    require(near.size() <= std::size_t(max_nodes), "atlas", "a shooter's near-field tree outgrew its bound");
+    nodes.write(0, near.data(), near.size() * sizeof(gpu_node));
+
+    const float chart = float(atlas.chart[i0]);
+    set_shot(centre[k], atlas.normal[i0], chart);
+    if (options.visibility == radiosity_visibility::stereographic) draw_item_buffer();
+    finish();
+    timings.visibility_ms += ms_since(start);
+
+    start = clock_type::now();
+    {
+        binding_state saved;
+        bind_common();
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        const program& p = *distribute_program;
+        glUseProgram(p.id());
+        p.set(0, int(width));
+        p.set(1, int(height));
+        p.set(2, shot_position);
+        p.set(3, t);
+        p.set(4, b);
+        p.set(5, shot_axis);
+        p.set(6, chart);
+        p.set(7, options.visibility == radiosity_visibility::stereographic ? 1 : 0);
+        p.set(8, float(options.resolution));
+        p.set(9, diagonal);
+        p.set(10, int(near.size()));
+        p.set(11, float(options.near_field * options.near_field));
+        glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
+        check_error("progressive_radiosity: the distribution pass");
+    }
+    finish();
+    timings.distribution_ms += ms_since(start);
+    const reduction got = reduce();
+    absorbed += got.absorbed;
+    escaped += power - got.intercepted;
+    ++shots;
+}
+
+void progressive_radiosity::state::shoot_light(const packed_light& l) {
+    const light_kind kind = l.kind();
+    const glm::vec3 axis = kind == light_kind::spot ? l.direction() : glm::vec3(0, 0, 1);
+    std::vector<glm::vec3> axes{axis};
+    // A point light, or a spot wider than a hemisphere, needs the other half too.
+    if (kind == light_kind::point || l.cos_cone() < 0.f) axes.push_back(-axis);
+    for (std::size_t h = 0; h < axes.size(); ++h) {
+        set_shot(l.position(), axes[h], -2.f);
+        if (options.visibility == radiosity_visibility::stereographic) draw_item_buffer();
+        {
+            binding_state saved;
+            bind_common();
+            glMemoryBarrier(GL_ALL_BARRIER_BITS);
+            const program& p = *light_program;
+            glUseProgram(p.id());
+            p.set(0, int(width));
+            p.set(1, int(height));
+            p.set(2, shot_position);
+            p.set(3, t);
+            p.set(4, b);
+            p.set(5, shot_axis);
+            p.set(6, -2.f);
+            p.set(7, options.visibility == radiosity_visibility::stereographic ? 1 : 0);
+            p.set(8, float(options.resolution));
+            p.set(9, diagonal);
+            p.set(10, kind == light_kind::spot ? 1 : 0);
+            p.set(11, l.direction());
+            p.set(12, l.intensity());
+            p.set(13, l.cos_cone());
+            p.set(14, l.cosine_falloff());
+            p.set(15, h == 0 ? 0 : 1);
+            glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
+            check_error("progressive_radiosity: shooting a light");
+        }
+        const reduction got = reduce();
+        emitted += got.intercepted;
+        absorbed += got.absorbed;
+    }
+}
+
+// ---- the public type --------------------------------------------------------------------
+
+progressive_radiosity::progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas,
+                                             radiosity_options options) {
+    options.validate();
+    scene.validate();
+    require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
+            "was not built from this scene (triangle counts differ)");
+    require(atlas.size() > 0 && atlas.block_first.size() == atlas.blocks() + 1 && atlas.blocks() > 0, "atlas",
+            "has no elements");
+    require(std::all_of(atlas.block_level.begin(), atlas.block_level.end(), [](std::uint8_t l) { return l == 0; }),
+            "atlas", "is subdivided; the GL backend takes base atlases only");
+    require(atlas.block_texels >= 1 && atlas.block_texels <= 16, "atlas.block_texels",
+            "must lie in [1, 16] for the GL backend (its near-field tree is a fixed-size array)");
+    require(atlas.width <= 65535 && atlas.height <= 65535, "atlas", "is wider or taller than 65535 texels");
+    for (const light& l : scene.lights)
+        require(pack(l).kind() != light_kind::directional, "scene.lights",
+                "holds a directional light, which the GL backend does not shoot yet (the CPU solver does)");
+    s_ = std::make_unique<state>(scene, atlas, options);
+    const auto start = clock_type::now();
+    for (const light& l : scene.lights) s_->shoot_light(pack(l));
+    finish();
+    s_->timings.lights_ms = ms_since(start);
+    s_->reduce();
+}
+
+progressive_radiosity::~progressive_radiosity() = default;
+progressive_radiosity::progressive_radiosity(progressive_radiosity&&) noexcept = default;
+progressive_radiosity& progressive_radiosity::operator=(progressive_radiosity&&) noexcept = default;
+
+bool progressive_radiosity::step() {
+    if (!(s_->next_power > 0)) return false;
+    s_->shoot(s_->next);
+    ++s_->steps;
+    return true;
+}
+
+std::size_t progressive_radiosity::solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress) {
+    require(fraction >= 0 && fraction < 1, "fraction", "must lie in [0, 1)");
+    std::size_t taken = 0;
+    while (unshot_fraction() > fraction && step()) {
+        ++taken;
+        if (progress && !progress(this->progress())) break;
+    }
+    return taken;
+}
+
+double progressive_radiosity::unshot_fraction() const noexcept {
+    const double e = s_->emitted.x + s_->emitted.y + s_->emitted.z;
+    return e > 0 ? s_->unshot_total / e : 0.0;
+}
+radiosity_progress progressive_radiosity::progress() const noexcept {
+    return {s_->steps, s_->shots, unshot_fraction()};
+}
+std::uint32_t progressive_radiosity::next_shooter() const noexcept { return s_->next; }
+double progressive_radiosity::next_shooter_power() const noexcept { return s_->next_power; }
+std::size_t progressive_radiosity::shooters() const noexcept { return s_->first.size() - 1; }
+std::uint32_t progressive_radiosity::shooter_first(std::size_t k) const { return s_->first.at(k); }
+glm::dvec3 progressive_radiosity::emitted_power() const noexcept { return s_->emitted; }
+glm::dvec3 progressive_radiosity::absorbed_power() const noexcept { return s_->absorbed; }
+glm::dvec3 progressive_radiosity::escaped_power() const noexcept { return s_->escaped; }
+glm::dvec3 progressive_radiosity::unshot_power() const {
+    const auto u = unshot();
+    glm::dvec3 sum(0.0);
+    for (std::size_t i = 0; i < u.size(); ++i) sum += glm::dvec3(u[i]) * double(s_->atlas.area[i]);
+    return sum;
+}
+std::vector<glm::vec3> progressive_radiosity::radiosity() const { return s_->read_elements(s_->radiosity); }
+std::vector<glm::vec3> progressive_radiosity::unshot() const { return s_->read_elements(s_->unshot); }
+glm::dvec3 progressive_radiosity::ambient() const {
+    const glm::dvec3 rho_avg = s_->albedo_area / s_->total_area;
+    return unshot_power() / s_->total_area / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
+}
+std::vector<glm::vec3> progressive_radiosity::display_radiosity() const {
+    std::vector<glm::vec3> out = radiosity();
+    const glm::vec3 amb = s_->options.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+    for (std::size_t i = 0; i < out.size(); ++i)
+        out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb);
+    return out;
+}
+image<glm::vec3> progressive_radiosity::lightmap() const {
+    const auto values = display_radiosity();
+    return s_->atlas.to_texels(std::span<const glm::vec3>(values));
+}
+texture_ref progressive_radiosity::radiosity_texture() const noexcept { return texture_ref(s_->radiosity); }
+texture_ref progressive_radiosity::unshot_texture() const noexcept { return texture_ref(s_->unshot); }
+const radiosity_timings& progressive_radiosity::timings() const noexcept { return s_->timings; }
+const lightmap_atlas& progressive_radiosity::atlas() const noexcept { return s_->atlas; }
+const radiosity_options& progressive_radiosity::options() const noexcept { return s_->options; }
+std::size_t progressive_radiosity::drawn_triangles() const noexcept { return s_->drawn; }
+
+}  // namespace bounce::gl
