@@ -1,0 +1,231 @@
+// gl::progressive_radiosity against cpu::progressive_radiosity on the same atlas with the same
+// options and visibility method (llvmpipe through EGL): the same shooters, radiosities within
+// float rounding without occlusion, visibility differences only at item-buffer edges with the
+// stereographic buffer, energy bookkeeping, the GPU reduction's choice, lights, bad input.
+#include "../gl/shared_context.hpp"
+#include "../radiosity/radiosity_scenes.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/gl/radiosity.hpp>
+#include <bounce/radiosity_subdivision.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+namespace {
+
+// Per-shooter unshot power from per-element unshot radiosities, in double and in element
+// order (the sum both solvers form), and the largest with ties to the lowest index.
+std::pair<std::uint32_t, double> largest_power(const gl::progressive_radiosity& solver,
+                                               const std::vector<glm::vec3>& unshot) {
+    const lightmap_atlas& atlas = solver.atlas();
+    std::pair<std::uint32_t, double> best{0, -1.0};
+    for (std::size_t k = 0; k < solver.shooters(); ++k) {
+        double p = 0;
+        for (std::uint32_t i = solver.shooter_first(k); i < solver.shooter_first(k + 1); ++i)
+            p += (double(unshot[i].x) + double(unshot[i].y) + double(unshot[i].z)) * double(atlas.area[i]);
+        if (p > best.second) best = {std::uint32_t(k), p};
+    }
+    return best;
+}
+
+}  // namespace
+
+TEST_CASE("without occlusion, GL and CPU shoot the same shooters and agree to float rounding",
+          "[gl][radiosity]") {
+    // Both backends run the same float kernels (disc_form_factor, shot_radiosity; emitted GLSL
+    // agrees with the CPU to 1e-5 of its terms, tests/radiosity) over the same near-field
+    // nodes, in another order. A shot's gain is a sum of positive terms, so each shot is off
+    // by at most 1e-5 of what it adds, and the unshot radiosity a later shot spreads carries
+    // its sources' relative error along: after s shots an element's radiosity is within
+    // 1e-5 (s + 1) of itself. The shooter powers are compared in double; their order is the
+    // same unless two are within that relative distance, which this box does not have.
+    gl_test::shared_context();
+    const auto scene = closed_box(2.f, 0.7f, 10.f);
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400});
+    cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{});
+    gl::progressive_radiosity gl_solver(scene.view(), atlas, {.visibility = gl::radiosity_visibility::none});
+    REQUIRE(gl_solver.shooters() == cpu_solver.shooters());
+    CHECK(gl_solver.emitted_power().x == Approx(cpu_solver.emitted_power().x).epsilon(1e-12));
+    const int shots = 40;
+    for (int s = 0; s < shots; ++s) {
+        const auto u = gl_solver.unshot();
+        const auto expected = largest_power(gl_solver, u);
+        INFO("step " << s);
+        CHECK(gl_solver.next_shooter() == expected.first);
+        CHECK(gl_solver.next_shooter_power() == Approx(expected.second).epsilon(1e-12));
+        REQUIRE(gl_solver.step());
+        REQUIRE(cpu_solver.step());
+    }
+    const auto bg = gl_solver.radiosity();
+    const auto bc = cpu_solver.radiosity();
+    double worst = 0;
+    for (std::size_t i = 0; i < bc.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            if (bc[i][c] > 0) worst = std::max(worst, std::abs(double(bg[i][c]) - double(bc[i][c])) / double(bc[i][c]));
+    INFO("worst relative difference " << worst);
+    CHECK(worst <= 1e-5 * (shots + 1));
+    CHECK(gl_solver.unshot_fraction() == Approx(cpu_solver.unshot_fraction()).epsilon(1e-5 * (shots + 1)));
+    CHECK(gl_solver.progress().shots == std::size_t(shots));
+}
+
+TEST_CASE("absorbed + unshot + escaped power equals emitted power on GL after every step", "[gl][radiosity][energy]") {
+    // The GL solver books, per shot, the intercepted power each element reports (float,
+    // incident power times visibility times area) and the absorbed share (1 - rho) of it, summed
+    // in double by the reduction; the unshot texture grows by the float gain rho x incident.
+    // The two differ by the kernel's rounding (a few ulps; allowance 4, as on the CPU) and the
+    // unshot texels are rounded once per step, so after s steps the balance holds to
+    // 4 (s + 3) 2^-24 of the emitted power, the CPU solver's bound.
+    gl_test::shared_context();
+    const auto check_balance = [](gl::progressive_radiosity& solver, int steps) {
+        for (int s = 0; s < steps && solver.step(); ++s) {
+            const glm::dvec3 e = solver.emitted_power();
+            const glm::dvec3 sum = solver.absorbed_power() + solver.unshot_power() + solver.escaped_power();
+            for (int c = 0; c < 3; ++c) CHECK(std::abs(sum[c] - e[c]) <= (s + 3) * 0x1p-24 * e[c] * 4);
+        }
+    };
+    SECTION("Cornell box, emitting quad, stereographic item buffer, blocks with the near field") {
+        const auto scene = cornell_box();
+        const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 500});
+        gl::progressive_radiosity solver(scene.view(), atlas, {.resolution = 128});
+        check_balance(solver, 40);
+        CHECK(solver.emitted_power().x > 0);
+        CHECK(solver.escaped_power().x > 0);  // the box's open front
+    }
+    SECTION("Cornell box, the spot light of its scene.json shot first, per-element shooters") {
+        const auto scene = cornell_box(true);
+        const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
+        gl::progressive_radiosity solver(scene.view(), atlas, {.shoot_blocks = false, .resolution = 128});
+        CHECK(solver.emitted_power().x > 0);
+        check_balance(solver, 40);
+    }
+}
+
+TEST_CASE("GL and CPU stereographic visibility differ only at item-buffer edges", "[gl][radiosity][visibility]") {
+    // Both draw the same tessellated pieces (the sagitta rule) into a 128^2 stereographic
+    // buffer; GL's rasterizer gets the pieces' corners projected by the emitted kernel in the
+    // vertex shader and snaps them itself, so a pixel whose centre lies within a rounding of a
+    // piece's edge may fall to the other side. An element can then only be answered
+    // differently when its pixel in the CPU's buffer borders a pixel of another id (a 3 x 3
+    // neighbourhood: the pixel itself may have flipped). Everywhere else the one shot (from
+    // the lamp, the first shooter on both) gives the same gain to float rounding (1e-5).
+    gl_test::shared_context();
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
+    const int res = 128;
+    cpu::progressive_radiosity cpu_solver(scene.view(), atlas,
+                                          cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = res}));
+    gl::progressive_radiosity gl_solver(scene.view(), atlas, {.resolution = res});
+    const auto b0 = cpu_solver.radiosity();
+    const std::vector<glm::vec3> before(b0.begin(), b0.end());
+    // The shooter's disc: its elements' area-weighted centroid and its chart's normal.
+    const std::uint32_t k = gl_solver.next_shooter();
+    glm::dvec3 c(0.0);
+    double area = 0;
+    for (std::uint32_t i = gl_solver.shooter_first(k); i < gl_solver.shooter_first(k + 1); ++i) {
+        c += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
+        area += double(atlas.area[i]);
+    }
+    const glm::vec3 centre(c / area), n = atlas.normal[gl_solver.shooter_first(k)];
+    const auto tb = orthonormal_basis<float, glm::vec3>(n);
+    REQUIRE(cpu_solver.step());
+    REQUIRE(gl_solver.step());
+    const auto bc = cpu_solver.radiosity();
+    const auto bg = gl_solver.radiosity();
+    const cpu::item_buffer& buf = cpu_solver.visibility().buffers()[0];
+    const auto id_at = [&](int x, int y) {
+        x = std::clamp(x, 0, buf.width - 1);
+        y = std::clamp(y, 0, buf.height - 1);
+        return buf.id[std::size_t(y) * std::size_t(buf.width) + std::size_t(x)];
+    };
+    std::size_t differing = 0, off_edge = 0, lit = 0;
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+        const float gain_cpu = bc[i].x - before[i].x, gain_gl = bg[i].x - before[i].x;
+        const float scale = std::max(gain_cpu, gain_gl);
+        if (scale > 0) ++lit;
+        if (std::abs(gain_cpu - gain_gl) <= 1e-5f * scale) continue;
+        ++differing;
+        const glm::vec3 l = to_shooter_frame<float, glm::vec3>(atlas.position[i], centre, tb[0], tb[1], n);
+        const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l) * float(res);
+        const int x = std::clamp(int(std::floor(uv.x)), 0, res - 1), y = std::clamp(int(std::floor(uv.y)), 0, res - 1);
+        bool edge = false;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) edge = edge || id_at(x + dx, y + dy) != id_at(x, y);
+        if (!edge) ++off_edge;
+    }
+    INFO("lit " << lit << ", differing " << differing << ", of them off an edge " << off_edge);
+    CHECK(lit > atlas.size() / 2);
+    CHECK(off_edge == 0);
+}
+
+TEST_CASE("with the stereographic item buffer, k shots on GL and CPU agree", "[gl][radiosity][visibility]") {
+    // Same atlas, options and buffer resolution. Where every visibility answer is the same
+    // (the previous test: answers may differ only at item-buffer edges), the solutions are
+    // within the float bound 1e-5 (s + 1) of the test without occlusion. An element answered
+    // differently in one shot would differ by that shot's whole gain; the share of the
+    // solution's power in such elements is what the relative L1 difference measures, and it is
+    // held to 1e-5 (s + 1) too: no element may be answered differently here.
+    gl_test::shared_context();
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
+    const int res = 128, shots = 30;
+    cpu::progressive_radiosity cpu_solver(scene.view(), atlas,
+                                          cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = res}));
+    gl::progressive_radiosity gl_solver(scene.view(), atlas, {.resolution = res});
+    std::size_t same_shooter = 0;
+    for (int s = 0; s < shots; ++s) {
+        const auto expected = largest_power(gl_solver, gl_solver.unshot());
+        same_shooter += expected.first == gl_solver.next_shooter() ? 1 : 0;
+        REQUIRE(gl_solver.step());
+        REQUIRE(cpu_solver.step());
+    }
+    CHECK(same_shooter == std::size_t(shots));
+    const auto bg = gl_solver.radiosity();
+    const auto bc = cpu_solver.radiosity();
+    double diff = 0, sum = 0, worst = 0;
+    for (std::size_t i = 0; i < bc.size(); ++i) {
+        const double a = double(atlas.area[i]);
+        for (int c = 0; c < 3; ++c) {
+            diff += std::abs(double(bg[i][c]) - double(bc[i][c])) * a;
+            sum += double(bc[i][c]) * a;
+            if (bc[i][c] > 0) worst = std::max(worst, std::abs(double(bg[i][c]) - double(bc[i][c])) / double(bc[i][c]));
+        }
+    }
+    INFO("relative L1 difference " << diff / sum << ", worst element " << worst);
+    CHECK(diff / sum <= 1e-5 * (shots + 1));
+    CHECK(gl_solver.unshot_fraction() == Approx(cpu_solver.unshot_fraction()).epsilon(1e-5 * (shots + 1)));
+    const auto escaped_gl = gl_solver.escaped_power(), escaped_cpu = cpu_solver.escaped_power();
+    CHECK(escaped_gl.x == Approx(escaped_cpu.x).epsilon(1e-4));
+}
+
+TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosity][errors]") {
+    gl_test::shared_context();
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 200});
+    const auto throws_naming = [&](gl::radiosity_options o, const char* name) {
+        CHECK_THROWS_WITH(gl::progressive_radiosity(scene.view(), atlas, o), Catch::Contains(name));
+    };
+    throws_naming({.near_field = -1}, "radiosity_options.near_field");
+    throws_naming({.resolution = 4}, "radiosity_options.resolution");
+    throws_naming({.tolerance_px = 0.f}, "radiosity_options.tolerance_px");
+    throws_naming({.max_tessellation_depth = 17}, "radiosity_options.max_tessellation_depth");
+    const auto other = closed_box(1.f, 0.5f, 1.f);
+    CHECK_THROWS_AS(gl::progressive_radiosity(other.view(), atlas), parameter_error);
+    auto with_sun = cornell_box();
+    directional_light sun;
+    sun.direction = {0, -1, 0};
+    sun.irradiance = {1, 1, 1};
+    with_sun.lights.push_back(sun);
+    CHECK_THROWS_WITH(gl::progressive_radiosity(with_sun.view(), atlas), Catch::Contains("scene.lights"));
+    const auto wide = build_lightmap_atlas(scene.view(), {.elements = 200, .block_texels = 32});
+    CHECK_THROWS_WITH(gl::progressive_radiosity(scene.view(), wide), Catch::Contains("atlas.block_texels"));
+    gl::progressive_radiosity solver(scene.view(), atlas, {.resolution = 64});
+    CHECK_THROWS_WITH(solver.solve(1.0), Catch::Contains("fraction"));
+    CHECK_THROWS_WITH(solver.solve(-0.1), Catch::Contains("fraction"));
+}
