@@ -367,7 +367,7 @@ int run(const options& o) {
     const camera& cam = scene.camera;
     gbuffer<float> g = embree::ray_cast_gbuffer(bvh, scene, cam, o.width, o.height);
     const float clamp_distance =
-        o.clamp >= 0.f ? o.clamp : 0.005f * glm::length(scene.bounds().second - scene.bounds().first);
+        o.clamp >= 0.f ? o.clamp : 0.01f * glm::length(scene.bounds().second - scene.bounds().first);
     require(std::isfinite(clamp_distance), "--clamp", "must be finite");
     // Checks the options before the references take minutes.
     (void)indirect_options_for(o, o.technique, o.vpls, pattern, clamp_distance);

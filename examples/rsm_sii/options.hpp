@@ -24,7 +24,7 @@ struct options {
     std::size_t rsm_resolution = 256;  // texels per side of each map (cube face)
     std::string selection = "warping"; // SII VPLs: warping (DS06 section 3.3) | grid
     float r_max = 1.5f;                // RSM gather disc radius, map units
-    float clamp = -1.f;                // d^2 clamped at clamp^2 (m); < 0: 0.5% of the scene's diagonal
+    float clamp = -1.f;                // d^2 clamped at clamp^2 (m); < 0: 1% of the scene's diagonal
     float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
     bool blur = true;
     bool thesis_weights = false;       // interleaved lights at weight 1 (Hahn 2012), not N M
@@ -109,7 +109,7 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(examples::detail::number_in(0, 2, true, "a radius"))
         ->capture_default_str();
     app.add_option("--clamp", o.clamp,
-                   "sender-receiver distance below which 1/d^2 is clamped (scene units); default 0.5% of the scene's diagonal");
+                   "sender-receiver distance below which 1/d^2 is clamped (scene units); default 1% of the scene's diagonal");
     app.add_option("--offset", o.offset, "senders moved this far along -n_p (scene units; DS05's remedy)")
         ->check(examples::finite_non_negative)
         ->capture_default_str();
