@@ -1,0 +1,126 @@
+#pragma once
+// radiosity's options: what the command line sets, how it is spelled and checked, and the
+// library settings it makes (main.cpp runs and reports).
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/embree/multi_bounce_reference.hpp>
+#include <bounce/errors.hpp>
+#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity_subdivision.hpp>
+
+#include <CLI/CLI.hpp>
+#include "../common/cli_number_checks.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace bounce::examples {
+
+struct options {
+    std::string scene = "cornell";
+    std::size_t elements = 10000;     // target element count of the atlas (before subdivision)
+    int block = 8;                    // shooting block side, texels (substructuring)
+    std::string visibility = "stereo";  // stereo | hemicube | rays
+    int resolution = 128;             // item buffer side (hemicube: per face)
+    float tolerance_px = 0.25f;       // stereographic tessellation: largest edge sagitta, pixels
+    bool adaptive = false;
+    int max_level = 2;                // adaptive: deepest level
+    double threshold = 0.25;          // adaptive: second-difference threshold
+    int subdivide_steps = 200;        // adaptive: subdivide after each of the first N steps
+    std::string backend = "cpu";      // cpu | gl
+    double converge = 0.9;            // stop when this fraction of the emitted power is shot
+    double max_seconds = 0;           // also stop after this much solving (0: no limit)
+    int shooters_per_step = 1;
+    double near_field = 4;
+    bool ambient = false;
+    int repeat = 1;                   // solves timed (medians reported)
+    std::size_t width = 256, height = 256;
+    bool reference = true;
+    std::uint32_t reference_paths = 256;
+    int curve_points = 16;            // error checkpoints along the solve (0: none)
+    bool quiet = false;
+    std::filesystem::path json, out, lightmaps, versus;
+};
+
+inline void add_options(CLI::App& app, options& o, std::string& adaptive, std::string& ambient,
+                        std::string& reference) {
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
+        ->capture_default_str();
+    app.add_option("--elements", o.elements, "target number of elements (lightmap texels)")
+        ->check(CLI::Range(std::size_t(16), std::size_t(50000000)))->capture_default_str();
+    app.add_option("--block", o.block, "side of a shooting block in texels (substructuring; 1: shoot elements)")
+        ->check(CLI::Range(1, 256))->capture_default_str();
+    app.add_option("--visibility", o.visibility, "stereo | hemicube | rays")
+        ->check(CLI::IsMember({"stereo", "hemicube", "rays"}))->capture_default_str();
+    app.add_option("--resolution", o.resolution, "item buffer side in pixels (hemicube: per face, even)")
+        ->check(CLI::Range(8, 8192))->capture_default_str();
+    app.add_option("--tolerance-px", o.tolerance_px, "stereographic tessellation: largest edge sagitta, pixels")
+        ->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--adaptive", adaptive, "adaptive subdivision: on | off")->check(CLI::IsMember({"on", "off"}))
+        ->capture_default_str();
+    app.add_option("--max-level", o.max_level, "adaptive: deepest quadtree level")->check(CLI::Range(0, 8))
+        ->capture_default_str();
+    app.add_option("--threshold", o.threshold, "adaptive: second-difference threshold (times the leaf's mean)")
+        ->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--subdivide-steps", o.subdivide_steps, "adaptive: subdivide after each of the first N steps")
+        ->check(CLI::Range(0, 1000000))->capture_default_str();
+    app.add_option("--backend", o.backend, "cpu | gl")->check(CLI::IsMember({"cpu", "gl"}))->capture_default_str();
+    app.add_option("--converge", o.converge, "stop when this fraction of the emitted power has been shot, in [0, 1)")
+        ->check(examples::detail::number_in(0, 1, false, "a fraction"))->capture_default_str();
+    app.add_option("--max-seconds", o.max_seconds, "also stop after this many seconds of solving (0: no limit)")
+        ->check(examples::finite_non_negative)->capture_default_str();
+    app.add_option("--shooters-per-step", o.shooters_per_step, "shooters taken from one choice")
+        ->check(CLI::Range(1, 4096))->capture_default_str();
+    app.add_option("--near-field", o.near_field, "a block shoots as its quadrants within this many sides (0: one disc)")
+        ->check(examples::finite_non_negative)->capture_default_str();
+    app.add_option("--ambient", ambient, "show the ambient term (Cohen et al. 1988): on | off")
+        ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+    app.add_option("--repeat", o.repeat, "solve N times; timings are medians")->check(CLI::Range(1, 100))
+        ->capture_default_str();
+    app.add_option("--width", o.width, "view width")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--height", o.height, "view height")->check(CLI::Range(1, 16384))->capture_default_str();
+    app.add_option("--reference", reference, "compare with the multi-bounce reference: on | off")
+        ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+    app.add_option("--reference-paths", o.reference_paths, "reference paths per pixel")
+        ->check(CLI::Range(1u, 1u << 20))->capture_default_str();
+    app.add_option("--curve-points", o.curve_points, "error checkpoints along the solve (0: none)")
+        ->check(CLI::Range(0, 1000))->capture_default_str();
+    app.add_flag("--quiet", o.quiet, "no progress line");
+    app.add_option("--json", o.json, "write the run report (JSON) here");
+    app.add_option("--out", o.out, "write the rendered view here (.png or .exr)");
+    app.add_option("--lightmaps", o.lightmaps, "write the lightmaps (EXR) into this folder");
+    app.add_option("--versus", o.versus, "also compare the view with this EXR view of another run (same size)");
+}
+
+/// The settings of the atlas the options ask for.
+inline atlas_options atlas_options_for(const options& o) {
+    atlas_options a;
+    a.elements = o.elements;
+    a.block_texels = o.block;
+    a.padding = 1;
+    return a;
+}
+
+inline cpu::radiosity_options solver_options_for(const options& o) {
+    cpu::radiosity_options r;
+    r.shoot_blocks = o.block > 1;
+    r.shooters_per_step = o.shooters_per_step;
+    r.ambient = o.ambient;
+    r.near_field = o.near_field;
+    return r;
+}
+
+inline subdivision_options subdivision_options_for(const options& o) {
+    subdivision_options s;
+    s.threshold = o.threshold;
+    s.max_level = o.max_level;
+    return s;
+}
+
+inline embree::multi_bounce_settings reference_settings_for(const options& o) {
+    embree::multi_bounce_settings s;
+    s.paths = o.reference_paths;
+    return s;
+}
+
+}  // namespace bounce::examples
