@@ -47,28 +47,6 @@ void indirect_options::validate() const {
             "must be 1: the GL renderer gathers at full resolution (no upsampling pass)");
 }
 
-void rsm_textures::validate(const char* name) const {
-    require(position.id != 0 && normal.id != 0 && flux.id != 0, name, "a map texture is missing");
-    require(position.format == texel_format::rgba32f && normal.format == texel_format::rgba32f &&
-                flux.format == texel_format::rgba32f,
-            name, "position, normal and flux must be RGBA32F textures");
-    require(flux.width > 0 && flux.height > 0, name, "the map has no size");
-    require(position.width == flux.width && position.height == flux.height && normal.width == flux.width &&
-                normal.height == flux.height,
-            name, "position, normal and flux maps differ in size");
-}
-
-rsm_images::rsm_images(const rsm_textures& t)
-    : position(t.width(), t.height()),
-      normal(t.width(), t.height()),
-      flux(t.width(), t.height()),
-      light_view_projection(t.light_view_projection) {
-    t.validate();
-    read_texture(t.position, position.view());
-    read_texture(t.normal, normal.view());
-    read_texture(t.flux, flux.view());
-}
-
 // ---- CPU-side choices, the CPU renderer's ------------------------------------------------
 
 std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count, std::uint64_t seed,

@@ -32,6 +32,7 @@
 
 #include <bounce/camera.hpp>
 #include <bounce/gl/objects.hpp>
+#include <bounce/gl/rsm_textures.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/interleaved_sampling.hpp>
 #include <bounce/vpl_sampling.hpp>
@@ -52,33 +53,6 @@
 #include <glm/vec4.hpp>
 
 namespace bounce::gl {
-
-/// A reflective shadow map as the caller's textures (all RGBA32F, one size, GL row order):
-/// world position (xyz), unit normal (xyz) and reflected flux (rgb, W per channel; 0
-/// where the map sees nothing), with the matrix that maps world positions to the map's
-/// clip space (bounce::rsm_view's convention). gl::rsm_renderer writes these.
-struct rsm_textures {
-    texture_ref position, normal, flux;
-    glm::mat4 light_view_projection{1.f};
-
-    std::size_t width() const noexcept { return flux.width; }
-    std::size_t height() const noexcept { return flux.height; }
-    /// Throws parameter_error naming `name` unless the three are set, RGBA32F and of one
-    /// non-zero size.
-    void validate(const char* name = "rsm") const;
-};
-
-/// Reads an RSM's textures into images (row 0 at the top) that a bounce::rsm_view can
-/// borrow: the CPU's copy of a map the GPU rendered (VPL selection reads it).
-struct rsm_images {
-    image<glm::vec3> position, normal, flux;
-    glm::mat4 light_view_projection{1.f};
-
-    rsm_images() = default;
-    /// Throws parameter_error on bad textures.
-    explicit rsm_images(const rsm_textures& t);
-    rsm_view view() const { return {position.view(), normal.view(), flux.view(), light_view_projection}; }
-};
 
 // ---- the options: cpu::indirect_options mirrored field by field --------------------------
 

@@ -1,0 +1,117 @@
+#pragma once
+/// \file rsm_renderer.hpp
+/// `gl::rsm_renderer`: reflective shadow maps (Dachsbacher and Stamminger 2005, section 3.1)
+/// rasterized from a scene_view's lights into RGBA32F textures (world position, unit
+/// normal, reflected flux), the flux computed per fragment by the emitted texel-flux kernels
+/// of rsm.hpp, so a GL renderer gets the maps embree::rsm_ray_caster casts on the CPU.
+///
+/// Map layouts, those of embree::rsm_ray_caster (adapters/embree/.../rsm_ray_cast.hpp), with
+/// the same light_view_projection matrices (every map square, `resolution` texels per side):
+/// - point light: the six faces of a cube (90-degree perspective maps along +x, -x, +y, -y,
+///   +z, -z, with the ray caster's up vectors);
+/// - spot light with a cone half-angle up to `max_single_map_cone_deg`: one perspective map
+///   of field of view twice the cone; a wider cone gets the cube faces its cone can reach
+///   (a face is left out when the angle between the axis and the face's direction exceeds
+///   the cone by more than the face's half-diagonal, 54.7 degrees; the ray caster also
+///   drops faces that happen to see no lit surface, which hold flux 0 here);
+/// - directional light: an orthographic map across the beam covering the scene's bounding
+///   sphere.
+/// Normals face the light (two-sided surfaces, surface.hpp's facing_normal), as the ray
+/// caster's; a texel that sees nothing holds position 0, normal -(view direction), flux 0.
+/// A texel's solid angle is exact: rectangle_solid_angle evaluated in double on the CPU
+/// once per map shape and read from a table, as the ray caster evaluates it.
+///
+/// Rasterization samples texel centres, as the ray caster's rays do; the two differ where a
+/// texel centre lies within rounding of a triangle edge, and where geometry lies closer to
+/// a spot or point light than 1/10000 of its farthest distance to the scene bounds (clipped
+/// by the near plane here). The render restores the GL state it changes (framebuffers,
+/// viewport, program, vertex array, storage binding 0, texture unit 0, depth and blend
+/// state, masks, polygon mode, clip control).
+
+#include <bounce/gl/gbuffer_pass.hpp>
+#include <bounce/gl/objects.hpp>
+#include <bounce/gl/rsm_textures.hpp>
+#include <bounce/light.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+namespace bounce::gl {
+
+/// Settings of rsm_renderer (those of embree::rsm_ray_cast_settings).
+struct rsm_render_options {
+    /// Texels per side of every map (and of every cube face); typical: 128-512.
+    std::size_t resolution = 256;
+    /// Widest spot cone (half-angle, degrees) in a single perspective map; wider ones use
+    /// cube faces. In (0, 90); typical: 60.
+    float max_single_map_cone_deg = 60.f;
+
+    /// Throws parameter_error naming the field.
+    void validate() const;
+};
+
+/// One map a light needs: which light, how the map sees it.
+struct rsm_map_layout {
+    std::size_t light = 0;                 ///< index of the light in the span rendered
+    glm::mat4 light_view_projection{1.f};  ///< world to the map's clip space (as the ray caster's)
+    glm::mat4 view{1.f};                   ///< world to the map's view space
+    glm::vec3 position{0.f};               ///< the light's position (perspective maps)
+    glm::vec3 forward{0.f, 0.f, -1.f};     ///< the map's view direction
+    glm::vec3 up{0.f, 1.f, 0.f};           ///< the up vector of its view (glm::lookAt's)
+    float fov_deg = 90.f;                  ///< perspective maps: full field of view
+    bool orthographic = false;
+    /// World size of a texel's side at unit distance (perspective) or everywhere
+    /// (orthographic), as reflective_shadow_map::texel_size.
+    float texel_size = 0.f;
+};
+
+class rsm_renderer {
+public:
+    /// Keeps references to `scene` (for its bounds and lights) and `mesh` (its geometry,
+    /// uploaded by the caller); both must outlive the renderer. A context must be current.
+    /// Throws parameter_error for bad options.
+    rsm_renderer(const scene_view& scene, const scene_mesh& mesh, const rsm_render_options& options = {});
+
+    const rsm_render_options& options() const noexcept { return options_; }
+
+    /// The maps `lights` need, in order (validated as validate_lights does, naming
+    /// "lights[i]").
+    std::vector<rsm_map_layout> layout(std::span<const light> lights) const;
+
+    /// Rasterizes the maps of `lights` into the caller's textures: `targets` must hold one
+    /// entry per map of layout(lights), each three RGBA32F textures of resolution^2 texels;
+    /// their light_view_projection is set. Throws parameter_error naming "targets".
+    void render(std::span<const light> lights, std::span<rsm_textures> targets);
+    /// Rasterizes into textures of the renderer's own (kept between frames), see maps().
+    void render(std::span<const light> lights);
+    /// The scene's own lights.
+    void render() { render(scene_.lights); }
+    /// The maps of the last render(lights) into the renderer's own textures.
+    std::span<const rsm_textures> maps() const noexcept { return refs_; }
+
+private:
+    void render_map(const rsm_map_layout& m, const packed_light& l, const rsm_textures& target);
+    const texture& solid_angles(float fov_deg);
+
+    scene_view scene_;
+    const scene_mesh& mesh_;
+    rsm_render_options options_;
+    program program_;
+    framebuffer fbo_;
+    std::optional<texture> depth_;
+    std::map<float, texture> solid_angles_;  // per field of view: the texels' exact solid angles (R32F)
+    struct owned {
+        texture position, normal, flux;
+    };
+    std::vector<owned> owned_;
+    std::vector<rsm_textures> refs_;
+};
+
+}  // namespace bounce::gl

@@ -1,0 +1,334 @@
+// Reflective shadow maps by rasterization (Dachsbacher and Stamminger 2005, section 3.1):
+// one indexed draw of the scene per map into three RGBA32F targets. The shaders are
+// plumbing (transform, interpolate, fetch Kd and the texel's solid angle, write); the
+// facing normal and the reflected flux are the kernels of surface.hpp and rsm.hpp, emitted.
+#include <bounce/gl/rsm_renderer.hpp>
+#include <bounce/gl/splat_pass.hpp>
+#include <bounce/glsl/emit.hpp>
+#include <bounce/camera.hpp>
+#include <bounce/rectangle_solid_angle.hpp>
+#include <bounce/rsm.hpp>
+#include <bounce/surface.hpp>
+
+#include "saved_state.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <variant>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace bounce::gl {
+
+// ---- rsm_textures -----------------------------------------------------------------------
+
+void rsm_textures::validate(const char* name) const {
+    require(position.id != 0 && normal.id != 0 && flux.id != 0, name, "a map texture is missing");
+    require(position.format == texel_format::rgba32f && normal.format == texel_format::rgba32f &&
+                flux.format == texel_format::rgba32f,
+            name, "position, normal and flux must be RGBA32F textures");
+    require(flux.width > 0 && flux.height > 0, name, "the map has no size");
+    require(position.width == flux.width && position.height == flux.height && normal.width == flux.width &&
+                normal.height == flux.height,
+            name, "position, normal and flux maps differ in size");
+}
+
+rsm_images::rsm_images(const rsm_textures& t)
+    : position(t.width(), t.height()),
+      normal(t.width(), t.height()),
+      flux(t.width(), t.height()),
+      light_view_projection(t.light_view_projection) {
+    t.validate();
+    read_texture(t.position, position.view());
+    read_texture(t.normal, normal.view());
+    read_texture(t.flux, flux.view());
+}
+
+// ---- rsm_renderer -----------------------------------------------------------------------
+
+void rsm_render_options::validate() const {
+    require(resolution >= 1 && resolution <= 8192, "resolution", "must lie in [1, 8192]");
+    require(std::isfinite(max_single_map_cone_deg) && max_single_map_cone_deg > 0.f && max_single_map_cone_deg < 90.f,
+            "max_single_map_cone_deg", "must lie in (0, 90)");
+}
+
+namespace {
+
+constexpr const char* vertex_source = R"(#version 450 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 0) uniform mat4 raster_view_projection;
+out vec3 world_position;
+out vec3 world_normal;
+void main() {
+    world_position = position;
+    world_normal = normal;
+    gl_Position = raster_view_projection * vec4(position, 1.0);
+}
+)";
+
+std::string fragment_source() {
+    glsl::function_set k;
+    k.add("facing_normal", facing_normal<glsl::f32, glsl::vec3>, "n", "p", "eye");
+    k.add("point_light_texel_flux", point_light_texel_flux<glsl::f32, glsl::vec3>, "albedo", "p", "n",
+          "light_position", "intensity", "solid_angle");
+    k.add("spot_light_texel_flux", spot_light_texel_flux<glsl::f32, glsl::vec3>, "albedo", "p", "n", "light_position",
+          "axis", "intensity", "cos_cone", "cosine_falloff", "solid_angle");
+    k.add("directional_light_texel_flux", directional_light_texel_flux<glsl::f32, glsl::vec3>, "albedo", "n",
+          "direction", "irradiance", "texel_area");
+    return R"(#version 450 core
+layout(std430, binding = 0) readonly buffer bounce_albedo { vec4 kd[]; };
+layout(binding = 0) uniform sampler2D texel_solid_angle;
+layout(location = 1) uniform vec3 light_position;
+layout(location = 2) uniform vec3 light_direction;
+layout(location = 3) uniform vec3 light_intensity;
+layout(location = 4) uniform float cos_cone;
+layout(location = 5) uniform float cosine_falloff;
+layout(location = 6) uniform int kind;
+layout(location = 7) uniform float texel_area;
+in vec3 world_position;
+in vec3 world_normal;
+layout(location = 0) out vec4 out_position;
+layout(location = 1) out vec4 out_normal;
+layout(location = 2) out vec4 out_flux;
+
+)" + k.source() + R"(
+void main() {
+    vec3 albedo = kd[gl_PrimitiveID].rgb;
+    // The normal faces the light: its position, or for a distant light a point up the beam.
+    vec3 eye = kind == 2 ? world_position - light_direction : light_position;
+    vec3 n = facing_normal(world_normal, world_position, eye);
+    vec3 flux;
+    if (kind == 0) {
+        flux = point_light_texel_flux(albedo, world_position, n, light_position, light_intensity,
+                                      texelFetch(texel_solid_angle, ivec2(gl_FragCoord.xy), 0).r);
+    } else if (kind == 1) {
+        flux = spot_light_texel_flux(albedo, world_position, n, light_position, light_direction, light_intensity,
+                                     cos_cone, cosine_falloff, texelFetch(texel_solid_angle, ivec2(gl_FragCoord.xy), 0).r);
+    } else {
+        flux = directional_light_texel_flux(albedo, n, light_direction, light_intensity, texel_area);
+    }
+    out_position = vec4(world_position, 0.0);
+    out_normal = vec4(n, 0.0);
+    out_flux = vec4(flux, 0.0);
+}
+)";
+}
+
+enum location : int {
+    loc_view_projection = 0,
+    loc_light_position = 1,
+    loc_light_direction = 2,
+    loc_light_intensity = 3,
+    loc_cos_cone = 4,
+    loc_cosine_falloff = 5,
+    loc_kind = 6,
+    loc_texel_area = 7,
+};
+
+struct face {
+    glm::vec3 forward, up;
+};
+// +x, -x, +y, -y, +z, -z with embree::rsm_ray_caster's up vectors.
+constexpr std::array<face, 6> cube_faces{{{{1, 0, 0}, {0, 1, 0}},
+                                          {{-1, 0, 0}, {0, 1, 0}},
+                                          {{0, 1, 0}, {0, 0, -1}},
+                                          {{0, -1, 0}, {0, 0, 1}},
+                                          {{0, 0, 1}, {0, 1, 0}},
+                                          {{0, 0, -1}, {0, 1, 0}}}};
+
+rsm_map_layout perspective_map(std::size_t light, const glm::vec3& position, const glm::vec3& forward,
+                               const glm::vec3& up, float fov_deg, std::size_t r) {
+    camera cam;
+    cam.position = position;
+    cam.look_at = position + forward;
+    cam.up = up;
+    cam.fov_y_deg = fov_deg;
+    rsm_map_layout m;
+    m.light = light;
+    m.view = cam.view_matrix();
+    m.light_view_projection = cam.projection_matrix(r, r) * m.view;
+    m.position = position;
+    m.forward = forward;
+    m.up = up;
+    m.fov_deg = fov_deg;
+    m.texel_size = float(2.0 * std::tan(glm::radians(double(fov_deg)) * 0.5) / double(r));
+    return m;
+}
+
+// Corner `c` (0..7) of the box [lo, hi].
+glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
+    return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
+}
+
+}  // namespace
+
+rsm_renderer::rsm_renderer(const scene_view& scene, const scene_mesh& mesh, const rsm_render_options& options)
+    : scene_(scene), mesh_(mesh), options_(options), program_(vertex_source, fragment_source()) {
+    options_.validate();
+}
+
+std::vector<rsm_map_layout> rsm_renderer::layout(std::span<const light> lights) const {
+    validate_lights(lights, "lights");
+    const std::size_t r = options_.resolution;
+    const auto [lo, hi] = scene_.bounds();
+    const glm::vec3 centre = 0.5f * (lo + hi);
+    const float radius = std::max(0.5f * glm::length(hi - lo) * 1.001f, 1e-3f);
+    std::vector<rsm_map_layout> out;
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+        const packed_light l = pack(lights[i]);
+        if (l.kind() == light_kind::directional) {
+            const glm::vec3 d = l.direction();
+            const glm::vec3 up = std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+            const glm::vec3 eye = centre - d * (2.f * radius);
+            rsm_map_layout m;
+            m.light = i;
+            m.view = glm::lookAt(eye, centre, up);
+            m.light_view_projection = glm::ortho(-radius, radius, -radius, radius, 0.f, 4.f * radius) * m.view;
+            m.position = eye;
+            m.forward = d;
+            m.up = up;
+            m.orthographic = true;
+            m.texel_size = float(2.0 * double(radius) / double(r));
+            out.push_back(m);
+            continue;
+        }
+        const bool spot = l.kind() == light_kind::spot;
+        const auto* sl = std::get_if<spot_light>(&lights[i]);
+        if (spot && sl->cone_deg <= options_.max_single_map_cone_deg) {
+            const glm::vec3 axis = l.direction();
+            const glm::vec3 up = std::abs(axis.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+            out.push_back(perspective_map(i, l.position(), axis, up, 2.f * sl->cone_deg, r));
+            continue;
+        }
+        for (const face& f : cube_faces) {
+            if (spot) {
+                // Every direction of a face lies within acos(1/sqrt 3) = 54.7 degrees of its
+                // axis: a cone farther than that from the face's axis cannot reach it.
+                const double angle = std::acos(std::clamp(double(glm::dot(l.direction(), f.forward)), -1.0, 1.0));
+                const double half_diagonal = std::acos(1.0 / std::sqrt(3.0));
+                if (angle - half_diagonal > glm::radians(double(sl->cone_deg))) continue;
+            }
+            out.push_back(perspective_map(i, l.position(), f.forward, f.up, 90.f, r));
+        }
+    }
+    return out;
+}
+
+const texture& rsm_renderer::solid_angles(float fov_deg) {
+    auto it = solid_angles_.find(fov_deg);
+    if (it != solid_angles_.end()) return it->second;
+    const std::size_t r = options_.resolution;
+    const double t = std::tan(glm::radians(double(fov_deg)) * 0.5);
+    // Texel (x, y), row y from the top, spans [x0, x1] x [y0, y1] of the image plane at unit
+    // distance, as embree::rsm_ray_caster computes it; stored in GL row order.
+    std::vector<float> dw(r * r);
+    for (std::size_t y = 0; y < r; ++y) {
+        const double y1 = (1.0 - 2.0 * double(y) / double(r)) * t, y0 = (1.0 - 2.0 * double(y + 1) / double(r)) * t;
+        for (std::size_t x = 0; x < r; ++x) {
+            const double x0 = (2.0 * double(x) / double(r) - 1.0) * t, x1 = (2.0 * double(x + 1) / double(r) - 1.0) * t;
+            dw[(r - 1 - y) * r + x] = float(rectangle_solid_angle<double>(x0, y0, x1, y1));
+        }
+    }
+    texture table(texel_format::r32f, r, r);
+    {
+        const detail::unpack_state unpack;
+        glTextureSubImage2D(table.id(), 0, 0, 0, GLsizei(r), GLsizei(r), GL_RED, GL_FLOAT, dw.data());
+        check_error("rsm_renderer solid-angle table");
+    }
+    return solid_angles_.emplace(fov_deg, std::move(table)).first->second;
+}
+
+void rsm_renderer::render(std::span<const light> lights, std::span<rsm_textures> targets) {
+    const auto maps = layout(lights);
+    if (targets.size() != maps.size())
+        throw parameter_error("targets", "must hold one map per entry of layout(lights) (" +
+                                             std::to_string(maps.size()) + ")");
+    const std::size_t r = options_.resolution;
+    for (const auto& t : targets) {
+        t.validate("targets");
+        require(t.width() == r && t.height() == r, "targets", "maps must be resolution x resolution texels");
+    }
+    if (!depth_ || depth_->width() != r) {
+        depth_.emplace(texel_format::depth32f, r, r);
+        fbo_.attach_depth(*depth_);
+    }
+    for (std::size_t k = 0; k < maps.size(); ++k) {
+        targets[k].light_view_projection = maps[k].light_view_projection;
+        render_map(maps[k], pack(lights[maps[k].light]), targets[k]);
+    }
+}
+
+void rsm_renderer::render(std::span<const light> lights) {
+    const std::size_t count = layout(lights).size();
+    const std::size_t r = options_.resolution;
+    if (owned_.size() != count || (!owned_.empty() && owned_[0].flux.width() != r)) {
+        owned_.clear();
+        for (std::size_t k = 0; k < count; ++k)
+            owned_.push_back({texture(texel_format::rgba32f, r, r), texture(texel_format::rgba32f, r, r),
+                              texture(texel_format::rgba32f, r, r)});
+    }
+    refs_.clear();
+    for (const auto& o : owned_) refs_.push_back({o.position, o.normal, o.flux, glm::mat4(1.f)});
+    render(lights, std::span<rsm_textures>(refs_));
+}
+
+void rsm_renderer::render_map(const rsm_map_layout& m, const packed_light& l, const rsm_textures& target) {
+    const std::size_t r = options_.resolution;
+    glm::mat4 raster = m.light_view_projection;
+    if (!m.orthographic) {
+        // Same x, y and w rows as the map's matrix (they do not depend on the depth range);
+        // near and far from the scene bounds, so no geometry beyond the camera's default far
+        // plane is lost.
+        auto [lo, hi] = scene_.bounds();
+        float far_depth = 0.f;
+        for (int c = 0; c < 8; ++c) far_depth = std::max(far_depth, glm::length(box_corner(lo, hi, c) - m.position));
+        far_depth = std::max(far_depth * 1.01f, 1e-3f);
+        raster = glm::perspective(glm::radians(m.fov_deg), 1.f, far_depth * 1e-4f, far_depth) * m.view;
+    }
+    const float texel_area = m.orthographic ? m.texel_size * m.texel_size : 0.f;
+
+    const detail::raster_state raster_saved;
+    const detail::blend_offset_state blend;
+    const detail::program_and_storage_state bindings({0u});
+    const detail::texture_unit_state units(0, 1);
+    glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, target.position.id, 0);
+    glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT1, target.normal.id, 0);
+    glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT2, target.flux.id, 0);
+    fbo_.set_draw_buffers(3);
+    fbo_.check_complete();
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo_.id());
+    glViewport(0, 0, GLsizei(r), GLsizei(r));
+    const float zero[4] = {0.f, 0.f, 0.f, 0.f};
+    const float away[4] = {-m.forward.x, -m.forward.y, -m.forward.z, 0.f};
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 0, zero);
+    glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 1, away);
+    glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 2, zero);
+    glClearNamedFramebufferfv(fbo_.id(), GL_DEPTH, 0, &far_depth);
+    if (mesh_.triangle_count() > 0) {
+        program_.set(loc_view_projection, raster);
+        program_.set(loc_light_position, l.position());
+        program_.set(loc_light_direction, l.direction());
+        program_.set(loc_light_intensity, l.intensity());
+        program_.set(loc_cos_cone, l.cos_cone());
+        program_.set(loc_cosine_falloff, l.cosine_falloff());
+        program_.set(loc_kind, int(l.kind()));
+        program_.set(loc_texel_area, texel_area);
+        glUseProgram(program_.id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh_.albedo_per_triangle().id());
+        glBindTextureUnit(0, m.orthographic ? 0 : solid_angles(m.fov_deg).id());
+        glBindSampler(0, 0);
+        glBindVertexArray(mesh_.vertices().id());
+        glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh_.triangle_count()), GL_UNSIGNED_INT, nullptr);
+    }
+    for (GLenum a : {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2})
+        glNamedFramebufferTexture(fbo_.id(), a, 0, 0);
+    check_error("rsm_renderer::render");
+}
+
+}  // namespace bounce::gl
