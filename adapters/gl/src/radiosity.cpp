@@ -46,10 +46,10 @@ double ms_since(clock_type::time_point t) { return std::chrono::duration<double,
 constexpr GLuint texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
                  partial_binding = 5;
 constexpr GLuint radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
-constexpr int reduce_group = 256;
-// Doubles per reduction entry: best power, best index, total unshot, intercepted rgb,
-// absorbed rgb, padding.
-constexpr std::size_t partial_doubles = 10;
+constexpr unsigned reduce_group = 64;
+// The reduction's buffer: the result (best power, best index, total unshot, intercepted rgb,
+// absorbed rgb) in the first 9 doubles, then from double 16 on 8 per shooter (power, intercepted rgb, absorbed rgb).
+constexpr std::size_t partial_doubles = 8;
 
 // The bindings the passes change beyond raster_state: program, the storage buffers and image
 // units above; restored on destruction.
@@ -147,7 +147,7 @@ struct texel_attributes {
 struct gpu_node {
     glm::vec4 position_area;
     glm::vec4 unshot;
-    std::array<std::int32_t, 4> meta;  // parent (-1: root), leaf (1/0)
+    std::array<std::int32_t, 4> meta;  // first child, child count (0: a leaf)
 };
 
 std::string version_header() { return "#version 450 core\n"; }
@@ -180,7 +180,6 @@ struct progressive_radiosity::state {
     std::unique_ptr<buffer> vertices;
     std::size_t vertex_capacity = 0;
     std::unique_ptr<program> item_program, distribute_program, light_program, reduce_program, finish_program;
-    std::size_t reduce_groups = 1;
 
     // Per shot, CPU side.
     glm::vec3 shot_position{0.f}, shot_axis{0.f, 0.f, 1.f}, t{1, 0, 0}, b{0, 1, 0};
@@ -281,8 +280,7 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     }
     std::vector<std::uint32_t> first_padded(first);
     first_buffer = buffer(first_padded.size() * sizeof(std::uint32_t), first_padded.data());
-    reduce_groups = (shooters + reduce_group - 1) / reduce_group;
-    partials = buffer((reduce_groups + 1) * partial_doubles * sizeof(double));
+    partials = buffer((shooters + 2) * partial_doubles * sizeof(double));
     // The near-field tree of a block of b x b texels: b^2 + (b/2)^2 + ... nodes at most.
     if (options.shoot_blocks) {
         int b = atlas.block_texels, count = 0;
@@ -422,22 +420,24 @@ void main() {
     if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
     vec3 pr = a.position_area.xyz, nr = a.normal_chart.xyz, rho = a.albedo.rgb;
     vec3 gain = vec3(0.0), incident = vec3(0.0);
-    // Parents follow their children in the node array, the root last: walking it backwards
-    // visits a node after its parent. A node is used as one disc when its parent was opened
-    // and it is a leaf or far; it is opened when its parent was and it is near.
-    bool opened[max_nodes];
-    for (int j = node_count - 1; j >= 0; --j) {
-        near_node nd = node[j];
-        bool parent_open = nd.meta.x < 0 || opened[nd.meta.x];
+    // The block as one disc where the receiver is farther than near_field times its side,
+    // else as its four quadrants, recursively, down to elements: the CPU solver's traversal
+    // (a stack, children pushed in order, so terms are summed in its order). Each node is
+    // visited at most once, so max_nodes bounds the loop.
+    int stack[64];
+    int top = 0;
+    stack[top++] = node_count - 1;
+    for (int visit = 0; visit < max_nodes && top > 0; ++visit) {
+        near_node nd = node[stack[--top]];
         bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
-        bool leaf = nd.meta.y != 0;
-        opened[j] = parent_open && near_node_ && !leaf;
-        if (parent_open && (leaf || !near_node_)) {
+        if (nd.meta.y == 0 || !near_node_) {
             float f = radiosity_form_factor(pr, nr, nd.position_area.xyz, shot_n, nd.position_area.w);
             if (f > 0.0) {
                 incident += nd.unshot.xyz * f;
                 gain += radiosity_shot(pr, nr, rho, nd.position_area.xyz, shot_n, nd.position_area.w, nd.unshot.xyz, 1.0);
             }
+        } else {
+            for (int c = 0; c < nd.meta.y && top < 64; ++c) stack[top++] = nd.meta.x + c;
         }
     }
     if (!(incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
@@ -481,81 +481,76 @@ void main() {
 )";
     light_program = std::make_unique<program>(program::compute(light));
 
-    // Reduction: per shooter its unshot power (channel sums times area, in double, in element
-    // order: the CPU solver's sum), with its elements' intercepted and absorbed power; then
-    // the largest power (ties to the lowest index) and the sums per work group; then one group.
-    const std::string reduce_common = version_header() + "layout(local_size_x = " + std::to_string(reduce_group) +
-                                      ") in;\n" + R"(
-const int entry = 10;
-layout(std430, binding = 5) buffer partial_block { double partial[]; };
-shared double s[256 * 9];
-void store_shared(uint i, double power, double index, double total, dvec3 ic, dvec3 ab) {
-    s[i * 9u] = power; s[i * 9u + 1u] = index; s[i * 9u + 2u] = total;
-    s[i * 9u + 3u] = ic.x; s[i * 9u + 4u] = ic.y; s[i * 9u + 5u] = ic.z;
-    s[i * 9u + 6u] = ab.x; s[i * 9u + 7u] = ab.y; s[i * 9u + 8u] = ab.z;
-}
-// Combines entry i with entry j: the larger power (ties: lower index) and the sums.
-void combine(uint i, uint j) {
-    bool take = s[j * 9u] > s[i * 9u] || (s[j * 9u] == s[i * 9u] && s[j * 9u + 1u] < s[i * 9u + 1u]);
-    if (take) { s[i * 9u] = s[j * 9u]; s[i * 9u + 1u] = s[j * 9u + 1u]; }
-    for (uint c = 2u; c < 9u; ++c) s[i * 9u + c] += s[j * 9u + c];
-}
-void reduce_and_write(uint out_index) {
-    uint i = gl_LocalInvocationID.x;
-    for (uint stride = 128u; stride > 0u; stride >>= 1u) {
-        barrier();
-        if (i < stride) combine(i, i + stride);
-    }
-    barrier();
-    if (i == 0u)
-        for (uint c = 0u; c < 9u; ++c) partial[out_index * uint(entry) + c] = s[c];
-}
-)";
-    const std::string reduce = reduce_common + R"(
+    // Reduction, in two passes with few barriers (llvmpipe runs a barrier as a switch of
+    // every invocation): per shooter (one invocation each) its unshot power, the channel sums
+    // times area in double and in element order (the CPU solver's sum), with its elements'
+    // intercepted and absorbed power; then one work group of 64 striding over the shooters
+    // (ties to the lowest index) and a shared-memory tree over its 64 partial results.
+    const std::string reduce = version_header() + R"(
+layout(local_size_x = 64) in;
 struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
 layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
 layout(std430, binding = 3) readonly buffer first_block { uint shooter_first[]; };
 layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
+layout(std430, binding = 5) buffer partial_block { double partial[]; };
 layout(rgba32f, binding = 1) uniform readonly image2D unshot_image;
 layout(rgba32f, binding = 2) uniform readonly image2D intercepted_image;
 layout(location = 0) uniform int atlas_width;
 layout(location = 1) uniform uint shooter_count;
 void main() {
     uint k = gl_GlobalInvocationID.x;
-    double power = -1.0, total = 0.0;
+    if (k >= shooter_count) return;
+    double power = 0.0;
     dvec3 ic = dvec3(0.0), ab = dvec3(0.0);
-    if (k < shooter_count) {
-        power = 0.0;
-        for (uint e = shooter_first[k]; e < shooter_first[k + 1u]; ++e) {
-            uint code = element_texel[e];
-            ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
-            texel_attributes a = texel[xy.y * atlas_width + xy.x];
-            vec4 u = imageLoad(unshot_image, xy);
-            power += (double(u.r) + double(u.g) + double(u.b)) * double(a.position_area.w);
-            dvec3 got = dvec3(imageLoad(intercepted_image, xy).rgb);
-            ic += got;
-            ab += (dvec3(1.0) - dvec3(a.albedo.rgb)) * got;
-        }
-        total = power;
+    for (uint e = shooter_first[k]; e < shooter_first[k + 1u]; ++e) {
+        uint code = element_texel[e];
+        ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
+        texel_attributes a = texel[xy.y * atlas_width + xy.x];
+        vec4 u = imageLoad(unshot_image, xy);
+        power += (double(u.r) + double(u.g) + double(u.b)) * double(a.position_area.w);
+        dvec3 got = dvec3(imageLoad(intercepted_image, xy).rgb);
+        ic += got;
+        ab += (dvec3(1.0) - dvec3(a.albedo.rgb)) * got;
     }
-    store_shared(gl_LocalInvocationID.x, power, double(k), total, ic, ab);
-    reduce_and_write(gl_WorkGroupID.x + 1u);
+    uint at = (k + 2u) * 8u;
+    partial[at] = power;
+    partial[at + 1u] = ic.x; partial[at + 2u] = ic.y; partial[at + 3u] = ic.z;
+    partial[at + 4u] = ab.x; partial[at + 5u] = ab.y; partial[at + 6u] = ab.z;
 }
 )";
     reduce_program = std::make_unique<program>(program::compute(reduce));
-    const std::string finish = reduce_common + R"(
-layout(location = 0) uniform uint group_count;
+    const std::string finish = version_header() + R"(
+layout(local_size_x = 64) in;
+layout(std430, binding = 5) buffer partial_block { double partial[]; };
+layout(location = 0) uniform uint shooter_count;
+shared double s[64 * 9];
 void main() {
     uint i = gl_LocalInvocationID.x;
-    store_shared(i, -1.0, 4294967295.0, 0.0, dvec3(0.0), dvec3(0.0));
-    for (uint g = i; g < group_count; g += 256u) {
-        uint at = (g + 1u) * uint(entry);
-        double p = partial[at], x = partial[at + 1u];
-        bool take = p > s[i * 9u] || (p == s[i * 9u] && x < s[i * 9u + 1u]);
-        if (take) { s[i * 9u] = p; s[i * 9u + 1u] = x; }
-        for (uint c = 2u; c < 9u; ++c) s[i * 9u + c] += partial[at + c];
+    double best = -1.0, index = 4294967295.0, total = 0.0;
+    dvec3 ic = dvec3(0.0), ab = dvec3(0.0);
+    for (uint k = i; k < shooter_count; k += 64u) {
+        uint at = (k + 2u) * 8u;
+        double p = partial[at];
+        if (p > best) { best = p; index = double(k); }
+        total += p;
+        ic += dvec3(partial[at + 1u], partial[at + 2u], partial[at + 3u]);
+        ab += dvec3(partial[at + 4u], partial[at + 5u], partial[at + 6u]);
     }
-    reduce_and_write(0u);
+    s[i * 9u] = best; s[i * 9u + 1u] = index; s[i * 9u + 2u] = total;
+    s[i * 9u + 3u] = ic.x; s[i * 9u + 4u] = ic.y; s[i * 9u + 5u] = ic.z;
+    s[i * 9u + 6u] = ab.x; s[i * 9u + 7u] = ab.y; s[i * 9u + 8u] = ab.z;
+    for (uint stride = 32u; stride > 0u; stride >>= 1u) {
+        barrier();
+        if (i < stride) {
+            uint j = i + stride;
+            bool take = s[j * 9u] > s[i * 9u] || (s[j * 9u] == s[i * 9u] && s[j * 9u + 1u] < s[i * 9u + 1u]);
+            if (take) { s[i * 9u] = s[j * 9u]; s[i * 9u + 1u] = s[j * 9u + 1u]; }
+            for (uint c = 2u; c < 9u; ++c) s[i * 9u + c] += s[j * 9u + c];
+        }
+    }
+    barrier();
+    if (i == 0u)
+        for (uint c = 0u; c < 9u; ++c) partial[c] = s[c];
 }
 )";
     finish_program = std::make_unique<program>(program::compute(finish));
@@ -583,15 +578,15 @@ progressive_radiosity::state::reduction progressive_radiosity::state::reduce() {
         glUseProgram(reduce_program->id());
         reduce_program->set(0, int(width));
         reduce_program->set(1, unsigned(first.size() - 1));
-        glDispatchCompute(GLuint(reduce_groups), 1, 1);
+        glDispatchCompute(GLuint((first.size() - 1 + reduce_group - 1) / reduce_group), 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glUseProgram(finish_program->id());
-        finish_program->set(0, unsigned(reduce_groups));
+        finish_program->set(0, unsigned(first.size() - 1));
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         check_error("progressive_radiosity: the shooter reduction");
     }
-    std::array<double, partial_doubles> r{};
+    std::array<double, 9> r{};
     partials.read(0, r.data(), sizeof(double) * 9);
     next_power = std::max(0.0, r[0]);
     next = std::uint32_t(std::clamp(r[1], 0.0, double(first.size() - 2)));
@@ -755,7 +750,6 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         level.push_back({cell, glm::dvec3(atlas.position[i]) * a, glm::dvec3(u) * a, a, 0, 0});
     }
     near.clear();
-    std::vector<std::int32_t> parent;
     const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
     for (;;) {
         std::stable_sort(level.begin(), level.end(),
@@ -763,8 +757,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         const std::int32_t base = std::int32_t(near.size());
         for (const node_sum& p : level) {
             near.push_back({glm::vec4(glm::vec3(p.moment / p.area), float(p.area)), glm::vec4(glm::vec3(p.power / p.area), 0.f),
-                            {-1, p.child_count == 0 ? 1 : 0, 0, 0}});
-            for (std::int32_t c = 0; c < p.child_count; ++c) near[std::size_t(p.first_child + c)].meta[0] = std::int32_t(near.size() - 1);
+                            {p.first_child, p.child_count, 0, 0}});
         }
         if (level.size() == 1) break;
         up.clear();

@@ -1,0 +1,102 @@
+// Figures for docs/radiosity-gl.md: the Cornell box (about 10,000 elements) solved to 90% by
+// gl::progressive_radiosity (llvmpipe here) and, in the same process, by
+// cpu::progressive_radiosity with the same atlas, options and item-buffer resolution. A study:
+// it prints each run, writes one run report per run into $BOUNCE_STUDY_OUT (when set; the
+// script docs/studies/radiosity_gl.sh adds them to docs/results/radiosity_gl.json), and checks
+// only that each run reached the fraction; speed is reported, never asserted.
+#include "../gl/shared_context.hpp"
+#include "../radiosity/radiosity_scenes.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/gl/radiosity.hpp>
+#include <bounce/study/run_report.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+namespace {
+
+struct run_figures {
+    double total_ms = 0, lights_ms = 0, visibility_ms = 0, choice_ms = 0, distribution_ms = 0;
+    std::size_t shots = 0, shooters = 0;
+    double unshot = 1, escaped = 0;
+};
+
+void write(const std::string& name, const std::string& backend, const std::string& renderer, const lightmap_atlas& atlas,
+           int resolution, const run_figures& f) {
+    std::printf("%-28s %-4s elements %6zu shooters %5zu shots %5zu unshot %.4f escaped %.4f total %8.1f ms (lights %.1f, "
+                "visibility %.1f, choice %.1f, distribution %.1f)\n",
+                name.c_str(), backend.c_str(), atlas.size(), f.shooters, f.shots, f.unshot, f.escaped, f.total_ms,
+                f.lights_ms, f.visibility_ms, f.choice_ms, f.distribution_ms);
+    const char* out = std::getenv("BOUNCE_STUDY_OUT");
+    if (!out) return;
+    study::run_report r;
+    r.technique = "radiosity";
+    r.scene = "cornell";
+    r.width = atlas.width;
+    r.height = atlas.height;
+    r.backend = backend;
+    r.gl_renderer = renderer;
+    r.parameters["visibility"] = "stereographic";
+    r.parameters["resolution"] = resolution;
+    r.parameters["block_texels"] = atlas.block_texels;
+    r.parameters["near_field"] = 4;
+    r.parameters["converge"] = 0.9;
+    r.timings_ms = {{"lights", f.lights_ms},
+                    {"visibility", f.visibility_ms},
+                    {"shooter_choice", f.choice_ms},
+                    {"distribution", f.distribution_ms},
+                    {"total", f.total_ms}};
+    r.set_count("elements", atlas.size());
+    r.set_count("shooters", f.shooters);
+    r.set_count("iterations", f.shots);
+    r.parameters["converged_fraction"] = 1.0 - f.unshot;
+    r.write(std::string(out) + "/" + name + "-" + backend + ".json");
+}
+
+}  // namespace
+
+TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on the CPU", "[gl][radiosity][study]") {
+    auto& context = gl_test::shared_context();
+    const std::string renderer = context.renderer();
+    const auto scene = cornell_box();
+    const double fraction = 0.1;
+    for (const int block : {4, 8})
+        for (const int resolution : {128, 256}) {
+            const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 10000, .block_texels = block});
+            const std::string name = "cornell-b" + std::to_string(block) + "-r" + std::to_string(resolution);
+            {
+                const auto t0 = std::chrono::steady_clock::now();
+                gl::progressive_radiosity solver(scene.view(), atlas, {.resolution = resolution});
+                solver.solve(fraction);
+                gl::finish();
+                run_figures f;
+                f.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+                const auto& t = solver.timings();
+                f = {f.total_ms, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
+                     solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
+                write(name, "gl", renderer, atlas, resolution, f);
+                CHECK(solver.unshot_fraction() <= fraction);
+            }
+            {
+                const auto t0 = std::chrono::steady_clock::now();
+                cpu::progressive_radiosity solver(scene.view(), atlas,
+                                                  cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = resolution}));
+                solver.solve(fraction);
+                run_figures f;
+                f.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+                const auto& t = solver.timings();
+                f = {f.total_ms, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
+                     solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
+                write(name, "cpu", "", atlas, resolution, f);
+                CHECK(solver.unshot_fraction() <= fraction);
+            }
+        }
+}
