@@ -26,6 +26,12 @@
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
+#ifdef BOUNCE_RSM_WITH_GL
+#include <bounce/gl/context.hpp>
+#include <bounce/gl/indirect_renderer.hpp>
+#include <bounce/gl/objects.hpp>
+#include <bounce/gl/splat_pass.hpp>
+#endif
 
 #include "options.hpp"
 
@@ -65,6 +71,16 @@ public:
     virtual std::string gl_renderer() const { return {}; }
 };
 
+/// Whether two option sets make the same frames (a backend keeps its renderer between them).
+bool cpu_backend_same(const cpu::indirect_options& a, const cpu::indirect_options& b) {
+    return a.technique == b.technique && a.count == b.count && a.pattern.n == b.pattern.n &&
+           a.pattern.m == b.pattern.m && a.assignment == b.assignment && a.blur == b.blur &&
+           a.energy_correct == b.energy_correct && a.selection == b.selection && a.r_max == b.r_max &&
+           a.light.offset == b.light.offset && a.light.min_distance2 == b.light.min_distance2 && a.seed == b.seed &&
+           a.shift == b.shift && a.sii_cutoff == b.sii_cutoff && a.low_resolution == b.low_resolution &&
+           a.disc == b.disc;
+}
+
 /// cpu::indirect_renderer on the ray-cast G-buffer and maps; one renderer per options, so
 /// its scratch buffers live across the repeats of a run.
 class cpu_backend final : public frame_backend {
@@ -72,31 +88,107 @@ public:
     cpu_backend(const gbuffer_view<float>& g, const camera& cam, std::span<const rsm_view> maps)
         : g_(g), cam_(cam), maps_(maps) {}
     cpu::indirect_timings render(const cpu::indirect_options& options, image_view<glm::vec3> out) override {
-        if (!renderer_ || !same(renderer_->options(), options)) renderer_.emplace(options);
+        if (!renderer_ || !cpu_backend_same(renderer_->options(), options)) renderer_.emplace(options);
         return renderer_->render(g_, cam_, maps_, out);
     }
 
 private:
-    static bool same(const cpu::indirect_options& a, const cpu::indirect_options& b) {
-        return a.technique == b.technique && a.count == b.count && a.pattern.n == b.pattern.n &&
-               a.pattern.m == b.pattern.m && a.assignment == b.assignment && a.blur == b.blur &&
-               a.energy_correct == b.energy_correct && a.selection == b.selection && a.r_max == b.r_max &&
-               a.light.offset == b.light.offset && a.light.min_distance2 == b.light.min_distance2 &&
-               a.seed == b.seed && a.shift == b.shift && a.sii_cutoff == b.sii_cutoff &&
-               a.low_resolution == b.low_resolution;
-    }
     gbuffer_view<float> g_;
     camera cam_;
     std::span<const rsm_view> maps_;
     std::optional<cpu::indirect_renderer> renderer_;
 };
 
+#ifdef BOUNCE_RSM_WITH_GL
+/// gl::indirect_renderer in an EGL context of its own, on the ray-cast G-buffer and maps
+/// uploaded as RGBA32F textures (what a GL renderer's own passes would have drawn); the
+/// stage times are the GPU's (time_stages: a glFinish after each stage); the read-back of the
+/// result is not timed.
+class gl_backend final : public frame_backend {
+public:
+    gl_backend(const gbuffer_view<float>& g, const camera& cam, const std::vector<embree::reflective_shadow_map>& maps)
+        : gb_(g), cam_(cam), out_(gl::texel_format::rgba32f, g.width(), g.height()) {
+        for (const auto& m : maps) {
+            textures_.push_back(upload(m.position));
+            textures_.push_back(upload(m.normal));
+            textures_.push_back(upload(m.flux));
+        }
+        for (std::size_t i = 0; i < maps.size(); ++i)
+            refs_.push_back({textures_[3 * i], textures_[3 * i + 1], textures_[3 * i + 2], maps[i].light_view_projection});
+    }
+    cpu::indirect_timings render(const cpu::indirect_options& o, image_view<glm::vec3> out) override {
+        const gl::indirect_options g = mirror(o);
+        if (!renderer_ || !same_as_last(o)) {
+            renderer_.reset();
+            renderer_.emplace(g);
+            last_ = o;
+        }
+        const gl::indirect_timings t = renderer_->render(gb_.textures(), cam_, refs_, out_);
+        gl::read_texture(out_, out);
+        cpu::indirect_timings c;
+        c.split_ms = t.split_ms;
+        c.shade_ms = t.shade_ms;
+        c.gather_ms = t.gather_ms;
+        c.blur_ms = t.blur_ms;
+        c.upsample_ms = t.upsample_ms;
+        c.vpls = t.vpls;
+        return c;
+    }
+    std::string gl_renderer() const override { return context_.renderer(); }
+
+private:
+    static gl::texture upload(const image<glm::vec3>& img) {
+        gl::texture t(gl::texel_format::rgba32f, img.width(), img.height());
+        image<glm::vec4> padded(img.width(), img.height());
+        for (std::size_t y = 0; y < img.height(); ++y)
+            for (std::size_t x = 0; x < img.width(); ++x) padded(x, y) = glm::vec4(img(x, y), 0.f);
+        gl::write_texture(t, padded.view());
+        return t;
+    }
+    // cpu::indirect_options field by field (the GL adapter mirrors them).
+    static gl::indirect_options mirror(const cpu::indirect_options& o) {
+        gl::indirect_options g;
+        g.technique = o.technique == cpu::indirect_technique::rsm_gather ? gl::indirect_technique::rsm_gather
+                                                                          : gl::indirect_technique::sii;
+        g.count = o.count;
+        g.pattern = o.pattern;
+        g.assignment = o.assignment;
+        g.shift = o.shift;
+        g.blur = o.blur;
+        g.energy_correct = o.energy_correct;
+        g.discontinuity.relative_depth = o.discontinuity.relative_depth;
+        g.discontinuity.cos_normal = o.discontinuity.cos_normal;
+        g.selection = o.selection == cpu::vpl_selection::grid ? gl::vpl_selection::grid : gl::vpl_selection::flux_warping;
+        g.r_max = o.r_max;
+        g.disc = o.disc == cpu::disc_weighting::unbiased ? gl::disc_weighting::unbiased : gl::disc_weighting::xi1_squared;
+        g.light.offset = o.light.offset;
+        g.light.min_distance2 = o.light.min_distance2;
+        g.sii_cutoff = o.sii_cutoff;
+        g.low_resolution = o.low_resolution;
+        g.seed = o.seed;
+        g.time_stages = true;
+        return g;
+    }
+    bool same_as_last(const cpu::indirect_options& o) const { return cpu_backend_same(last_, o); }
+
+    gl::context context_;  // first: everything below needs it current
+    gl::gbuffer_upload gb_;
+    camera cam_;
+    gl::texture out_;
+    std::vector<gl::texture> textures_;
+    std::vector<gl::rsm_textures> refs_;
+    std::optional<gl::indirect_renderer> renderer_;
+    cpu::indirect_options last_;
+};
+#endif
+
 std::unique_ptr<frame_backend> make_backend(const std::string& name, const gbuffer_view<float>& g, const camera& cam,
-                                            std::span<const rsm_view> maps) {
-    if (name == "cpu") return std::make_unique<cpu_backend>(g, cam, maps);
-    throw parameter_error("--backend", "'" + name +
-                                           "': the GL backend (gl::indirect_renderer) is not built into this "
-                                           "program yet; use --backend cpu");
+                                            const embree::rsm_ray_caster& caster) {
+    if (name == "cpu") return std::make_unique<cpu_backend>(g, cam, caster.views());
+#ifdef BOUNCE_RSM_WITH_GL
+    if (name == "gl") return std::make_unique<gl_backend>(g, cam, caster.maps());
+#endif
+    throw parameter_error("--backend", "'" + name + "': this build has no GL adapter; use --backend cpu");
 }
 
 // ---- references --------------------------------------------------------------------------
@@ -380,7 +472,7 @@ int run(const options& o) {
     const double rsm_ms = rsm_timer.median_ms("rsm");
     fmt::print(stderr, "{} maps of {}^2 texels cast in {:.1f} ms\n", caster.maps().size(), o.rsm_resolution, rsm_ms);
 
-    auto backend = make_backend(o.backend, g.view(), cam, caster.views());
+    auto backend = make_backend(o.backend, g.view(), cam, caster);
     const references refs = reference_images(bvh, scene, cam, g.view(), o.ref_spp);
     context c{o, g.view(), *backend, refs, study::coverage_mask(g.view()), clamp_distance, rsm_ms};
 
