@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Runs the measurements behind docs/rsm-sii-interleaved.md (sections 11-13): Hahn 2012's grid
+# on the Cornell box in one process (so every ratio comes from one run), the pictures of each
+# technique on the Cornell box and Sponza, and adds each run's report (with its commit and
+# machine) to the study's one results file, docs/results/rsm_sii.json; then redraws the
+# figures and tables (docs/studies/rsm_sii_figures.py).
+# Usage: docs/studies/rsm_sii.sh [study|pictures|all]  (BIN=DIR/bin, RUNS=DIR for another build folder)
+# Takes about 30 minutes on 2 shared cores; the references (4096 rays per pixel, with and
+# without indirect visibility) are computed once and cached in build/cache.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+bin="${BIN:-build/bin}/rsm_sii"
+which="${1:-all}"
+results=docs/results/rsm_sii.json
+runs="${RUNS:-build/runs}"
+mkdir -p "$runs" docs/figures
+
+add() {  # add NAME: the report build/runs/NAME.json into the results file
+  python3 docs/studies/results.py add "$results" "$1" "$runs/$1.json"
+}
+
+if [[ "$which" == study || "$which" == all ]]; then
+  "$bin" --study --scene cornell --width 512 --height 384 --ref-spp 4096 --repeat 3 --json "$runs/cornell-study.json"
+  add cornell-study
+fi
+
+if [[ "$which" == pictures || "$which" == all ]]; then
+  # Each technique's indirect light beside the unoccluded reference (one exposure), 1024
+  # VPLs (disc samples per map for the gather) at 4x4, energy-correct, blurred.
+  for scene in cornell sponza; do
+    for technique in rsm sii; do
+      name="$scene-$technique-1024-4x4"
+      "$bin" --scene "$scene" --technique "$technique" --vpls 1024 --pattern 4x4 --width 320 --height 240 \
+        --ref-spp 1024 --json "$runs/$name.json" --indirect-out "docs/figures/rsm_sii_${scene}_${technique}.png"
+      add "$name"
+    done
+  done
+fi
+
+/usr/bin/python3 docs/studies/rsm_sii_figures.py "$results"
