@@ -60,6 +60,9 @@ struct irradiance_probe {
     float harmonic_mean_distance = std::numeric_limits<float>::infinity();
     /// Inside geometry: flagged by the source, skipped by lookups and heuristics.
     bool inside = false;
+    /// Set by the build: half the diagonal of the largest leaf this probe is a corner of
+    /// (world units). The weighted lookup lets the probe reach support * reach.
+    float reach = 0.f;
 };
 
 /// Something that fills probes at positions: `source(positions, out)` with spans of equal
@@ -122,7 +125,7 @@ struct irradiance_volume_gpu_node {
 };
 static_assert(sizeof(irradiance_volume_gpu_node) == 80, "std430 node layout");
 
-/// std430 layout of one probe (592 bytes): position.xyz and w = 1 (usable) or 0 (inside),
+/// std430 layout of one probe (592 bytes): position.xyz and w = reach (0: inside geometry),
 /// 9 radiance coefficients and 3 x 9 gradient coefficients as vec4 (w unused).
 struct irradiance_volume_gpu_probe {
     float position[4];
@@ -141,10 +144,15 @@ struct irradiance_volume_gpu_layout {
 
 /// How `irradiance_volume::weighted` averages probes.
 struct weighted_lookup {
-    /// Exponent b of w_j ~ (1 / |p - s_j|)^b, in (0, 16]. Typical: 2-4.
-    float b = 4.f;
+    /// Exponent b of w_j ~ (1 / |p - s_j|)^b, in (0, 4]. Typical: 1-2 (higher b makes
+    /// Shepard's flat spots at the probes and steep steps between them).
+    float b = 2.f;
     /// Extrapolate each probe with its gradient (Oat's I'_i = I_i + grad I_i . d).
     bool gradients = true;
+    /// A probe's weight reaches 0 at support * its reach (half the diagonal of the largest
+    /// leaf it is a corner of): > 1, so that the corners of the leaf holding p always
+    /// reach p. Typical: 1.5.
+    float support = 1.5f;
 };
 
 /// An octree of SH probes over a box. Build with `build`; immutable afterwards, so
@@ -188,24 +196,33 @@ public:
     /// holding p at normal n (unit), renormalized over the usable corners; 0 if none is.
     glm::vec3 trilinear(glm::vec3 p, glm::vec3 n) const;
 
-    /// Distance-weighted average of the probes of the leaf holding p and of the leaves
-    /// holding p +- its edge along each axis (the leaf's face neighbours), each probe once.
+    /// Distance-weighted average (weighted_probe_accumulate) of every usable probe whose
+    /// reach (times how.support) covers p, found by descending into the nodes whose box,
+    /// grown by support times its half-diagonal, holds p; each probe is added once, from
+    /// the leaf that sets its reach. Continuous in p wherever the probes are.
     glm::vec3 weighted(glm::vec3 p, glm::vec3 n, const weighted_lookup& how) const;
 
-    /// The probe indices `weighted` averages at p, in the order it adds them (the order
-    /// the GPU lookup uses too).
-    void weighted_candidates(glm::vec3 p, std::vector<std::uint32_t>& out) const;
+    /// The probe indices `weighted` averages at p (those within support * reach), in the
+    /// order it adds them.
+    void weighted_candidates(glm::vec3 p, float support, std::vector<std::uint32_t>& out) const;
+
+    /// The leaf that sets each probe's reach (the largest of the leaves it is a corner of;
+    /// the first in node order among equals).
+    const std::vector<std::uint32_t>& probe_owners() const noexcept { return owner_; }
+    /// The smallest reach of a usable probe (the `ref` scale of the weights).
+    float reference_reach() const noexcept { return reference_reach_; }
 
     /// Nodes and probes as std430 buffers.
     irradiance_volume_gpu_layout flatten() const;
 
-    /// Cap on the weight at a probe, relative to the leaf's shortest edge (see
-    /// weighted_probe_accumulate).
+    /// Cap on the weight at a probe, in units of its reach (see weighted_probe_accumulate).
     static constexpr float min_relative_distance = 1e-4f;
 
 private:
     std::vector<node> nodes_;
     std::vector<irradiance_probe> probes_;
+    std::vector<std::uint32_t> owner_;
+    float reference_reach_ = 1.f;
 };
 
 // ---- implementation ------------------------------------------------------------------------
@@ -509,6 +526,18 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
         for (auto& idx : nd.corner) idx = remap[idx] == std::numeric_limits<std::uint32_t>::max() ? 0u : remap[idx];
     }
     for (const auto& p : v.probes_) stats.probes_inside += p.inside ? 1 : 0;
+    // Reach and owner: the largest leaf each probe is a corner of.
+    v.owner_.assign(v.probes_.size(), 0);
+    for (auto& p : v.probes_) p.reach = 0.f;
+    for (std::uint32_t i = 0; i < v.nodes_.size(); ++i) {
+        const node& nd = v.nodes_[i];
+        if (!nd.leaf()) continue;
+        const float half_diagonal = 0.5f * glm::length(nd.size);
+        for (std::uint32_t idx : nd.corner)
+            if (half_diagonal > v.probes_[idx].reach) v.probes_[idx].reach = half_diagonal, v.owner_[idx] = i;
+    }
+    v.reference_reach_ = std::numeric_limits<float>::infinity();
+    for (const auto& p : v.probes_) v.reference_reach_ = std::min(v.reference_reach_, p.reach);
     if (stats_out) *stats_out = stats;
     return v;
 }
@@ -548,39 +577,40 @@ inline glm::vec3 irradiance_volume::trilinear(glm::vec3 p, glm::vec3 n) const {
     return probe_average<float, glm::vec3>(sum, wsum);
 }
 
-inline void irradiance_volume::weighted_candidates(glm::vec3 p, std::vector<std::uint32_t>& out) const {
+inline void irradiance_volume::weighted_candidates(glm::vec3 p, float support, std::vector<std::uint32_t>& out) const {
     out.clear();
-    const node& root = nodes_.front();
-    p = glm::clamp(p, root.lo, root.lo + root.size);
-    const std::uint32_t home = find_leaf(p);
-    const glm::vec3 edge = nodes_[home].size;
-    const auto add_leaf = [&](std::uint32_t li) {
-        for (std::uint32_t idx : nodes_[li].corner)
-            if (std::find(out.begin(), out.end(), idx) == out.end()) out.push_back(idx);
-    };
-    add_leaf(home);
-    for (int axis = 0; axis < 3; ++axis)
-        for (float sign : {-1.f, 1.f}) {
-            glm::vec3 q = p;
-            q[axis] += sign * edge[axis];
-            add_leaf(find_leaf(q));
+    std::uint32_t stack[8 * depth_limit + 8];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const std::uint32_t i = stack[--top];
+        const node& nd = nodes_[i];
+        const float grow = support * 0.5f * glm::length(nd.size);
+        const glm::vec3 lo = nd.lo - grow, hi = nd.lo + nd.size + grow;
+        if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
+        if (!nd.leaf()) {
+            for (int k = 7; k >= 0; --k) stack[top++] = std::uint32_t(nd.first_child + k);
+            continue;
         }
+        for (std::uint32_t idx : nd.corner) {
+            const irradiance_probe& pr = probes_[idx];
+            if (owner_[idx] == i && !pr.inside && glm::length(p - pr.position) < support * pr.reach) out.push_back(idx);
+        }
+    }
 }
 
 inline glm::vec3 irradiance_volume::weighted(glm::vec3 p, glm::vec3 n, const weighted_lookup& how) const {
-    require(how.b > 0 && how.b <= 16, "b", "the distance exponent must lie in (0, 16]");
+    require(how.b > 0 && how.b <= 4, "b", "the distance exponent must lie in (0, 4]");
+    require(how.support > 1 && std::isfinite(how.support), "support", "must be finite and > 1");
     thread_local std::vector<std::uint32_t> candidates;
-    weighted_candidates(p, candidates);
-    const node& root = nodes_.front();
-    const glm::vec3 pc = glm::clamp(p, root.lo, root.lo + root.size);
-    const glm::vec3 edge = nodes_[find_leaf(pc)].size;
-    const float scale = std::min({edge.x, edge.y, edge.z});
+    weighted_candidates(p, how.support, candidates);
     glm::vec3 sum(0.f);
     float wsum = 0.f;
+    const float ref = how.support * reference_reach_;
     for (std::uint32_t idx : candidates) {
         const irradiance_probe& pr = probes_[idx];
         std::tie(sum, wsum) = weighted_probe_accumulate<irradiance_volume_bands, float, glm::vec3>(
-            sum, wsum, p, n, pr.position, pr.inside ? 0.f : 1.f, how.b, scale, min_relative_distance,
+            sum, wsum, p, n, pr.position, pr.inside ? 0.f : how.support * pr.reach, ref, how.b, min_relative_distance,
             how.gradients ? 1.f : 0.f, pr.radiance, pr.gradient[0], pr.gradient[1], pr.gradient[2]);
     }
     return probe_average<float, glm::vec3>(sum, wsum);
@@ -601,7 +631,7 @@ inline irradiance_volume_gpu_layout irradiance_volume::flatten() const {
     for (const auto& p : probes_) {
         irradiance_volume_gpu_probe g{};
         for (int k = 0; k < 3; ++k) g.position[k] = p.position[k];
-        g.position[3] = p.inside ? 0.f : 1.f;
+        g.position[3] = p.inside ? 0.f : p.reach;
         for (std::size_t i = 0; i < irradiance_volume_coefficients; ++i)
             for (int k = 0; k < 3; ++k) {
                 g.radiance[i][k] = p.radiance[i][k];

@@ -58,23 +58,28 @@ V probe_irradiance(const std::array<V, sh_count(L)>& c, const std::array<V, sh_c
 }
 
 /// One probe's term of the distance-weighted average (Oat 2006, "Interpolating between
-/// probes"): w = valid (1 / max(|p - s| / scale, min_distance))^b, added with the probe's
-/// irradiance at p, extrapolated by the gradients scaled by `gradient_scale` (1: on, 0:
-/// off). `scale` (world units) only normalizes distances so that w stays in float range:
-/// every term of one lookup uses the same scale, which cancels in the average.
-/// `min_distance` (relative to scale, typical 1e-4) caps the weight at a probe, so the
-/// average there is that probe's value to within (min_distance)^b of the others' weights.
-/// `valid` is 1 for a usable probe and 0 for one inside geometry. Returns the new
-/// (sum of w E, sum of w).
+/// probes": w_j ~ (1 / |p - s_j|)^b), in Franke and Nielson's compactly supported form
+/// ("Smooth interpolation of large sets of scattered data", IJNME 15, 1980):
+///   w = ((R - d)_+ / (R d))^b = (1/d - 1/R)_+^b,   d = |p - s|,  R = `reach`,
+/// which is Oat's (1/d)^b near the probe and falls continuously to 0 at d = R, so the
+/// average is continuous wherever the caller adds every probe with d < R (a probe then
+/// enters and leaves it with weight 0: nothing pops). `reach` = 0 marks a probe inside
+/// geometry (no weight). Computed as ((1 - t)_+ / max(t, min_distance))^b (ref / R)^b with
+/// t = d / R: `ref` (world units, e.g. the smallest reach of the volume) only keeps the
+/// numbers in float range and cancels in the average; `min_distance` (typical 1e-4) caps
+/// the weight at the probe, where the average is then the probe's value. The probe's
+/// irradiance at p is extrapolated by its gradients scaled by `gradient_scale` (1: on,
+/// 0: off). Returns the new (sum of w E, sum of w).
 template <int L, real T, vec3_of<T> V>
 std::pair<V, T> weighted_probe_accumulate(const V& sum, const T& weight_sum, const V& p, const V& n, const V& s,
-                                          const T& valid, const T& b, const T& scale, const T& min_distance,
+                                          const T& reach, const T& ref, const T& b, const T& min_distance,
                                           const T& gradient_scale, const std::array<V, sh_count(L)>& c,
                                           const std::array<V, sh_count(L)>& gx, const std::array<V, sh_count(L)>& gy,
                                           const std::array<V, sh_count(L)>& gz) {
     const V d = p - s;
-    const T r = max(length(d) / scale, min_distance);
-    const T w = valid * pow(T(1) / r, b);
+    const T r = max(reach, T(1e-30));
+    const T t = length(d) / r;
+    const T w = select(reach > T(0), pow(max(T(1) - t, T(0)) / max(t, min_distance), b) * pow(ref / r, b), T(0));
     const V e = probe_irradiance<L, T, V>(c, gx, gy, gz, d * gradient_scale, n);
     return {sum + e * w, weight_sum + w};
 }
