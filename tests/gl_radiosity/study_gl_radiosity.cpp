@@ -1,6 +1,7 @@
 // Figures for docs/radiosity-gl.md: the Cornell box (about 10,000 elements) solved to 90% by
 // gl::progressive_radiosity (llvmpipe here) and, in the same process, by
-// cpu::progressive_radiosity with the same atlas, options and item-buffer resolution. A study:
+// cpu::progressive_radiosity with the same atlas, options and item buffers (stereographic
+// 128^2 and 256^2, hemicube 64^2 and 128^2 per face; blocks of 4 x 4 and 8 x 8 texels). A study:
 // it prints each run, writes one run report per run into $BOUNCE_STUDY_OUT (when set; the
 // script docs/studies/radiosity_gl.sh adds them to docs/results/radiosity_gl.json), and checks
 // only that each run reached the fraction; speed is reported, never asserted.
@@ -30,7 +31,7 @@ struct run_figures {
 };
 
 void write(const std::string& name, const std::string& backend, const std::string& renderer, const lightmap_atlas& atlas,
-           int resolution, const run_figures& f) {
+           bool hemicube, int resolution, const run_figures& f) {
     std::printf("%-28s %-4s elements %6zu shooters %5zu shots %5zu unshot %.4f escaped %.4f total %8.1f ms (lights %.1f, "
                 "visibility %.1f, choice %.1f, distribution %.1f)\n",
                 name.c_str(), backend.c_str(), atlas.size(), f.shooters, f.shots, f.unshot, f.escaped, f.total_ms,
@@ -44,7 +45,7 @@ void write(const std::string& name, const std::string& backend, const std::strin
     r.height = atlas.height;
     r.backend = backend;
     r.gl_renderer = renderer;
-    r.parameters["visibility"] = "stereographic";
+    r.parameters["visibility"] = hemicube ? "hemicube" : "stereographic";
     r.parameters["resolution"] = resolution;
     r.parameters["block_texels"] = atlas.block_texels;
     r.parameters["near_field"] = 4;
@@ -68,13 +69,19 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
     const std::string renderer = context.renderer();
     const auto scene = cornell_box();
     const double fraction = 0.1;
+    for (const bool hemicube : {false, true})
     for (const int block : {4, 8})
         for (const int resolution : {128, 256}) {
+            const int res = hemicube ? resolution / 2 : resolution;  // a face of 64^2 or 128^2
             const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 10000, .block_texels = block});
-            const std::string name = "cornell-b" + std::to_string(block) + "-r" + std::to_string(resolution);
+            const std::string name = std::string("cornell-") + (hemicube ? "hemicube" : "stereo") + "-b" +
+                                     std::to_string(block) + "-r" + std::to_string(res);
             {
                 const auto t0 = std::chrono::steady_clock::now();
-                gl::progressive_radiosity solver(scene.view(), atlas, {.resolution = resolution});
+                gl::progressive_radiosity solver(
+                    scene.view(), atlas,
+                    {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
+                     .resolution = res});
                 solver.solve(fraction);
                 gl::finish();
                 run_figures f;
@@ -82,20 +89,24 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
                 const auto& t = solver.timings();
                 f = {f.total_ms, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
                      solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
-                write(name, "gl", renderer, atlas, resolution, f);
+                write(name, "gl", renderer, atlas, hemicube, res, f);
                 CHECK(solver.unshot_fraction() <= fraction);
             }
             {
                 const auto t0 = std::chrono::steady_clock::now();
-                cpu::progressive_radiosity solver(scene.view(), atlas,
-                                                  cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = resolution}));
+                cpu::progressive_radiosity solver(
+                    scene.view(), atlas,
+                    cpu::item_buffer_visibility(
+                        scene.view(), atlas,
+                        {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
+                         .resolution = res}));
                 solver.solve(fraction);
                 run_figures f;
                 f.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
                 const auto& t = solver.timings();
                 f = {f.total_ms, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
                      solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
-                write(name, "cpu", "", atlas, resolution, f);
+                write(name, "cpu", "", atlas, hemicube, res, f);
                 CHECK(solver.unshot_fraction() <= fraction);
             }
         }

@@ -98,30 +98,39 @@ TEST_CASE("absorbed + unshot + escaped power equals emitted power on GL after ev
         CHECK(solver.emitted_power().x > 0);
         CHECK(solver.escaped_power().x > 0);  // the box's open front
     }
-    SECTION("Cornell box, the spot light of its scene.json shot first, per-element shooters") {
+    SECTION("Cornell box, the spot light of its scene.json shot first, per-element shooters, hemicube") {
         const auto scene = cornell_box(true);
         const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
-        gl::progressive_radiosity solver(scene.view(), atlas, {.shoot_blocks = false, .resolution = 128});
+        gl::progressive_radiosity solver(
+            scene.view(), atlas,
+            {.shoot_blocks = false, .visibility = gl::radiosity_visibility::hemicube, .resolution = 64});
         CHECK(solver.emitted_power().x > 0);
         check_balance(solver, 40);
     }
 }
 
-TEST_CASE("GL and CPU stereographic visibility differ only at item-buffer edges", "[gl][radiosity][visibility]") {
-    // Both draw the same tessellated pieces (the sagitta rule) into a 128^2 stereographic
-    // buffer; GL's rasterizer gets the pieces' corners projected by the emitted kernel in the
-    // vertex shader and snaps them itself, so a pixel whose centre lies within a rounding of a
-    // piece's edge may fall to the other side. An element can then only be answered
-    // differently when its pixel in the CPU's buffer borders a pixel of another id (a 3 x 3
-    // neighbourhood: the pixel itself may have flipped). Everywhere else the one shot (from
-    // the lamp, the first shooter on both) gives the same gain to float rounding (1e-5).
-    gl_test::shared_context();
+namespace {
+
+// One shot (from the lamp, the first shooter on both) on GL and on the CPU with the same
+// projection and resolution: the elements answered differently, and how many of them do not
+// look through an edge pixel of the CPU's buffer (one whose 3 x 3 neighbourhood holds another
+// id, the pixel itself included, since it may be the one that flipped).
+struct one_shot_comparison {
+    std::size_t lit = 0, differing = 0, off_edge = 0;
+};
+
+one_shot_comparison compare_one_shot(bool hemicube, int res) {
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
-    const int res = 128;
-    cpu::progressive_radiosity cpu_solver(scene.view(), atlas,
-                                          cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = res}));
-    gl::progressive_radiosity gl_solver(scene.view(), atlas, {.resolution = res});
+    cpu::progressive_radiosity cpu_solver(
+        scene.view(), atlas,
+        cpu::item_buffer_visibility(scene.view(), atlas,
+                                    {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
+                                     .resolution = res}));
+    gl::progressive_radiosity gl_solver(
+        scene.view(), atlas,
+        {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
+         .resolution = res});
     const auto b0 = cpu_solver.radiosity();
     const std::vector<glm::vec3> before(b0.begin(), b0.end());
     // The shooter's disc: its elements' area-weighted centroid and its chart's normal.
@@ -138,33 +147,59 @@ TEST_CASE("GL and CPU stereographic visibility differ only at item-buffer edges"
     REQUIRE(gl_solver.step());
     const auto bc = cpu_solver.radiosity();
     const auto bg = gl_solver.radiosity();
-    const cpu::item_buffer& buf = cpu_solver.visibility().buffers()[0];
-    const auto id_at = [&](int x, int y) {
-        x = std::clamp(x, 0, buf.width - 1);
-        y = std::clamp(y, 0, buf.height - 1);
-        return buf.id[std::size_t(y) * std::size_t(buf.width) + std::size_t(x)];
-    };
-    std::size_t differing = 0, off_edge = 0, lit = 0;
+    const auto buffers = cpu_solver.visibility().buffers();
+    one_shot_comparison out;
     for (std::size_t i = 0; i < atlas.size(); ++i) {
         const float gain_cpu = bc[i].x - before[i].x, gain_gl = bg[i].x - before[i].x;
         const float scale = std::max(gain_cpu, gain_gl);
-        if (scale > 0) ++lit;
+        if (scale > 0) ++out.lit;
         if (std::abs(gain_cpu - gain_gl) <= 1e-5f * scale) continue;
-        ++differing;
+        ++out.differing;
         const glm::vec3 l = to_shooter_frame<float, glm::vec3>(atlas.position[i], centre, tb[0], tb[1], n);
-        const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l) * float(res);
-        const int x = std::clamp(int(std::floor(uv.x)), 0, res - 1), y = std::clamp(int(std::floor(uv.y)), 0, res - 1);
+        std::size_t face = 0;
+        glm::vec2 uv;
+        if (hemicube) {
+            const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
+            face = std::size_t(std::clamp(int(f.x + 0.5f), 0, 4));
+            uv = {f.y, f.z};
+        } else uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
+        const cpu::item_buffer& buf = buffers[face];
+        const auto id_at = [&](int x, int y) {
+            x = std::clamp(x, 0, buf.width - 1);
+            y = std::clamp(y, 0, buf.height - 1);
+            return buf.id[std::size_t(y) * std::size_t(buf.width) + std::size_t(x)];
+        };
+        const int x = std::clamp(int(std::floor(uv.x * float(buf.width))), 0, buf.width - 1);
+        const int y = std::clamp(int(std::floor(uv.y * float(buf.height))), 0, buf.height - 1);
         bool edge = false;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) edge = edge || id_at(x + dx, y + dy) != id_at(x, y);
-        if (!edge) ++off_edge;
+        if (!edge) ++out.off_edge;
     }
-    INFO("lit " << lit << ", differing " << differing << ", of them off an edge " << off_edge);
-    CHECK(lit > atlas.size() / 2);
-    CHECK(off_edge == 0);
+    return out;
 }
 
-TEST_CASE("with the stereographic item buffer, k shots on GL and CPU agree", "[gl][radiosity][visibility]") {
+}  // namespace
+
+TEST_CASE("GL and CPU item-buffer visibility differ only at item-buffer edges", "[gl][radiosity][visibility]") {
+    // Both draw the same geometry into buffers of the same size: the stereographic one the
+    // same tessellated pieces (the sagitta rule), the hemicube the triangles on five
+    // perspective faces. GL's rasterizer gets the corners projected in the vertex shader (the
+    // emitted kernels) and snaps them itself, so a pixel whose centre lies within a rounding of
+    // an edge may fall to the other side: an element can only be answered differently when
+    // its pixel borders a pixel of another id. Everywhere else the one shot gives the same
+    // gain to float rounding (1e-5). Most elements see the lamp.
+    gl_test::shared_context();
+    for (const bool hemicube : {false, true}) {
+        const auto r = compare_one_shot(hemicube, 128);
+        INFO((hemicube ? "hemicube" : "stereographic") << ": lit " << r.lit << ", differing " << r.differing
+                                                       << ", of them off an edge " << r.off_edge);
+        CHECK(r.lit > 300);
+        CHECK(r.off_edge == 0);
+    }
+}
+
+TEST_CASE("with item-buffer visibility, k shots on GL and CPU agree", "[gl][radiosity][visibility]") {
     // Same atlas, options and buffer resolution. Where every visibility answer is the same
     // (the previous test: answers may differ only at item-buffer edges), the solutions are
     // within the float bound 1e-5 (s + 1) of the test without occlusion. An element answered
@@ -175,9 +210,17 @@ TEST_CASE("with the stereographic item buffer, k shots on GL and CPU agree", "[g
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
     const int res = 128, shots = 30;
-    cpu::progressive_radiosity cpu_solver(scene.view(), atlas,
-                                          cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = res}));
-    gl::progressive_radiosity gl_solver(scene.view(), atlas, {.resolution = res});
+    const bool hemicube = GENERATE(false, true);
+    INFO((hemicube ? "hemicube" : "stereographic"));
+    cpu::progressive_radiosity cpu_solver(
+        scene.view(), atlas,
+        cpu::item_buffer_visibility(scene.view(), atlas,
+                                    {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
+                                     .resolution = res}));
+    gl::progressive_radiosity gl_solver(
+        scene.view(), atlas,
+        {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
+         .resolution = res});
     std::size_t same_shooter = 0;
     for (int s = 0; s < shots; ++s) {
         const auto expected = largest_power(gl_solver, gl_solver.unshot());
@@ -213,6 +256,7 @@ TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosit
     };
     throws_naming({.near_field = -1}, "radiosity_options.near_field");
     throws_naming({.resolution = 4}, "radiosity_options.resolution");
+    throws_naming({.visibility = gl::radiosity_visibility::hemicube, .resolution = 65}, "radiosity_options.resolution");
     throws_naming({.tolerance_px = 0.f}, "radiosity_options.tolerance_px");
     throws_naming({.max_tessellation_depth = 17}, "radiosity_options.max_tessellation_depth");
     const auto other = closed_box(1.f, 0.5f, 1.f);

@@ -33,8 +33,11 @@ void radiosity_options::validate() const {
     require(tolerance_px > 0.f && std::isfinite(tolerance_px), "radiosity_options.tolerance_px", "must be positive");
     require(max_tessellation_depth >= 0 && max_tessellation_depth <= 16, "radiosity_options.max_tessellation_depth",
             "must lie in [0, 16]");
-    require(visibility == radiosity_visibility::stereographic || visibility == radiosity_visibility::none,
+    require(visibility == radiosity_visibility::stereographic || visibility == radiosity_visibility::hemicube ||
+                visibility == radiosity_visibility::none,
             "radiosity_options.visibility", "is not a known method");
+    require(visibility != radiosity_visibility::hemicube || resolution % 2 == 0, "radiosity_options.resolution",
+            "a hemicube needs an even resolution (its side faces keep half the rows)");
 }
 
 namespace {
@@ -152,6 +155,23 @@ struct gpu_node {
 
 std::string version_header() { return "#version 450 core\n"; }
 
+// Rows of the item buffer: one square, or the hemicube's top face (res rows) above its four
+// half side faces (res / 2 rows each).
+std::size_t item_rows(const radiosity_options& o) {
+    return std::size_t(o.resolution) * (o.visibility == radiosity_visibility::hemicube ? 3 : 1);
+}
+
+// The hemicube faces' (right, up, forward) in the shooter's frame: radiosity.hpp's table.
+std::array<glm::vec3, 3> face_axes(int face) {
+    switch (face) {
+        case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};
+        case 2: return {glm::vec3(0, -1, 0), glm::vec3(0, 0, 1), glm::vec3(-1, 0, 0)};
+        case 3: return {glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 1, 0)};
+        case 4: return {glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)};
+        default: return {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
+    }
+}
+
 }  // namespace
 
 struct progressive_radiosity::state {
@@ -179,7 +199,10 @@ struct progressive_radiosity::state {
     buffer texels, nodes, planes, first_buffer, element_texel, partials;
     std::unique_ptr<buffer> vertices;
     std::size_t vertex_capacity = 0;
-    std::unique_ptr<program> item_program, distribute_program, light_program, reduce_program, finish_program;
+    vertex_array cube_vao;
+    std::unique_ptr<buffer> cube_vertices;
+    std::size_t cube_vertex_count = 0;
+    std::unique_ptr<program> item_program, cube_program, distribute_program, light_program, reduce_program, finish_program;
 
     // Per shot, CPU side.
     glm::vec3 shot_position{0.f}, shot_axis{0.f, 0.f, 1.f}, t{1, 0, 0}, b{0, 1, 0};
@@ -204,6 +227,8 @@ struct progressive_radiosity::state {
     };
     reduction reduce();
     void draw_item_buffer();
+    void draw_hemicube();
+    void draw_visibility();
     void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
     void shoot(std::uint32_t k);
     void shoot_light(const packed_light& l);
@@ -219,8 +244,8 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
       radiosity(texel_format::rgba32f, width, height),
       unshot(texel_format::rgba32f, width, height),
       intercepted(texel_format::rgba32f, width, height),
-      item_color(texel_format::rgba32f, std::size_t(o.resolution), std::size_t(o.resolution)),
-      item_depth(texel_format::depth32f, std::size_t(o.resolution), std::size_t(o.resolution)),
+      item_color(texel_format::rgba32f, std::size_t(o.resolution), item_rows(o)),
+      item_depth(texel_format::depth32f, std::size_t(o.resolution), item_rows(o)),
       texels(std::size_t(width) * height * sizeof(texel_attributes)),
       nodes(std::size_t(1) * sizeof(gpu_node)),
       planes(std::max<std::size_t>(scene.triangles.size(), 1) * sizeof(glm::vec4)),
@@ -323,6 +348,7 @@ void progressive_radiosity::state::compile() {
     glsl::function_set fs;
     fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
     fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
+    fs.add("radiosity_hemicube_coords", hemicube_face_coords<f32, vec3>, "local_direction");
     fs.add("radiosity_item_sees", item_buffer_sees<f32, vec3>, "element", "element_chart", "shown_chart",
            "plane_normal", "plane_offset", "shown_depth", "diagonal");
     const std::string lookup_functions = fs.source();
@@ -363,6 +389,52 @@ void main() {
 )";
     item_program = std::make_unique<program>(vertex, fragment);
 
+    // Hemicube faces (Cohen and Greenberg 1985): perspective views of the untessellated
+    // triangles, 1/z interpolated by the rasterizer (exact under perspective), depth the
+    // distance along the face's forward axis, as cpu::item_buffer_visibility stores it. Side
+    // faces keep their upper half: clip y = 2 up - forward maps up / forward in [0, 1] onto
+    // the viewport.
+    glsl::function_set cube_vs_fs;
+    cube_vs_fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
+    const std::string cube_vertex = version_header() + cube_vs_fs.source() + R"(
+layout(location = 0) in vec3 world_position;
+layout(location = 1) in vec2 ids;
+layout(location = 0) uniform vec3 shot_position;
+layout(location = 1) uniform vec3 shot_t;
+layout(location = 2) uniform vec3 shot_b;
+layout(location = 3) uniform vec3 shot_n;
+layout(location = 4) uniform vec3 face_right;
+layout(location = 5) uniform vec3 face_up;
+layout(location = 6) uniform vec3 face_forward;
+layout(location = 7) uniform int side_face;
+layout(location = 8) uniform float near_z;
+layout(location = 9) uniform float far_z;
+layout(location = 0) out float forward_depth;
+layout(location = 1) flat out vec2 item_ids;
+void main() {
+    vec3 l = radiosity_to_shooter_frame(world_position, shot_position, shot_t, shot_b, shot_n);
+    vec3 q = vec3(dot(l, face_right), dot(l, face_up), dot(l, face_forward));
+    float y = side_face != 0 ? 2.0 * q.y - q.z : q.y;
+    float a = (far_z + near_z) / (far_z - near_z), b = -2.0 * far_z * near_z / (far_z - near_z);
+    gl_Position = vec4(q.x, y, a * q.z + b, q.z);
+    forward_depth = q.z;
+    item_ids = ids;
+}
+)";
+    const std::string cube_fragment = version_header() + R"(
+layout(location = 9) uniform float far_z;
+layout(location = 10) uniform float shot_chart;
+layout(location = 0) in float forward_depth;
+layout(location = 1) flat in vec2 item_ids;
+layout(location = 0) out vec4 item;
+void main() {
+    if (item_ids.x == shot_chart) discard;
+    gl_FragDepth = forward_depth / far_z;
+    item = vec4(item_ids, forward_depth, 1.0);
+}
+)";
+    cube_program = std::make_unique<program>(cube_vertex, cube_fragment);
+
     const std::string common = R"(
 struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
 layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
@@ -381,13 +453,25 @@ layout(location = 6) uniform float shot_chart;
 layout(location = 7) uniform int occlusion;
 layout(location = 8) uniform float resolution;
 layout(location = 9) uniform float diagonal;
-// Visibility of the element at world position p (chart `chart`) from the shot.
+layout(location = 20) uniform int hemicube;
+// Visibility of the element at world position p (chart `chart`) from the shot: its pixel in
+// the stereographic buffer, or on its hemicube face (top face in rows [0, res), side face f
+// in rows res + (f - 1) res / 2 on).
 float shot_visibility(vec3 p, float chart) {
     if (occlusion == 0) return 1.0;
     vec3 l = radiosity_to_shooter_frame(p, shot_position, shot_t, shot_b, shot_n);
-    vec2 uv = radiosity_item_coords(l);
     int res = int(resolution);
-    ivec2 pixel = clamp(ivec2(floor(uv * resolution)), ivec2(0), ivec2(res - 1));
+    ivec2 pixel;
+    if (hemicube != 0) {
+        vec3 f = radiosity_hemicube_coords(l);
+        int face = clamp(int(f.x + 0.5), 0, 4);
+        int rows = face == 0 ? res : res / 2;
+        pixel = ivec2(clamp(int(floor(f.y * resolution)), 0, res - 1),
+                      clamp(int(floor(f.z * float(rows))), 0, rows - 1) + (face == 0 ? 0 : res + (face - 1) * (res / 2)));
+    } else {
+        vec2 uv = radiosity_item_coords(l);
+        pixel = clamp(ivec2(floor(uv * resolution)), ivec2(0), ivec2(res - 1));
+    }
     vec4 item = imageLoad(item_image, pixel);
     vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
     return radiosity_item_sees(l, chart, item.x, plane.xyz, plane.w, item.z, diagonal);
@@ -693,6 +777,72 @@ void progressive_radiosity::state::draw_item_buffer() {
     check_error("progressive_radiosity: drawing the item buffer");
 }
 
+void progressive_radiosity::state::draw_visibility() {
+    if (options.visibility == radiosity_visibility::stereographic) draw_item_buffer();
+    else if (options.visibility == radiosity_visibility::hemicube) draw_hemicube();
+}
+
+void progressive_radiosity::state::draw_hemicube() {
+    // Each triangle's plane in the shooter's frame, facing away from it, for the lookup.
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+        const glm::vec3 nl(glm::dot(glm::vec3(world_plane[k]), t), glm::dot(glm::vec3(world_plane[k]), b),
+                           glm::dot(glm::vec3(world_plane[k]), shot_axis));
+        const float d = glm::dot(nl, to_shooter_frame<float, glm::vec3>(corners[k][0], shot_position, t, b, shot_axis));
+        local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
+    }
+    planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));
+    if (!cube_vertices) {
+        std::vector<item_vertex> v;
+        for (std::size_t k = 0; k < corners.size(); ++k)
+            for (int m = 0; m < 3; ++m) v.push_back({corners[k][std::size_t(m)], float(triangle_chart[k]), float(k)});
+        cube_vertex_count = v.size();
+        cube_vertices = std::make_unique<buffer>(std::max<std::size_t>(v.size(), 1) * sizeof(item_vertex), v.data());
+        glVertexArrayVertexBuffer(cube_vao.id(), 0, cube_vertices->id(), 0, GLsizei(sizeof(item_vertex)));
+        glEnableVertexArrayAttrib(cube_vao.id(), 0);
+        glEnableVertexArrayAttrib(cube_vao.id(), 1);
+        glVertexArrayAttribFormat(cube_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribFormat(cube_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
+        glVertexArrayAttribBinding(cube_vao.id(), 0, 0);
+        glVertexArrayAttribBinding(cube_vao.id(), 1, 0);
+    }
+    float far_distance = 0.f;
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        far_distance = std::max(far_distance, glm::length(corner - shot_position));
+    }
+    const float far_z = far_distance * 1.01f + 1e-6f * diagonal, near_z = 1e-6f * diagonal;
+    detail::raster_state raster;
+    binding_state saved;
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(item_fbo.id(), GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(item_fbo.id(), GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
+    const program& p = *cube_program;
+    glUseProgram(p.id());
+    p.set(0, shot_position);
+    p.set(1, t);
+    p.set(2, b);
+    p.set(3, shot_axis);
+    p.set(8, near_z);
+    p.set(9, far_z);
+    p.set(10, shot_chart);
+    glBindVertexArray(cube_vao.id());
+    const int res = options.resolution;
+    for (int face = 0; face < 5; ++face) {
+        const auto axes = face_axes(face);
+        p.set(4, axes[0]);
+        p.set(5, axes[1]);
+        p.set(6, axes[2]);
+        p.set(7, face == 0 ? 0 : 1);
+        if (face == 0) glViewport(0, 0, res, res);
+        else glViewport(0, res + (face - 1) * (res / 2), res, res / 2);
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
+    }
+    drawn = 5 * cube_vertex_count / 3;
+    check_error("progressive_radiosity: drawing the hemicube");
+}
+
 std::vector<glm::vec3> progressive_radiosity::state::read_elements(const texture& tex) const {
     const std::vector<float> all = tex.read_floats();
     std::vector<glm::vec3> out(atlas.size());
@@ -778,7 +928,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
 
     const float chart = float(atlas.chart[i0]);
     set_shot(centre[k], atlas.normal[i0], chart);
-    if (options.visibility == radiosity_visibility::stereographic) draw_item_buffer();
+    draw_visibility();
     finish();
     timings.visibility_ms += ms_since(start);
 
@@ -796,8 +946,9 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         p.set(4, b);
         p.set(5, shot_axis);
         p.set(6, chart);
-        p.set(7, options.visibility == radiosity_visibility::stereographic ? 1 : 0);
+        p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
         p.set(8, float(options.resolution));
+        p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
         p.set(9, diagonal);
         p.set(10, int(near.size()));
         p.set(11, float(options.near_field * options.near_field));
@@ -820,7 +971,7 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
     if (kind == light_kind::point || l.cos_cone() < 0.f) axes.push_back(-axis);
     for (std::size_t h = 0; h < axes.size(); ++h) {
         set_shot(l.position(), axes[h], -2.f);
-        if (options.visibility == radiosity_visibility::stereographic) draw_item_buffer();
+        draw_visibility();
         {
             binding_state saved;
             bind_common();
@@ -834,8 +985,9 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             p.set(4, b);
             p.set(5, shot_axis);
             p.set(6, -2.f);
-            p.set(7, options.visibility == radiosity_visibility::stereographic ? 1 : 0);
+            p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
             p.set(8, float(options.resolution));
+            p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
             p.set(9, diagonal);
             p.set(10, kind == light_kind::spot ? 1 : 0);
             p.set(11, l.direction());

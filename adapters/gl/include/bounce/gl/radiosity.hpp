@@ -27,8 +27,9 @@
 /// Point and spot lights are shot first, in the constructor, as the CPU solver does (their
 /// direct irradiance from lights.hpp times visibility from the light, a hemisphere at a time).
 ///
-/// Not here (the CPU solver has them): directional lights, the hemicube (the options offer
-/// stereographic or no occlusion), several shooters per step, adaptive subdivision.
+/// Visibility can also come from a hemicube (five perspective faces drawn by GL, no
+/// tessellation needed) or be left out. Not here (the CPU solver has them): directional lights,
+/// several shooters per step, adaptive subdivision.
 ///
 /// Every pass works in the context current on the calling thread, on textures and buffers the
 /// solver owns, and restores the context state it touches (program, framebuffers, viewport,
@@ -54,6 +55,7 @@ namespace bounce::gl {
 /// How visibility is found for each shot.
 enum class radiosity_visibility {
     stereographic,  ///< item buffer in the stereographic projection (Coombe and Harris 2005)
+    hemicube,       ///< item buffers on the five faces of a hemicube (Cohen and Greenberg 1985)
     none            ///< every element sees every shooter (open scenes, tests, the unoccluded bound)
 };
 
@@ -67,7 +69,7 @@ struct radiosity_options {
                                ///< times its side, else as its quadrants, recursively; 0: one disc
                                ///< (typical: 2-4)
     radiosity_visibility visibility = radiosity_visibility::stereographic;
-    int resolution = 256;            ///< item buffer side, pixels (typical: 128-512)
+    int resolution = 256;            ///< item buffer side, pixels (hemicube: per face, even; typical: 128-512)
     float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
     int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges
 
@@ -151,7 +153,8 @@ public:
     const radiosity_timings& timings() const noexcept;
     const lightmap_atlas& atlas() const noexcept;
     const radiosity_options& options() const noexcept;
-    /// Pieces drawn into the item buffer in the last shot (tessellation included).
+    /// Pieces drawn into the item buffer in the last shot (tessellation included; hemicube:
+    /// triangles times five faces).
     std::size_t drawn_triangles() const noexcept;
 
 private:
