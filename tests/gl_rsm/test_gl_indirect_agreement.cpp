@@ -145,8 +145,9 @@ TEST_CASE("GL RSM gather equals the CPU's, plain and interleaved with blur", "[g
     gl::indirect_options o;
     o.technique = gl::indirect_technique::rsm_gather;
     o.count = 256;
+    // 8x8 and 16x2 take the tent's radii 7 and 15.
     for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{2, 2}, interleave_pattern{4, 4},
-                                       interleave_pattern{3, 2}}) {
+                                       interleave_pattern{3, 2}, interleave_pattern{8, 8}, interleave_pattern{16, 2}}) {
         o.pattern = p;
         check_agreement(s, o);
     }
