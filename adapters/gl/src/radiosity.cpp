@@ -33,6 +33,8 @@ void radiosity_options::validate() const {
     require(tolerance_px > 0.f && std::isfinite(tolerance_px), "radiosity_options.tolerance_px", "must be positive");
     require(max_tessellation_depth >= 0 && max_tessellation_depth <= 16, "radiosity_options.max_tessellation_depth",
             "must lie in [0, 16]");
+    require(parallel_resolution >= 8 && parallel_resolution <= 16384, "radiosity_options.parallel_resolution",
+            "must lie in [8, 16384]");
     require(visibility == radiosity_visibility::stereographic || visibility == radiosity_visibility::hemicube ||
                 visibility == radiosity_visibility::none,
             "radiosity_options.visibility", "is not a known method");
@@ -202,7 +204,12 @@ struct progressive_radiosity::state {
     vertex_array cube_vao;
     std::unique_ptr<buffer> cube_vertices;
     std::size_t cube_vertex_count = 0;
-    std::unique_ptr<program> item_program, cube_program, distribute_program, light_program, reduce_program, finish_program;
+    // A directional light's orthographic buffer, made when the scene has one.
+    std::unique_ptr<texture> parallel_color, parallel_depth;
+    std::unique_ptr<framebuffer> parallel_fbo;
+    glm::vec2 ortho_lo{0.f};
+    float ortho_scale = 1.f;
+    std::unique_ptr<program> item_program, cube_program, parallel_program, distribute_program, light_program, reduce_program, finish_program;
 
     // Per shot, CPU side.
     glm::vec3 shot_position{0.f}, shot_axis{0.f, 0.f, 1.f}, t{1, 0, 0}, b{0, 1, 0};
@@ -228,6 +235,8 @@ struct progressive_radiosity::state {
     reduction reduce();
     void draw_item_buffer();
     void draw_hemicube();
+    void draw_parallel();
+    void world_vertices();
     void draw_visibility();
     void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
     void shoot(std::uint32_t k);
@@ -349,6 +358,8 @@ void progressive_radiosity::state::compile() {
     fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
     fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
     fs.add("radiosity_hemicube_coords", hemicube_face_coords<f32, vec3>, "local_direction");
+    fs.add("radiosity_parallel_sees", parallel_item_sees<f32, vec3>, "element", "element_chart", "shown_chart",
+           "plane_normal", "plane_offset", "shown_depth", "direction", "diagonal");
     fs.add("radiosity_item_sees", item_buffer_sees<f32, vec3>, "element", "element_chart", "shown_chart",
            "plane_normal", "plane_offset", "shown_depth", "diagonal");
     const std::string lookup_functions = fs.source();
@@ -434,6 +445,36 @@ void main() {
 }
 )";
     cube_program = std::make_unique<program>(cube_vertex, cube_fragment);
+
+    // A directional light: an orthographic view along it over the scene's box; the depth is
+    // the distance along the light, linear, so the rasterizer's depth is exact.
+    const std::string parallel_vertex = version_header() + R"(
+layout(location = 0) in vec3 world_position;
+layout(location = 1) in vec2 ids;
+layout(location = 0) uniform vec3 shot_t;
+layout(location = 1) uniform vec3 shot_b;
+layout(location = 2) uniform vec3 shot_n;
+layout(location = 3) uniform vec2 ortho_lo;
+layout(location = 4) uniform float ortho_scale;
+layout(location = 5) uniform float parallel_resolution;
+layout(location = 6) uniform float depth_lo;
+layout(location = 7) uniform float depth_hi;
+layout(location = 0) out float along;
+layout(location = 1) flat out vec2 item_ids;
+void main() {
+    vec2 pixel = (vec2(dot(world_position, shot_t), dot(world_position, shot_b)) - ortho_lo) * ortho_scale;
+    along = dot(world_position, shot_n);
+    gl_Position = vec4(pixel / parallel_resolution * 2.0 - 1.0, (along - depth_lo) / (depth_hi - depth_lo) * 2.0 - 1.0, 1.0);
+    item_ids = ids;
+}
+)";
+    const std::string parallel_fragment = version_header() + R"(
+layout(location = 0) in float along;
+layout(location = 1) flat in vec2 item_ids;
+layout(location = 0) out vec4 item;
+void main() { item = vec4(item_ids, along, 1.0); }
+)";
+    parallel_program = std::make_unique<program>(parallel_vertex, parallel_fragment);
 
     const std::string common = R"(
 struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
@@ -535,6 +576,8 @@ void main() {
     glsl::function_set light_fs;
     light_fs.add("radiosity_point_irradiance", point_light_irradiance<f32, vec3>, "p", "n", "light_position",
                  "intensity");
+    light_fs.add("radiosity_directional_irradiance", directional_light_irradiance<f32, vec3>, "n", "direction",
+                 "irradiance");
     light_fs.add("radiosity_spot_irradiance", spot_light_irradiance<f32, vec3>, "p", "n", "light_position", "axis",
                  "intensity", "cos_cone", "cosine_falloff");
     const std::string light = version_header() + "layout(local_size_x = 8, local_size_y = 8) in;\n" +
@@ -545,6 +588,21 @@ layout(location = 12) uniform vec3 intensity;
 layout(location = 13) uniform float cos_cone;
 layout(location = 14) uniform float cosine_falloff;
 layout(location = 15) uniform int strict_side;
+layout(location = 16) uniform int parallel;
+layout(location = 17) uniform vec2 ortho_lo;
+layout(location = 18) uniform float ortho_scale;
+layout(location = 19) uniform float parallel_resolution;
+// Visibility along a directional light: the element's pixel in the orthographic buffer,
+// whose planes are the triangles' world planes.
+float parallel_visibility(vec3 p, float chart) {
+    if (occlusion == 0) return 1.0;
+    vec3 l = radiosity_to_shooter_frame(p, vec3(0.0), shot_t, shot_b, shot_n);
+    int res = int(parallel_resolution);
+    ivec2 pixel = clamp(ivec2(floor((l.xy - ortho_lo) * ortho_scale)), ivec2(0), ivec2(res - 1));
+    vec4 item = imageLoad(item_image, pixel);
+    vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
+    return radiosity_parallel_sees(p, chart, item.x, plane.xyz, plane.w, item.z, shot_n, diagonal);
+}
 void main() {
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
     if (xy.x >= atlas_width || xy.y >= atlas_height) return;
@@ -554,11 +612,12 @@ void main() {
     vec3 p = a.position_area.xyz, n = a.normal_chart.xyz;
     // Each element belongs to one hemisphere of the light: z >= 0 of the first, z > 0 of the second.
     float z = dot(p - shot_position, shot_n);
-    bool side = strict_side != 0 ? z > 0.0 : z >= 0.0;
-    vec3 e = spot != 0 ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
-                       : radiosity_point_irradiance(p, n, shot_position, intensity);
+    bool side = parallel != 0 || (strict_side != 0 ? z > 0.0 : z >= 0.0);
+    vec3 e = parallel != 0 ? radiosity_directional_irradiance(n, light_axis, intensity)
+           : spot != 0     ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
+                           : radiosity_point_irradiance(p, n, shot_position, intensity);
     if (!side || !(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
-    float v = shot_visibility(p, a.normal_chart.w);
+    float v = parallel != 0 ? parallel_visibility(p, a.normal_chart.w) : shot_visibility(p, a.normal_chart.w);
     if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
     receive(xy, a.albedo.rgb * (e * v), e * (v * a.position_area.w));
 }
@@ -782,6 +841,78 @@ void progressive_radiosity::state::draw_visibility() {
     else if (options.visibility == radiosity_visibility::hemicube) draw_hemicube();
 }
 
+void progressive_radiosity::state::world_vertices() {
+    if (cube_vertices) return;
+    std::vector<item_vertex> v;
+    for (std::size_t k = 0; k < corners.size(); ++k)
+        for (int m = 0; m < 3; ++m) v.push_back({corners[k][std::size_t(m)], float(triangle_chart[k]), float(k)});
+    cube_vertex_count = v.size();
+    cube_vertices = std::make_unique<buffer>(std::max<std::size_t>(v.size(), 1) * sizeof(item_vertex), v.data());
+    glVertexArrayVertexBuffer(cube_vao.id(), 0, cube_vertices->id(), 0, GLsizei(sizeof(item_vertex)));
+    glEnableVertexArrayAttrib(cube_vao.id(), 0);
+    glEnableVertexArrayAttrib(cube_vao.id(), 1);
+    glVertexArrayAttribFormat(cube_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribFormat(cube_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
+    glVertexArrayAttribBinding(cube_vao.id(), 0, 0);
+    glVertexArrayAttribBinding(cube_vao.id(), 1, 0);
+}
+
+void progressive_radiosity::state::draw_parallel() {
+    const int res = options.parallel_resolution;
+    if (!parallel_fbo) {
+        parallel_color = std::make_unique<texture>(texel_format::rgba32f, std::size_t(res), std::size_t(res));
+        parallel_depth = std::make_unique<texture>(texel_format::depth32f, std::size_t(res), std::size_t(res));
+        parallel_fbo = std::make_unique<framebuffer>();
+        parallel_fbo->attach_color(0, *parallel_color);
+        parallel_fbo->attach_depth(*parallel_depth);
+        parallel_fbo->set_draw_buffers(1);
+        parallel_fbo->check_complete();
+    }
+    world_vertices();
+    // The planes the lookup reads are the world planes here.
+    std::vector<glm::vec4> wp(world_plane);
+    wp.resize(local_plane.size(), glm::vec4(0.f, 0.f, 1.f, 0.f));
+    planes.write(0, wp.data(), wp.size() * sizeof(glm::vec4));
+    // The scene's box projected across the light, widened by a pixel each side
+    // (cpu::item_buffer_visibility's parallel buffer); its extent along the light.
+    glm::vec2 mn(std::numeric_limits<float>::max()), mx(-std::numeric_limits<float>::max());
+    float d0 = std::numeric_limits<float>::max(), d1 = -std::numeric_limits<float>::max();
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        const glm::vec2 q(glm::dot(corner, t), glm::dot(corner, b));
+        mn = glm::min(mn, q);
+        mx = glm::max(mx, q);
+        d0 = std::min(d0, glm::dot(corner, shot_axis));
+        d1 = std::max(d1, glm::dot(corner, shot_axis));
+    }
+    const float side = std::max(std::max(mx.x - mn.x, mx.y - mn.y), 1e-30f) * (1.f + 2.f / float(res));
+    ortho_lo = 0.5f * (mn + mx) - glm::vec2(0.5f * side);
+    ortho_scale = float(res) / side;
+    const float margin = 0.01f * diagonal;
+    detail::raster_state raster;
+    binding_state saved;
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(parallel_fbo->id(), GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(parallel_fbo->id(), GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, parallel_fbo->id());
+    glViewport(0, 0, res, res);
+    const program& p = *parallel_program;
+    glUseProgram(p.id());
+    p.set(0, t);
+    p.set(1, b);
+    p.set(2, shot_axis);
+    p.set(3, ortho_lo);
+    p.set(4, ortho_scale);
+    p.set(5, float(res));
+    p.set(6, d0 - margin);
+    p.set(7, d1 + margin);
+    glBindVertexArray(cube_vao.id());
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
+    drawn = cube_vertex_count / 3;
+    check_error("progressive_radiosity: drawing the directional light's buffer");
+}
+
 void progressive_radiosity::state::draw_hemicube() {
     // Each triangle's plane in the shooter's frame, facing away from it, for the lookup.
     for (std::size_t k = 0; k < corners.size(); ++k) {
@@ -791,20 +922,7 @@ void progressive_radiosity::state::draw_hemicube() {
         local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
     }
     planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));
-    if (!cube_vertices) {
-        std::vector<item_vertex> v;
-        for (std::size_t k = 0; k < corners.size(); ++k)
-            for (int m = 0; m < 3; ++m) v.push_back({corners[k][std::size_t(m)], float(triangle_chart[k]), float(k)});
-        cube_vertex_count = v.size();
-        cube_vertices = std::make_unique<buffer>(std::max<std::size_t>(v.size(), 1) * sizeof(item_vertex), v.data());
-        glVertexArrayVertexBuffer(cube_vao.id(), 0, cube_vertices->id(), 0, GLsizei(sizeof(item_vertex)));
-        glEnableVertexArrayAttrib(cube_vao.id(), 0);
-        glEnableVertexArrayAttrib(cube_vao.id(), 1);
-        glVertexArrayAttribFormat(cube_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribFormat(cube_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
-        glVertexArrayAttribBinding(cube_vao.id(), 0, 0);
-        glVertexArrayAttribBinding(cube_vao.id(), 1, 0);
-    }
+    world_vertices();
     float far_distance = 0.f;
     for (int m = 0; m < 8; ++m) {
         const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
@@ -965,6 +1083,46 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
 
 void progressive_radiosity::state::shoot_light(const packed_light& l) {
     const light_kind kind = l.kind();
+    if (kind == light_kind::directional) {
+        set_shot(glm::vec3(0.f), l.direction(), -2.f);
+        if (options.visibility != radiosity_visibility::none) draw_parallel();
+        {
+            binding_state saved;
+            bind_common();
+            if (parallel_color)
+                glBindImageTexture(item_unit, parallel_color->id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+            glMemoryBarrier(GL_ALL_BARRIER_BITS);
+            const program& p = *light_program;
+            glUseProgram(p.id());
+            p.set(0, int(width));
+            p.set(1, int(height));
+            p.set(2, shot_position);
+            p.set(3, t);
+            p.set(4, b);
+            p.set(5, shot_axis);
+            p.set(6, -2.f);
+            p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
+            p.set(8, float(options.resolution));
+            p.set(9, diagonal);
+            p.set(10, 0);
+            p.set(11, l.direction());
+            p.set(12, l.intensity());
+            p.set(13, l.cos_cone());
+            p.set(14, l.cosine_falloff());
+            p.set(15, 0);
+            p.set(16, 1);
+            p.set(17, ortho_lo);
+            p.set(18, ortho_scale);
+            p.set(19, float(options.parallel_resolution));
+            p.set(20, 0);
+            glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
+            check_error("progressive_radiosity: shooting a directional light");
+        }
+        const reduction got = reduce();
+        emitted += got.intercepted;
+        absorbed += got.absorbed;
+        return;
+    }
     const glm::vec3 axis = kind == light_kind::spot ? l.direction() : glm::vec3(0, 0, 1);
     std::vector<glm::vec3> axes{axis};
     // A point light, or a spot wider than a hemisphere, needs the other half too.
@@ -995,6 +1153,10 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             p.set(13, l.cos_cone());
             p.set(14, l.cosine_falloff());
             p.set(15, h == 0 ? 0 : 1);
+            p.set(16, 0);
+            p.set(17, ortho_lo);
+            p.set(18, ortho_scale);
+            p.set(19, float(options.parallel_resolution));
             glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
             check_error("progressive_radiosity: shooting a light");
         }
@@ -1019,9 +1181,6 @@ progressive_radiosity::progressive_radiosity(const scene_view& scene, const ligh
     require(atlas.block_texels >= 1 && atlas.block_texels <= 16, "atlas.block_texels",
             "must lie in [1, 16] for the GL backend (its near-field tree is a fixed-size array)");
     require(atlas.width <= 65535 && atlas.height <= 65535, "atlas", "is wider or taller than 65535 texels");
-    for (const light& l : scene.lights)
-        require(pack(l).kind() != light_kind::directional, "scene.lights",
-                "holds a directional light, which the GL backend does not shoot yet (the CPU solver does)");
     s_ = std::make_unique<state>(scene, atlas, options);
     const auto start = clock_type::now();
     for (const light& l : scene.lights) s_->shoot_light(pack(l));

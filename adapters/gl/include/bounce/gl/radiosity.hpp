@@ -24,12 +24,13 @@
 ///  4. a compute reduction (per shooter, then per work group, then one group) finds the next
 ///     shooter, the total unshot power and the shot's intercepted and absorbed power, in
 ///     double: the convergence fraction is known after every step.
-/// Point and spot lights are shot first, in the constructor, as the CPU solver does (their
-/// direct irradiance from lights.hpp times visibility from the light, a hemisphere at a time).
+/// Point, spot and directional lights are shot first, in the constructor, as the CPU solver
+/// does (their direct irradiance from lights.hpp times visibility from the light: a
+/// hemisphere at a time, or an orthographic buffer along a directional light).
 ///
 /// Visibility can also come from a hemicube (five perspective faces drawn by GL, no
-/// tessellation needed) or be left out. Not here (the CPU solver has them): directional lights,
-/// several shooters per step, adaptive subdivision.
+/// tessellation needed) or be left out. Not here (the CPU solver has them): several shooters
+/// per step, adaptive subdivision.
 ///
 /// Every pass works in the context current on the calling thread, on textures and buffers the
 /// solver owns, and restores the context state it touches (program, framebuffers, viewport,
@@ -72,6 +73,7 @@ struct radiosity_options {
     int resolution = 256;            ///< item buffer side, pixels (hemicube: per face, even; typical: 128-512)
     float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
     int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges
+    int parallel_resolution = 1024;  ///< side of a directional light's buffer, pixels
 
     /// Throws parameter_error naming the option ("radiosity_options.resolution" ...).
     void validate() const;
@@ -80,7 +82,7 @@ struct radiosity_options {
 /// Time spent per stage since construction, milliseconds, each stage ended by glFinish (so
 /// the figures are the GPU's time, not the driver's queueing).
 struct radiosity_timings {
-    double lights_ms = 0;        ///< point and spot lights, their visibility included (construction)
+    double lights_ms = 0;        ///< the scene's lights, their visibility included (construction)
     double visibility_ms = 0;    ///< reading the shooter back, tessellating and drawing the item buffer
     double choice_ms = 0;        ///< the reduction that picks the next shooter and sums powers
     double distribution_ms = 0;  ///< form factors and updates over the atlas texels
@@ -98,9 +100,9 @@ class progressive_radiosity {
 public:
     /// Uploads `atlas` (copied: base blocks only, as build_lightmap_atlas makes them; a
     /// subdivided atlas is refused) and the scene's triangles, compiles the passes, shoots the
-    /// point and spot lights and runs the first reduction. `scene` is read only here. Throws
+    /// scene's lights and runs the first reduction. `scene` is read only here. Throws
     /// parameter_error on bad options, an atlas not built from `scene`, a subdivided atlas,
-    /// blocks wider than 16 texels, or a directional light; gl_error when GL cannot run it.
+    /// or blocks wider than 16 texels; gl_error when GL cannot run it.
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, radiosity_options options = {});
     ~progressive_radiosity();
     progressive_radiosity(progressive_radiosity&&) noexcept;

@@ -48,6 +48,25 @@ T item_buffer_sees(const V& element, T element_chart, T shown_chart, const V& pl
     return select(own || beyond, T(1), T(0));
 }
 
+/// item_buffer_sees for a directional light's orthographic buffer (rays along the unit
+/// `direction` the light travels): the element at world position `element` is seen when its
+/// pixel shows its chart or nothing, or when the shown surface's plane (world: unit
+/// `plane_normal`, n . x = `plane_offset`) is met downstream of the element along the light
+/// (less 1e-6 of the scene's `diagonal`); for a plane parallel to the light, when the
+/// pixel's stored depth along the light `shown_depth` is not upstream of the element's.
+/// cpu::item_buffer_visibility's rule for parallel shots.
+template <real T, vec3_of<T> V>
+T parallel_item_sees(const V& element, T element_chart, T shown_chart, const V& plane_normal, T plane_offset,
+                     T shown_depth, const V& direction, T diagonal) {
+    const T nd = dot(plane_normal, direction);
+    const auto parallel = abs(nd) <= T(1e-6);
+    const T s = (plane_offset - dot(plane_normal, element)) / select(parallel, T(1), nd);
+    const T slack = T(1e-6) * diagonal;
+    const auto beyond = select(parallel, shown_depth >= dot(element, direction) - slack, s >= -slack);
+    const auto own = shown_chart == element_chart || shown_chart < T(0);
+    return select(own || beyond, T(1), T(0));
+}
+
 /// Whether a receiver at `receiver` sees a node of a block shooter's quadtree (centre
 /// `node_position`, area `node_area`) as its children rather than as one disc: it lies within
 /// sqrt(`near2`) node sides of the node (cpu::progressive_radiosity's near field, a
