@@ -43,7 +43,7 @@ T item_buffer_sees(const V& element, T element_chart, T shown_chart, const V& pl
     const T slack = T(1e-4) * dist + T(1e-6) * diagonal;
     const auto edge_on = nw <= T(1e-6);
     const T met = plane_offset / select(edge_on, T(1), nw);
-    const auto beyond = select(edge_on, shown_depth >= dist - slack, met >= dist - slack);
+    const auto beyond = (edge_on && shown_depth >= dist - slack) || (!edge_on && met >= dist - slack);
     const auto own = shown_chart == element_chart || shown_chart < T(0);
     return select(own || beyond, T(1), T(0));
 }
@@ -62,7 +62,7 @@ T parallel_item_sees(const V& element, T element_chart, T shown_chart, const V& 
     const auto parallel = abs(nd) <= T(1e-6);
     const T s = (plane_offset - dot(plane_normal, element)) / select(parallel, T(1), nd);
     const T slack = T(1e-6) * diagonal;
-    const auto beyond = select(parallel, shown_depth >= dot(element, direction) - slack, s >= -slack);
+    const auto beyond = (parallel && shown_depth >= dot(element, direction) - slack) || (!parallel && s >= -slack);
     const auto own = shown_chart == element_chart || shown_chart < T(0);
     return select(own || beyond, T(1), T(0));
 }
