@@ -10,6 +10,7 @@
 #include <bounce/radiosity_subdivision.hpp>
 
 #include <catch2/catch.hpp>
+#include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)
 
 #include <algorithm>
 #include <cmath>
@@ -279,6 +280,64 @@ TEST_CASE("a directional light shot first gives the CPU's direct radiosity, shad
     CHECK(differing <= atlas.size() / 100);
     CHECK(gl_solver.emitted_power().x == Approx(cpu_solver.emitted_power().x).epsilon(0.01));
     CHECK(gl_solver.emitted_power().x > 0);
+}
+
+TEST_CASE("the GL solver leaves the caller's GL state as it found it", "[gl][radiosity][state]") {
+    // A renderer's own state: program, framebuffer, viewport, vertex array, raster state, the
+    // storage-buffer bindings and image units the passes use.
+    gl_test::shared_context();
+    const auto scene = cornell_box(true);
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 200});
+    gl::texture colour(gl::texel_format::rgba32f, 8, 8);
+    gl::framebuffer fbo;
+    fbo.attach_color(0, colour);
+    gl::vertex_array vao;
+    gl::buffer ssbo(64);
+    const gl::program prog = gl::program::compute("#version 450\nlayout(local_size_x = 1) in;\nvoid main() {}\n");
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+    glViewport(1, 2, 3, 4);
+    glBindVertexArray(vao.id());
+    glUseProgram(prog.id());
+    glEnable(GL_BLEND);
+    glEnable(GL_CULL_FACE);
+    glDisable(GL_DEPTH_TEST);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 2, ssbo.id(), 0, 32);
+    glBindImageTexture(3, colour.id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    for (const auto v : {gl::radiosity_visibility::stereographic, gl::radiosity_visibility::hemicube}) {
+        gl::progressive_radiosity solver(scene.view(), atlas, {.visibility = v, .resolution = 32});
+        solver.solve(0.5);
+        (void)solver.radiosity();
+    }
+    GLint draw_fb = 0, viewport[4] = {}, bound_vao = 0, program = 0, storage = 0, image = 0, access = 0;
+    GLint64 size = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw_fb);
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &bound_vao);
+    glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+    glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, 2, &storage);
+    glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, 2, &size);
+    glGetIntegeri_v(GL_IMAGE_BINDING_NAME, 3, &image);
+    glGetIntegeri_v(GL_IMAGE_BINDING_ACCESS, 3, &access);
+    CHECK(GLuint(draw_fb) == fbo.id());
+    CHECK(viewport[0] == 1);
+    CHECK(viewport[3] == 4);
+    CHECK(GLuint(bound_vao) == vao.id());
+    CHECK(GLuint(program) == prog.id());
+    CHECK(GLuint(storage) == ssbo.id());
+    CHECK(size == 32);
+    CHECK(GLuint(image) == colour.id());
+    CHECK(access == GL_WRITE_ONLY);
+    CHECK(glIsEnabled(GL_BLEND) == GL_TRUE);
+    CHECK(glIsEnabled(GL_CULL_FACE) == GL_TRUE);
+    CHECK(glIsEnabled(GL_DEPTH_TEST) == GL_FALSE);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, 0);
+    glBindImageTexture(3, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+    gl::check_error("state test");
 }
 
 TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosity][errors]") {
