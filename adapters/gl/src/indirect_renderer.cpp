@@ -43,8 +43,9 @@ void indirect_options::validate() const {
     require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
     light.validate();
     require(std::isfinite(sii_cutoff) && sii_cutoff >= 0.f, "sii_cutoff", "must be finite and >= 0");
-    require(low_resolution == 1, "low_resolution",
-            "must be 1: the GL renderer gathers at full resolution (no upsampling pass)");
+    require(low_resolution >= 1 && low_resolution <= 8, "low_resolution", "must lie in [1, 8]");
+    require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
+            "applies to the RSM gather only");
 }
 
 // ---- CPU-side choices, the CPU renderer's ------------------------------------------------
@@ -211,11 +212,16 @@ layout(location = 3) uniform vec2 map_size;
 layout(location = 4) uniform float weight_scale;
 layout(location = 5) uniform float offset;
 layout(location = 6) uniform float min_distance2;
+// The upsampling's fallback: only the pixels its mask marks are gathered (the others keep
+// the interpolated value below them).
+layout(binding = 5) uniform sampler2D fallback_mask;
+layout(location = 7) uniform int masked;
 layout(location = 0) out vec4 irradiance;
 
 )" + k.source() + R"(
 void main() {
     ivec2 g = ivec2(gl_FragCoord.xy);
+    if (masked != 0 && texelFetch(fallback_mask, g, 0).r == 0.0) discard;
     vec4 position_depth = texelFetch(gbuffer_position_depth, g, 0);
     if (!covered(position_depth.w)) {
         irradiance = vec4(0.0);
@@ -244,6 +250,87 @@ void main() {
                                     flux * (sample_k.z * weight_scale), offset, min_distance2);
     }
     irradiance = vec4(e, 0.0);
+}
+)";
+}
+
+// Downsampling: low-resolution pixel (x, y) takes the full-resolution pixel
+// (min(W - 1, f x + f/2), min(H - 1, f y + f/2)), rows from the top (cpu::downsample_gbuffer).
+constexpr const char* downsample_fragment = R"(#version 450 core
+layout(binding = 0) uniform sampler2D source_position_depth;
+layout(binding = 1) uniform sampler2D source_normal;
+layout(location = 0) uniform vec2 frame_size;
+layout(location = 2) uniform vec2 low_size;
+layout(location = 3) uniform int factor;
+layout(location = 0) out vec4 low_position_depth;
+layout(location = 1) out vec4 low_normal;
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    int y = int(low_size.y) - 1 - g.y;
+    int sx = min(int(frame_size.x) - 1, g.x * factor + factor / 2);
+    int sy = min(int(frame_size.y) - 1, y * factor + factor / 2);
+    ivec2 source = ivec2(sx, int(frame_size.y) - 1 - sy);
+    low_position_depth = texelFetch(source_position_depth, source, 0);
+    low_normal = vec4(texelFetch(source_normal, source, 0).xyz, 0.0);
+}
+)";
+
+// Geometry-aware upsampling (DS05 section 3.3, cpu::upsample_or_gather): interpolate the
+// four low-resolution samples around the pixel when at least three are suitable; otherwise
+// mark the pixel for the full-resolution gather.
+std::string upsample_fragment() {
+    glsl::function_set k;
+    k.add("geometry_aware_upsample_weights", geometry_aware_upsample_weights<glsl::f32, glsl::vec3>, "x", "n",
+          "positions", "normals", "frac_x", "frac_y", "max_plane_distance", "cos_normal", "result");
+    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
+layout(binding = 1) uniform sampler2D gbuffer_normal;
+layout(binding = 2) uniform sampler2D low_position_depth;
+layout(binding = 3) uniform sampler2D low_normal;
+layout(binding = 4) uniform sampler2D low_irradiance;
+layout(location = 2) uniform vec2 low_size;
+layout(location = 3) uniform int factor;
+layout(location = 4) uniform float tan_half_fov;
+layout(location = 5) uniform float plane_footprints;
+layout(location = 6) uniform float cos_normal;
+layout(location = 0) out vec4 irradiance;
+layout(location = 1) out vec4 fallback;
+
+)" + k.source() + R"(
+void main() {
+    ivec2 g = ivec2(gl_FragCoord.xy);
+    vec4 position_depth = texelFetch(gbuffer_position_depth, g, 0);
+    if (!covered(position_depth.w)) {
+        irradiance = vec4(0.0);
+        fallback = vec4(0.0);
+        return;
+    }
+    float f = float(factor);
+    // Low-resolution sample c sits at full-resolution pixel f c + f/2.
+    float lx = (float(g.x) - float(factor / 2)) / f, ly = (float(top_row(g.y)) - float(factor / 2)) / f;
+    float fx0 = floor(lx), fy0 = floor(ly);
+    vec3 ps[4], ns[4], es[4];
+    for (int k = 0; k < 4; ++k) {
+        int cx = int(clamp(fx0 + float(k & 1), 0.0, low_size.x - 1.0));
+        int cy = int(clamp(fy0 + float(k >> 1), 0.0, low_size.y - 1.0));
+        ivec2 t = ivec2(cx, int(low_size.y) - 1 - cy);
+        vec4 low = texelFetch(low_position_depth, t, 0);
+        bool seen = covered(low.w);
+        ps[k] = seen ? low.xyz : vec3(1e30);
+        ns[k] = seen ? texelFetch(low_normal, t, 0).xyz : vec3(0.0);
+        es[k] = texelFetch(low_irradiance, t, 0).rgb;
+    }
+    // plane_footprints f camera.pixel_footprint(depth, H), in the CPU's order.
+    precise float tolerance = plane_footprints * f * (2.0 * position_depth.w * tan_half_fov / frame_size.y);
+    float w[5];
+    geometry_aware_upsample_weights(position_depth.xyz, texelFetch(gbuffer_normal, g, 0).xyz, ps, ns,
+                                    clamp(lx - fx0, 0.0, 1.0), clamp(ly - fy0, 0.0, 1.0), tolerance, cos_normal, w);
+    if (w[4] >= 3.0 && w[0] + w[1] + w[2] + w[3] > 0.0) {
+        irradiance = vec4(es[0] * w[0] + es[1] * w[1] + es[2] * w[2] + es[3] * w[3], 0.0);
+        fallback = vec4(0.0);
+    } else {
+        irradiance = vec4(0.0);
+        fallback = vec4(1.0);
+    }
 }
 )";
 }
@@ -390,6 +477,12 @@ enum location : int {
     loc_weight_scale = 4,
     loc_offset = 5,
     loc_min_distance2 = 6,
+    loc_masked = 7,
+    loc_low_size = 2,
+    loc_factor = 3,
+    loc_tan_half_fov = 4,
+    loc_plane_footprints = 5,
+    loc_upsample_cos_normal = 6,
 };
 
 // One VPL as the splat shader reads it (std430).
@@ -407,6 +500,7 @@ struct indirect_renderer::passes {
     program gather_rsm{fullscreen_vertex, gather_rsm_fragment()};
     program splat{splat_vertex, splat_fragment()};
     program discontinuity{fullscreen_vertex, discontinuity_fragment()};
+    std::optional<program> downsample, upsample;  // made on the first low-resolution frame
     std::optional<program> tent_x, tent_y;
     int tent_r = 0;
     framebuffer fbo;
@@ -417,8 +511,15 @@ struct indirect_renderer::passes {
     std::size_t width = 0, height = 0;
     // The disc pattern (grouped) and its group starts, kept while unchanged.
     std::optional<buffer> disc, groups;
+    // The same pattern in its own order, as one group (the upsampling's fallback gather).
+    std::optional<buffer> whole_disc, whole_group;
     std::size_t disc_count = 0, disc_texels = 0;
     std::optional<buffer> vpls, rects;
+    // Low-resolution G-buffer and result, the fallback mask, and the query that counts the
+    // fallback's pixels.
+    std::optional<texture> low_position_depth, low_normal, low_irradiance, fallback_mask;
+    std::size_t low_width = 0, low_height = 0;
+    object_id query = 0;
 
     passes() {
         const GLuint vao = rect_vao.id();
@@ -427,6 +528,28 @@ struct indirect_renderer::passes {
         glEnableVertexArrayAttrib(vao, 0);
         glVertexArrayBindingDivisor(vao, 0, 1);
         check_error("indirect_renderer vertex array");
+    }
+    ~passes() {
+        if (query != 0) glDeleteQueries(1, &query);
+    }
+    passes(const passes&) = delete;
+    passes& operator=(const passes&) = delete;
+
+    void ensure_low(std::size_t full_w, std::size_t full_h, std::size_t lw, std::size_t lh) {
+        if (!downsample) {
+            downsample.emplace(fullscreen_vertex, downsample_fragment);
+            upsample.emplace(fullscreen_vertex, upsample_fragment());
+            glCreateQueries(GL_SAMPLES_PASSED, 1, &query);
+        }
+        if (!low_position_depth || low_width != lw || low_height != lh) {
+            low_position_depth.emplace(texel_format::rgba32f, lw, lh);
+            low_normal.emplace(texel_format::rgba32f, lw, lh);
+            low_irradiance.emplace(texel_format::rgba32f, lw, lh);
+            low_width = lw;
+            low_height = lh;
+        }
+        if (!fallback_mask || fallback_mask->width() != full_w || fallback_mask->height() != full_h)
+            fallback_mask.emplace(texel_format::rgba32f, full_w, full_h);
     }
 
     void ensure_scratch(std::size_t w, std::size_t h) {
@@ -519,11 +642,8 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
                     "must all have one size (the disc pattern's weights hold its texel count)");
 
     passes& p = *passes_;
-    const interleave_pattern& pattern = options_.pattern;
-    const bool interleaved = pattern.cells() > 1;
     const std::size_t w = g.width(), h = g.height();
     indirect_timings t;
-
     const detail::raster_state raster;
     const detail::blend_offset_state blend;
     const detail::program_and_storage_state bindings({0u, 1u});
@@ -531,10 +651,84 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
     glDisable(GL_DITHER);
-
     auto start = clock::now();
+
+    const int f = options_.low_resolution;
+    if (f == 1) {
+        frame(g, w, h, cam, maps, irradiance.id, t, start);
+    } else {
+        const std::size_t lw = (w + std::size_t(f) - 1) / std::size_t(f), lh = (h + std::size_t(f) - 1) / std::size_t(f);
+        p.ensure_low(w, h, lw, lh);
+        p.target({p.low_position_depth->id(), p.low_normal->id()}, lw, lh);
+        passes::textures({g.position_depth.id, g.normal.id});
+        p.downsample->set(loc_size, glm::vec2(float(w), float(h)));
+        p.downsample->set(loc_low_size, glm::vec2(float(lw), float(lh)));
+        p.downsample->set(loc_factor, f);
+        p.fullscreen(*p.downsample);
+        check_error("indirect_renderer downsample");
+        t.split_ms += lap(start);
+        const gbuffer_textures low{*p.low_position_depth, *p.low_normal, *p.low_normal};
+        frame(low, lw, lh, cam, maps, p.low_irradiance->id(), t, start);
+
+        // Interpolate where three low-resolution samples suit the pixel, mark the others,
+        // then gather the marked pixels at full resolution with the whole pattern (weight 1).
+        p.target({irradiance.id, p.fallback_mask->id()}, w, h);
+        passes::textures({g.position_depth.id, g.normal.id, p.low_position_depth->id(), p.low_normal->id(),
+                          p.low_irradiance->id()});
+        const program& up = *p.upsample;
+        up.set(loc_size, glm::vec2(float(w), float(h)));
+        up.set(loc_low_size, glm::vec2(float(lw), float(lh)));
+        up.set(loc_factor, f);
+        up.set(loc_tan_half_fov, cam.tan_half_fov());
+        up.set(loc_plane_footprints, options_.upsample.plane_footprints);
+        up.set(loc_upsample_cos_normal, options_.upsample.cos_normal);
+        p.fullscreen(up);
+        if (!maps.empty()) {
+            p.target({irradiance.id}, w, h);
+            glEnable(GL_BLEND);
+            glBlendEquation(GL_FUNC_ADD);
+            glBlendFunc(GL_ONE, GL_ONE);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, p.whole_disc->id());
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, p.whole_group->id());
+            const program& prog = p.gather_rsm;
+            passes::frame_uniforms(prog, w, h, interleave_pattern{1, 1});
+            prog.set(loc_weight_scale, 1.f);
+            prog.set(loc_offset, options_.light.offset);
+            prog.set(loc_min_distance2, options_.light.min_distance2);
+            prog.set(loc_masked, 1);
+            for (std::size_t k = 0; k < maps.size(); ++k) {
+                const auto& m = maps[k];
+                passes::textures({g.position_depth.id, g.normal.id, m.position.id, m.normal.id, m.flux.id,
+                                  p.fallback_mask->id()});
+                prog.set(loc_light_view_projection, m.light_view_projection);
+                prog.set(loc_map_size, glm::vec2(float(m.width()), float(m.height())));
+                // Every fallback pixel draws once per map: count them on the first.
+                if (k == 0) glBeginQuery(GL_SAMPLES_PASSED, p.query);
+                p.fullscreen(prog);
+                if (k == 0) glEndQuery(GL_SAMPLES_PASSED);
+            }
+            prog.set(loc_masked, 0);
+            glDisable(GL_BLEND);
+            GLuint64 samples = 0;
+            glGetQueryObjectui64v(p.query, GL_QUERY_RESULT, &samples);
+            t.fallback_pixels = std::size_t(samples);
+        }
+        check_error("indirect_renderer upsample");
+        t.upsample_ms = lap(start);
+    }
+    p.release_targets();
+    check_error("indirect_renderer::render");
+    return t;
+}
+
+void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::size_t h, const camera& cam,
+                              std::span<const rsm_textures> maps, object_id out, indirect_timings& t,
+                              clock::time_point& start) {
+    passes& p = *passes_;
+    const interleave_pattern& pattern = options_.pattern;
+    const bool interleaved = pattern.cells() > 1;
     gbuffer_textures shaded = g;
-    object_id shaded_out = irradiance.id;
+    object_id shaded_out = out;
     if (interleaved) {
         p.ensure_scratch(w, h);
         p.target({p.split_position_depth->id(), p.split_normal->id()}, w, h);
@@ -546,7 +740,7 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
         shaded_out = p.split_out->id();
     }
     check_error("indirect_renderer split");
-    t.split_ms = lap(start);
+    t.split_ms += lap(start);
 
     // Shade the sub-buffers.
     const float zero[4] = {0.f, 0.f, 0.f, 0.f};
@@ -566,6 +760,11 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
                 for (std::size_t k = 0; k < full.size(); ++k) grouped[k] = glm::vec4(full[groups.order[k]], 0.f);
                 p.disc.emplace(std::span<const glm::vec4>(grouped));
                 p.groups.emplace(std::span<const std::uint32_t>(groups.begin));
+                std::vector<glm::vec4> whole(full.size());
+                for (std::size_t k = 0; k < full.size(); ++k) whole[k] = glm::vec4(full[k], 0.f);
+                const std::uint32_t one_group[2] = {0u, std::uint32_t(full.size())};
+                p.whole_disc.emplace(std::span<const glm::vec4>(whole));
+                p.whole_group.emplace(std::span<const std::uint32_t>(one_group));
                 p.disc_count = options_.count;
                 p.disc_texels = texels;
             }
@@ -652,16 +851,16 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
         }
     }
     check_error("indirect_renderer shade");
-    t.shade_ms = lap(start);
+    t.shade_ms += lap(start);
 
     if (interleaved) {
-        const object_id gathered = options_.blur ? p.gathered->id() : irradiance.id;
+        const object_id gathered = options_.blur ? p.gathered->id() : out;
         p.target({gathered}, w, h);
         passes::textures({p.split_out->id()});
         passes::frame_uniforms(p.gather, w, h, pattern);
         p.fullscreen(p.gather);
         check_error("indirect_renderer gather");
-        t.gather_ms = lap(start);
+        t.gather_ms += lap(start);
         if (options_.blur) {
             p.target({p.edges->id()}, w, h);
             passes::textures({g.position_depth.id, g.normal.id});
@@ -677,18 +876,15 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
             p.tent_x->set(loc_pattern_width, float(pattern.n));
             p.fullscreen(*p.tent_x);
 
-            p.target({irradiance.id}, w, h);
+            p.target({out}, w, h);
             passes::textures({p.scratch->id(), p.edges->id(), g.position_depth.id});
             passes::frame_uniforms(*p.tent_y, w, h, pattern);
             p.tent_y->set(loc_pattern_width, float(pattern.m));
             p.fullscreen(*p.tent_y);
             check_error("indirect_renderer blur");
-            t.blur_ms = lap(start);
+            t.blur_ms += lap(start);
         }
     }
-    p.release_targets();
-    check_error("indirect_renderer::render");
-    return t;
 }
 
 }  // namespace bounce::gl

@@ -12,6 +12,9 @@
 ///        RSM gather: a fragment pass reading the disc pattern from a storage buffer
 ///        SII: one instanced quad per VPL on its split-buffer rectangle, additive blending
 ///   -> gather (fragment pass) -> discontinuity buffer -> separable geometry-aware tent
+///   (the RSM gather may also run at 1/f resolution: a downsampling pass, the frame above at
+///   low resolution, then the geometry-aware upsampling with the full-resolution fallback
+///   gather of DS05 section 3.3, as the CPU renderer does)
 ///
 /// It is the GL twin of cpu::indirect_renderer: the same options (mirrored here, since the
 /// GL adapter does not include the CPU adapter), the same disc pattern and light groups,
@@ -20,9 +23,6 @@
 /// kernel of rsm.hpp and interleaved_sampling.hpp, so its image agrees with the CPU's to
 /// float rounding (tests/gl_rsm). Each pixel sums its terms in the CPU's order (blending
 /// adds in primitive order).
-///
-/// Not here: the RSM gather at low resolution with upsampling (the CPU's
-/// `low_resolution` > 1) is refused with parameter_error.
 ///
 /// Textures are in GL row order (row 0 at the bottom); the index maps are applied to the
 /// rows counted from the top, as on the CPU, so both backends put a pixel in the same
@@ -86,6 +86,13 @@ struct discontinuity_params {
     void validate() const;
 };
 
+/// Tolerances of the geometry-aware upsampling (geometry_aware_upsample_weights).
+struct upsample_params {
+    float cos_normal = 0.9f;       ///< smallest cosine between a sample's normal and the pixel's (typical: 0.9)
+    float plane_footprints = 2.f;  ///< largest distance to the pixel's tangent plane, in low-resolution pixel
+                                   ///< footprints at the pixel's depth (typical: 1-4)
+};
+
 /// What `indirect_renderer` does per frame; the fields, defaults and meanings of
 /// cpu::indirect_options (adapters/cpu/include/bounce/cpu/indirect_renderer.hpp).
 struct indirect_options {
@@ -104,7 +111,8 @@ struct indirect_options {
     disc_weighting disc = disc_weighting::unbiased;
     pixel_light_params light;
     float sii_cutoff = 0.f;  ///< SII splat cutoff, W/m^2 per pixel over all VPLs; 0: whole screen
-    int low_resolution = 1;  ///< must be 1 here (the CPU renderer's upsampling is not on GL)
+    int low_resolution = 1;  ///< RSM gather at 1/f resolution with upsampling (f in 1..8)
+    upsample_params upsample;
     std::uint64_t seed = 1;  ///< disc pattern and VPL sampling
     /// GL only: glFinish after every stage, so the stage times are the GPU's (wall clock
     /// between finishes). Off, the times measure only the issuing of commands.
@@ -117,13 +125,13 @@ struct indirect_options {
 /// Per-stage wall-clock times of one frame (ms; the GPU's when time_stages) and counts,
 /// as cpu::indirect_timings.
 struct indirect_timings {
-    double split_ms = 0;    ///< G-buffer split into sub-buffers
+    double split_ms = 0;    ///< G-buffer split into sub-buffers (and downsampling)
     double shade_ms = 0;    ///< RSM read-back and VPL selection (SII), upload, the gather or splat passes
     double gather_ms = 0;   ///< sub-buffers back to image order
     double blur_ms = 0;     ///< discontinuity buffer and the two tent passes
-    double upsample_ms = 0; ///< always 0 (no low-resolution gather on GL)
+    double upsample_ms = 0; ///< low-resolution upsampling with full-resolution fallback
     std::size_t vpls = 0;   ///< SII: VPLs splatted; RSM gather: disc samples per pixel and map
-    std::size_t fallback_pixels = 0;  ///< always 0
+    std::size_t fallback_pixels = 0;  ///< pixels the upsampling gathered at full resolution (an occlusion query)
     double total_ms() const noexcept { return split_ms + shade_ms + gather_ms + blur_ms + upsample_ms; }
 };
 
@@ -164,6 +172,8 @@ private:
     struct passes;
     using clock = std::chrono::steady_clock;
     double lap(clock::time_point& t) const;
+    void frame(const gbuffer_textures& g, std::size_t w, std::size_t h, const camera& cam,
+               std::span<const rsm_textures> maps, object_id out, indirect_timings& t, clock::time_point& start);
 
     indirect_options options_;
     std::unique_ptr<passes> passes_;
