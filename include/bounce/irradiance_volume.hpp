@@ -554,11 +554,11 @@ inline int irradiance_volume::depth() const noexcept {
 
 inline std::uint32_t irradiance_volume::find_leaf(glm::vec3 p) const {
     const node& root = nodes_.front();
-    p = glm::clamp(p, root.lo, root.lo + root.size);
+    p = volume_clamp<float, glm::vec3>(p, root.lo, root.size);
     std::uint32_t i = 0;
     while (!nodes_[i].leaf()) {
         const node& n = nodes_[i];
-        const float octant = octree_octant<float, glm::vec3>(p, n.lo + n.size * 0.5f);
+        const float octant = octree_octant<float, glm::vec3>(p, n.lo, n.size);
         i = std::uint32_t(n.first_child) + std::uint32_t(octant);
     }
     return i;
@@ -585,9 +585,7 @@ inline void irradiance_volume::weighted_candidates(glm::vec3 p, float support, s
     while (top > 0) {
         const std::uint32_t i = stack[--top];
         const node& nd = nodes_[i];
-        const float grow = support * 0.5f * glm::length(nd.size);
-        const glm::vec3 lo = nd.lo - grow, hi = nd.lo + nd.size + grow;
-        if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
+        if (octree_node_reaches<float, glm::vec3>(p, nd.lo, nd.size, support) == 0.f) continue;
         if (!nd.leaf()) {
             for (int k = 7; k >= 0; --k) stack[top++] = std::uint32_t(nd.first_child + k);
             continue;

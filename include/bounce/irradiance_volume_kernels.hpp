@@ -26,13 +26,32 @@ inline constexpr int irradiance_volume_bands = 3;
 /// Coefficients per channel of a probe.
 inline constexpr std::size_t irradiance_volume_coefficients = sh_count(irradiance_volume_bands);
 
-/// The child of an octree cell holding `p`: 0..7 with bit 0 set for p.x >= centre.x, bit 1
-/// for y, bit 2 for z (a point on a splitting plane belongs to the upper child). Returned
-/// as a number so that the same kernel runs in GLSL, where the caller converts it to int.
+/// The child of the octree cell [lo, lo + size] holding `p`: 0..7 with bit 0 set for
+/// p.x >= centre.x, bit 1 for y, bit 2 for z, centre = lo + size / 2 (a point on a
+/// splitting plane belongs to the upper child; size / 2 is exact, so every backend finds
+/// the same centre). Returned as a number so that the same kernel runs in GLSL, where the
+/// caller converts it to an index.
 template <real T, vec3_of<T> V>
-T octree_octant(const V& p, const V& centre) {
+T octree_octant(const V& p, const V& lo, const V& size) {
+    const V centre = lo + size * T(0.5);
     return select(p.x >= centre.x, T(1), T(0)) + select(p.y >= centre.y, T(2), T(0)) +
            select(p.z >= centre.z, T(4), T(0));
+}
+
+/// `p` clamped into the box [lo, lo + size] (lookups outside a volume use its boundary).
+template <real T, vec3_of<T> V>
+V volume_clamp(const V& p, const V& lo, const V& size) {
+    return clamp(p, lo, lo + size);
+}
+
+/// 1 when the box [lo, lo + size] grown on every side by `support` times its half
+/// diagonal holds p, else 0: whether a weighted lookup at p must descend into an octree
+/// node (no probe of a leaf inside it reaches farther than that).
+template <real T, vec3_of<T> V>
+T octree_node_reaches(const V& p, const V& lo, const V& size, const T& support) {
+    const T grow = support * T(0.5) * length(size);
+    const V a = lo - V(grow), b = lo + size + V(grow);
+    return select(p.x >= a.x && p.y >= a.y && p.z >= a.z && p.x <= b.x && p.y <= b.y && p.z <= b.z, T(1), T(0));
 }
 
 /// Trilinear weights of the 8 corners of the box [lo, lo + size] at `p` (clamped into the

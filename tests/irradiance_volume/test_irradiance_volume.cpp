@@ -297,13 +297,13 @@ TEST_CASE("the weighted lookup does not pop across a subdivision boundary", "[ir
         worst_weighted = std::max(worst_weighted, std::abs(v.weighted(left, n, {}).x - v.weighted(right, n, {}).x));
         worst_trilinear = std::max(worst_trilinear, std::abs(v.trilinear(left, n).x - v.trilinear(right, n).x));
     }
-    // Budget: the weighted lookup is continuous (every probe enters with weight 0), so over
-    // 2 eps it changes by at most its largest slope times 2 eps. Its slope is at most the
-    // field's (|grad| <= 4 here: 4 y + 2 z, times pi Y00 < 1) times Shepard's steepening
-    // between probes, below (1 + b / min t) for b = 2 and t >= 1e-4 only at a probe: we
-    // allow a slope of 1000, i.e. 2e-4 * 1000 = 0.2 of... no: 0.2 absolute is too loose;
-    // measured slopes stay below 20, so 2 eps * 20 = 0.004, and we check 0.01 of the range
-    // (0.027), far below trilinear's jump, which does not shrink with eps.
+    // Budget: the weighted lookup is continuous (every probe enters and leaves the average
+    // with weight 0), so over 2 eps it changes by at most its slope times 2 eps. The field's
+    // slope is below 4 (4 y + 2 z, times pi Y00 < 1); Shepard's averages steepen it between
+    // probes by a factor of order b + 1 = 3 (Franke and Nielson 1980), so 2e-4 * 4 * 3 =
+    // 0.0024 < 0.01 of the range (2.66). Trilinear lookups jump at the T-junctions by an
+    // amount that does not shrink with eps (the quadratic's deviation from the coarse
+    // corners' interpolation, ~ 2 * 0.5^2 / 4 * pi Y00), far above it.
     CHECK(worst_weighted < 0.01f * range);
     CHECK(worst_trilinear > 0.01f * range);  // the budget is tight enough to see trilinear pop
 }

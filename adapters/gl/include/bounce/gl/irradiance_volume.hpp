@@ -1,0 +1,62 @@
+#pragma once
+/// \file irradiance_volume.hpp
+/// Irradiance-volume lookups on the GPU (Oat 2006): the flattened octree and probes
+/// (irradiance_volume::flatten, std430) in storage buffers, and a compute pass that lights
+/// points with the same kernels as the CPU (irradiance_volume_kernels.hpp, printed as GLSL
+/// by glsl::emit). The pass's own GLSL is plumbing only: buffer reads, the descent loop,
+/// the traversal stack and the loops over corners.
+
+#include <bounce/gl/objects.hpp>
+#include <bounce/irradiance_volume.hpp>
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace bounce::gl {
+
+/// A volume's nodes, probes and probe owners in three storage buffers (created in the
+/// current context; destroy before it).
+class irradiance_volume_buffers {
+public:
+    /// Uploads `volume`. Throws gl_error when a buffer exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE.
+    explicit irradiance_volume_buffers(const irradiance_volume& volume);
+
+    const buffer& nodes() const noexcept { return nodes_; }    ///< irradiance_volume_gpu_node[]
+    const buffer& probes() const noexcept { return probes_; }  ///< irradiance_volume_gpu_probe[]
+    const buffer& owners() const noexcept { return owners_; }  ///< uint[]: probe_owners()
+    float reference_reach() const noexcept { return reference_reach_; }
+
+private:
+    buffer nodes_, probes_, owners_;
+    float reference_reach_;
+};
+
+/// Which interpolation the GPU lookup runs.
+enum class volume_interpolation { trilinear, weighted };
+
+/// The compute pass that lights points from irradiance_volume_buffers.
+class irradiance_volume_lookup {
+public:
+    /// Compiles the pass (current context). Throws shader_error when it does not compile.
+    irradiance_volume_lookup();
+
+    /// The compute shader's source: the emitted kernels and the plumbing around them.
+    static std::string shader_source();
+
+    /// Irradiance (W/m^2, RGB) at each point with its unit normal, as
+    /// irradiance_volume::trilinear or ::weighted compute it. Restores the program and the
+    /// storage-buffer bindings 0..4 it uses. Throws parameter_error on mismatched sizes or
+    /// a `how` the CPU lookup refuses, gl_error on a GL failure.
+    std::vector<glm::vec3> light_points(const irradiance_volume_buffers& volume, std::span<const glm::vec3> points,
+                                        std::span<const glm::vec3> normals, volume_interpolation interpolation,
+                                        const weighted_lookup& how = {}) const;
+
+private:
+    program program_;
+};
+
+}  // namespace bounce::gl

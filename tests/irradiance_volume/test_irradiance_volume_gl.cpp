@@ -1,0 +1,95 @@
+// The GPU lookups of an irradiance volume (gl/irradiance_volume.hpp: the kernels of
+// irradiance_volume_kernels.hpp emitted to GLSL, run by a compute pass on llvmpipe in CI)
+// agree with the CPU's (irradiance_volume.hpp) on an adaptive octree with gradients and
+// inside probes.
+//
+// Tolerance 1e-5 relative to the largest irradiance of the volume: both sides add the same
+// nonzero terms in the same order (the GPU also adds the zero-weight terms the CPU skips,
+// which change nothing); each term is a 9-coefficient SH evaluation (about 40 float
+// operations, ~2 ulp each in the worst case on either side: 40 * 2 * 6e-8 = 5e-6 of the
+// term's size) times a weight whose pow() llvmpipe evaluates to a few ulp; the average is a
+// convex combination, so the error stays below ~5e-6 of the largest term: 1e-5 of the
+// largest irradiance covers it.
+#include "../gl/shared_context.hpp"
+#include "../owned_scene.hpp"
+
+#include <bounce/gl/irradiance_volume.hpp>
+#include <bounce/irradiance_volume.hpp>
+#include <bounce/sampling.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+using namespace bounce;
+
+TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_volume][gl]") {
+    gl_test::shared_context();
+    test::owned_scene scene;
+    scene.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
+    scene.positions = {{0.3f, -0.9f, -0.9f}, {0.3f, 0.9f, -0.9f}, {0.3f, -0.9f, 0.9f}};
+    scene.triangles = {{0, 1, 2}};
+    scene.material_of = {0};
+    // A smooth non-linear field with analytic gradients; probes with z < -0.8 are inside.
+    const auto source = [](std::span<const glm::vec3> p, std::span<irradiance_probe> out) {
+        for (std::size_t j = 0; j < p.size(); ++j) {
+            const glm::vec3 x = p[j];
+            out[j] = {};
+            out[j].position = x;
+            out[j].inside = x.z < -0.8f;
+            for (std::size_t i = 0; i < 9; ++i) {
+                const float a = 0.3f * float(i + 1);
+                out[j].radiance[i] = glm::vec3(std::sin(a * x.x) + 1.5f, std::cos(a * x.y) + x.z, 0.5f * x.x * x.y + 1.f) /
+                                     float(i + 1);
+                out[j].gradient[0][i] = glm::vec3(a * std::cos(a * x.x), 0.f, 0.5f * x.y) / float(i + 1);
+                out[j].gradient[1][i] = glm::vec3(0.f, -a * std::sin(a * x.y), 0.5f * x.x) / float(i + 1);
+                out[j].gradient[2][i] = glm::vec3(0.f, 1.f, 0.f) / float(i + 1);
+            }
+            out[j].harmonic_mean_distance = 1;
+        }
+    };
+    irradiance_volume_settings s;
+    s.min_depth = 1;
+    s.max_depth = 3;
+    s.distance_ratio = s.neighbour_change = s.gradient_ratio = s.cull_tolerance = 0;
+    s.geometry_triangles = 1;
+    const auto volume = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, source);
+    REQUIRE(volume.depth() == 3);
+
+    std::vector<glm::vec3> points, normals;
+    pcg32 rng(5);
+    for (int i = 0; i < 1500; ++i) {
+        // Inside the volume, a little outside it, and on its splitting planes.
+        glm::vec3 p(2.2f * rng.next_float() - 1.1f, 2.2f * rng.next_float() - 1.1f, 2.2f * rng.next_float() - 1.1f);
+        if (i % 7 == 0) p.x = 0.f;
+        if (i % 11 == 0) p.y = 0.25f;
+        const float z = 2 * rng.next_float() - 1, phi = 6.2831853f * rng.next_float(), r = std::sqrt(std::max(0.f, 1 - z * z));
+        points.push_back(p);
+        normals.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+    }
+    const gl::irradiance_volume_buffers buffers(volume);
+    const gl::irradiance_volume_lookup lookup;
+    struct variant {
+        gl::volume_interpolation interpolation;
+        weighted_lookup how;
+    };
+    for (const variant v : {variant{gl::volume_interpolation::trilinear, {}}, variant{gl::volume_interpolation::weighted, {}},
+                            variant{gl::volume_interpolation::weighted, {1.f, false, 2.5f}},
+                            variant{gl::volume_interpolation::weighted, {4.f, true, 1.2f}}}) {
+        const auto gpu = lookup.light_points(buffers, points, normals, v.interpolation, v.how);
+        std::vector<glm::vec3> cpu(points.size());
+        float largest = 0;
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            cpu[i] = v.interpolation == gl::volume_interpolation::trilinear ? volume.trilinear(points[i], normals[i])
+                                                                            : volume.weighted(points[i], normals[i], v.how);
+            for (int k = 0; k < 3; ++k) largest = std::max(largest, std::abs(cpu[i][k]));
+        }
+        REQUIRE(largest > 0.1f);
+        for (std::size_t i = 0; i < points.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                INFO("point " << i << " channel " << k << " interpolation " << int(v.interpolation) << " b " << v.how.b);
+                REQUIRE(gpu[i][k] == Approx(cpu[i][k]).margin(1e-5 * largest));
+            }
+    }
+}
