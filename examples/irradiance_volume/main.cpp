@@ -76,7 +76,7 @@ struct options {
     std::uint32_t frames = 16;
     std::uint32_t sphere_points = 256;
     std::uint32_t popping_steps = 128;
-    float radius = 0.04f;      // fraction of the volume's diagonal
+    float radius = 0.02f;      // fraction of the volume's diagonal
     float margin = -0.01f;     // fraction of the scene's extent added on every side
     std::vector<float> path;   // x0 y0 z0 x1 y1 z1 as fractions of the volume's box
     float distance_ratio = 1.f, neighbour_change = 0.25f, gradient_ratio = 0.3f, cull = 0.05f;
@@ -281,7 +281,7 @@ int run(const options& o) {
     std::vector<float> path = o.path;
     if (path.empty())
         path = scene.name == "cornell" ? std::vector<float>{0.2f, 0.75f, 0.55f, 0.8f, 0.75f, 0.55f}
-                                       : std::vector<float>{0.15f, 0.3f, 0.5f, 0.85f, 0.3f, 0.5f};
+                                       : std::vector<float>{0.15f, 0.2f, 0.5f, 0.85f, 0.2f, 0.5f};
     const glm::vec3 a = lo + extent * glm::vec3(path[0], path[1], path[2]);
     const glm::vec3 b = lo + extent * glm::vec3(path[3], path[4], path[5]);
     const float radius = o.radius * glm::length(extent);
