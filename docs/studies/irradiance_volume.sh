@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The figures of docs/sh-and-irradiance-volumes.md, irradiance-volume sections: uniform grids
+# and adaptive octrees (build/bin/irradiance_volume) lighting a sphere moving through the
+# Cornell box and Sponza, every lookup (trilinear, weighted, weighted with gradients) on
+# each bake, error against the reference integrator's one-bounce indirect irradiance on the
+# sphere. Every run goes into docs/results/irradiance_volume.json; the strip pictures into
+# docs/figures/irradiance_volume_*.png. Sponza needs BOUNCE_SCENES (or ../shared/scenes).
+# About 25 minutes on 2 shared cores (the adaptive Sponza bake dominates).
+# Usage: docs/studies/irradiance_volume.sh [cornell|sponza|sh]   (BOUNCE_BIN: default build/bin)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+bin="${BOUNCE_BIN:-build/bin}/irradiance_volume"
+out=build/runs/irradiance_volume
+results=docs/results/irradiance_volume.json
+figures=docs/figures
+mkdir -p "$out" "$figures"
+common=(--rays 512 --ref-samples 1024 --frames 8 --sphere-points 128 --gradient-step 0.5)
+run() {  # run NAME ARGS...: one run, its report added to the results file
+  local name=$1; shift
+  "$bin" --json "$out/$name.json" "$@" 2>/dev/null | tail -4
+  python3 docs/studies/results.py add "$results" "$name" "$out/$name.json"
+}
+part=${1:-all}
+
+if [[ $part == all || $part == cornell ]]; then
+  # The built-in box (0.55 m): uniform grids of depth 3 and 4 against an adaptive octree of
+  # depth 4 with the default heuristics.
+  run cornell-uniform-3 --scene cornell --mode uniform --max-depth 3 "${common[@]}"
+  run cornell-uniform-4 --scene cornell --mode uniform --max-depth 4 "${common[@]}" --out "$figures/irradiance_volume_cornell.png"
+  run cornell-adaptive-4 --scene cornell --mode adaptive --max-depth 4 "${common[@]}"
+fi
+
+if [[ $part == all || $part == sponza ]]; then
+  # Sponza (sphere through the atrium at 20% of the height): uniform grids of depth 3 and 4;
+  # adaptive octrees of depth 5 with the default heuristics and with a selective set
+  # (geometry off, harmonic mean distance at 0.3 of the cell diagonal, culling at 10%).
+  run sponza-uniform-3 --scene sponza --mode uniform --max-depth 3 "${common[@]}"
+  run sponza-uniform-4 --scene sponza --mode uniform --max-depth 4 "${common[@]}"
+  run sponza-adaptive-4 --scene sponza --mode adaptive --max-depth 4 "${common[@]}"
+  run sponza-adaptive-5 --scene sponza --mode adaptive --max-depth 5 "${common[@]}"
+  run sponza-adaptive-5-selective --scene sponza --mode adaptive --max-depth 5 --geometry-triangles 0 \
+    --distance-ratio 0.3 --cull 0.1 --b 1 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
+fi
+
+if [[ $part == all || $part == sh ]]; then
+  # SH projection and irradiance errors per order of environments captured along the paths.
+  "$bin" --scene cornell --sh-study --json "$out/sh-cornell.json"
+  python3 docs/studies/results.py add "$results" sh-cornell "$out/sh-cornell.json"
+  "$bin" --scene sponza --sh-study --json "$out/sh-sponza.json"
+  python3 docs/studies/results.py add "$results" sh-sponza "$out/sh-sponza.json"
+fi
