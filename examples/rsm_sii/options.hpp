@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include "../common/cli_number_checks.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -38,17 +39,12 @@ struct options {
 /// "NxM" -> pattern; throws parameter_error naming --pattern.
 inline interleave_pattern parse_pattern(const std::string& s) {
     const auto x = s.find('x');
-    int n = 0, m = 0;
-    try {
-        if (x == std::string::npos) throw std::invalid_argument(s);
-        std::size_t used_n = 0, used_m = 0;
-        n = std::stoi(s.substr(0, x), &used_n);
-        m = std::stoi(s.substr(x + 1), &used_m);
-        if (used_n != x || used_m != s.size() - x - 1) throw std::invalid_argument(s);
-    } catch (const std::exception&) {
+    const auto digits = [](const std::string& t) {
+        return !t.empty() && t.size() <= 4 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (x == std::string::npos || !digits(s.substr(0, x)) || !digits(s.substr(x + 1)))
         throw parameter_error("--pattern", "'" + s + "' is not of the form NxM (e.g. 4x4)");
-    }
-    interleave_pattern p{n, m};
+    interleave_pattern p{std::stoi(s.substr(0, x)), std::stoi(s.substr(x + 1))};
     try {
         p.validate();
     } catch (const parameter_error&) {
