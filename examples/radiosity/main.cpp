@@ -205,6 +205,7 @@ nlohmann::ordered_json reference_json(const options& o, const embree::multi_boun
 int run(const options& o) {
     check_writable(o.json, "--json");
     check_writable(o.out, "--out");
+    check_writable(o.reference_out, "--reference-out");
     if (!o.out.empty() && o.out.extension() != ".png" && o.out.extension() != ".exr")
         throw parameter_error("--out", "must end in .png or .exr: " + o.out.string());
     if (!o.lightmaps.empty()) {
@@ -333,6 +334,10 @@ int run(const options& o) {
     if (!o.out.empty()) {
         if (o.out.extension() == ".exr") io::write_exr(o.out, view.view());
         else io::write_png(o.out, view.view());
+    }
+    if (!o.reference_out.empty() && cmp.reference) {
+        if (o.reference_out.extension() == ".exr") io::write_exr(o.reference_out, cmp.reference->radiance.view());
+        else io::write_png(o.reference_out, cmp.reference->radiance.view());
     }
     if (!o.lightmaps.empty()) {
         io::write_exr(o.lightmaps / "radiosity.exr", r.lightmap.view());

@@ -39,7 +39,7 @@ struct options {
     std::uint32_t reference_paths = 256;
     int curve_points = 16;            // error checkpoints along the solve (0: none)
     bool quiet = false;
-    std::filesystem::path json, out, lightmaps, versus;
+    std::filesystem::path json, out, lightmaps, versus, reference_out;
 };
 
 inline void add_options(CLI::App& app, options& o, std::string& adaptive, std::string& ambient,
@@ -89,6 +89,7 @@ inline void add_options(CLI::App& app, options& o, std::string& adaptive, std::s
     app.add_option("--json", o.json, "write the run report (JSON) here");
     app.add_option("--out", o.out, "write the rendered view here (.png or .exr)");
     app.add_option("--lightmaps", o.lightmaps, "write the lightmaps (EXR) into this folder");
+    app.add_option("--reference-out", o.reference_out, "write the reference view here (.png or .exr)");
     app.add_option("--versus", o.versus, "also compare the view with this EXR view of another run (same size)");
 }
 

@@ -143,8 +143,14 @@ struct lightmap_atlas {
     /// square of fine texels its cell covers (elements deeper than `level` are averaged,
     /// area-weighted); fine texels no element covers (a chart's slanted edge, padding) take
     /// their base texel's to_texels value. level = 0 is to_texels.
+    /// With `interpolate_base`, the fine texels of elements that were never split (level 0)
+    /// take the bilinear interpolation of the base texels at their centres instead of their
+    /// element's constant value, so that a bilinear lookup of the fine map shows unsplit
+    /// regions as a bilinear lookup of the base map would (the chapter's reconstruction of
+    /// the coarse level), rather than as blocks of 2^level texels.
     template <class T>
-    image<T> to_fine_texels(std::span<const T> values, int level, const T& background = T{}) const {
+    image<T> to_fine_texels(std::span<const T> values, int level, const T& background = T{},
+                            bool interpolate_base = false) const {
         require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
         const image<T> base = to_texels(values, background);
         if (level == 0) return base;
@@ -153,8 +159,10 @@ struct lightmap_atlas {
         std::vector<T> sum(w * h, T{});
         std::vector<float> weight(w * h, 0.f);
         std::vector<std::int64_t> single(w * h, -1);  // the one element of a fine texel, or -2 for several
+        std::vector<std::uint8_t> unsplit(size(), 0);  // elements of level 0
         for (std::size_t k = 0; k < blocks(); ++k) {
             const int l = block_level.empty() ? 0 : int(block_level[k]);
+            for (std::uint32_t e = block_first[k]; e < block_first[k + 1]; ++e) unsplit[e] = l == 0 ? 1 : 0;
             const double cells = std::ldexp(1.0, l);  // cells per base texel
             for (std::uint32_t e = block_first[k]; e < block_first[k + 1]; ++e) {
                 const lightmap_chart& ch = charts[chart[e]];
@@ -186,6 +194,19 @@ struct lightmap_atlas {
                 // Only a texel's own fine texels come from its elements; padding copies its source texel.
                 const bool own = texel[std::size_t(e)].x == bx && texel[std::size_t(e)].y == by;
                 const std::int64_t one = single[y * w + x];
+                if (interpolate_base && own && one >= 0 && unsplit[std::size_t(one)]) {
+                    // Base texel coordinates of the fine texel's centre; base texel i's centre is i + 1/2.
+                    const double u = (double(x) + 0.5) / double(f) - 0.5, v = (double(y) + 0.5) / double(f) - 0.5;
+                    const double fu = std::floor(u), fv = std::floor(v);
+                    const float tu = float(u - fu), tv = float(v - fv);
+                    const auto at = [&](double i, double j) {
+                        return base(std::size_t(std::clamp(i, 0.0, double(base.width() - 1))),
+                                    std::size_t(std::clamp(j, 0.0, double(base.height() - 1))));
+                    };
+                    out(x, y) = (1.f - tv) * ((1.f - tu) * at(fu, fv) + tu * at(fu + 1, fv)) +
+                                tv * ((1.f - tu) * at(fu, fv + 1) + tu * at(fu + 1, fv + 1));
+                    continue;
+                }
                 out(x, y) = !own || one == -1 ? base(bx, by) : one >= 0 ? values[std::size_t(one)] : sum[y * w + x] / weight[y * w + x];
             }
         return out;

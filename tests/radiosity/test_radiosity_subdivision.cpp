@@ -170,6 +170,36 @@ TEST_CASE("subdividing during a solve keeps the power balance and refines where 
     CHECK(solver.unshot_fraction() <= 0.1);
 }
 
+TEST_CASE("subdivision evaluates the lights' direct light again at the children", "[radiosity][subdivision][lights]") {
+    // The Cornell box lit by its spot light only: right after construction an element's
+    // radiosity is rho E_direct. Split leaves, and each child must hold rho E_direct at its own
+    // position, as a solver built on the refined atlas computes it, not its parent's value;
+    // the change is counted as emitted power, so the balance still holds. The children's
+    // value is rho E_p + rho (E_c - E_p) in float: within 4 ulps of the larger of rho E_c and
+    // rho E_p (a child in shadow keeps the rounding of its lit parent's value), bounded by
+    // the largest radiosity.
+    const auto scene = cornell_box(true);
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 1500, .block_texels = 8});
+    cpu::item_buffer_visibility vis(scene.view(), atlas, {.resolution = 128});
+    cpu::progressive_radiosity solver(scene.view(), atlas, vis);
+    std::size_t splits = 0;
+    for (int pass = 0; pass < 2; ++pass) splits += solver.subdivide(scene.view(), {.threshold = 0.25, .min_texels = 2, .max_level = 2});
+    REQUIRE(splits > 0);
+    cpu::progressive_radiosity fresh(scene.view(), solver.atlas(), vis);
+    REQUIRE(fresh.radiosity().size() == solver.radiosity().size());
+    glm::vec3 largest(0.f);
+    for (const glm::vec3& b : fresh.radiosity()) largest = glm::max(largest, b);
+    for (std::size_t i = 0; i < solver.radiosity().size(); ++i) {
+        const glm::vec3 a = solver.radiosity()[i], b = fresh.radiosity()[i];
+        for (int c = 0; c < 3; ++c) REQUIRE(std::abs(a[c] - b[c]) <= 4 * 0x1p-24f * largest[c]);
+    }
+    // (Inherited values would miss by far more: a leaf split across the boxes' shadow on the
+    // red wall has lit and shadowed children.)
+    const glm::dvec3 balance = solver.absorbed_power() + solver.unshot_power() + solver.escaped_power();
+    CHECK(balance.x == Approx(solver.emitted_power().x).epsilon(1e-6));
+    CHECK(solver.emitted_power().x == Approx(fresh.emitted_power().x).epsilon(1e-5));
+}
+
 TEST_CASE("bad subdivision input raises parameter_error naming it", "[radiosity][subdivision][errors]") {
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});

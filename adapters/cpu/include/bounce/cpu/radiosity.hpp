@@ -119,7 +119,9 @@ public:
         }
         build_shooters();
         const auto start = clock::now();
-        for (const light& l : scene.lights) shoot_light(pack(l));
+        direct_.assign(n, vec(0));
+        for (const light& l : scene.lights) lights_.push_back(pack(l));
+        for (const packed_light& l : lights_) shoot_light(l, false);
         timings_.lights_ms = ms_since(start);
         refresh_powers();
     }
@@ -204,11 +206,12 @@ public:
     }
 
     /// display_radiosity laid out as the atlas at 2^level times its resolution
-    /// (lightmap_atlas::to_fine_texels; level > 0 shows what adaptive subdivision added), for
+    /// (lightmap_atlas::to_fine_texels, unsplit regions interpolated from the base texels;
+    /// level > 0 shows what adaptive subdivision added), for
     /// writing a lightmap or texturing a view.
     image<glm::vec3> lightmap(int level = 0) const {
         const auto values = display_radiosity();
-        return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level);
+        return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level, glm::vec3(0.f), true);
     }
 
     const radiosity_timings& timings() const noexcept { return timings_; }
@@ -220,7 +223,12 @@ public:
     /// Adaptive subdivision (radiosity_subdivision.hpp): splits the leaves whose radiosity
     /// fails the test, gives each child element its parent's radiosity and unshot radiosity
     /// (power is unchanged: children's areas add up to their parent's), and rebuilds the
-    /// shooters. `scene` is the scene the atlas was built from. Returns the leaves split.
+    /// shooters. Point, spot and directional lights are then evaluated again at the children
+    /// (their direct light is known in closed form, so it is re-gathered rather than
+    /// inherited): each child's radiosity and unshot radiosity change by rho times the change
+    /// of its direct irradiance, and that power is added to the emitted (and its 1 - rho
+    /// share to the absorbed) power, so the balance still holds. `scene` is the scene the
+    /// atlas was built from. Returns the leaves split.
     /// The chapter runs this test after every reconstruction pass; calling it every step or
     /// every few steps from the first shots on keeps most of the light at the finer level.
     std::size_t subdivide(const scene_view& scene, const subdivision_options& options) {
@@ -230,15 +238,21 @@ public:
         const auto split = blocks_to_subdivide(atlas_, std::span<const glm::vec3>(b), options);
         if (!split.empty()) {
             atlas_refinement r = refine_lightmap_atlas(scene, atlas_, split);
-            std::vector<vec> radiosity(r.parent.size()), unshot(r.parent.size());
+            std::vector<vec> radiosity(r.parent.size()), unshot(r.parent.size()), direct(r.parent.size());
             for (std::size_t i = 0; i < r.parent.size(); ++i) {
                 radiosity[i] = radiosity_[r.parent[i]];
                 unshot[i] = unshot_[r.parent[i]];
+                direct[i] = direct_[r.parent[i]];
             }
             atlas_ = std::move(r.atlas);
             radiosity_ = std::move(radiosity);
             unshot_ = std::move(unshot);
-            build_shooters();
+            direct_ = direct;
+            build_shooters();  // the distribution below walks the new shooters' elements
+            if (!lights_.empty()) {
+                regather_lights(direct);
+                refresh_powers();
+            }
         }
         timings_.subdivision_ms += ms_since(start);
         return split.size();
@@ -403,9 +417,33 @@ private:
         ++shots_;
     }
 
+    // The lights' direct irradiance at every element of the refined atlas, against what the
+    // elements inherited (`inherited`): the difference is added as described at subdivide().
+    // Elements that were not split get bitwise their old value (same visibility, same sums).
+    void regather_lights(const std::vector<vec>& inherited) {
+        const auto start = clock::now();
+        direct_.assign(inherited.size(), vec(0));
+        for (const packed_light& l : lights_) shoot_light(l, true);
+        glm::dvec3 added(0), absorbed(0);
+        for (std::size_t i = 0; i < direct_.size(); ++i) {
+            const vec d = direct_[i] - inherited[i];
+            if (d == vec(0)) continue;
+            const vec rho = vec(atlas_.albedo[i]);
+            radiosity_[i] += rho * d;
+            unshot_[i] += rho * d;
+            const glm::dvec3 power = glm::dvec3(d) * double(atlas_.area[i]);
+            added += power;
+            absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * power;
+        }
+        emitted_ += added;
+        absorbed_ += absorbed;
+        timings_.lights_ms += ms_since(start);
+    }
+
     // Direct light from one point, spot or directional light: each element's irradiance
     // E (lights.hpp) times visibility becomes incident power; rho E is its first radiosity.
-    void shoot_light(const packed_light& l) {
+    // With `measure_only` the irradiance is only added to direct_ (regather_lights).
+    void shoot_light(const packed_light& l, bool measure_only) {
         const lightmap_atlas& at = atlas_;
         const light_kind kind = l.kind();
         std::vector<shot_frame> frames;
@@ -440,6 +478,8 @@ private:
                 if (!(e.x > 0.f || e.y > 0.f || e.z > 0.f)) return;
                 const float v = vis.visible(p, at.chart[i]);
                 if (!(v > 0.f)) return;
+                direct_[i] += vec(e * v);
+                if (measure_only) return;
                 const vec rho = vec(at.albedo[i]);
                 const vec gain = rho * vec(e * v);
                 radiosity_[i] += gain;
@@ -448,6 +488,7 @@ private:
                 s.intercepted += intercepted;
                 s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
             });
+            if (measure_only) continue;
             emitted_ += total.intercepted;
             absorbed_ += total.absorbed;
         }
@@ -457,6 +498,8 @@ private:
     Visibility visibility_;
     radiosity_options options_;
     std::vector<vec> radiosity_, unshot_;
+    std::vector<vec> direct_;             // direct irradiance from lights_ per element (W/m^2)
+    std::vector<packed_light> lights_;    // the scene's point, spot and directional lights
     std::vector<std::uint32_t> first_;
     std::vector<glm::vec3> centre_;
     std::vector<Real> shooter_area_;
