@@ -477,7 +477,8 @@ int run(const options& o) {
         j["lookups"] = lookups;
         j["build"] = {{"split_min_depth", stats.split_min_depth}, {"split_distance", stats.split_distance},
                       {"split_neighbour", stats.split_neighbour}, {"split_geometry", stats.split_geometry},
-                      {"split_gradient", stats.split_gradient},   {"culled", stats.culled}};
+                      {"split_gradient", stats.split_gradient},   {"culled", stats.culled},
+                      {"inside_cells", stats.inside_cells}};
         j["light_transport"] =
             "one-bounce indirect: probes and reference integrate Kd/pi * direct irradiance at the first hit";
         std::ofstream(o.json) << j.dump(2) << "\n";

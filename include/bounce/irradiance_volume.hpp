@@ -73,7 +73,8 @@ concept probe_source = requires(S& s, std::span<const glm::vec3> positions, std:
 };
 
 /// The octree's shape and Oat's subdivision heuristics. A heuristic is off when its
-/// threshold is 0. A cell above min_depth and below max_depth is split when any fires.
+/// threshold is 0. A cell at or above min_depth and below max_depth is split when any
+/// fires, unless all its corners are inside geometry (nothing there to light).
 struct irradiance_volume_settings {
     /// Depth every cell reaches (0: the root may stay a leaf). Uniform grid: min = max.
     int min_depth = 1;
@@ -109,6 +110,7 @@ struct irradiance_volume_settings {
 struct irradiance_volume_build_stats {
     std::size_t split_min_depth = 0, split_distance = 0, split_neighbour = 0, split_geometry = 0, split_gradient = 0;
     std::size_t culled = 0;          ///< subdivisions undone by culling
+    std::size_t inside_cells = 0;    ///< cells not split because every corner is inside geometry
     std::size_t probes_baked = 0;    ///< probes the source computed, culled ones included
     std::size_t probes_inside = 0;   ///< probes of the final volume flagged inside
 };
@@ -367,9 +369,14 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
             const cell& c = level[ci];
             const node& nd = v.nodes_[c.node];
             bool split = false;
+            bool any_usable = false;
+            for (std::uint32_t idx : nd.corner) any_usable = any_usable || !all[idx].inside;
             if (depth < s.min_depth) {
                 split = true;
                 ++stats.split_min_depth;
+            } else if (!any_usable) {
+                // Every corner inside geometry: nothing here to light, nothing to refine.
+                ++stats.inside_cells;
             } else {
                 const float diagonal = glm::length(nd.size), edge = std::max({nd.size.x, nd.size.y, nd.size.z});
                 std::array<const irradiance_probe*, 8> corners{};
