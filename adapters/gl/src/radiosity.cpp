@@ -1047,7 +1047,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     const float chart = float(atlas.chart[i0]);
     set_shot(centre[k], atlas.normal[i0], chart);
     draw_visibility();
-    finish();
+    if (options.timed_stages) finish();
     timings.visibility_ms += ms_since(start);
 
     start = clock_type::now();
@@ -1073,7 +1073,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
         check_error("progressive_radiosity: the distribution pass");
     }
-    finish();
+    if (options.timed_stages) finish();
     timings.distribution_ms += ms_since(start);
     const reduction got = reduce();
     absorbed += got.absorbed;

@@ -74,13 +74,18 @@ struct radiosity_options {
     float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
     int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges
     int parallel_resolution = 1024;  ///< side of a directional light's buffer, pixels
+    bool timed_stages = true;  ///< end visibility and distribution with glFinish so that timings()
+                               ///< splits the GPU's time by stage; false leaves one wait per step
+                               ///< (the reduction's read-back), which then carries the GPU's time
 
     /// Throws parameter_error naming the option ("radiosity_options.resolution" ...).
     void validate() const;
 };
 
-/// Time spent per stage since construction, milliseconds, each stage ended by glFinish (so
-/// the figures are the GPU's time, not the driver's queueing).
+/// Time spent per stage since construction, milliseconds, each stage ended by glFinish when
+/// radiosity_options::timed_stages is set (so the figures are the GPU's time, not the
+/// driver's queueing); otherwise the GPU's work is counted where the step waits for it, in
+/// choice_ms.
 struct radiosity_timings {
     double lights_ms = 0;        ///< the scene's lights, their visibility included (construction)
     double visibility_ms = 0;    ///< reading the shooter back, tessellating and drawing the item buffer
