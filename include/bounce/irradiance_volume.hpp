@@ -13,10 +13,10 @@
 ///   lattice of the finest level, and each lattice point holds at most one probe. A probe
 ///   inside geometry (flagged by its source) is kept but skipped by every lookup.
 /// - Lookups: `find_leaf` descends with the `octree_octant` kernel; `trilinear` weighs the
-///   leaf's 8 corners; `weighted` takes the distance-weighted average of the probes of the
-///   leaf and of the six leaves across its faces, each extrapolated with its gradient
-///   (irradiance_volume_kernels.hpp), so probes of finer neighbours (T-junctions) enter
-///   smoothly instead of popping in.
+///   leaf's 8 corners; `weighted` takes Oat's distance-weighted average of the probes
+///   around p, each extrapolated with its gradient, with Franke and Nielson's compactly
+///   supported weights and a per-probe reach (irradiance_volume_kernels.hpp), so probes of
+///   finer neighbours (T-junctions) enter smoothly instead of popping in.
 /// - `flatten` lays nodes and probes out as std430 storage buffers for the GPU.
 ///
 /// Probes come from a caller's `probe_source`: Embree ray casting
