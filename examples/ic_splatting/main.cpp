@@ -109,6 +109,14 @@ int run_with(const options& o) {
     limits.min_pixels = o.min_pixels;
     limits.max_pixels = o.max_pixels;
     limits.gradient_limit = o.gradient_limit;
+    if (o.radius == "hessian") {
+        if (o.sampler != "embree")
+            throw parameter_error("--radius", "'hessian' needs the Embree sampler (the raster's reduction has no Hessian)");
+        if (!o.a_sweep.empty())
+            throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
+        limits.policy = radius_policy::hessian;
+        limits.hessian_a = o.a;
+    }
     const embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     chosen_sampler sampler = std::cref(embree_sampler);
     cpu::irradiance_cache_options cache_options = cache_options_for(o, o.a);
@@ -166,6 +174,8 @@ int run_with(const options& o) {
                 gs.light.render(tex);
                 gl::finish();
             });
+            // Older records shrunk by the cache's neighbour clamp: the GPU's copy restarts.
+            if (cache.clamp_to_neighbours() > 0) gs.splatter.reset();
             double snap_ms = 0;
             const auto st = gs.splatter.render(tex, cam, cache.records(), [&](gbuffer_view<float> g, image_view<glm::vec4> splat) {
                 if (o.sampler != "embree") {
@@ -227,7 +237,7 @@ int run_with(const options& o) {
                          {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
                          {"shadow_resolution", o.shadow_resolution},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
-                         {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
+                         {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"radius", o.radius},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
                          {"max_extrapolation", o.max_extrapolation},
                          {"front_tolerance", o.front_tolerance},
@@ -253,10 +263,109 @@ int run_with(const options& o) {
         return study::comparable_mask(g.view(), ray.view(), scene_size);
     };
 
+    // --indirect-exr and --indirect-out: the indirect image, and it beside the reference's
+    // with one exposure (the walkthrough's last frame, or the single frame).
+    auto write_indirect = [&](const image<glm::vec3>& indirect, const embree::reference_images& ref,
+                              const image<float>& mask) {
+        if (!o.indirect_exr.empty()) io::write_exr(o.indirect_exr, indirect.view());
+        if (o.indirect_out.empty()) return;
+        image<glm::vec3> pair(2 * o.width, o.height);
+        for (std::size_t y = 0; y < o.height; ++y)
+            for (std::size_t x = 0; x < o.width; ++x) {
+                pair(x, y) = indirect(x, y);
+                pair(o.width + x, y) = ref.indirect(x, y);
+            }
+        io::write_png(o.indirect_out, pair.view(), io::auto_exposure(ref.indirect.view(), mask.view()));
+    };
+
     nlohmann::ordered_json extra = nlohmann::ordered_json::object();
     study::stage_timer timer;
 
-    if (o.progressive > 0) {
+    if (o.walkthrough > 0) {
+        // The walkthrough: one cache kept and grown along the camera path, every frame
+        // compared with its own reference, and brute-force Monte Carlo timed at each
+        // frame's error (on every walkthrough_mc_stride-th frame; their mean time stands
+        // for every frame).
+        nlohmann::ordered_json frames = nlohmann::ordered_json::array();
+        const study::camera_path path(bvh, scene.camera, o.walkthrough);
+        double cache_total_ms = 0, error_sum = 0, mc_ms_sum = 0, mc_error_sum = 0;
+        std::size_t mc_frames = 0, mc_unreached = 0;
+        for (std::size_t f = 0; f < o.walkthrough; ++f) {
+            const camera cam = path.at(f);
+            study::stage_timer ft;
+            const auto t0 = clock_type::now();
+            auto fr = frame(cam, o.a, ft);
+            const double frame_ms = ms_since(t0);
+            cache_total_ms += frame_ms;
+            const auto ref = reference_for(cam);
+            const image<float> mask = mask_for(fr.g, cam);
+            const auto err = study::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
+            error_sum += err.rel_rms;
+            nlohmann::ordered_json entry = {{"frame", f},         {"records", cache.records().size()},
+                                            {"new_records", fr.new_records}, {"ms", frame_ms},
+                                            {"rel_rms", err.rel_rms}};
+            fmt::print("frame {:2}: {:6} records (+{:5}), {:8.1f} ms, indirect rel_rms {:.4f}", f, cache.records().size(),
+                       fr.new_records, frame_ms, err.rel_rms);
+            if (o.walkthrough_fresh) {
+                // The same camera from an empty cache: what the grown cache must not lose to.
+                const std::vector<irradiance_record> kept = cache.records();
+                cache.assign({});
+#ifdef BOUNCE_IC_WITH_GL
+                if (gl_state) gl_state->splatter.reset();
+#endif
+                study::stage_timer fresh_t;
+                const auto t1 = clock_type::now();
+                const auto fresh = frame(cam, o.a, fresh_t);
+                const double fresh_ms = ms_since(t1);
+                const auto fresh_err =
+                    study::compare_luminance(fresh.indirect.view(), ref.indirect.view(), mask_for(fresh.g, cam).view());
+                entry["fresh"] = {{"records", cache.records().size()}, {"ms", fresh_ms}, {"rel_rms", fresh_err.rel_rms}};
+                fmt::print("; fresh: {:6} records, {:8.1f} ms, rel_rms {:.4f}", cache.records().size(), fresh_ms,
+                           fresh_err.rel_rms);
+                cache.assign(kept);
+#ifdef BOUNCE_IC_WITH_GL
+                if (gl_state) gl_state->splatter.reset();
+#endif
+            }
+            if (o.walkthrough_mc_stride > 0 && f % o.walkthrough_mc_stride == 0) {
+                const auto mc = study::monte_carlo_at_equal_error(bvh, scene, fr.g.view(), ref.indirect.view(),
+                                                                  mask.view(), err.rel_rms, o.ref_spp / 2);
+                entry["mc_equal_error"] = mc.equal_error_json(frame_ms);
+                mc_ms_sum += mc.ms;
+                mc_error_sum += err.rel_rms;
+                ++mc_frames;
+                if (!mc.reached) ++mc_unreached;
+                fmt::print("; monte carlo {}{:.0f} spp, {:.1f} ms", mc.reached ? "~" : ">", mc.spp, mc.ms);
+            }
+            fmt::print("\n");
+            if (f + 1 == o.walkthrough) write_indirect(fr.indirect, ref, mask);
+            frames.push_back(entry);
+            for (const auto& s : ft.stages()) timer.add_sample(s, ft.median_ms(s));
+            timer.add_sample("total", frame_ms);
+        }
+        nlohmann::ordered_json walk = {{"frames_count", o.walkthrough},
+                                       {"path", "study::camera_path: forward a tenth of the way to the target "
+                                                "(at most half way to the first surface), panning -10 to +10 degrees"},
+                                       {"total_ms", cache_total_ms},
+                                       {"mean_rel_rms", error_sum / double(o.walkthrough)},
+                                       {"frames", frames}};
+        if (mc_frames > 0) {
+            const double mc_total = mc_ms_sum / double(mc_frames) * double(o.walkthrough);
+            walk["mc_equal_error"] = {{"frames_measured", mc_frames},
+                                      {"stride", o.walkthrough_mc_stride},
+                                      {"frames_not_reached", mc_unreached},
+                                      {"mean_rel_rms_measured", mc_error_sum / double(mc_frames)},
+                                      {"total_ms", mc_total},
+                                      {"speedup", mc_total / cache_total_ms}};
+            fmt::print("walkthrough: cache {:.1f} ms over {} frames, mean rel_rms {:.4f}; Monte Carlo at equal per-frame "
+                       "error {}{:.1f} ms: {:.1f}x\n",
+                       cache_total_ms, o.walkthrough, error_sum / double(o.walkthrough), mc_unreached ? ">" : "~",
+                       mc_total, mc_total / cache_total_ms);
+        }
+        extra["walkthrough"] = walk;
+        report.set_timings(timer);
+        report.set_count("records", cache.records().size());
+    } else if (o.progressive > 0) {
         // Progressive mode: records are view-independent, so each frame of the camera path
         // reuses the cache and adds at most N records.
         nlohmann::ordered_json frames = nlohmann::ordered_json::array();
@@ -344,17 +453,7 @@ int run_with(const options& o) {
             if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
             if (!o.out.empty()) io::write_png(o.out, combined.view(), io::auto_exposure(combined.view(), mask.view()));
         }
-        if (!o.indirect_exr.empty()) io::write_exr(o.indirect_exr, fr.indirect.view());
-        if (!o.indirect_out.empty()) {
-            // The indirect images side by side with one exposure: the cache's, the reference's.
-            image<glm::vec3> pair(2 * o.width, o.height);
-            for (std::size_t y = 0; y < o.height; ++y)
-                for (std::size_t x = 0; x < o.width; ++x) {
-                    pair(x, y) = fr.indirect(x, y);
-                    pair(o.width + x, y) = ref.indirect(x, y);
-                }
-            io::write_png(o.indirect_out, pair.view(), io::auto_exposure(ref.indirect.view(), mask.view()));
-        }
+        write_indirect(fr.indirect, ref, mask);
     }
 
     if (!o.cache_out.empty()) study::save_records(o.cache_out, cache.records(), cache_params);

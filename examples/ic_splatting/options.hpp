@@ -31,10 +31,14 @@ struct options {
     std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
     float fill_holes = 4.f;       // progressive: wide splat's a / a (0: leave holes black)
     std::size_t frames = 8;
+    std::size_t walkthrough = 0;      // frames of the walkthrough (0: off)
+    bool walkthrough_fresh = false;   // walkthrough: also render each frame from an empty cache
+    std::size_t walkthrough_mc_stride = 1;  // walkthrough: Monte Carlo at equal error on every k-th frame (0: none)
     std::vector<float> a_sweep;
     std::uint32_t record_samples = 1024, ref_spp = 1024;
     float min_pixels = 1.5f, max_pixels = 64.f;
-    bool neighbour_clamp = false;
+    std::string radius = "split-sphere";  // split-sphere | hessian (radius_policy)
+    bool neighbour_clamp = true;
     std::string scan = "batched";
     std::string scan_order;  // linear | coarse-to-fine; empty: linear, coarse-to-fine when progressive
     std::size_t scan_batch = 0;
@@ -85,7 +89,8 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
             {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
             {"shadow_resolution", o.sampler == "raster" ? o.shadow_resolution : 0},  // the raster's records see the maps
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
-            {"gradient_limit", o.gradient_limit}, {"height", o.height}};
+            {"gradient_limit", o.gradient_limit}, {"height", o.height}, {"radius", o.radius},
+            {"hessian_a", o.radius == "hessian" ? o.a : 0.f}};
 }
 
 /// Declares every option on `app`, writing into `o` (and `gradients`: "on" or "off").
@@ -127,6 +132,11 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
         ->check(examples::finite_positive);
     app.add_option("--record-samples", o.record_samples, "hemisphere rays per record")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
     app.add_option("--ref-spp", o.ref_spp, "reference integrator samples per pixel")->check(CLI::Range(1u, 1u << 20))->capture_default_str();
+    app.add_option("--radius", o.radius,
+                   "record radius: split-sphere (harmonic mean distance, Ward et al. 1988) | hessian (occlusion Hessian, "
+                   "Schwarzhaupt et al. 2012: a is the relative error at the zone's edge)")
+        ->check(CLI::IsMember({"split-sphere", "hessian"}))
+        ->capture_default_str();
     app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(examples::finite_positive)->capture_default_str();
     app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
@@ -138,7 +148,17 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread; 16 planes per atlas for --sampler raster)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
-    app.add_flag("--neighbour-clamp", o.neighbour_clamp, "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|)");
+    app.add_flag("--neighbour-clamp,!--no-neighbour-clamp", o.neighbour_clamp,
+                 "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|), new records and, each frame, older ones (default on)");
+    app.add_option("--walkthrough", o.walkthrough,
+                   "render N frames along the camera path (docs/irradiance-splatting.md) with one growing cache, "
+                   "reporting per-frame error and time and Monte Carlo at equal per-frame error");
+    app.add_flag("--walkthrough-fresh", o.walkthrough_fresh,
+                 "walkthrough: also render every frame from an empty cache (its error and records, not timed in the total)");
+    app.add_option("--walkthrough-mc-stride", o.walkthrough_mc_stride,
+                   "walkthrough: Monte Carlo at equal error on every k-th frame, its mean time standing for every frame "
+                   "(0: none)")
+        ->capture_default_str();
     app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
     app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--front-tolerance", o.front_tolerance,

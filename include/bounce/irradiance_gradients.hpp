@@ -64,7 +64,24 @@ struct hemisphere_estimate {
     std::array<glm::dvec3, 3> rotation{};        ///< grad_r per channel (R, G, B)
     std::array<glm::dvec3, 3> translation{};     ///< grad_t per channel
     double harmonic_mean_distance = std::numeric_limits<double>::infinity();  ///< R; inf if nothing was hit
+    /// Translation Hessian per channel in the tangent plane (local x, y), occlusion-aware:
+    /// see translation_hessian. Zero from samplers that do not estimate it.
+    std::array<glm::dmat2, 3> hessian{glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
 };
+
+/// The second derivative of irradiance under translation in the tangent plane, from the
+/// record's own hemisphere samples with their hit distances (the occlusion Hessian of
+/// Schwarzhaupt, Jensen and Jarosz 2012, which builds on the Hessians of Jarosz,
+/// Schoenefeld, Kobbelt and Jensen 2012; the per-sample form here is bounce's, derived in
+/// docs/irradiance-splatting.md). Each cell's hit is a small patch at distance r along its
+/// local direction w, facing the point, whose projected solid angle h dA / |q - x|^3
+/// changes as the point moves by d in the tangent plane; its Hessian at d = 0 is
+/// dOmega (15 w_t w_t^T - 3 I) / r^2 (w_t: the tangential part of w, dOmega = pi / (M N)).
+/// Each cell contributes that times (L_k - E / pi): radiance equal to the hemisphere's mean
+/// moves no irradiance however near it is (a uniformly lit enclosure has constant E), so
+/// only occluders that differ from what they hide count. Escaped rays contribute nothing.
+/// Needs e.irradiance already estimated.
+void add_translation_hessian(const hemisphere_samples& s, hemisphere_estimate& e);
 
 /// Irradiance, gradients and harmonic mean distance of one hemisphere (see file comment).
 hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s,
@@ -163,7 +180,30 @@ inline hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, tran
             for (int c = 0; c < 3; ++c) e.translation[c] += v_lo * (rate * dL[c]);
         }
     }
+    add_translation_hessian(s, e);
     return e;
+}
+
+inline void add_translation_hessian(const hemisphere_samples& s, hemisphere_estimate& e) {
+    const double d_omega = std::numbers::pi / double(s.size());
+    const glm::dvec3 mean = e.irradiance / std::numbers::pi;
+    glm::dmat2 h[3] = {glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const double r = s.distance[i];
+        if (!std::isfinite(r)) continue;
+        const glm::dvec3 w(s.direction[i]);
+        const double xx = 15 * w.x * w.x - 3, yy = 15 * w.y * w.y - 3, xy = 15 * w.x * w.y;
+        const glm::dvec3 dl = (glm::dvec3(s.radiance[i]) - mean) * (d_omega / (r * r));
+        for (int c = 0; c < 3; ++c) {
+            h[c][0][0] += dl[c] * xx;
+            h[c][1][1] += dl[c] * yy;
+            h[c][0][1] += dl[c] * xy;
+        }
+    }
+    for (int c = 0; c < 3; ++c) {
+        h[c][1][0] = h[c][0][1];
+        e.hessian[c] = h[c];
+    }
 }
 
 }  // namespace bounce

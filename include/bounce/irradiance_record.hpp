@@ -143,9 +143,25 @@ V hole_filled_splat(const V& sum, T weight, const V& wide_sum, T wide_weight, T 
     return normalized_splat<T, V>(sum + wide_sum * lambda, weight + wide_weight * lambda);
 }
 
+/// Where a record's radius R comes from before the limits.
+enum class radius_policy {
+    /// The split sphere (Ward et al. 1988): R = the harmonic mean hit distance, the distance
+    /// at which its first-order error bound reaches 100%; the zone a R bounds it by a.
+    split_sphere,
+    /// Hessian-based error control (Schwarzhaupt, Jensen and Jarosz 2012): R such that the
+    /// second-order term 1/2 lambda d^2 of the record's gradient extrapolation, lambda the
+    /// largest |eigenvalue| of its occlusion Hessian (add_translation_hessian), reaches the
+    /// relative error a at the zone's edge d = a R: R = sqrt(2 E / (a lambda)) per channel,
+    /// the smallest. So `a` keeps its meaning, the relative error allowed at the zone's
+    /// edge; only the model of how fast E changes differs. Records depend on a.
+    hessian,
+};
+
 /// Limits on a record's radius R (Tabellion and Lamorlette 2004; Krivanek et al. 2006).
 /// Every value is optional; defaults leave R unchanged.
 struct radius_limits {
+    radius_policy policy = radius_policy::split_sphere;  ///< where R comes from
+    float hessian_a = 0.15f;  ///< radius_policy::hessian: the cache's accuracy a the radius is made for
     float min_world = 0.f;  ///< R >= this (world units)
     float max_world = std::numeric_limits<float>::infinity();  ///< R <= this (world units)
     /// R >= min_pixels * footprint: stops records piling up where geometry is close.
@@ -177,6 +193,21 @@ inline float limit_radius(double harmonic_mean, const glm::dvec3& e, const std::
     return float(r);
 }
 
+/// R = sqrt(2 E_c / (a lambda_c)), the smallest over channels with E_c > 0 (radius_policy::
+/// hessian), lambda_c the largest |eigenvalue| of channel c's symmetric 2x2 Hessian;
+/// +infinity where every Hessian vanishes.
+inline double hessian_radius(const glm::dvec3& e, const std::array<glm::dmat2, 3>& hessian, double a) {
+    double r = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < 3; ++c) {
+        const glm::dmat2& h = hessian[c];
+        const double mid = 0.5 * (h[0][0] + h[1][1]);
+        const double half = std::sqrt(0.25 * (h[0][0] - h[1][1]) * (h[0][0] - h[1][1]) + h[0][1] * h[0][1]);
+        const double lambda = std::abs(mid) + half;  // max(|mid + half|, |mid - half|)
+        if (e[c] > 0 && lambda > 0) r = std::min(r, std::sqrt(2 * e[c] / (a * lambda)));
+    }
+    return r;
+}
+
 /// Neighbour clamping (Krivanek et al. 2006): R_i <= R_j + |p_i - p_j|, so the radius
 /// field is 1-Lipschitz and a small record is never surrounded by much larger ones that
 /// hide the detail it found. Returns the clamped R of `rec` against `others`.
@@ -204,7 +235,12 @@ inline irradiance_record make_record(const glm::vec3& p, const glm::vec3& n, con
         translation_world[c] = to_world * est.translation[c];
         r.translation[c] = glm::vec3(translation_world[c]);
     }
-    r.radius = limit_radius(est.harmonic_mean_distance, est.irradiance, translation_world, lim, pixel_footprint);
+    require(lim.policy != radius_policy::hessian || (std::isfinite(lim.hessian_a) && lim.hessian_a > 0.f), "hessian_a",
+            "must be a positive number");
+    const double unlimited = lim.policy == radius_policy::hessian
+                                 ? hessian_radius(est.irradiance, est.hessian, double(lim.hessian_a))
+                                 : est.harmonic_mean_distance;
+    r.radius = limit_radius(unlimited, est.irradiance, translation_world, lim, pixel_footprint);
     return r;
 }
 

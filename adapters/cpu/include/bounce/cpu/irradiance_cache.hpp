@@ -75,7 +75,8 @@ struct irradiance_cache_options {
     /// are this many times wider (hole_filled_splat); 0 leaves them black. Typical 4.
     float fill_holes = 4.f;
     /// Clamp each new record's radius to its neighbours': R_i <= R_j + |p_i - p_j|
-    /// (Krivanek et al. 2006's neighbour clamping).
+    /// (Krivanek et al. 2006's neighbour clamping), and at the start of each frame the
+    /// records of earlier frames to the later ones (clamp_to_neighbours).
     bool neighbour_clamp = false;
 
     /// The weight-sum threshold the scan uses.
@@ -100,6 +101,7 @@ struct cache_frame_stats {
     std::size_t new_records = 0;  ///< records the scan added
     std::size_t measured = 0;     ///< records the batched scan measured (new + wasted + refused)
     std::size_t wasted = 0;       ///< guesses dropped because covered by the time the scan got there
+    std::size_t reclamped = 0;    ///< older records whose radius clamp_to_neighbours shrank (render only)
     double splat_existing_ms = 0; ///< step 1: the records held before the frame (octree: inserting them)
     double scan_ms = 0;           ///< step 2 without record computation
     double records_ms = 0;        ///< step 2's record computation (the sampler)
@@ -130,6 +132,45 @@ public:
     void assign(std::vector<irradiance_record> records) {
         records_ = std::move(records);
         clamp_ = neighbour_index(lo_, hi_);
+        settled_ = 0;
+    }
+
+    /// Neighbour clamping both ways over the whole cache: every radius becomes
+    /// min_j (R_j + |p_i - p_j|) over every record j (itself included), so the radius field
+    /// is 1-Lipschitz (Krivanek et al. 2006) whichever record came first. One pass is exact:
+    /// by the triangle inequality the clamped radii already satisfy it against each other.
+    /// Why: the scan clamps a new record against older ones only (a record splatted in this
+    /// frame must not shrink under the pixels it already covers), so a large record made
+    /// before a small neighbour keeps claiming the neighbour's surroundings. In one frame
+    /// that costs little, because each small record sits on the pixel it was made for; from
+    /// another camera, the pixel centres move off the small records' sub-pixel zones and
+    /// the old large records cover them with the wrong irradiance, so the miss test finds
+    /// nothing to fix (a grown Sponza cache got worse with every frame of a walkthrough).
+    /// A no-op (returns 0) without neighbour_clamp or when no record was added since the
+    /// last call; otherwise returns how many radii shrank. render() calls it at the start
+    /// of every frame; a caller that splats elsewhere (gl::irradiance_splatter) calls it
+    /// before the frame and resets the splatter's copy when it returns more than 0.
+    std::size_t clamp_to_neighbours() {
+        if (!options_.neighbour_clamp || settled_ == records_.size()) return 0;
+        neighbour_index index(lo_, hi_);
+        index.sync(records_);
+        std::vector<float> radius(records_.size());
+        tbb::parallel_for(std::size_t(0), records_.size(),
+                          [&](std::size_t i) { radius[i] = index.clamped_radius(records_[i]); });
+        std::size_t shrunk = 0;
+        for (std::size_t i = 0; i < records_.size(); ++i)
+            if (radius[i] < records_[i].radius) {
+                records_[i].radius = radius[i];
+                ++shrunk;
+            }
+        if (shrunk == 0) {
+            clamp_ = std::move(index);
+        } else {
+            clamp_ = neighbour_index(lo_, hi_);  // `index` holds the radii before the clamp
+            clamp_.sync(records_);
+        }
+        settled_ = records_.size();
+        return shrunk;
     }
 
     /// One frame: the indirect radiance rho/pi * E of every pixel of `g` seen by `cam` into
@@ -143,6 +184,7 @@ public:
         require(indirect.width() == g.width() && indirect.height() == g.height(), "indirect",
                 "size differs from the G-buffer");
         cache_frame_stats stats;
+        timed(stats.splat_existing_ms, [&] { stats.reclamped = clamp_to_neighbours(); });
         image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));
         std::optional<image<glm::vec4>> wide;
         const splat_params& sp = options_.splat;
@@ -310,6 +352,7 @@ private:
     irradiance_cache_options options_;
     std::vector<irradiance_record> records_;
     neighbour_index clamp_;
+    std::size_t settled_ = 0;  // records_.size() at the last clamp_to_neighbours
     std::vector<std::uint32_t> order_;
     std::pair<std::size_t, std::size_t> order_size_{0, 0};
 };
