@@ -341,9 +341,10 @@ TEST_CASE("the GL indirect renderer keeps the caller's GL state", "[gl][rsm]") {
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     glBindTextureUnit(3, colour.id());
-    for (const auto technique : {gl::indirect_technique::sii, gl::indirect_technique::rsm_gather}) {
+    for (const int variant : {0, 1, 2}) {
         gl::indirect_options o;
-        o.technique = technique;
+        o.technique = variant == 0 ? gl::indirect_technique::sii : gl::indirect_technique::rsm_gather;
+        o.low_resolution = variant == 2 ? 2 : 1;  // the downsampling, upsampling and fallback passes too
         o.count = 16;
         gl::indirect_renderer r(o);
         r.render(gb.textures(), s.cam, maps, out);
