@@ -19,8 +19,9 @@ def main(path):
 
     configs = sorted({n.split("-r")[0] + "-r" + n.split("-r")[1].split("-")[0] for n in runs}, key=order)
     print("| visibility | blocks | buffer | shots | GL total (visibility / choice / distribution) | "
-          "GL total, one wait per step | CPU total (visibility / choice / distribution) | GL / CPU | load |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "GL total, one wait per step | CPU total (visibility / choice / distribution) | GL / CPU | "
+          "GL vs CPU solution (rel. L1) | load |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for c in configs:
         gl, cpu, untimed = runs.get(c + "-gl"), runs.get(c + "-cpu"), runs.get(c + "-gl-untimed")
         if not gl or not cpu:
@@ -33,11 +34,13 @@ def main(path):
                                                     t["distribution"])
 
         load = p.get("load_average")
-        print("| %s | %d x %d | %d^2%s | %d | %s | %s | %s | %.2f | %s |" % (
+        versus = p.get("relative_l1_versus_cpu")
+        print("| %s | %d x %d | %d^2%s | %d | %s | %s | %s | %.2f | %s | %s |" % (
             p["visibility"], p["block_texels"], p["block_texels"], p["resolution"],
             " per face" if p["visibility"] == "hemicube" else "", gl["iterations"], stages(gl),
             "%.0f ms" % untimed["timings_ms"]["total"] if untimed else "-", stages(cpu),
-            gl["timings_ms"]["total"] / cpu["timings_ms"]["total"], "%.1f" % load if load is not None else "-"))
+            gl["timings_ms"]["total"] / cpu["timings_ms"]["total"], "%.1e" % versus if versus is not None else "-",
+            "%.1f" % load if load is not None else "-"))
 
 
 if __name__ == "__main__":

@@ -15,9 +15,11 @@
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 using namespace bounce;
 using namespace bounce::radiosity_test;
@@ -30,8 +32,19 @@ struct run_figures {
     double unshot = 1, escaped = 0;
 };
 
+// Relative L1 difference (area-weighted, channels summed) between two solutions.
+double relative_l1(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b, const lightmap_atlas& atlas) {
+    double diff = 0, sum = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            diff += std::abs(double(a[i][c]) - double(b[i][c])) * double(atlas.area[i]);
+            sum += double(b[i][c]) * double(atlas.area[i]);
+        }
+    return diff / sum;
+}
+
 void write(const std::string& name, const std::string& backend, const std::string& renderer, const lightmap_atlas& atlas,
-           bool hemicube, int resolution, const run_figures& f) {
+           bool hemicube, int resolution, const run_figures& f, double versus_cpu = -1) {
     std::printf("%-28s %-4s elements %6zu shooters %5zu shots %5zu unshot %.4f escaped %.4f total %8.1f ms (lights %.1f, "
                 "visibility %.1f, choice %.1f, distribution %.1f)\n",
                 name.c_str(), backend.c_str(), atlas.size(), f.shooters, f.shots, f.unshot, f.escaped, f.total_ms,
@@ -59,6 +72,8 @@ void write(const std::string& name, const std::string& backend, const std::strin
     r.set_count("shooters", f.shooters);
     r.set_count("iterations", f.shots);
     r.parameters["converged_fraction"] = 1.0 - f.unshot;
+    // How far the GL solution at 90% is from the CPU's (relative L1 over the elements).
+    if (versus_cpu >= 0) r.parameters["relative_l1_versus_cpu"] = versus_cpu;
     // The machine is shared: the one-minute load average when the run ended, beside its times.
     if (std::FILE* load = std::fopen("/proc/loadavg", "r")) {
         double one_minute = 0;
@@ -82,6 +97,8 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
             const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 10000, .block_texels = block});
             const std::string name = std::string("cornell-") + (hemicube ? "hemicube" : "stereo") + "-b" +
                                      std::to_string(block) + "-r" + std::to_string(res);
+            std::vector<glm::vec3> gl_solution;
+            run_figures gl_figures;
             {
                 const auto t0 = std::chrono::steady_clock::now();
                 gl::progressive_radiosity solver(
@@ -90,12 +107,13 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
                      .resolution = res});
                 solver.solve(fraction);
                 gl::finish();
+                gl_solution = solver.radiosity();
                 run_figures f;
                 f.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
                 const auto& t = solver.timings();
                 f = {f.total_ms, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
                      solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
-                write(name, "gl", renderer, atlas, hemicube, res, f);
+                gl_figures = f;
                 CHECK(solver.unshot_fraction() <= fraction);
             }
             {
@@ -132,6 +150,10 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
                 f = {f.total_ms, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
                      solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
                 write(name, "cpu", "", atlas, hemicube, res, f);
+                const auto b = solver.radiosity();
+                const double versus = relative_l1(gl_solution, std::vector<glm::vec3>(b.begin(), b.end()), atlas);
+                std::printf("%-28s GL versus CPU at 90%%: relative L1 %.3g\n", name.c_str(), versus);
+                write(name, "gl", renderer, atlas, hemicube, res, gl_figures, versus);
                 CHECK(solver.unshot_fraction() <= fraction);
             }
         }

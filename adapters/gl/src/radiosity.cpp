@@ -1243,9 +1243,9 @@ std::vector<glm::vec3> progressive_radiosity::display_radiosity() const {
         out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb);
     return out;
 }
-image<glm::vec3> progressive_radiosity::lightmap() const {
+image<glm::vec3> progressive_radiosity::lightmap(int level) const {
     const auto values = display_radiosity();
-    return s_->atlas.to_texels(std::span<const glm::vec3>(values));
+    return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
 }
 texture_ref progressive_radiosity::radiosity_texture() const noexcept { return texture_ref(s_->radiosity); }
 texture_ref progressive_radiosity::unshot_texture() const noexcept { return texture_ref(s_->unshot); }

@@ -150,8 +150,10 @@ public:
     /// The ambient radiosity (Cohen et al. 1988) and B plus rho times it when the options ask.
     glm::dvec3 ambient() const;
     std::vector<glm::vec3> display_radiosity() const;
-    /// display_radiosity laid out as the atlas (lightmap_atlas::to_texels, padding filled).
-    image<glm::vec3> lightmap() const;
+    /// display_radiosity laid out as the atlas at 2^level times its resolution
+    /// (lightmap_atlas::to_fine_texels; level 0: to_texels, padding filled), as
+    /// cpu::progressive_radiosity::lightmap gives it.
+    image<glm::vec3> lightmap(int level = 0) const;
     /// The solver's radiosity and unshot textures (RGBA32F, atlas size, element texels only;
     /// padding texels hold 0), for a renderer to sample; valid while the solver lives.
     texture_ref radiosity_texture() const noexcept;
