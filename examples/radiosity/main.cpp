@@ -27,6 +27,11 @@
 #include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
 
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+#include <bounce/gl/context.hpp>
+#include <bounce/gl/radiosity.hpp>
+#endif
+
 #include "multi_bounce_cache.hpp"
 #include "options.hpp"
 
@@ -97,16 +102,33 @@ struct comparison {
     }
 };
 
-// One solve on the CPU backend with `make_visibility()`'s visibility, timed into `timer`;
-// with `curve`, the error at checkpoints (their time left out of every timing).
-template <class MakeVisibility>
-solve_result solve_cpu(const options& o, const io::scene& scene, const MakeVisibility& make_visibility,
-                       study::stage_timer& timer, const comparison* curve) {
+// What differs between the backends' solvers, for the one solve loop below.
+template <class S>
+constexpr bool is_cpu_solver = requires(S& s, const io::scene& sc) { s.subdivide(sc, subdivision_options{}); };
+
+template <class Solver>
+image<glm::vec3> lightmap_of(const Solver& solver, int level) {
+    if constexpr (is_cpu_solver<Solver>) return solver.lightmap(level);
+    else return solver.lightmap();
+}
+
+template <class Solver>
+std::vector<glm::vec3> unshot_of(const Solver& solver) {
+    const auto u = solver.unshot();
+    return std::vector<glm::vec3>(u.begin(), u.end());
+}
+
+// One solve with the solver `make_solver(atlas)` builds (either backend), timed into
+// `timer`; with `curve`, the error at checkpoints (their time left out of every timing).
+template <class MakeSolver>
+solve_result solve_with(const options& o, const io::scene& scene, const MakeSolver& make_solver,
+                        study::stage_timer& timer, const comparison* curve) {
     const auto start = clock_type::now();
     double paused_ms = 0;  // spent on the curve's evaluations
     const lightmap_atlas atlas = build_lightmap_atlas(scene, atlas_options_for(o));
     const double atlas_ms = ms_since(start);
-    cpu::progressive_radiosity solver(scene, atlas, make_visibility(atlas), solver_options_for(o));
+    auto solver = make_solver(atlas);
+    using solver_type = decltype(solver);
     const int level = o.adaptive ? o.max_level : 0;
     solve_result r;
     const double target = 1.0 - o.converge;
@@ -123,7 +145,7 @@ solve_result solve_cpu(const options& o, const io::scene& scene, const MakeVisib
         }
         if (!due || (!r.curve.empty() && r.curve.back().step == r.steps)) return;
         const auto t0 = clock_type::now();
-        const auto v = curve->view(solver.atlas(), solver.lightmap(level), level, o.width, o.height);
+        const auto v = curve->view(solver.atlas(), lightmap_of(solver, level), level, o.width, o.height);
         r.curve.push_back({r.steps, solver.progress().shots, solver.atlas().size(), ms_since(start) - paused_ms - ms_since(t0),
                            solver.unshot_fraction(), curve->rel_rms(v)});
         paused_ms += ms_since(t0);
@@ -133,7 +155,8 @@ solve_result solve_cpu(const options& o, const io::scene& scene, const MakeVisib
         if (o.max_seconds > 0 && (ms_since(start) - paused_ms) > o.max_seconds * 1e3) break;
         if (!solver.step()) break;
         ++r.steps;
-        if (o.adaptive && r.steps <= std::size_t(o.subdivide_steps)) r.splits += solver.subdivide(scene, sub);
+        if constexpr (is_cpu_solver<solver_type>)
+            if (o.adaptive && r.steps <= std::size_t(o.subdivide_steps)) r.splits += solver.subdivide(scene, sub);
         r.converged.push_back(1.0 - solver.unshot_fraction());
         r.iteration_ms.push_back(ms_since(start) - paused_ms);
         evaluate(false);
@@ -153,7 +176,7 @@ solve_result solve_cpu(const options& o, const io::scene& scene, const MakeVisib
     timer.add_sample("visibility", t.visibility_ms);
     timer.add_sample("shooter_choice", t.choice_ms);
     timer.add_sample("reconstruction", t.distribution_ms);
-    timer.add_sample("subdivision", t.subdivision_ms);
+    if constexpr (is_cpu_solver<solver_type>) timer.add_sample("subdivision", t.subdivision_ms);
     timer.add_sample("total", total_ms);
     r.shots = solver.progress().shots;
     r.shooters = solver.shooters();
@@ -162,21 +185,44 @@ solve_result solve_cpu(const options& o, const io::scene& scene, const MakeVisib
     r.emitted = solver.emitted_power();
     r.absorbed = solver.absorbed_power();
     r.escaped = solver.escaped_power();
-    r.lightmap = solver.lightmap(level);
-    std::vector<glm::vec3> unshot(solver.unshot().begin(), solver.unshot().end());
+    r.lightmap = lightmap_of(solver, level);
+    const std::vector<glm::vec3> unshot = unshot_of(solver);
     r.unshot = solver.atlas().to_fine_texels(std::span<const glm::vec3>(unshot), level);
     r.atlas = solver.atlas();
     return r;
 }
 
-// The run on the backend the options name; the one place a backend is chosen.
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+gl::radiosity_options gl_options_for(const options& o) {
+    gl::radiosity_options g;
+    g.shoot_blocks = o.block > 1;
+    g.ambient = o.ambient;
+    g.near_field = o.near_field;
+    g.visibility = o.visibility == "hemicube" ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic;
+    g.resolution = o.resolution;
+    g.tolerance_px = o.tolerance_px;
+    return g;
+}
+#endif
+
+// The run on the backend the options name: the one place a backend is chosen. The CPU
+// backend takes `make_visibility(atlas)`'s visibility; the GL backend draws its own item
+// buffers in the context current on this thread.
 template <class MakeVisibility>
 solve_result solve_on_backend(const options& o, const io::scene& scene, const MakeVisibility& make_visibility,
                               study::stage_timer& timer, const comparison* curve) {
-    if (o.backend == "gl")
-        throw parameter_error("--backend", "'gl' needs gl::progressive_radiosity, which this build does not have yet; "
-                                           "use --backend cpu");
-    return solve_cpu(o, scene, make_visibility, timer, curve);
+    if (o.backend == "gl") {
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+        return solve_with(o, scene, [&](const lightmap_atlas& a) {
+            return gl::progressive_radiosity(scene, a, gl_options_for(o));
+        }, timer, curve);
+#else
+        throw parameter_error("--backend", "'gl' needs the GL adapter, which this build does not have");
+#endif
+    }
+    return solve_with(o, scene, [&](const lightmap_atlas& a) {
+        return cpu::progressive_radiosity(scene, a, make_visibility(a), solver_options_for(o));
+    }, timer, curve);
 }
 
 double luminance_sum(const glm::dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
@@ -217,6 +263,12 @@ int run(const options& o) {
         throw parameter_error("--versus", "no such file: " + o.versus.string());
     if (o.visibility == "hemicube" && o.resolution % 2 != 0)
         throw parameter_error("--resolution", "a hemicube needs an even resolution");
+    if (o.backend == "gl") {
+        // What the GL solver does not offer (docs/radiosity-gl.md), refused before any work.
+        if (o.visibility == "rays") throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
+        if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
+        if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
+    }
     const io::scene scene = io::load_scene_arg(o.scene);
     for (const auto& w : scene.warnings) fmt::print(stderr, "{}: {}\n", scene.name, w);
     const embree::accel bvh(scene);
@@ -257,6 +309,10 @@ int run(const options& o) {
         return v;
     }();
     const embree::device device;
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+    std::optional<gl::context> gl_context;  // current on this thread while it lives
+    if (o.backend == "gl") gl_context.emplace();
+#endif
     std::optional<solve_result> result;
     for (int rep = 0; rep < o.repeat; ++rep) {
         const comparison* curve = rep == 0 ? &cmp : nullptr;
@@ -281,6 +337,9 @@ int run(const options& o) {
     report.width = o.width;
     report.height = o.height;
     report.backend = o.backend;
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+    if (gl_context) report.gl_renderer = gl_context->renderer();
+#endif
     report.parameters = {{"elements", o.elements}, {"block", o.block}, {"visibility", o.visibility},
                          {"resolution", o.resolution}, {"tolerance_px", o.tolerance_px},
                          {"adaptive", o.adaptive ? "on" : "off"}, {"max_level", o.max_level},
