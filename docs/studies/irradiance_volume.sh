@@ -31,15 +31,19 @@ if [[ $part == all || $part == cornell ]]; then
 fi
 
 if [[ $part == all || $part == sponza ]]; then
-  # Sponza (sphere through the atrium at 20% of the height): uniform grids of depth 3 and 4;
-  # adaptive octrees of depth 5 with the default heuristics and with a selective set
-  # (geometry off, harmonic mean distance at 0.3 of the cell diagonal, culling at 10%).
+  # Sponza (sphere through the atrium at 20% of the height): uniform grids of depth 3, 4 and
+  # 5; adaptive octrees of depth 4 and 5 with the default heuristics, of depth 5 with the
+  # harmonic-mean-distance heuristic alone (ratio 0.5), and of depth 5 with the geometry
+  # heuristic off, distance ratio 0.5, neighbour change 0.5 and culling at 20%.
   run sponza-uniform-3 --scene sponza --mode uniform --max-depth 3 "${common[@]}"
   run sponza-uniform-4 --scene sponza --mode uniform --max-depth 4 "${common[@]}"
+  run sponza-uniform-5 --scene sponza --mode uniform --max-depth 5 "${common[@]}"
   run sponza-adaptive-4 --scene sponza --mode adaptive --max-depth 4 "${common[@]}"
   run sponza-adaptive-5 --scene sponza --mode adaptive --max-depth 5 "${common[@]}"
-  run sponza-adaptive-5-selective --scene sponza --mode adaptive --max-depth 5 --geometry-triangles 0 \
-    --distance-ratio 0.3 --cull 0.1 --b 1 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
+  run sponza-adaptive-5-distance --scene sponza --mode adaptive --max-depth 5 --geometry-triangles 0 \
+    --neighbour-change 0 --gradient-ratio 0 --distance-ratio 0.5 --cull 0.05 "${common[@]}"
+  run sponza-adaptive-5-cull --scene sponza --mode adaptive --max-depth 5 --cull 0.2 --neighbour-change 0.5 \
+    --distance-ratio 0.5 --geometry-triangles 0 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
 fi
 
 if [[ $part == all || $part == sh ]]; then
