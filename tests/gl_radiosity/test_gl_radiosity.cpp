@@ -282,6 +282,40 @@ TEST_CASE("a directional light shot first gives the CPU's direct radiosity, shad
     CHECK(gl_solver.emitted_power().x > 0);
 }
 
+TEST_CASE("the GL lightmap texture is the solver's lightmap, padding filled, with and without the ambient term",
+          "[gl][radiosity]") {
+    // Both lay out display_radiosity by element_at: the same float values (each texel holds one
+    // element's value, no division) through the same kernel radiosity_with_ambient; with the
+    // ambient term GLSL may fuse its multiply-add, 1e-6 of the value.
+    gl_test::shared_context();
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300, .padding = 2});
+    for (const bool ambient : {false, true}) {
+        gl::progressive_radiosity solver(scene.view(), atlas, {.ambient = ambient, .resolution = 64});
+        for (int s = 0; s < 10; ++s) REQUIRE(solver.step());
+        const auto expected = solver.lightmap();
+        const gl::texture_ref t = solver.update_lightmap_texture();
+        REQUIRE(t.width == atlas.width);
+        REQUIRE(t.height == atlas.height);
+        const auto got = t.read_floats();
+        double worst = 0;
+        std::size_t charted = 0;
+        for (std::uint32_t y = 0; y < atlas.height; ++y)
+            for (std::uint32_t x = 0; x < atlas.width; ++x) {
+                const float* g = &got[4 * (std::size_t(y) * atlas.width + x)];
+                const glm::vec3 e = expected(x, y);
+                const bool on_chart = atlas.element_at(x, y) >= 0;
+                charted += on_chart ? 1 : 0;
+                CHECK(g[3] == (on_chart ? 1.f : 0.f));
+                for (int c = 0; c < 3; ++c)
+                    worst = std::max(worst, std::abs(double(g[c]) - double(e[c])) / std::max(1e-30, double(std::abs(e[c]))));
+            }
+        INFO("ambient " << ambient << ", worst relative difference " << worst);
+        CHECK(charted > atlas.size());  // padding texels were filled
+        CHECK(worst <= (ambient ? 1e-6 : 0.0));
+    }
+}
+
 TEST_CASE("the GL solver leaves the caller's GL state as it found it", "[gl][radiosity][state]") {
     // A renderer's own state: program, framebuffer, viewport, vertex array, raster state, the
     // storage-buffer bindings and image units the passes use.

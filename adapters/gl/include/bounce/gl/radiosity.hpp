@@ -154,8 +154,13 @@ public:
     /// (lightmap_atlas::to_fine_texels; level 0: to_texels, padding filled), as
     /// cpu::progressive_radiosity::lightmap gives it.
     image<glm::vec3> lightmap(int level = 0) const;
+    /// Writes display_radiosity laid out as the atlas into the solver's lightmap texture
+    /// (RGBA32F, atlas size, alpha 1 on charts, 0 elsewhere) on the GPU, padding texels
+    /// filled from their element as lightmap() fills them, so a renderer can sample it
+    /// bilinearly with the atlas's corner_uvs; returns it (valid while the solver lives).
+    texture_ref update_lightmap_texture();
     /// The solver's radiosity and unshot textures (RGBA32F, atlas size, element texels only;
-    /// padding texels hold 0), for a renderer to sample; valid while the solver lives.
+    /// padding texels hold 0); valid while the solver lives.
     texture_ref radiosity_texture() const noexcept;
     texture_ref unshot_texture() const noexcept;
 
