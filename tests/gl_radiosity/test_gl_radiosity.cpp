@@ -389,6 +389,9 @@ TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosit
     const auto other = closed_box(1.f, 0.5f, 1.f);
     CHECK_THROWS_AS(gl::progressive_radiosity(other.view(), atlas), parameter_error);
     throws_naming({.parallel_resolution = 4}, "radiosity_options.parallel_resolution");
+    const std::vector<std::uint32_t> split{0};
+    const auto refined = refine_lightmap_atlas(scene.view(), atlas, split);
+    CHECK_THROWS_WITH(gl::progressive_radiosity(scene.view(), refined.atlas), Catch::Contains("subdivided"));
     const auto wide = build_lightmap_atlas(scene.view(), {.elements = 200, .block_texels = 32});
     CHECK_THROWS_WITH(gl::progressive_radiosity(scene.view(), wide), Catch::Contains("atlas.block_texels"));
     gl::progressive_radiosity solver(scene.view(), atlas, {.resolution = 64});
