@@ -170,7 +170,7 @@ def tables(run):
              f"{run['provenance']['cores']} logical cores, shared with other builds). "
              f"{run['width']}x{run['height']}, {run['parameters']['maps']} maps of "
              f"{run['parameters']['rsm_resolution']}^2 texels, clamp {run['parameters']['clamp']:.4g}, "
-             f"medians of {run['repeat']} frames.", ""]
+             f"Each run's times are medians of --repeat frames (rsm_sii.sh: 3; one for the 4096-VPL runs).", ""]
     for technique in ("rsm", "sii"):
         lines += [f"### {NAMES[technique]}: total frame time, ms (Hahn 2012's seconds x 1000 in brackets)", "",
                   "| VPLs | " + " | ".join(p if p != "1x1" else "plain" for p in PATTERNS) + " |",

@@ -493,6 +493,7 @@ int run(const options& o) {
 
     std::optional<run_result> single;
     if (o.study) {
+        report.repeat = std::size_t(o.repeat);
         extra.update(run_study(c));
     } else {
         std::optional<run_result> plain;
