@@ -5,7 +5,7 @@
 # each bake, error against the reference integrator's one-bounce indirect irradiance on the
 # sphere. Every run goes into docs/results/irradiance_volume.json; the strip pictures into
 # docs/figures/irradiance_volume_*.png. Sponza needs BOUNCE_SCENES (or ../shared/scenes).
-# About 25 minutes on 2 shared cores (the adaptive Sponza bake dominates).
+# About 40 minutes on 2 shared cores (the adaptive Sponza bake dominates).
 # Usage: docs/studies/irradiance_volume.sh [cornell|sponza|sh]   (BOUNCE_BIN: default build/bin)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -34,7 +34,8 @@ if [[ $part == all || $part == sponza ]]; then
   # Sponza (sphere through the atrium at 20% of the height): uniform grids of depth 3, 4 and
   # 5; adaptive octrees of depth 4 and 5 with the default heuristics, of depth 5 with the
   # harmonic-mean-distance heuristic alone (ratio 0.5), and of depth 5 with the geometry
-  # heuristic off, distance ratio 0.5, neighbour change 0.5 and culling at 20%.
+  # heuristic off, distance ratio 0.5, neighbour change 0.5 and culling at 20%, and of depth
+  # 5 on the lighting heuristics alone (neighbour change 0.25, gradient 0.3, culling 5%).
   run sponza-uniform-3 --scene sponza --mode uniform --max-depth 3 "${common[@]}"
   run sponza-uniform-4 --scene sponza --mode uniform --max-depth 4 "${common[@]}"
   run sponza-uniform-5 --scene sponza --mode uniform --max-depth 5 "${common[@]}"
@@ -43,7 +44,9 @@ if [[ $part == all || $part == sponza ]]; then
   run sponza-adaptive-5-distance --scene sponza --mode adaptive --max-depth 5 --geometry-triangles 0 \
     --neighbour-change 0 --gradient-ratio 0 --distance-ratio 0.5 --cull 0.05 "${common[@]}"
   run sponza-adaptive-5-cull --scene sponza --mode adaptive --max-depth 5 --cull 0.2 --neighbour-change 0.5 \
-    --distance-ratio 0.5 --geometry-triangles 0 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
+    --distance-ratio 0.5 --geometry-triangles 0 "${common[@]}"
+  run sponza-adaptive-5-lighting --scene sponza --mode adaptive --max-depth 5 --distance-ratio 0 \
+    --geometry-triangles 0 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
 fi
 
 if [[ $part == all || $part == sh ]]; then
