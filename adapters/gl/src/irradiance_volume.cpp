@@ -7,6 +7,7 @@
 #include <bounce/irradiance_volume_kernels.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 namespace bounce::gl {
 
