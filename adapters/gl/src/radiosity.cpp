@@ -190,7 +190,7 @@ struct progressive_radiosity::state {
     std::vector<glm::vec4> world_plane;
     float diagonal = 1.f;
     glm::vec3 lo{0.f}, hi{0.f};
-    int max_nodes = 1;
+    int max_nodes = 1, stack_size = 4;
     double total_area = 0;
     glm::dvec3 albedo_area{0.0};
 
@@ -328,6 +328,11 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
             b = (b + 1) / 2;
         }
         max_nodes = count;
+        // Depth-first, a stack holds at most 3 siblings waiting per level below the root plus
+        // the 4 children just pushed: 3 (levels - 1) + 4 with levels = ceil(log2 b) + 1.
+        int levels = 1;
+        for (int side = atlas.block_texels; side > 1; side = (side + 1) / 2) ++levels;
+        stack_size = 3 * (levels - 1) + 4;
     }
     nodes = buffer(std::size_t(max_nodes) * sizeof(gpu_node));
 
@@ -536,7 +541,8 @@ void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
     dist_fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
     const std::string distribute = version_header() + "layout(local_size_x = 8, local_size_y = 8) in;\n" +
                                    lookup_functions + dist_fs.source() + common +
-                                   "const int max_nodes = " + std::to_string(max_nodes) + ";\n" + R"(
+                                   "const int max_nodes = " + std::to_string(max_nodes) + ";\n" +
+                                   "const int stack_size = " + std::to_string(stack_size) + ";\n" + R"(
 struct near_node { vec4 position_area; vec4 unshot; ivec4 meta; };
 layout(std430, binding = 1) readonly buffer nodes_block { near_node node[]; };
 layout(location = 10) uniform int node_count;
@@ -553,20 +559,30 @@ void main() {
     // else as its four quadrants, recursively, down to elements: the CPU solver's traversal
     // (a stack, children pushed in order, so terms are summed in its order). Each node is
     // visited at most once, so max_nodes bounds the loop.
-    int stack[64];
-    int top = 0;
-    stack[top++] = node_count - 1;
-    for (int visit = 0; visit < max_nodes && top > 0; ++visit) {
-        near_node nd = node[stack[--top]];
-        bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
-        if (nd.meta.y == 0 || !near_node_) {
-            float f = radiosity_form_factor(pr, nr, nd.position_area.xyz, shot_n, nd.position_area.w);
-            if (f > 0.0) {
-                incident += nd.unshot.xyz * f;
-                gain += radiosity_shot(pr, nr, rho, nd.position_area.xyz, shot_n, nd.position_area.w, nd.unshot.xyz, 1.0);
+    // Most receivers are far from the whole block: one disc, no stack.
+    near_node root = node[node_count - 1];
+    if (root.meta.y == 0 || !(radiosity_near_field(pr, root.position_area.xyz, root.position_area.w, near2) > 0.5)) {
+        float f = radiosity_form_factor(pr, nr, root.position_area.xyz, shot_n, root.position_area.w);
+        if (f > 0.0) {
+            incident = root.unshot.xyz * f;
+            gain = radiosity_shot(pr, nr, rho, root.position_area.xyz, shot_n, root.position_area.w, root.unshot.xyz, 1.0);
+        }
+    } else {
+        int stack[stack_size];
+        int top = 0;
+        for (int c = 0; c < root.meta.y; ++c) stack[top++] = root.meta.x + c;
+        for (int visit = 0; visit < max_nodes && top > 0; ++visit) {
+            near_node nd = node[stack[--top]];
+            bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
+            if (nd.meta.y == 0 || !near_node_) {
+                float f = radiosity_form_factor(pr, nr, nd.position_area.xyz, shot_n, nd.position_area.w);
+                if (f > 0.0) {
+                    incident += nd.unshot.xyz * f;
+                    gain += radiosity_shot(pr, nr, rho, nd.position_area.xyz, shot_n, nd.position_area.w, nd.unshot.xyz, 1.0);
+                }
+            } else {
+                for (int c = 0; c < nd.meta.y && top < stack_size; ++c) stack[top++] = nd.meta.x + c;
             }
-        } else {
-            for (int c = 0; c < nd.meta.y && top < 64; ++c) stack[top++] = nd.meta.x + c;
         }
     }
     if (!(incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
