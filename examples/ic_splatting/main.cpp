@@ -446,6 +446,34 @@ int run_with(const options& o) {
                        mc.reached ? "~" : "more than ", mc.spp, mc.ms, mc.reached ? "" : "at least ", mc.ms / ms, ms);
         }
 
+        if (o.ray_rates) {
+            if (o.sampler != "embree") throw parameter_error("--ray-rates", "applies to --sampler embree only");
+            // The same records' rays twice in this run: shaded into records, and traced alone.
+            const std::size_t count = std::min<std::size_t>(2048, cache.records().size());
+            std::vector<glm::vec3> p(count), n(count);
+            std::vector<double> footprint(count, 0.0);
+            std::vector<std::optional<irradiance_record>> out(count);
+            for (std::size_t k = 0; k < count; ++k) {
+                p[k] = cache.records()[k].position;
+                n[k] = cache.records()[k].normal;
+            }
+            const double rays = double(count) * embree_sampler.grid().count();
+            auto t0 = clock_type::now();
+            embree_sampler(std::span<const glm::vec3>(p), std::span<const glm::vec3>(n),
+                           std::span<const double>(footprint), std::span(out));
+            const double record_s = ms_since(t0) / 1000;
+            t0 = clock_type::now();
+            embree_sampler.trace_only(p, n);
+            const double trace_s = ms_since(t0) / 1000;
+            extra["ray_rates"] = {{"records", count},
+                                  {"rays", rays},
+                                  {"record_rays_per_s", rays / record_s},
+                                  {"embree_rays_per_s", rays / trace_s},
+                                  {"record_fraction_of_embree", trace_s / record_s}};
+            fmt::print("ray rates over {} records: records {:.3g} rays/s, Embree alone {:.3g} rays/s ({:.2f} of it)\n",
+                       count, rays / record_s, rays / trace_s, trace_s / record_s);
+        }
+
         if (!o.out.empty() || !o.exr.empty()) {
             image<glm::vec3> combined(o.width, o.height);
             if (fr.combined) combined = *fr.combined;

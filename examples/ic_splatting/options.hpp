@@ -48,6 +48,7 @@ struct options {
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
     int repeat = 1;
     bool mc_compare = false;
+    bool ray_rates = false;  // time records against Embree's raw rate for the same rays
     std::filesystem::path json, out, exr, indirect_out, indirect_exr, cache_in, cache_out;
 };
 
@@ -167,6 +168,9 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(examples::finite_non_negative);
     app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
     app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");
+    app.add_flag("--ray-rates", o.ray_rates,
+                 "Embree sampler: re-measure up to 2048 of the frame's records, and trace their hemisphere rays alone, "
+                 "reporting record_rays_per_s and embree_rays_per_s");
     app.add_option("--json", o.json, "write the run report here");
     app.add_option("--out", o.out, "write the final image (direct + indirect) as PNG");
     app.add_option("--exr", o.exr, "write the final image as EXR");

@@ -268,6 +268,27 @@ void reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemispher
     });
 }
 
+std::size_t reference_integrator::trace_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid,
+                                                  std::uint64_t seed) const {
+    check_point(p, n);
+    require(grid.m > 0 && grid.n > 0, "grid", "needs at least one stratum in theta and in phi");
+    // The directions of sample_hemisphere: the same stream, drawn in the same order.
+    const auto tb = orthonormal_basis<float, glm::vec3>(n);
+    pcg32 rng(seed);
+    const float m = float(grid.m), nn = float(grid.n);
+    ray r;
+    r.origin = p + epsilon_ * n;
+    std::size_t hits = 0;
+    for (std::uint32_t j = 0; j < grid.m; ++j)
+        for (std::uint32_t k = 0; k < grid.n; ++k) {
+            const float u = rng.next_float(), v = rng.next_float();
+            const glm::vec3 local = stratified_cosine_direction<float, glm::vec3>(float(j), float(k), m, nn, u, v);
+            r.direction = glm::normalize(local.x * tb[0] + local.y * tb[1] + local.z * n);
+            hits += bvh_.intersect(r).found() ? 1 : 0;
+        }
+    return hits;
+}
+
 hemisphere_samples reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid,
                                                            std::uint64_t seed) const {
     hemisphere_samples s;

@@ -73,6 +73,19 @@ public:
                           [&](std::size_t k) { out[k] = (*this)(points[k], normals[k], footprints[k]); });
     }
 
+    /// The hemisphere rays the records at points[k], normals[k] would cast, traced without
+    /// shading, the points on every core; returns the rays cast. For comparing a record's
+    /// cost with Embree's raw rate on the same rays.
+    std::size_t trace_only(std::span<const glm::vec3> points, std::span<const glm::vec3> normals) const {
+        require(normals.size() == points.size(), "normals", "must have one entry per point");
+        tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t k) {
+            integrator_.trace_hemisphere(points[k], normals[k], grid_, derive_seed(seed_, 0x1c, point_key(points[k], normals[k])));
+        });
+        return points.size() * grid_.count();
+    }
+
+    hemisphere_grid grid() const noexcept { return grid_; }
+
 private:
     const reference_integrator& integrator_;
     hemisphere_grid grid_;

@@ -133,6 +133,11 @@ public:
     void sample_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid, std::uint64_t seed,
                            hemisphere_samples& out) const;
 
+    /// The rays sample_hemisphere(p, n, grid, seed) casts, traced alone: nearest hits, no
+    /// shading (no shadow rays). Returns how many hit a surface. Embree's raw rate for a
+    /// record's rays, against which the shaded records are measured.
+    std::size_t trace_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid, std::uint64_t seed) const;
+
     /// Radiance (W/(m^2 sr), RGB) arriving at r.origin from direction r.direction (unit):
     /// Kd / pi * E_d at the first surface hit, or the environment on a miss. `distance`
     /// receives the hit distance (+infinity on a miss) when not null.
