@@ -15,13 +15,13 @@ def main(path):
         runs = {r["name"]: r for r in json.load(f)["runs"]}
     def order(name):  # cornell-stereo-b4-r128: visibility, then blocks, then resolution
         parts = name.split("-")
-        return ("hemicube" in name, int(parts[-2][1:]), int(parts[-1][1:]))
+        return (parts[0] != "cornell", "hemicube" in name, int(parts[-2][1:]), int(parts[-1][1:]))
 
     configs = sorted({n.split("-r")[0] + "-r" + n.split("-r")[1].split("-")[0] for n in runs}, key=order)
-    print("| visibility | blocks | buffer | shots | GL total (visibility / choice / distribution) | "
+    print("| scene | visibility | blocks | buffer | shots | GL total (visibility / choice / distribution) | "
           "GL total, one wait per step | CPU total (visibility / choice / distribution) | GL / CPU | "
           "GL vs CPU solution (rel. L1) | load |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for c in configs:
         gl, cpu, untimed = runs.get(c + "-gl"), runs.get(c + "-cpu"), runs.get(c + "-gl-untimed")
         if not gl or not cpu:
@@ -35,8 +35,8 @@ def main(path):
 
         load = p.get("load_average")
         versus = p.get("relative_l1_versus_cpu")
-        print("| %s | %d x %d | %d^2%s | %d | %s | %s | %s | %.2f | %s | %s |" % (
-            p["visibility"], p["block_texels"], p["block_texels"], p["resolution"],
+        print("| %s | %s | %d x %d | %d^2%s | %d | %s | %s | %s | %.2f | %s | %s |" % (
+            gl["scene"], p["visibility"], p["block_texels"], p["block_texels"], p["resolution"],
             " per face" if p["visibility"] == "hemicube" else "", gl["iterations"], stages(gl),
             "%.0f ms" % untimed["timings_ms"]["total"] if untimed else "-", stages(cpu),
             gl["timings_ms"]["total"] / cpu["timings_ms"]["total"], "%.1e" % versus if versus is not None else "-",

@@ -10,6 +10,7 @@
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/gl/radiosity.hpp>
+#include <bounce/io/scene.hpp>
 #include <bounce/study/run_report.hpp>
 
 #include <catch2/catch.hpp>
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -44,7 +46,7 @@ double relative_l1(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>
 }
 
 void write(const std::string& name, const std::string& backend, const std::string& renderer, const lightmap_atlas& atlas,
-           bool hemicube, int resolution, const run_figures& f, double versus_cpu = -1) {
+           bool hemicube, int resolution, const run_figures& f, double versus_cpu = -1, const char* scene = "cornell") {
     std::printf("%-28s %-4s elements %6zu shooters %5zu shots %5zu unshot %.4f escaped %.4f total %8.1f ms (lights %.1f, "
                 "visibility %.1f, choice %.1f, distribution %.1f)\n",
                 name.c_str(), backend.c_str(), atlas.size(), f.shooters, f.shots, f.unshot, f.escaped, f.total_ms,
@@ -53,7 +55,7 @@ void write(const std::string& name, const std::string& backend, const std::strin
     if (!out) return;
     study::run_report r;
     r.technique = "radiosity";
-    r.scene = "cornell";
+    r.scene = scene;
     r.width = atlas.width;
     r.height = atlas.height;
     r.backend = backend;
@@ -157,4 +159,58 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
                 CHECK(solver.unshot_fraction() <= fraction);
             }
         }
+}
+
+TEST_CASE("study: Sponza (66k triangles, 100,000 elements) to 90% on GL and on the CPU", "[gl][radiosity][study]") {
+    // scene.json's sun and point light, its default material; hemicube 128^2, 8 x 8 blocks
+    // (the CPU study's Sponza settings, docs/radiosity.md section 6); at most a minute each.
+    const char* dir = std::getenv("BOUNCE_SCENES");
+    const std::string path = std::string(dir ? dir : BOUNCE_SOURCE_DIR "/../shared/scenes") + "/sponza/scene.json";
+    if (!std::ifstream(path)) {
+        WARN("sponza/scene.json not found; skipped");
+        return;
+    }
+    auto& context = gl_test::shared_context();
+    const io::scene scene = io::load_scene(path);
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 100000, .block_texels = 8});
+    const double fraction = 0.1;
+    const auto within_a_minute = [](std::chrono::steady_clock::time_point t0) {
+        return [t0](const auto&) {
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < 60.0;
+        };
+    };
+    std::vector<glm::vec3> gl_solution;
+    run_figures gl_figures;
+    {
+        const auto t0 = std::chrono::steady_clock::now();
+        gl::progressive_radiosity solver(scene.view(), atlas,
+                                         {.visibility = gl::radiosity_visibility::hemicube, .resolution = 128});
+        solver.solve(fraction, within_a_minute(t0));
+        gl::finish();
+        const double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const auto& t = solver.timings();
+        gl_figures = {total, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
+                      solver.shooters(), solver.unshot_fraction(), solver.escaped_power().x / solver.emitted_power().x};
+        gl_solution = solver.radiosity();
+        CHECK(solver.unshot_fraction() < 1.0);
+    }
+    {
+        const auto t0 = std::chrono::steady_clock::now();
+        cpu::progressive_radiosity solver(
+            scene.view(), atlas,
+            cpu::item_buffer_visibility(scene.view(), atlas, {.projection = cpu::item_projection::hemicube, .resolution = 128}));
+        solver.solve(fraction, within_a_minute(t0));
+        const double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        const auto& t = solver.timings();
+        const run_figures f{total, t.lights_ms, t.visibility_ms, t.choice_ms, t.distribution_ms, solver.progress().shots,
+                            solver.shooters(), solver.unshot_fraction(),
+                            solver.escaped_power().x / solver.emitted_power().x};
+        write("sponza-hemicube-b8-r128", "cpu", "", atlas, true, 128, f, -1, "sponza");
+        const auto b = solver.radiosity();
+        const double versus = relative_l1(gl_solution, std::vector<glm::vec3>(b.begin(), b.end()), atlas);
+        std::printf("sponza GL versus CPU: relative L1 %.3g\n", versus);
+        write("sponza-hemicube-b8-r128", "gl", context.renderer(), atlas, true, 128, gl_figures,
+              solver.progress().shots == gl_figures.shots ? versus : -1, "sponza");
+        CHECK(solver.unshot_fraction() < 1.0);
+    }
 }

@@ -489,6 +489,8 @@ void main() { item = vec4(item_ids, along, 1.0); }
 struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
 layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
 layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
+layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
+layout(location = 21) uniform uint element_count;
 layout(rgba32f, binding = 0) uniform image2D radiosity_image;
 layout(rgba32f, binding = 1) uniform image2D unshot_image;
 layout(rgba32f, binding = 2) uniform writeonly image2D intercepted_image;
@@ -539,7 +541,7 @@ void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
     dist_fs.add("radiosity_shot", shot_radiosity<f32, vec3>, "receiver_position", "receiver_normal", "receiver_albedo",
                 "shooter_position", "shooter_normal", "shooter_area", "shooter_unshot", "visibility");
     dist_fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
-    const std::string distribute = version_header() + "layout(local_size_x = 8, local_size_y = 8) in;\n" +
+    const std::string distribute = version_header() + "layout(local_size_x = 64) in;\n" +
                                    lookup_functions + dist_fs.source() + common +
                                    "const int max_nodes = " + std::to_string(max_nodes) + ";\n" +
                                    "const int stack_size = " + std::to_string(stack_size) + ";\n" + R"(
@@ -548,8 +550,10 @@ layout(std430, binding = 1) readonly buffer nodes_block { near_node node[]; };
 layout(location = 10) uniform int node_count;
 layout(location = 11) uniform float near2;
 void main() {
-    ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
-    if (xy.x >= atlas_width || xy.y >= atlas_height) return;
+    // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
+    if (gl_GlobalInvocationID.x >= element_count) return;
+    uint code = element_texel[gl_GlobalInvocationID.x];
+    ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
     texel_attributes a = texel[xy.y * atlas_width + xy.x];
     if (!(a.position_area.w > 0.0)) return;
     if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
@@ -600,7 +604,7 @@ void main() {
                  "irradiance");
     light_fs.add("radiosity_spot_irradiance", spot_light_irradiance<f32, vec3>, "p", "n", "light_position", "axis",
                  "intensity", "cos_cone", "cosine_falloff");
-    const std::string light = version_header() + "layout(local_size_x = 8, local_size_y = 8) in;\n" +
+    const std::string light = version_header() + "layout(local_size_x = 64) in;\n" +
                               lookup_functions + light_fs.source() + common + R"(
 layout(location = 10) uniform int spot;
 layout(location = 11) uniform vec3 light_axis;
@@ -624,8 +628,10 @@ float parallel_visibility(vec3 p, float chart) {
     return radiosity_parallel_sees(p, chart, item.x, plane.xyz, plane.w, item.z, shot_n, diagonal);
 }
 void main() {
-    ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
-    if (xy.x >= atlas_width || xy.y >= atlas_height) return;
+    // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
+    if (gl_GlobalInvocationID.x >= element_count) return;
+    uint code = element_texel[gl_GlobalInvocationID.x];
+    ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
     texel_attributes a = texel[xy.y * atlas_width + xy.x];
     if (!(a.position_area.w > 0.0)) return;
     if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
@@ -1087,10 +1093,11 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
         p.set(8, float(options.resolution));
         p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
+        p.set(21, unsigned(atlas.size()));
         p.set(9, diagonal);
         p.set(10, int(near.size()));
         p.set(11, float(options.near_field * options.near_field));
-        glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
+        glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
         check_error("progressive_radiosity: the distribution pass");
     }
     if (options.timed_stages) finish();
@@ -1135,7 +1142,8 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             p.set(18, ortho_scale);
             p.set(19, float(options.parallel_resolution));
             p.set(20, 0);
-            glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
+            p.set(21, unsigned(atlas.size()));
+            glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
             check_error("progressive_radiosity: shooting a directional light");
         }
         const reduction got = reduce();
@@ -1166,6 +1174,8 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
             p.set(8, float(options.resolution));
             p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
+            p.set(21, unsigned(atlas.size()));
+        p.set(21, unsigned(atlas.size()));
             p.set(9, diagonal);
             p.set(10, kind == light_kind::spot ? 1 : 0);
             p.set(11, l.direction());
@@ -1177,7 +1187,7 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             p.set(17, ortho_lo);
             p.set(18, ortho_scale);
             p.set(19, float(options.parallel_resolution));
-            glDispatchCompute((width + 7) / 8, (height + 7) / 8, 1);
+            glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
             check_error("progressive_radiosity: shooting a light");
         }
         const reduction got = reduce();
