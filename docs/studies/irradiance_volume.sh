@@ -45,6 +45,8 @@ if [[ $part == all || $part == sponza ]]; then
     --neighbour-change 0 --gradient-ratio 0 --distance-ratio 0.5 --cull 0.05 "${common[@]}"
   run sponza-adaptive-5-cull --scene sponza --mode adaptive --max-depth 5 --cull 0.2 --neighbour-change 0.5 \
     --distance-ratio 0.5 --geometry-triangles 0 "${common[@]}"
+  run sponza-adaptive-5-loose --scene sponza --mode adaptive --max-depth 5 --distance-ratio 0.25 \
+    --neighbour-change 0.6 --gradient-ratio 0.6 --geometry-triangles 0 --cull 0.1 "${common[@]}"
   run sponza-adaptive-5-lighting --scene sponza --mode adaptive --max-depth 5 --distance-ratio 0 \
     --geometry-triangles 0 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
 fi
