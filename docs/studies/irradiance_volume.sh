@@ -28,6 +28,7 @@ if [[ $part == all || $part == cornell ]]; then
   run cornell-uniform-3 --scene cornell --mode uniform --max-depth 3 "${common[@]}"
   run cornell-uniform-4 --scene cornell --mode uniform --max-depth 4 "${common[@]}" --out "$figures/irradiance_volume_cornell.png"
   run cornell-adaptive-4 --scene cornell --mode adaptive --max-depth 4 "${common[@]}"
+  run cornell-adaptive-4-b1 --scene cornell --mode adaptive --max-depth 4 --b 1 "${common[@]}"
 fi
 
 if [[ $part == all || $part == sponza ]]; then
