@@ -75,7 +75,7 @@ run sponza-hemicube-100000 --scene sponza --visibility hemicube --elements 10000
 "$bin" --quiet --visibility rays --elements 10000 --converge 0.999 --reference off --out "$figures/radiosity_rays.png"
 "$bin" --quiet --visibility stereo --elements 10000 --converge 0.9 --reference off --out "$figures/radiosity_stereo_90.png"
 "$bin" --quiet --visibility rays --elements 2500 --adaptive on --converge 0.999 --reference off \
-  --out "$figures/radiosity_adaptive.png"
+  --out "$figures/radiosity_adaptive_view.png"
 "$bin" --quiet --scene sponza --visibility rays --elements 100000 --converge 0.95 --reference off \
   --out "$figures/radiosity_sponza.png"
 /usr/bin/python3 docs/studies/radiosity_figures.py "$results"
