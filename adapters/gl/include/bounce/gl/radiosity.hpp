@@ -17,7 +17,7 @@
 ///     by GL in the stereographic projection (stereographic_item_coords, emitted from
 ///     radiosity.hpp) into an item buffer holding chart id, triangle id and the exact depth at
 ///     each pixel centre (item_plane_depth), depth tested on a separate depth attachment;
-///  3. a compute pass over the atlas texels evaluates, per receiving element, the shot from
+///  3. a compute pass, one invocation per element at its texel, evaluates the shot from
 ///     the shooter's near-field nodes (disc_form_factor and shot_radiosity, emitted), looks
 ///     its pixel up with item_buffer_sees (the CPU's concave-corner rule) and adds the result
 ///     to the radiosity and unshot textures, writing the power it intercepted;
@@ -90,7 +90,7 @@ struct radiosity_timings {
     double lights_ms = 0;        ///< the scene's lights, their visibility included (construction)
     double visibility_ms = 0;    ///< reading the shooter back, tessellating and drawing the item buffer
     double choice_ms = 0;        ///< the reduction that picks the next shooter and sums powers
-    double distribution_ms = 0;  ///< form factors and updates over the atlas texels
+    double distribution_ms = 0;  ///< form factors and updates of the elements (their texels)
 };
 
 /// Where a solve stands after a step.
