@@ -21,7 +21,7 @@
 ///     the shooter's near-field nodes (disc_form_factor and shot_radiosity, emitted), looks
 ///     its pixel up with item_buffer_sees (the CPU's concave-corner rule) and adds the result
 ///     to the radiosity and unshot textures, writing the power it intercepted;
-///  4. a compute reduction (per shooter, then per work group, then one group) finds the next
+///  4. a compute reduction (one invocation per shooter, then one group of 64) finds the next
 ///     shooter, the total unshot power and the shot's intercepted and absorbed power, in
 ///     double: the convergence fraction is known after every step.
 /// Point, spot and directional lights are shot first, in the constructor, as the CPU solver
