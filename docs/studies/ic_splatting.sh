@@ -55,7 +55,8 @@ seams() {  # seams TAG ARGS...: Ward's and the smoothed weight over the whole a 
 
 study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling's a factor) RAYS(per record)
   local tag=$1 scene=$2 spp=$3 clamp=$4 fill=$5 rays=$6
-  local flags=() other=clamp  # other: the cross-check run with the other clamping setting
+  # ic_splatting clamps by default; the study says which setting each run has.
+  local flags=(--no-neighbour-clamp) other=clamp  # other: the cross-check run with the other clamping setting
   if [[ $clamp == on ]]; then flags=(--neighbour-clamp); other=noclamp; fi
   local base=(--scene "$scene" --width 512 --height 512 --ref-spp "$spp" "${flags[@]}")
   local common=("${base[@]}" --record-samples "$rays")
@@ -100,7 +101,7 @@ study() {  # study TAG SCENE REFSPP CLAMP(on|off) FILL(progressive hole filling'
   fi
   if [[ $clamp == on ]]; then
     run "$tag-$other" --scene "$scene" --width 512 --height 512 --ref-spp "$spp" --record-samples "$rays" --a 0.15 \
-        --weight ward-smooth
+        --weight ward-smooth --no-neighbour-clamp
   else
     run "$tag-$other" "${common[@]}" --a 0.15 --weight ward-smooth --neighbour-clamp
   fi
