@@ -90,7 +90,8 @@ public:
     /// before compose, which replaces the result.
     void read_indirect(image_view<glm::vec3> out) const { compose_.read(out); }
     /// The records the GPU holds are dropped: the next frame uploads the list it is given
-    /// (after the caller replaced or shrank its records).
+    /// (after the caller replaced or shrank its records, as when
+    /// cpu::irradiance_cache::clamp_to_neighbours returns more than 0).
     void reset() noexcept { on_gpu_ = wide_on_gpu_ = 0; }
 
 private:
