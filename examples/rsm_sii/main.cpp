@@ -62,17 +62,19 @@ double ms_since(clock_type::time_point t0) {
 }
 
 // ---- the backend, chosen in one place -----------------------------------------------------
+// Both backends take the same bounce::indirect_options and report bounce::indirect_timings
+// (include/bounce/indirect_options.hpp): a run's options reach either unchanged.
 
 /// Renders one frame of indirect irradiance with the given options into `out`.
 class frame_backend {
 public:
     virtual ~frame_backend() = default;
-    virtual cpu::indirect_timings render(const cpu::indirect_options& options, image_view<glm::vec3> out) = 0;
+    virtual indirect_timings render(const indirect_options& options, image_view<glm::vec3> out) = 0;
     virtual std::string gl_renderer() const { return {}; }
 };
 
 /// Whether two option sets make the same frames (a backend keeps its renderer between them).
-bool cpu_backend_same(const cpu::indirect_options& a, const cpu::indirect_options& b) {
+bool same_frames(const indirect_options& a, const indirect_options& b) {
     return a.technique == b.technique && a.count == b.count && a.pattern.n == b.pattern.n &&
            a.pattern.m == b.pattern.m && a.assignment == b.assignment && a.blur == b.blur &&
            a.energy_correct == b.energy_correct && a.selection == b.selection && a.r_max == b.r_max &&
@@ -87,8 +89,8 @@ class cpu_backend final : public frame_backend {
 public:
     cpu_backend(const gbuffer_view<float>& g, const camera& cam, std::span<const rsm_view> maps)
         : g_(g), cam_(cam), maps_(maps) {}
-    cpu::indirect_timings render(const cpu::indirect_options& options, image_view<glm::vec3> out) override {
-        if (!renderer_ || !cpu_backend_same(renderer_->options(), options)) renderer_.emplace(options);
+    indirect_timings render(const indirect_options& options, image_view<glm::vec3> out) override {
+        if (!renderer_ || !same_frames(renderer_->options(), options)) renderer_.emplace(options);
         return renderer_->render(g_, cam_, maps_, out);
     }
 
@@ -116,23 +118,14 @@ public:
         for (std::size_t i = 0; i < maps.size(); ++i)
             refs_.push_back({textures_[3 * i], textures_[3 * i + 1], textures_[3 * i + 2], maps[i].light_view_projection});
     }
-    cpu::indirect_timings render(const cpu::indirect_options& o, image_view<glm::vec3> out) override {
-        const gl::indirect_options g = mirror(o);
-        if (!renderer_ || !same_as_last(o)) {
+    indirect_timings render(const indirect_options& o, image_view<glm::vec3> out) override {
+        if (!renderer_ || !same_frames(renderer_->options(), o)) {
             renderer_.reset();
-            renderer_.emplace(g);
-            last_ = o;
+            renderer_.emplace(o, /*time_stages=*/true);
         }
-        const gl::indirect_timings t = renderer_->render(gb_.textures(), cam_, refs_, out_);
+        const indirect_timings t = renderer_->render(gb_.textures(), cam_, refs_, out_);
         gl::read_texture(out_, out);
-        cpu::indirect_timings c;
-        c.split_ms = t.split_ms;
-        c.shade_ms = t.shade_ms;
-        c.gather_ms = t.gather_ms;
-        c.blur_ms = t.blur_ms;
-        c.upsample_ms = t.upsample_ms;
-        c.vpls = t.vpls;
-        return c;
+        return t;
     }
     std::string gl_renderer() const override { return context_.renderer(); }
 
@@ -145,32 +138,6 @@ private:
         gl::write_texture(t, padded.view());
         return t;
     }
-    // cpu::indirect_options field by field (the GL adapter mirrors them).
-    static gl::indirect_options mirror(const cpu::indirect_options& o) {
-        gl::indirect_options g;
-        g.technique = o.technique == cpu::indirect_technique::rsm_gather ? gl::indirect_technique::rsm_gather
-                                                                          : gl::indirect_technique::sii;
-        g.count = o.count;
-        g.pattern = o.pattern;
-        g.assignment = o.assignment;
-        g.shift = o.shift;
-        g.blur = o.blur;
-        g.energy_correct = o.energy_correct;
-        g.discontinuity.relative_depth = o.discontinuity.relative_depth;
-        g.discontinuity.cos_normal = o.discontinuity.cos_normal;
-        g.selection = o.selection == cpu::vpl_selection::grid ? gl::vpl_selection::grid : gl::vpl_selection::flux_warping;
-        g.r_max = o.r_max;
-        g.disc = o.disc == cpu::disc_weighting::unbiased ? gl::disc_weighting::unbiased : gl::disc_weighting::xi1_squared;
-        g.light.offset = o.light.offset;
-        g.light.min_distance2 = o.light.min_distance2;
-        g.sii_cutoff = o.sii_cutoff;
-        g.low_resolution = o.low_resolution;
-        g.seed = o.seed;
-        g.time_stages = true;
-        return g;
-    }
-    bool same_as_last(const cpu::indirect_options& o) const { return cpu_backend_same(last_, o); }
-
     gl::context context_;  // first: everything below needs it current
     gl::gbuffer_upload gb_;
     camera cam_;
@@ -178,7 +145,6 @@ private:
     std::vector<gl::texture> textures_;
     std::vector<gl::rsm_textures> refs_;
     std::optional<gl::indirect_renderer> renderer_;
-    cpu::indirect_options last_;
 };
 #endif
 
@@ -282,7 +248,7 @@ struct run_result {
     interleave_pattern pattern{1, 1};
     bool thesis_weights = false;
     study::stage_timer timer;
-    cpu::indirect_timings last;
+    indirect_timings last;
     image<glm::vec3> radiance;
     study::error_figures vs_unoccluded, vs_full;
     std::optional<study::error_figures> vs_plain;
@@ -306,7 +272,7 @@ run_result measure(context& c, const std::string& technique, std::size_t count, 
                    bool thesis_weights, const image<glm::vec3>* plain, double plain_total_ms, int repeat) {
     options o = c.o;
     o.thesis_weights = thesis_weights;
-    const cpu::indirect_options opts = indirect_options_for(o, technique, count, pattern, c.clamp_distance);
+    const indirect_options opts = indirect_options_for(o, technique, count, pattern, c.clamp_distance);
     run_result r;
     r.technique = technique;
     r.count = count;

@@ -1,6 +1,6 @@
 #pragma once
 // rsm_sii's options: what the command line sets, how it is spelled and checked, and the
-// library settings (cpu::indirect_options) they make. main.cpp runs and reports.
+// library settings (bounce::indirect_options) they make. main.cpp runs and reports.
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/errors.hpp>
 
@@ -61,16 +61,16 @@ inline light_assignment parse_assign(const std::string& s) {
 }
 
 /// The renderer's options for a run of `technique` with `count` lights and `pattern`.
-inline cpu::indirect_options indirect_options_for(const options& o, const std::string& technique, std::size_t count,
+inline indirect_options indirect_options_for(const options& o, const std::string& technique, std::size_t count,
                                                   interleave_pattern pattern, float clamp_distance) {
-    cpu::indirect_options c;
-    c.technique = technique == "rsm" ? cpu::indirect_technique::rsm_gather : cpu::indirect_technique::sii;
+    indirect_options c;
+    c.technique = technique == "rsm" ? indirect_technique::rsm_gather : indirect_technique::sii;
     c.count = count;
     c.pattern = pattern;
     c.assignment = parse_assign(o.assign);
     c.blur = o.blur;
     c.energy_correct = !o.thesis_weights;
-    c.selection = o.selection == "grid" ? cpu::vpl_selection::grid : cpu::vpl_selection::flux_warping;
+    c.selection = o.selection == "grid" ? vpl_selection::grid : vpl_selection::flux_warping;
     c.r_max = o.r_max;
     c.light.offset = o.offset;
     c.light.min_distance2 = clamp_distance * clamp_distance;

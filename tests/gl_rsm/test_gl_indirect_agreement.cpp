@@ -1,8 +1,9 @@
 // gl::indirect_renderer against cpu::indirect_renderer on the same G-buffer, the same
 // reflective shadow map and the same options: the RSM gather and SII, without and with
 // interleaving (patterns 2x2, 4x4 and 3x2 on an image whose size is no multiple of them),
-// blur on, SII with and without the splat cutoff; the CPU-side choices (disc pattern, VPLs)
-// equal bit for bit; bad input refused by name; the caller's GL state kept.
+// blur on, SII with and without the splat cutoff; the renderers take one
+// bounce::indirect_options; the VPLs GL splats are the core's select_vpls; bad input
+// refused by name; the caller's GL state kept.
 //
 // Tolerance. Every pixel is a sum of non-negative terms (pixel-light irradiances), added in
 // the same order on both backends, then (interleaved, blurred) a convex combination of such
@@ -35,31 +36,6 @@ using namespace bounce;
 using rsm_test::corner_scene;
 
 namespace {
-
-cpu::indirect_options cpu_options(const gl::indirect_options& o) {
-    cpu::indirect_options c;
-    c.technique = o.technique == gl::indirect_technique::rsm_gather ? cpu::indirect_technique::rsm_gather
-                                                                     : cpu::indirect_technique::sii;
-    c.count = o.count;
-    c.pattern = o.pattern;
-    c.assignment = o.assignment;
-    c.shift = o.shift;
-    c.blur = o.blur;
-    c.energy_correct = o.energy_correct;
-    c.discontinuity.relative_depth = o.discontinuity.relative_depth;
-    c.discontinuity.cos_normal = o.discontinuity.cos_normal;
-    c.selection = o.selection == gl::vpl_selection::grid ? cpu::vpl_selection::grid : cpu::vpl_selection::flux_warping;
-    c.r_max = o.r_max;
-    c.disc = o.disc == gl::disc_weighting::unbiased ? cpu::disc_weighting::unbiased : cpu::disc_weighting::xi1_squared;
-    c.light.offset = o.light.offset;
-    c.light.min_distance2 = o.light.min_distance2;
-    c.sii_cutoff = o.sii_cutoff;
-    c.low_resolution = o.low_resolution;
-    c.upsample.cos_normal = o.upsample.cos_normal;
-    c.upsample.plane_footprints = o.upsample.plane_footprints;
-    c.seed = o.seed;
-    return c;
-}
 
 // An RGBA32F texture holding `img` (row 0 at the top), alpha `a`.
 gl::texture upload(const image<glm::vec3>& img) {
@@ -108,11 +84,11 @@ comparison compare(const corner_scene& s, const image<glm::vec3>& gl_img, const 
 
 struct frame {
     image<glm::vec3> gl_img, cpu_img;
-    gl::indirect_timings timings;
-    cpu::indirect_timings cpu_timings;
+    indirect_timings timings;
+    indirect_timings cpu_timings;
 };
 
-frame render_both(const corner_scene& s, const gl::indirect_options& o) {
+frame render_both(const corner_scene& s, const indirect_options& o) {
     gl::gbuffer_upload gb(const_cast<gbuffer<float>&>(s.gb).view());
     map_textures map(s);
     gl::texture out(gl::texel_format::rgba32f, s.gb.width(), s.gb.height());
@@ -123,7 +99,7 @@ frame render_both(const corner_scene& s, const gl::indirect_options& o) {
     f.gl_img = image<glm::vec3>(s.gb.width(), s.gb.height());
     gl::read_texture(out, f.gl_img.view());
 
-    cpu::indirect_renderer cpu_renderer(cpu_options(o));
+    cpu::indirect_renderer cpu_renderer(o);  // the same options
     f.cpu_img = image<glm::vec3>(s.gb.width(), s.gb.height());
     const rsm_view cpu_maps[] = {s.map()};
     auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
@@ -131,7 +107,7 @@ frame render_both(const corner_scene& s, const gl::indirect_options& o) {
     return f;
 }
 
-frame check_agreement(const corner_scene& s, const gl::indirect_options& o) {
+frame check_agreement(const corner_scene& s, const indirect_options& o) {
     frame f = render_both(s, o);
     const comparison c = compare(s, f.gl_img, f.cpu_img);
     INFO("pattern " << o.pattern.n << "x" << o.pattern.m << ", worst relative " << c.worst_relative
@@ -147,8 +123,8 @@ frame check_agreement(const corner_scene& s, const gl::indirect_options& o) {
 TEST_CASE("GL RSM gather equals the CPU's, plain and interleaved with blur", "[gl][rsm]") {
     gl_test::shared_context();
     const corner_scene s(61, 47);  // no multiple of 2, 3 or 4
-    gl::indirect_options o;
-    o.technique = gl::indirect_technique::rsm_gather;
+    indirect_options o;
+    o.technique = indirect_technique::rsm_gather;
     o.count = 256;
     // 8x8 and 16x2 take the tent's radii 7 and 15.
     for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{2, 2}, interleave_pattern{4, 4},
@@ -160,7 +136,7 @@ TEST_CASE("GL RSM gather equals the CPU's, plain and interleaved with blur", "[g
         o.pattern = {2, 2};
         o.light.offset = 0.01f;
         o.light.min_distance2 = 1e-4f;
-        o.disc = gl::disc_weighting::xi1_squared;
+        o.disc = disc_weighting::xi1_squared;
         o.shift = 3;
         check_agreement(s, o);
     }
@@ -170,8 +146,8 @@ TEST_CASE("GL RSM gather at low resolution, upsampled with the full-resolution f
           "[gl][rsm]") {
     gl_test::shared_context();
     const corner_scene s(61, 47);
-    gl::indirect_options o;
-    o.technique = gl::indirect_technique::rsm_gather;
+    indirect_options o;
+    o.technique = indirect_technique::rsm_gather;
     o.count = 128;
     for (const int f : {2, 3})
         for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{2, 2}}) {
@@ -188,8 +164,8 @@ TEST_CASE("GL RSM gather at low resolution, upsampled with the full-resolution f
 TEST_CASE("GL SII equals the CPU's, plain and interleaved with blur, with and without the cutoff", "[gl][rsm]") {
     gl_test::shared_context();
     const corner_scene s(61, 47);
-    gl::indirect_options o;
-    o.technique = gl::indirect_technique::sii;
+    indirect_options o;
+    o.technique = indirect_technique::sii;
     o.count = 128;
     // The corner map's VPLs carry about 0.02 W each: a cutoff of 1 W/m^2 over 128 VPLs bounds
     // each splat by a sphere of radius 0.4 m in a 2 m scene, so the rectangles matter.
@@ -212,7 +188,7 @@ TEST_CASE("GL SII equals the CPU's, plain and interleaved with blur, with and wi
     }
     SECTION("grid VPLs, similarity assignment, weight 1 (the thesis's)") {
         o.pattern = {2, 2};
-        o.selection = gl::vpl_selection::grid;
+        o.selection = vpl_selection::grid;
         o.assignment = light_assignment::similarity;
         o.energy_correct = false;
         check_agreement(s, o);
@@ -222,33 +198,41 @@ TEST_CASE("GL SII equals the CPU's, plain and interleaved with blur, with and wi
 TEST_CASE("GL interleaving without blur is the split, shaded and gathered image of the CPU", "[gl][rsm]") {
     gl_test::shared_context();
     const corner_scene s(37, 29);
-    gl::indirect_options o;
-    o.technique = gl::indirect_technique::sii;
+    indirect_options o;
+    o.technique = indirect_technique::sii;
     o.count = 64;
     o.blur = false;
     o.pattern = {4, 3};
     check_agreement(s, o);
 }
 
-TEST_CASE("the GL renderer's disc pattern and VPLs are the CPU's, bit for bit", "[gl][rsm]") {
-    const auto a = gl::rsm_disc_pattern(400, 1.5f, 1024, 7, gl::disc_weighting::unbiased);
-    const auto b = cpu::rsm_disc_pattern(400, 1.5f, 1024, 7, cpu::disc_weighting::unbiased);
-    CHECK(a == b);
-    const auto c = gl::rsm_disc_pattern(100, 0.3f, 64, 2, gl::disc_weighting::xi1_squared);
-    const auto d = cpu::rsm_disc_pattern(100, 0.3f, 64, 2, cpu::disc_weighting::xi1_squared);
-    CHECK(c == d);
-
-    const corner_scene s(8, 8);
-    const rsm_view maps[] = {s.map()};
-    gl::indirect_options o;
-    o.count = 300;
-    o.seed = 5;
-    const auto v = gl::select_vpls(maps, o);
-    const auto w = vpls_by_flux_warping(s.map(), 300, 5);
-    REQUIRE(v.size() == w.size());
-    for (std::size_t k = 0; k < v.size(); ++k) {
-        CHECK(v[k].position == w[k].position);
-        CHECK(v[k].flux == w[k].flux);
+TEST_CASE("the GL renderer splats the core's VPLs (select_vpls), dealt and weighted as the CPU's", "[gl][rsm]") {
+    gl_test::shared_context();
+    const corner_scene s(16, 12, 8);
+    gl::gbuffer_upload gb(const_cast<gbuffer<float>&>(s.gb).view());
+    map_textures map(s);
+    gl::texture out(gl::texel_format::rgba32f, 16, 12);
+    const gl::rsm_textures maps[] = {map.refs};
+    const rsm_view views[] = {s.map()};
+    for (const vpl_selection selection : {vpl_selection::flux_warping, vpl_selection::grid}) {
+        indirect_options o;
+        o.technique = indirect_technique::sii;
+        o.count = 60;
+        o.seed = 5;
+        o.pattern = {2, 2};
+        o.selection = selection;
+        gl::indirect_renderer r(o);
+        const indirect_timings t = r.render(gb.textures(), s.cam, maps, out);
+        // The host-side choices are the core's (rsm_sampling.hpp), on the read-back map.
+        const auto all = select_vpls(views, o);
+        const light_groups g = assign_lights(all.size(), 4, light_assignment::interleaved);
+        REQUIRE(t.vpls == all.size());
+        REQUIRE(r.splatted_vpls().size() == all.size());
+        for (std::size_t k = 0; k < all.size(); ++k) {
+            const vpl& want = all[g.order[k]];
+            CHECK(r.splatted_vpls()[k].position == want.position);
+            CHECK(r.splatted_vpls()[k].flux == want.flux * 4.f);
+        }
     }
 }
 
@@ -299,8 +283,8 @@ TEST_CASE("the GL indirect renderer refuses bad input by name", "[gl][rsm]") {
         throws_naming([] { gl::texture t(gl::texel_format::rgba32f, 0, 4); }, "");
     }
     SECTION("maps of two sizes for the gather") {
-        gl::indirect_options o;
-        o.technique = gl::indirect_technique::rsm_gather;
+        indirect_options o;
+        o.technique = indirect_technique::rsm_gather;
         gl::indirect_renderer gather(o);
         const corner_scene other(16, 12, 4);
         map_textures small(other);
@@ -308,10 +292,10 @@ TEST_CASE("the GL indirect renderer refuses bad input by name", "[gl][rsm]") {
         throws_naming([&] { gather.render(gb.textures(), s.cam, two, out); }, "maps");
     }
     SECTION("options") {
-        gl::indirect_options o;
+        indirect_options o;
         o.low_resolution = 2;  // SII has no low-resolution pass
         throws_naming([&] { gl::indirect_renderer x(o); }, "low_resolution");
-        o.technique = gl::indirect_technique::rsm_gather;
+        o.technique = indirect_technique::rsm_gather;
         o.low_resolution = 9;
         throws_naming([&] { gl::indirect_renderer x(o); }, "low_resolution");
         o = {};
@@ -342,8 +326,8 @@ TEST_CASE("the GL indirect renderer keeps the caller's GL state", "[gl][rsm]") {
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
     glBindTextureUnit(3, colour.id());
     for (const int variant : {0, 1, 2}) {
-        gl::indirect_options o;
-        o.technique = variant == 0 ? gl::indirect_technique::sii : gl::indirect_technique::rsm_gather;
+        indirect_options o;
+        o.technique = variant == 0 ? indirect_technique::sii : indirect_technique::rsm_gather;
         o.low_resolution = variant == 2 ? 2 : 1;  // the downsampling, upsampling and fallback passes too
         o.count = 16;
         gl::indirect_renderer r(o);

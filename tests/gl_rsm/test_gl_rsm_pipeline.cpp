@@ -55,9 +55,9 @@ TEST_CASE("GL maps and GL indirect light of a point and a spot light equal the C
     std::vector<rsm_view> views;
     for (const auto& im : images) views.push_back(im.view());
 
-    for (const auto technique : {gl::indirect_technique::rsm_gather, gl::indirect_technique::sii}) {
+    for (const auto technique : {indirect_technique::rsm_gather, indirect_technique::sii}) {
         for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{4, 2}}) {
-            gl::indirect_options o;
+            indirect_options o;
             o.technique = technique;
             o.count = 96;
             o.pattern = p;
@@ -68,16 +68,10 @@ TEST_CASE("GL maps and GL indirect light of a point and a spot light equal the C
             image<glm::vec3> gl_img(w, h);
             gl::read_texture(out, gl_img.view());
 
-            cpu::indirect_options c;
-            c.technique = technique == gl::indirect_technique::sii ? cpu::indirect_technique::sii
-                                                                   : cpu::indirect_technique::rsm_gather;
-            c.count = o.count;
-            c.pattern = p;
-            c.light.min_distance2 = o.light.min_distance2;
-            cpu::indirect_renderer cpu_renderer(c);
+            cpu::indirect_renderer cpu_renderer(o);  // the same options
             image<glm::vec3> cpu_img(w, h);
-            const cpu::indirect_timings ct = cpu_renderer.render(gb.view(), cam, views, cpu_img.view());
-            if (technique == gl::indirect_technique::sii) CHECK(ct.vpls > std::size_t(80));
+            const indirect_timings ct = cpu_renderer.render(gb.view(), cam, views, cpu_img.view());
+            if (technique == indirect_technique::sii) CHECK(ct.vpls > std::size_t(80));
 
             double worst = 0, mean = 0;
             for (std::size_t y = 0; y < h; ++y)

@@ -1,10 +1,13 @@
 // The CPU passes and cpu::indirect_renderer: energy-correct interleaving (the expectation
 // over relabellings of the sub-buffers is the non-interleaved value, the thesis's Section
 // 5.2 loss avoided), thread-count independence, the splat cutoff's bound, the blur and
-// upsampling at discontinuities, and bad input.
+// upsampling at discontinuities, the core's splat rectangles (rsm_sampling.hpp) against
+// cpu::splat_rect, and bad input.
 #include "corner_scene.hpp"
 
 #include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/cpu/splatting.hpp>
+#include <bounce/rsm_sampling.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -21,7 +24,7 @@ namespace {
 constexpr double u32 = 0x1p-24;
 double higham_gamma(double n) { return n * u32 / (1 - n * u32); }
 
-image<glm::vec3> render(const corner_scene& s, cpu::indirect_options o, cpu::indirect_timings* t = nullptr) {
+image<glm::vec3> render(const corner_scene& s, indirect_options o, indirect_timings* t = nullptr) {
     cpu::indirect_renderer r(o);
     image<glm::vec3> out(s.gb.width(), s.gb.height());
     const rsm_view maps[] = {s.map()};
@@ -79,12 +82,12 @@ TEST_CASE("averaged over every relabelling of the sub-buffers, interleaved SII a
     // scale N M rounds each term once (u) and the mean of N M values adds gamma_(N M):
     // |mean - plain| <= (2 gamma_K + gamma_(N M) + 2 u) plain.
     const corner_scene s(50, 37);
-    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather})
+    for (const auto tech : {indirect_technique::sii, indirect_technique::rsm_gather})
         for (const interleave_pattern p : {interleave_pattern{3, 2}, interleave_pattern{4, 4}})
             for (const auto how :
                  {light_assignment::interleaved, light_assignment::blocked, light_assignment::similarity}) {
-                if (tech == cpu::indirect_technique::rsm_gather && how != light_assignment::interleaved) continue;
-                cpu::indirect_options o;
+                if (tech == indirect_technique::rsm_gather && how != light_assignment::interleaved) continue;
+                indirect_options o;
                 o.technique = tech;
                 o.count = 301;  // not a multiple of N M
                 o.pattern = {1, 1};
@@ -124,8 +127,8 @@ TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the
     const corner_scene s(96, 72);
     const float texel = 2.f / 32.f;
     const auto exact = full_rsm_sum(s, texel * texel);
-    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
-        cpu::indirect_options o;
+    for (const auto tech : {indirect_technique::sii, indirect_technique::rsm_gather}) {
+        indirect_options o;
         o.technique = tech;
         o.count = 1024;
         o.light.min_distance2 = texel * texel;
@@ -154,10 +157,10 @@ TEST_CASE("blurred interleaved SII and RSM keep the energy and stay close to the
 TEST_CASE("SII and the RSM gather converge to the full RSM sum", "[indirect]") {
     const corner_scene s(64, 48);
     const auto exact = full_rsm_sum(s);
-    cpu::indirect_options o;
+    indirect_options o;
     o.pattern = {1, 1};
     o.count = 4096;
-    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
+    for (const auto tech : {indirect_technique::sii, indirect_technique::rsm_gather}) {
         o.technique = tech;
         const double e = rel_rms(s, render(s, o), exact);
         INFO("technique " << int(tech) << " rel_rms " << e);
@@ -166,14 +169,14 @@ TEST_CASE("SII and the RSM gather converge to the full RSM sum", "[indirect]") {
     // DS05's xi1^2 weights over-weight the disc's rim (docs, section 4): with a disc that
     // reaches the whole map the gather stays far from the sum however many samples
     // (measured 0.65 at 1024 and at 4096 on this scene).
-    o.technique = cpu::indirect_technique::rsm_gather;
-    o.disc = cpu::disc_weighting::xi1_squared;
+    o.technique = indirect_technique::rsm_gather;
+    o.disc = disc_weighting::xi1_squared;
     CHECK(rel_rms(s, render(s, o), exact) > 0.3);
-    o.disc = cpu::disc_weighting::unbiased;
+    o.disc = disc_weighting::unbiased;
     // Every texel as a VPL (a grid the map's size) is the full sum itself, up to float
     // summation of 1024 terms.
-    o.technique = cpu::indirect_technique::sii;
-    o.selection = cpu::vpl_selection::grid;
+    o.technique = indirect_technique::sii;
+    o.selection = vpl_selection::grid;
     o.count = s.map_flux.width() * s.map_flux.height();
     CHECK(rel_rms(s, render(s, o), exact) < 2 * higham_gamma(double(o.count)) + 1e-5);
 }
@@ -183,7 +186,7 @@ TEST_CASE("the plain splat and gather passes give what the renderer gives withou
     const corner_scene s(40, 30);
     auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
     const rsm_view maps[] = {s.map()};
-    cpu::indirect_options o;
+    indirect_options o;
     o.pattern = {1, 1};
     o.count = 300;
     const auto via_renderer = render(s, o);
@@ -191,9 +194,9 @@ TEST_CASE("the plain splat and gather passes give what the renderer gives withou
     cpu::splat_vpls(gbv, s.cam, vpls_by_flux_warping(s.map(), o.count, o.seed), {}, direct.view());
     for (std::size_t y = 0; y < 30; ++y)
         for (std::size_t x = 0; x < 40; ++x) REQUIRE(direct(x, y) == via_renderer(x, y));
-    o.technique = cpu::indirect_technique::rsm_gather;
+    o.technique = indirect_technique::rsm_gather;
     const auto gathered = render(s, o);
-    const auto pattern = cpu::rsm_disc_pattern(o.count, o.r_max, s.map_flux.width() * s.map_flux.height(), o.seed);
+    const auto pattern = rsm_disc_pattern(o.count, o.r_max, s.map_flux.width() * s.map_flux.height(), o.seed);
     cpu::rsm_gather(gbv, maps, pattern, {}, direct.view());
     for (std::size_t y = 0; y < 30; ++y)
         for (std::size_t x = 0; x < 40; ++x) REQUIRE(direct(x, y) == gathered(x, y));
@@ -208,8 +211,8 @@ TEST_CASE("the gather reaches every texel whatever the map's projection, receive
                               glm::lookAt(glm::vec3(-5, 0, 1), glm::vec3(-10, 0, 1), glm::vec3(0, 0, 1));
     const glm::vec4 clip = s.light_view_projection * glm::vec4(s.gb.position(32, 24), 1.f);
     REQUIRE(clip.w < 0.f);
-    cpu::indirect_options o;
-    o.technique = cpu::indirect_technique::rsm_gather;
+    indirect_options o;
+    o.technique = indirect_technique::rsm_gather;
     o.pattern = {1, 1};
     // Unbiased but noisier than centring on the receiver's texel (the near texels fall where
     // the disc's samples are sparse): measured 0.25, 0.12, 0.022 at 1024, 4096, 16384
@@ -229,8 +232,8 @@ TEST_CASE("the gather reaches every texel whatever the map's projection, receive
 TEST_CASE("images smaller than the pattern (empty sub-buffers) render, and keep the energy property", "[indirect]") {
     for (const auto& [w, h] : {std::pair{1, 1}, std::pair{3, 2}, std::pair{9, 5}}) {
         const corner_scene s{std::size_t(w), std::size_t(h)};
-        for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
-            cpu::indirect_options o;
+        for (const auto tech : {indirect_technique::sii, indirect_technique::rsm_gather}) {
+            indirect_options o;
             o.technique = tech;
             o.count = 128;
             o.pattern = {1, 1};
@@ -255,8 +258,8 @@ TEST_CASE("images smaller than the pattern (empty sub-buffers) render, and keep 
 
 TEST_CASE("results are bitwise the same for one thread and for two", "[indirect]") {
     const corner_scene s(61, 45);
-    for (const auto tech : {cpu::indirect_technique::sii, cpu::indirect_technique::rsm_gather}) {
-        cpu::indirect_options o;
+    for (const auto tech : {indirect_technique::sii, indirect_technique::rsm_gather}) {
+        indirect_options o;
         o.technique = tech;
         o.count = 512;
         o.pattern = {4, 2};
@@ -270,7 +273,7 @@ TEST_CASE("results are bitwise the same for one thread and for two", "[indirect]
 
 TEST_CASE("the SII splat bounds cut off at most the cutoff at any pixel", "[indirect]") {
     const corner_scene s(64, 48);
-    cpu::indirect_options o;
+    indirect_options o;
     o.pattern = {1, 1};
     o.count = 2048;
     const auto full = render(s, o);
@@ -288,6 +291,48 @@ TEST_CASE("the SII splat bounds cut off at most the cutoff at any pixel", "[indi
                     REQUIRE(lost <= double(o.sii_cutoff) + 2 * higham_gamma(2048) * double(full(x, y)[c]));
                     REQUIRE(lost >= -2 * higham_gamma(2048) * double(full(x, y)[c]));
                 }
+    }
+}
+
+TEST_CASE("the core's sphere rectangle rounds as cpu::splat_rect, and split rectangles hold the sub-buffer's pixels",
+          "[indirect]") {
+    // rsm_sampling.hpp's sphere_pixel_rect is what both RSM backends splat over; the
+    // irradiance splatting's cpu::splat_rect (cpu/splatting.hpp) rounds the same way.
+    const corner_scene s(61, 47);
+    const glm::mat4 view = s.cam.view_matrix();
+    pcg32 rng(3);
+    for (int k = 0; k < 2000; ++k) {
+        const glm::vec3 c(float(rng.next_double()) * 4.f - 2.f, float(rng.next_double()) * 4.f - 2.f,
+                          float(rng.next_double()) * 3.f - 0.5f);
+        const float radius = float(rng.next_double()) * 1.5f;
+        const bounce::pixel_rect a = sphere_pixel_rect(s.cam, view, c, radius, 61, 47);
+        const cpu::pixel_rect b = cpu::splat_rect(s.cam, view, c, radius, 61, 47);
+        INFO("sphere " << k);
+        CHECK(a.empty() == b.empty());
+        if (!a.empty() && !b.empty()) CHECK((a.x0 == b.x0 && a.x1 == b.x1 && a.y0 == b.y0 && a.y1 == b.y1));
+    }
+    // A split rectangle holds exactly the pixels of the image rectangle in its sub-buffer.
+    const interleave_pattern p{3, 2};
+    const std::size_t w = 13, h = 9;
+    const cpu::interleave_maps maps(p, w, h);
+    for (int k = 0; k < 60; ++k) {
+        bounce::pixel_rect r;
+        r.x0 = int(rng.next_u32() % w);
+        r.x1 = int(rng.next_u32() % w);
+        r.y0 = int(rng.next_u32() % h);
+        r.y1 = int(rng.next_u32() % h);
+        for (int j = 0; j < p.m; ++j)
+            for (int i = 0; i < p.n; ++i) {
+                const bounce::pixel_rect q = split_buffer_rect(r, p, i, j, maps.sub_buffer(i, j));
+                for (std::size_t y = 0; y < h; ++y)
+                    for (std::size_t x = 0; x < w; ++x) {
+                        const bool in_image = int(x) >= r.x0 && int(x) <= r.x1 && int(y) >= r.y0 && int(y) <= r.y1 &&
+                                              int(x) % p.n == i && int(y) % p.m == j;
+                        const int u = int(maps.split_x[x]), v = int(maps.split_y[y]);
+                        const bool in_split = !q.empty() && u >= q.x0 && u <= q.x1 && v >= q.y0 && v <= q.y1;
+                        CHECK(in_image == in_split);
+                    }
+            }
     }
 }
 
@@ -315,14 +360,14 @@ TEST_CASE("the geometry-aware blur keeps each surface's value: nothing bleeds ac
 
 TEST_CASE("the low-resolution gather interpolates on smooth surfaces and gathers at full resolution at edges",
           "[indirect]") {
-    cpu::indirect_options o;
-    o.technique = cpu::indirect_technique::rsm_gather;
+    indirect_options o;
+    o.technique = indirect_technique::rsm_gather;
     o.count = 256;
     o.pattern = {1, 1};
     const corner_scene floor_only(64, 48, 32, false);
     o.light.min_distance2 = 0.0625f * 0.0625f;
     o.low_resolution = 2;
-    cpu::indirect_timings t;
+    indirect_timings t;
     const auto low = render(floor_only, o, &t);
     // On one plane every sample is suitable, except beside the floor's silhouette, where a
     // low-resolution sample may see nothing: only pixels within f = 2 pixels of an uncovered
@@ -365,7 +410,7 @@ TEST_CASE("bad options and sizes raise parameter_error naming the parameter", "[
         }
         return std::string("(nothing thrown)");
     };
-    cpu::indirect_options o;
+    indirect_options o;
     o.count = 0;
     CHECK(name_of([&] { cpu::indirect_renderer r(o); }) == "count");
     o = {};

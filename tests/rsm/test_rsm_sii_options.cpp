@@ -36,10 +36,10 @@ TEST_CASE("rsm_sii's options make the renderer's options, and bad values are ref
     o.selection = "grid";
     o.thesis_weights = true;
     const auto c = examples::indirect_options_for(o, "rsm", 512, {8, 8}, 0.01f);
-    CHECK(c.technique == cpu::indirect_technique::rsm_gather);
+    CHECK(c.technique == indirect_technique::rsm_gather);
     CHECK(c.count == 512);
     CHECK(c.assignment == light_assignment::similarity);
-    CHECK(c.selection == cpu::vpl_selection::grid);
+    CHECK(c.selection == vpl_selection::grid);
     CHECK_FALSE(c.energy_correct);
     CHECK(c.light.min_distance2 == Approx(1e-4f));
     o.assign = "random";

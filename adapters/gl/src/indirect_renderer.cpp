@@ -8,8 +8,7 @@
 #include <bounce/gl/indirect_renderer.hpp>
 #include <bounce/glsl/emit.hpp>
 #include <bounce/rsm.hpp>
-#include <bounce/sampling.hpp>
-#include <bounce/splat_bounds.hpp>
+#include <bounce/rsm_sampling.hpp>
 
 #include "saved_state.hpp"
 
@@ -23,115 +22,7 @@
 
 namespace bounce::gl {
 
-// ---- options ----------------------------------------------------------------------------
-
-void pixel_light_params::validate() const {
-    require(std::isfinite(offset) && offset >= 0.f, "offset", "must be finite and >= 0");
-    require(std::isfinite(min_distance2) && min_distance2 >= 0.f, "min_distance2", "must be finite and >= 0");
-}
-
-void discontinuity_params::validate() const {
-    require(std::isfinite(relative_depth) && relative_depth >= 0.f, "relative_depth", "must be finite and >= 0");
-    require(std::isfinite(cos_normal) && cos_normal >= -1.f && cos_normal <= 1.f, "cos_normal", "must lie in [-1, 1]");
-}
-
-void indirect_options::validate() const {
-    require(count > 0 && count <= (std::size_t(1) << 24), "count", "must lie in [1, 2^24]");
-    pattern.validate();
-    require(shift >= 0 && shift < pattern.cells(), "shift", "must lie in [0, N M)");
-    discontinuity.validate();
-    require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
-    light.validate();
-    require(std::isfinite(sii_cutoff) && sii_cutoff >= 0.f, "sii_cutoff", "must be finite and >= 0");
-    require(low_resolution >= 1 && low_resolution <= 8, "low_resolution", "must lie in [1, 8]");
-    require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
-            "applies to the RSM gather only");
-}
-
-// ---- CPU-side choices, the CPU renderer's ------------------------------------------------
-
-std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count, std::uint64_t seed,
-                                        disc_weighting weighting) {
-    require(count > 0, "count", "must be positive");
-    require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
-    require(texel_count > 0, "texel_count", "must be positive");
-    pcg32 rng(seed);
-    const glm::dvec2 shift(rng.next_double(), rng.next_double());
-    std::vector<glm::vec3> out(count);
-    for (std::size_t k = 0; k < count; ++k) {
-        const glm::dvec2 xi = halton2(k, shift);
-        out[k] = weighting == disc_weighting::unbiased
-                     ? rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count))
-                     : rsm_disc_sample_xi1_squared<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count),
-                                                                       double(count));
-    }
-    for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
-    return out;
-}
-
-std::vector<vpl> select_vpls(std::span<const rsm_view> maps, const indirect_options& options) {
-    std::vector<vpl> out;
-    std::vector<double> totals;
-    double sum = 0;
-    for (const auto& m : maps) {
-        totals.push_back(flux_warping(m).total());
-        sum += totals.back();
-    }
-    for (std::size_t i = 0; i < maps.size(); ++i) {
-        if (!(totals[i] > 0)) continue;
-        // VPLs shared between maps in proportion to their flux, so each carries about the
-        // same flux whichever map it comes from.
-        const auto share = std::max<std::size_t>(1, std::size_t(std::llround(double(options.count) * totals[i] / sum)));
-        std::vector<vpl> more;
-        if (options.selection == vpl_selection::flux_warping) {
-            more = vpls_by_flux_warping(maps[i], share, options.seed + i);
-        } else {
-            const double aspect = double(maps[i].width()) / double(maps[i].height());
-            const auto gx = std::max<std::size_t>(1, std::size_t(std::llround(std::sqrt(double(share) * aspect))));
-            const auto gy = std::max<std::size_t>(1, (share + gx - 1) / gx);
-            more = vpls_on_grid(maps[i], gx, gy);
-        }
-        out.insert(out.end(), more.begin(), more.end());
-    }
-    return out;
-}
-
 namespace {
-
-// A pixel rectangle, inclusive, rows counted from the top.
-struct pixel_box {
-    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-    bool empty() const noexcept { return x0 > x1 || y0 > y1; }
-};
-
-// The pixels whose centres a sphere can cover, widened by 1/8 pixel: the rectangle
-// cpu::splat_rect computes (cpu/splatting.hpp), from the same kernel and the same rounding.
-pixel_box sphere_pixels(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float radius,
-                        std::size_t width, std::size_t height) {
-    const glm::vec3 c = glm::vec3(view * glm::vec4(centre, 1.f));
-    const auto b =
-        sphere_ndc_bounds<float, glm::vec3>(c, radius, cam.near_plane, cam.tan_half_fov(), float(width) / float(height));
-    if (!(b[0] <= b[2]) || b[0] >= 2.f) return {};
-    auto px = [&](float ndc) { return double(ndc + 1.f) * 0.5 * double(width); };
-    auto py = [&](float ndc) { return double(1.f - ndc) * 0.5 * double(height); };
-    constexpr double m = 0.125;
-    pixel_box r;
-    r.x0 = int(std::max(0.0, std::ceil(px(b[0]) - 0.5 - m)));
-    r.x1 = int(std::min(double(width) - 1, std::floor(px(b[2]) - 0.5 + m)));
-    r.y0 = int(std::max(0.0, std::ceil(py(b[3]) - 0.5 - m)));
-    r.y1 = int(std::min(double(height) - 1, std::floor(py(b[1]) - 0.5 + m)));
-    return r;
-}
-
-// Image columns [lo, hi] that belong to sub-buffer i of an n-wide pattern (x = i + a n) as
-// split-buffer columns: a in [ceil((lo - i) / n), floor((hi - i) / n)], from the sub-buffer's
-// origin (as cpu::splat_vpls).
-void local_span(int lo, int hi, int i, int n, std::size_t extent, std::size_t origin, int& a, int& b) {
-    a = lo <= i ? 0 : (lo - i + n - 1) / n;
-    b = hi < i ? -1 : std::min((hi - i) / n, int(extent) - 1);
-    a += int(origin);
-    b += int(origin);
-}
 
 constexpr const char* fullscreen_vertex = R"(#version 450 core
 void main() {
@@ -612,7 +503,8 @@ struct indirect_renderer::passes {
     }
 };
 
-indirect_renderer::indirect_renderer(const indirect_options& options) : options_(options) {
+indirect_renderer::indirect_renderer(const indirect_options& options, bool time_stages)
+    : options_(options), time_stages_(time_stages) {
     options_.validate();
     passes_ = std::make_unique<passes>();
 }
@@ -620,7 +512,7 @@ indirect_renderer::indirect_renderer(const indirect_options& options) : options_
 indirect_renderer::~indirect_renderer() = default;
 
 double indirect_renderer::lap(clock::time_point& t) const {
-    if (options_.time_stages) finish();
+    if (time_stages_) finish();
     const auto now = clock::now();
     const double ms = std::chrono::duration<double, std::milli>(now - t).count();
     t = now;
@@ -788,7 +680,7 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
             glDisable(GL_BLEND);
         }
     } else {
-        // VPLs from the read-back maps, as the CPU renderer selects them.
+        // VPLs from the read-back maps, selected as the CPU renderer selects them.
         std::vector<rsm_images> images;
         images.reserve(maps.size());
         for (const auto& m : maps) images.emplace_back(m);
@@ -801,7 +693,8 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
             for (const auto& l : all) positions.push_back(l.position);
         const light_groups groups =
             assign_lights(all.size(), pattern.cells(), options_.assignment, positions, options_.shift);
-        // Each VPL's rectangle in the split buffer (cpu::splat_vpls), in group order.
+        // Each VPL's rectangle in the split buffer (as cpu::splat_vpls: rsm_sampling.hpp's
+        // vpl_splat_rect and split_buffer_rect), in group order.
         const glm::mat4 view = cam.view_matrix();
         splatted_.clear();
         std::vector<gpu_vpl> packed;
@@ -813,17 +706,9 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
                 const vpl& l = all[groups.order[k]];
                 const vpl scaled{l.position, l.normal, l.flux * scale};
                 splatted_.push_back(scaled);
-                pixel_box r{0, 0, int(w) - 1, int(h) - 1};
-                if (options_.sii_cutoff > 0.f) {
-                    const float flux_max = std::max(std::max(l.flux.x, l.flux.y), l.flux.z);
-                    const auto [centre, radius] = pixel_light_bounding_sphere<float, glm::vec3>(
-                        l.position, l.normal, flux_max, options_.sii_cutoff / float(all.size()), options_.light.offset);
-                    r = sphere_pixels(cam, view, centre, radius, w, h);
-                }
-                if (r.empty() || sub.width == 0 || sub.height == 0) continue;
-                pixel_box q;
-                local_span(r.x0, r.x1, i, pattern.n, sub.width, sub.x0, q.x0, q.x1);
-                local_span(r.y0, r.y1, j, pattern.m, sub.height, sub.y0, q.y0, q.y1);
+                const pixel_rect q = split_buffer_rect(
+                    vpl_splat_rect(cam, view, l, all.size(), options_.sii_cutoff, options_.light.offset, w, h), pattern,
+                    i, j, sub);
                 if (q.empty()) continue;
                 packed.push_back({glm::vec4(scaled.position, 0.f), glm::vec4(scaled.normal, 0.f),
                                   glm::vec4(scaled.flux, 0.f)});

@@ -11,13 +11,19 @@
 /// own G-buffer and reflective shadow maps; scratch buffers are kept between frames and
 /// reallocated only when the size changes. The result is irradiance (W/m^2 per channel);
 /// outgoing radiance is rho_d / pi times it (lambertian_radiance).
+///
+/// The options and timings (bounce::indirect_options, bounce::indirect_timings in
+/// indirect_options.hpp) and the host-side choices (disc pattern, VPL selection, splat
+/// rectangles in rsm_sampling.hpp) are the core's, shared with gl::indirect_renderer.
 
 #include <bounce/camera.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/cpu/sii_splat.hpp>
 #include <bounce/gbuffer.hpp>
+#include <bounce/indirect_options.hpp>
 #include <bounce/interleaved_sampling.hpp>
+#include <bounce/rsm_sampling.hpp>
 #include <bounce/vpl_sampling.hpp>
 
 #include <chrono>
@@ -26,66 +32,6 @@
 #include <vector>
 
 namespace bounce::cpu {
-
-enum class indirect_technique {
-    rsm_gather,  ///< every pixel gathers a disc of map texels (DS05)
-    sii,         ///< every VPL is splatted over its screen bounds (DS06)
-};
-
-enum class vpl_selection {
-    grid,          ///< texels on a regular grid (Hahn 2012, section 4.1.2)
-    flux_warping,  ///< hierarchical importance warping on the flux (DS06 section 3.3)
-};
-
-/// What `indirect_renderer` does per frame.
-struct indirect_options {
-    indirect_technique technique = indirect_technique::sii;
-    /// SII: VPLs per frame over all maps; RSM gather: disc samples per pixel and map before
-    /// interleaving (each sub-buffer uses count / (N M)). Default 400, DS05's choice for the
-    /// gather; typical 400-4096.
-    std::size_t count = 400;
-    interleave_pattern pattern{4, 4};  ///< 1 x 1: no interleaving (typical: 4 x 4, 8 x 8)
-    light_assignment assignment = light_assignment::interleaved;
-    int shift = 0;     ///< relabelling of the sub-buffers (assign_lights), in [0, N M); 0 normally
-    bool blur = true;  ///< geometry-aware tent over the gathered buffer (only when interleaved)
-    /// Interleaved lights weighted N M (docs section 5); false reproduces the thesis's
-    /// weight 1 and its loss of 1 - 1/(N M) of the energy, for comparison.
-    bool energy_correct = true;
-    discontinuity_params discontinuity;
-    vpl_selection selection = vpl_selection::flux_warping;  ///< SII only
-    float r_max = 1.5f;  ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
-    disc_weighting disc = disc_weighting::unbiased;  ///< RSM gather sample weights (DS05's xi1^2 to compare)
-    pixel_light_params light;                        ///< singularity remedies (rsm.hpp)
-    float sii_cutoff = 0.f;                          ///< SII splat cutoff, W/m^2 (sii_params::cutoff); 0: whole screen
-    int low_resolution = 1;                          ///< RSM gather at 1/f resolution with upsampling (f in 1..8)
-    upsample_params upsample;
-    std::uint64_t seed = 1;  ///< disc pattern and VPL sampling
-
-    void validate() const {
-        require(count > 0 && count <= (std::size_t(1) << 24), "count", "must lie in [1, 2^24]");
-        pattern.validate();
-        require(shift >= 0 && shift < pattern.cells(), "shift", "must lie in [0, N M)");
-        discontinuity.validate();
-        require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
-        light.validate();
-        require(std::isfinite(sii_cutoff) && sii_cutoff >= 0.f, "sii_cutoff", "must be finite and >= 0");
-        require(low_resolution >= 1 && low_resolution <= 8, "low_resolution", "must lie in [1, 8]");
-        require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
-                "applies to the RSM gather only");
-    }
-};
-
-/// Per-stage wall-clock times of one frame (milliseconds) and its counts.
-struct indirect_timings {
-    double split_ms = 0;              ///< G-buffer split into sub-buffers (and downsampling)
-    double shade_ms = 0;              ///< VPL selection and the gather or splat on the sub-buffers
-    double gather_ms = 0;             ///< sub-buffers back to image order
-    double blur_ms = 0;               ///< discontinuity buffer and geometry-aware blur
-    double upsample_ms = 0;           ///< low-resolution upsampling with full-resolution fallback
-    std::size_t vpls = 0;             ///< SII: VPLs splatted; RSM gather: disc samples per pixel and map
-    std::size_t fallback_pixels = 0;  ///< pixels the upsampling gathered at full resolution
-    double total_ms() const noexcept { return split_ms + shade_ms + gather_ms + blur_ms + upsample_ms; }
-};
 
 class indirect_renderer {
 public:
@@ -205,30 +151,7 @@ private:
 
     void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
                      const interleave_maps& imaps, image_view<glm::vec3> out, indirect_timings& t) {
-        vpls_.clear();
-        std::vector<double> totals;
-        double sum = 0;
-        for (const auto& m : maps) {
-            totals.push_back(flux_warping(m).total());
-            sum += totals.back();
-        }
-        for (std::size_t i = 0; i < maps.size(); ++i) {
-            if (!(totals[i] > 0)) continue;
-            // VPLs shared between maps in proportion to their flux, so each carries about
-            // the same flux whichever map it comes from.
-            const auto share =
-                std::max<std::size_t>(1, std::size_t(std::llround(double(options_.count) * totals[i] / sum)));
-            std::vector<vpl> more;
-            if (options_.selection == vpl_selection::flux_warping) {
-                more = vpls_by_flux_warping(maps[i], share, options_.seed + i);
-            } else {
-                const double aspect = double(maps[i].width()) / double(maps[i].height());
-                const auto gx = std::max<std::size_t>(1, std::size_t(std::llround(std::sqrt(double(share) * aspect))));
-                const auto gy = std::max<std::size_t>(1, (share + gx - 1) / gx);
-                more = vpls_on_grid(maps[i], gx, gy);
-            }
-            vpls_.insert(vpls_.end(), more.begin(), more.end());
-        }
+        vpls_ = select_vpls(maps, options_);
         t.vpls = vpls_.size();
         fill_zero(out);
         std::vector<glm::vec3> positions;

@@ -10,6 +10,7 @@
 
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
+#include <bounce/indirect_options.hpp>
 #include <bounce/interleaved_sampling.hpp>
 
 #include <array>
@@ -96,18 +97,6 @@ inline void split_gbuffer(const gbuffer_view<float>& gb, const gbuffer_view<floa
     split_image<glm::vec3>(gb.albedo, split.albedo, maps);
     split_image<float>(gb.depth, split.depth, maps);
 }
-
-/// Tolerances of the discontinuity buffer (geometry_discontinuity).
-struct discontinuity_params {
-    float relative_depth = 0.05f;  ///< depth step, relative to the nearer depth (typical: 0.02-0.1)
-    float cos_normal = 0.9f;       ///< smallest cosine between normals of one surface (typical: 0.9, 25 deg)
-
-    void validate() const {
-        require(std::isfinite(relative_depth) && relative_depth >= 0.f, "relative_depth", "must be finite and >= 0");
-        require(std::isfinite(cos_normal) && cos_normal >= -1.f && cos_normal <= 1.f, "cos_normal",
-                "must lie in [-1, 1]");
-    }
-};
 
 /// The discontinuity buffer (step 5): `edges`(x, y).x is 1 where pixel (x, y) and its right
 /// neighbour are on different surfaces (geometry_discontinuity), .y likewise with the pixel

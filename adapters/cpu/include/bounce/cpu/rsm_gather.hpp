@@ -9,17 +9,21 @@
 /// Interleaved, the pixels of sub-buffer s use only the samples dealt to s, with their
 /// weights multiplied by N M (interleaved_sampling.hpp): a pixel of a split G-buffer reads
 /// one contiguous run of the (reordered) pattern, so an 8 x 8 pattern does 1/64 of the
-/// work per pixel. Each pixel is computed by one task in a fixed order: results do not
-/// depend on the thread count.
+/// work per pixel. The pattern (rsm_disc_pattern, grouped_pattern) and the parameter
+/// structs (pixel_light_params, upsample_params) are the core's (rsm_sampling.hpp,
+/// indirect_options.hpp), shared with the GL backend. Each pixel is computed by one task
+/// in a fixed order: results do not depend on the thread count.
 
 #include <bounce/camera.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/gbuffer.hpp>
+#include <bounce/indirect_options.hpp>
 #include <bounce/rsm.hpp>
-#include <bounce/sampling.hpp>
+#include <bounce/rsm_sampling.hpp>
 #include <bounce/vpl_sampling.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <span>
 #include <vector>
@@ -28,58 +32,6 @@
 #include <tbb/parallel_for.h>
 
 namespace bounce::cpu {
-
-/// Parameters of the pixel-light irradiance shared by the RSM gather and SII
-/// (rsm.hpp's pixel_light_irradiance).
-struct pixel_light_params {
-    float offset = 0.f;         ///< sender moved along -n_p (m, >= 0; typical: half a texel footprint)
-    float min_distance2 = 0.f;  ///< d^2 clamped below at this (m^2, >= 0; typical: texel footprint^2)
-
-    void validate() const {
-        require(std::isfinite(offset) && offset >= 0.f, "offset", "must be finite and >= 0");
-        require(std::isfinite(min_distance2) && min_distance2 >= 0.f, "min_distance2", "must be finite and >= 0");
-    }
-};
-
-/// `count` disc samples (du, dv, w) for a map of `texel_count` texels: rsm_disc_sample on
-/// the points of the Halton sequence (stratified over the disc), listed in a shuffled order
-/// so that dealing them interleaved gives each sub-buffer a random subset rather than one
-/// radius band (the base-2 coordinate of every 64th Halton point lies in one 1/64 interval).
-/// `r_max` in map units (0, 2]: 1.5 reaches every texel from any centre inside the map.
-/// How the disc samples are weighted (rsm.hpp).
-enum class disc_weighting {
-    unbiased,     ///< w proportional to xi1 (rsm_disc_sample): estimates the disc's texel sum
-    xi1_squared,  ///< DS05's xi1^2 (rsm_disc_sample_xi1_squared): over-weights the rim
-};
-
-inline std::vector<glm::vec3> rsm_disc_pattern(std::size_t count, float r_max, std::size_t texel_count,
-                                               std::uint64_t seed = 1,
-                                               disc_weighting weighting = disc_weighting::unbiased) {
-    require(count > 0, "count", "must be positive");
-    require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
-    require(texel_count > 0, "texel_count", "must be positive");
-    pcg32 rng(seed);
-    const glm::dvec2 shift(rng.next_double(), rng.next_double());
-    std::vector<glm::vec3> out(count);
-    for (std::size_t k = 0; k < count; ++k) {
-        const glm::dvec2 xi = halton2(k, shift);
-        out[k] =
-            weighting == disc_weighting::unbiased
-                ? rsm_disc_sample<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count), double(count))
-                : rsm_disc_sample_xi1_squared<double, glm::dvec3>(xi.x, xi.y, double(r_max), double(texel_count),
-                                                                  double(count));
-    }
-    for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
-    return out;
-}
-
-/// The pattern in the order the sub-buffers read it: group s's samples contiguous, from
-/// `groups.begin[s]`.
-inline std::vector<glm::vec3> grouped_pattern(std::span<const glm::vec3> pattern, const light_groups& groups) {
-    std::vector<glm::vec3> out(groups.order.size());
-    for (std::size_t k = 0; k < out.size(); ++k) out[k] = pattern[groups.order[k]];
-    return out;
-}
 
 namespace detail {
 /// The centre of a receiver's disc in `map` (rsm_disc_centre).
@@ -156,13 +108,6 @@ inline void rsm_gather(const gbuffer_view<float>& gb, std::span<const rsm_view> 
     for (std::size_t k = 0; k < pattern.size(); ++k) all.order[k] = std::uint32_t(k);
     rsm_gather(gb, imaps, maps, pattern, all, lp, out);
 }
-
-/// Tolerances of the geometry-aware upsampling (geometry_aware_upsample_weights).
-struct upsample_params {
-    float cos_normal = 0.9f;       ///< smallest cosine between a sample's normal and the pixel's (typical: 0.9)
-    float plane_footprints = 2.f;  ///< largest distance to the pixel's tangent plane, in low-resolution pixel
-                                   ///< footprints at the pixel's depth (typical: 1-4)
-};
 
 /// Picks the G-buffer pixel at the centre of each factor x factor block
 /// (pixel (f x + f/2, f y + f/2), clamped) into `low`, whose size is ceil(size / f).

@@ -14,9 +14,10 @@
 #include <bounce/camera.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
-#include <bounce/cpu/splatting.hpp>
 #include <bounce/gbuffer.hpp>
+#include <bounce/indirect_options.hpp>
 #include <bounce/rsm.hpp>
+#include <bounce/rsm_sampling.hpp>
 #include <bounce/vpl_sampling.hpp>
 
 #include <algorithm>
@@ -50,14 +51,12 @@ struct sii_params {
     }
 };
 
-/// Screen rectangle (full-resolution pixels) of VPL `l` for a frame of `vpl_count` VPLs.
-inline pixel_rect sii_splat_rect(const camera& cam, const glm::mat4& view, const vpl& l, std::size_t vpl_count,
-                                 const sii_params& params, std::size_t width, std::size_t height) {
-    if (params.cutoff == 0.f) return {0, 0, int(width) - 1, int(height) - 1};
-    const float flux_max = std::max(std::max(l.flux.x, l.flux.y), l.flux.z);
-    const auto [centre, radius] = pixel_light_bounding_sphere<float, glm::vec3>(
-        l.position, l.normal, flux_max, params.cutoff / float(vpl_count), params.light.offset);
-    return splat_rect(cam, view, centre, radius, width, height);
+/// Screen rectangle (full-resolution pixels) of VPL `l` for a frame of `vpl_count` VPLs
+/// (rsm_sampling.hpp's vpl_splat_rect, which the GL backend uses too).
+inline bounce::pixel_rect sii_splat_rect(const camera& cam, const glm::mat4& view, const vpl& l,
+                                         std::size_t vpl_count, const sii_params& params, std::size_t width,
+                                         std::size_t height) {
+    return vpl_splat_rect(cam, view, l, vpl_count, params.cutoff, params.light.offset, width, height);
 }
 
 /// Adds the irradiance of `vpls` to `out` (the split buffer of `gb`'s image, or the image
@@ -77,28 +76,14 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
     const float scale = params.energy_correct ? interleaved_weight_scale<float>(float(p.n), float(p.m)) : 1.f;
 
     // Rectangles in the split buffer, one per VPL, in the order of `groups.order`.
-    std::vector<pixel_rect> rects(vpls.size());
+    std::vector<bounce::pixel_rect> rects(vpls.size());
     tbb::parallel_for(std::size_t(0), std::size_t(p.cells()), [&](std::size_t s) {
         const int i = int(s) % p.n, j = int(s) / p.n;
         const auto sub = maps.sub_buffer(i, j);
-        // Image column x belongs to sub-buffer i when x = i + a n; the rectangle's columns
-        // [x0, x1] hold a in [ceil((x0 - i) / n), floor((x1 - i) / n)].
-        const auto local = [](int lo, int hi, int i, int n, std::size_t extent, std::size_t origin, int& a, int& b) {
-            a = lo <= i ? 0 : (lo - i + n - 1) / n;
-            b = hi < i ? -1 : std::min((hi - i) / n, int(extent) - 1);
-            a += int(origin);
-            b += int(origin);
-        };
-        for (std::uint32_t k = groups.begin[s]; k < groups.begin[s + 1]; ++k) {
-            const pixel_rect r =
-                sii_splat_rect(cam, view, vpls[groups.order[k]], vpls.size(), params, maps.width, maps.height);
-            pixel_rect q;
-            if (!r.empty() && sub.width > 0 && sub.height > 0) {
-                local(r.x0, r.x1, i, p.n, sub.width, sub.x0, q.x0, q.x1);
-                local(r.y0, r.y1, j, p.m, sub.height, sub.y0, q.y0, q.y1);
-            }
-            rects[k] = q;
-        }
+        for (std::uint32_t k = groups.begin[s]; k < groups.begin[s + 1]; ++k)
+            rects[k] = split_buffer_rect(
+                sii_splat_rect(cam, view, vpls[groups.order[k]], vpls.size(), params, maps.width, maps.height), p, i,
+                j, sub);
     });
 
     const int tile = params.tile;
