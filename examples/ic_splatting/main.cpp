@@ -97,6 +97,8 @@ template <class W>
 int run_with(const options& o) {
     if (o.falloff_kappa != 1.f && o.sampler != "raster")
         throw parameter_error("--falloff-kappa", "applies to --sampler raster only");
+    if (o.walkthrough > 0 && (o.progressive > 0 || !o.a_sweep.empty()))
+        throw parameter_error("--walkthrough", "renders its own frames: not with --progressive or --a-sweep");
     if ((o.plane_turn != 0.0 || o.hashed_turn) && o.sampler != "raster")
         throw parameter_error("--plane-turn/--hashed-turn", "apply to --sampler raster only");
     study::stage_timer setup;
@@ -515,6 +517,10 @@ int main(int argc, char** argv) {
     add_options(app, o, gradients);
     CLI11_PARSE(app, argc, argv);
     o.gradients = gradients == "on";
+    // A radius floor of pixel footprints ties a record to the camera that made it: another
+    // camera's pixels take its inflated zone as coverage (docs/irradiance-splatting.md,
+    // "Many frames"), so a walkthrough has none unless asked.
+    if (o.walkthrough > 0 && app.count("--min-pixels") == 0) o.min_pixels = 0.f;
     try {
         return run(o);
     } catch (const bounce::error& e) {

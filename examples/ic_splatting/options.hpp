@@ -138,7 +138,7 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                    "Schwarzhaupt et al. 2012: a is the relative error at the zone's edge)")
         ->check(CLI::IsMember({"split-sphere", "hessian"}))
         ->capture_default_str();
-    app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints")->check(examples::finite_non_negative)->capture_default_str();
+    app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints (--walkthrough: 0 unless given)")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(examples::finite_positive)->capture_default_str();
     app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
         ->check(CLI::IsMember({"batched", "sequential"}))
