@@ -195,9 +195,7 @@ solve_result solve_with(const options& o, const io::scene& scene, const MakeSolv
 #ifdef BOUNCE_RADIOSITY_WITH_GL
 gl::radiosity_options gl_options_for(const options& o) {
     gl::radiosity_options g;
-    g.shoot_blocks = o.block > 1;
-    g.ambient = o.ambient;
-    g.near_field = o.near_field;
+    g.shooting = solver_options_for(o);  // --shooters-per-step is refused above unless 1
     g.visibility = o.visibility == "hemicube" ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic;
     g.resolution = o.resolution;
     g.tolerance_px = o.tolerance_px;

@@ -5,6 +5,7 @@
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/errors.hpp>
 #include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity_options.hpp>
 #include <bounce/radiosity_subdivision.hpp>
 
 #include <CLI/CLI.hpp>
@@ -102,8 +103,9 @@ inline atlas_options atlas_options_for(const options& o) {
     return a;
 }
 
-inline cpu::radiosity_options solver_options_for(const options& o) {
-    cpu::radiosity_options r;
+// The shooting options, the same for both backends (include/bounce/radiosity_options.hpp).
+inline radiosity_options solver_options_for(const options& o) {
+    radiosity_options r;
     r.shoot_blocks = o.block > 1;
     r.shooters_per_step = o.shooters_per_step;
     r.ambient = o.ambient;

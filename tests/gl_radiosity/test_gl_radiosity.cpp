@@ -104,7 +104,7 @@ TEST_CASE("absorbed + unshot + escaped power equals emitted power on GL after ev
         const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
         gl::progressive_radiosity solver(
             scene.view(), atlas,
-            {.shoot_blocks = false, .visibility = gl::radiosity_visibility::hemicube, .resolution = 64});
+            {.shooting = {.shoot_blocks = false}, .visibility = gl::radiosity_visibility::hemicube, .resolution = 64});
         CHECK(solver.emitted_power().x > 0);
         check_balance(solver, 40);
     }
@@ -291,7 +291,7 @@ TEST_CASE("the GL lightmap texture is the solver's lightmap, padding filled, wit
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300, .padding = 2});
     for (const bool ambient : {false, true}) {
-        gl::progressive_radiosity solver(scene.view(), atlas, {.ambient = ambient, .resolution = 64});
+        gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient}, .resolution = 64});
         for (int s = 0; s < 10; ++s) REQUIRE(solver.step());
         const auto expected = solver.lightmap();
         const gl::texture_ref t = solver.update_lightmap_texture();
@@ -381,7 +381,8 @@ TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosit
     const auto throws_naming = [&](gl::radiosity_options o, const char* name) {
         CHECK_THROWS_WITH(gl::progressive_radiosity(scene.view(), atlas, o), Catch::Contains(name));
     };
-    throws_naming({.near_field = -1}, "radiosity_options.near_field");
+    throws_naming({.shooting = {.near_field = -1}}, "radiosity_options.near_field");
+    throws_naming({.shooting = {.shooters_per_step = 2}}, "radiosity_options.shooters_per_step");
     throws_naming({.resolution = 4}, "radiosity_options.resolution");
     throws_naming({.visibility = gl::radiosity_visibility::hemicube, .resolution = 65}, "radiosity_options.resolution");
     throws_naming({.tolerance_px = 0.f}, "radiosity_options.tolerance_px");

@@ -27,8 +27,8 @@
 namespace bounce::gl {
 
 void radiosity_options::validate() const {
-    require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
-            "must be finite and non-negative");
+    shooting.validate();
+    require(shooting.shooters_per_step == 1, "radiosity_options.shooters_per_step", "must be 1 on the GL solver");
     require(resolution >= 8 && resolution <= 8192, "radiosity_options.resolution", "must lie in [8, 8192]");
     require(tolerance_px > 0.f && std::isfinite(tolerance_px), "radiosity_options.tolerance_px", "must be positive");
     require(max_tessellation_depth >= 0 && max_tessellation_depth <= 16, "radiosity_options.max_tessellation_depth",
@@ -295,7 +295,7 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     }
 
     // Shooters: blocks or elements, their centres and texel rectangles.
-    if (options.shoot_blocks) first.assign(atlas.block_first.begin(), atlas.block_first.end());
+    if (options.shooting.shoot_blocks) first.assign(atlas.block_first.begin(), atlas.block_first.end());
     else {
         first.resize(n + 1);
         std::iota(first.begin(), first.end(), std::uint32_t(0));
@@ -320,7 +320,7 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     first_buffer = buffer(first_padded.size() * sizeof(std::uint32_t), first_padded.data());
     partials = buffer((shooters + 2) * partial_doubles * sizeof(double));
     // The near-field tree of a block of b x b texels: b^2 + (b/2)^2 + ... nodes at most.
-    if (options.shoot_blocks) {
+    if (options.shooting.shoot_blocks) {
         int b = atlas.block_texels, count = 0;
         for (;;) {
             count += b * b;
@@ -1024,7 +1024,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     std::vector<node_sum> level, up;
     glm::vec4 block_rect(0.f, 0.f, 1.f, 1.f);
     glm::uvec2 grid(1u);
-    if (options.shoot_blocks) {
+    if (options.shooting.shoot_blocks) {
         block_rect = atlas.block_rect[k];
         grid = atlas.block_grid[k];
     }
@@ -1096,7 +1096,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         p.set(21, unsigned(atlas.size()));
         p.set(9, diagonal);
         p.set(10, int(near.size()));
-        p.set(11, float(options.near_field * options.near_field));
+        p.set(11, float(options.shooting.near_field * options.shooting.near_field));
         glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
         check_error("progressive_radiosity: the distribution pass");
     }
@@ -1268,7 +1268,7 @@ glm::dvec3 progressive_radiosity::ambient() const {
 }
 std::vector<glm::vec3> progressive_radiosity::display_radiosity() const {
     std::vector<glm::vec3> out = radiosity();
-    const glm::vec3 amb = s_->options.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+    const glm::vec3 amb = s_->options.shooting.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
     for (std::size_t i = 0; i < out.size(); ++i)
         out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb);
     return out;
@@ -1316,7 +1316,7 @@ void main() {
                 }
         st.source_texel = std::make_unique<buffer>(src.size() * sizeof(std::uint32_t), src.data());
     }
-    const glm::vec3 amb = st.options.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+    const glm::vec3 amb = st.options.shooting.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
     {
         binding_state saved;
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, st.texels.id());

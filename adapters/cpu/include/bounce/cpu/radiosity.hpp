@@ -36,6 +36,7 @@
 #include <bounce/lightmap_atlas.hpp>
 #include <bounce/lights.hpp>
 #include <bounce/radiosity.hpp>
+#include <bounce/radiosity_options.hpp>
 #include <bounce/radiosity_subdivision.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -57,37 +58,11 @@
 
 namespace bounce::cpu {
 
-/// How the solver shoots.
-struct radiosity_options {
-    bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
-    int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16)
-    bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
-    double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
-                                   ///< times its side (sqrt of its area), else as its quadrants,
-                                   ///< recursively; 0: always one disc (typical: 2-4)
-
-    void validate() const {
-        require(shooters_per_step >= 1 && shooters_per_step <= 4096, "radiosity_options.shooters_per_step",
-                "must lie in [1, 4096]");
-        require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
-                "must be finite and non-negative");
-    }
-};
-
-/// Time spent per stage since construction, milliseconds.
-struct radiosity_timings {
-    double lights_ms = 0;        ///< shooting point, spot and directional lights, their visibility included (construction)
-    double visibility_ms = 0;    ///< begin_shot of the surface shots: item buffers, ray casts
-    double choice_ms = 0;        ///< choosing shooters (reduction)
-    double distribution_ms = 0;  ///< form factors and updates over the elements
-    double subdivision_ms = 0;   ///< adaptive subdivision: the test and the refined atlas
-};
-
-/// Where a solve stands after a step.
-struct radiosity_progress {
-    std::size_t steps = 0, shots = 0;
-    double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
-};
+// The options, timings and progress are the core's (radiosity_options.hpp), shared with the
+// GL solver.
+using bounce::radiosity_options;
+using bounce::radiosity_progress;
+using bounce::radiosity_timings;
 
 /// The solver. `Real` is the type of the radiosity arrays and of the kernel's arithmetic
 /// (float, as a GPU would; double for reference solutions). `Visibility` models

@@ -41,6 +41,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
 #include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity_options.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cstddef>
@@ -60,15 +61,11 @@ enum class radiosity_visibility {
     none            ///< every element sees every shooter (open scenes, tests, the unoccluded bound)
 };
 
-/// Options of gl::progressive_radiosity: the shooting options of cpu::radiosity_options and
-/// the item-buffer options of cpu::item_buffer_visibility::options, with the same meanings
-/// and defaults (mirrored here: the GL adapter does not include the CPU adapter).
+/// Options of gl::progressive_radiosity: the shooting options shared with the CPU solver
+/// (radiosity_options.hpp; shooters_per_step must be 1 here) and the item-buffer options of
+/// cpu::item_buffer_visibility::options, with the same meanings and defaults.
 struct radiosity_options {
-    bool shoot_blocks = true;  ///< substructuring: shoot per atlas block (true) or per element
-    bool ambient = false;      ///< display_radiosity adds the ambient term (Cohen et al. 1988)
-    double near_field = 4;     ///< a block shoots as one disc to receivers farther than this many
-                               ///< times its side, else as its quadrants, recursively; 0: one disc
-                               ///< (typical: 2-4)
+    bounce::radiosity_options shooting{};  ///< as cpu::progressive_radiosity takes them
     radiosity_visibility visibility = radiosity_visibility::stereographic;
     int resolution = 256;            ///< item buffer side, pixels (hemicube: per face, even; typical: 128-512)
     float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
@@ -82,22 +79,9 @@ struct radiosity_options {
     void validate() const;
 };
 
-/// Time spent per stage since construction, milliseconds, each stage ended by glFinish when
-/// radiosity_options::timed_stages is set (so the figures are the GPU's time, not the
-/// driver's queueing); otherwise the GPU's work is counted where the step waits for it, in
-/// choice_ms.
-struct radiosity_timings {
-    double lights_ms = 0;        ///< the scene's lights, their visibility included (construction)
-    double visibility_ms = 0;    ///< reading the shooter back, tessellating and drawing the item buffer
-    double choice_ms = 0;        ///< the reduction that picks the next shooter and sums powers
-    double distribution_ms = 0;  ///< form factors and updates of the elements (their texels)
-};
-
-/// Where a solve stands after a step.
-struct radiosity_progress {
-    std::size_t steps = 0, shots = 0;
-    double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
-};
+/// The core's timings and progress (radiosity_options.hpp); subdivision_ms stays 0 here.
+using bounce::radiosity_progress;
+using bounce::radiosity_timings;
 
 /// The GL solver. Move-only; owns its GL objects (create, use and destroy it with one context
 /// current).
