@@ -241,3 +241,28 @@ TEST_CASE("the unoccluded reference image reports its measured noise, and bad se
     const light bad[] = {spot_light{{0, 0, 2}, {0, 0, 0}, glm::vec3(1.f), 30.f}};
     CHECK_THROWS_AS(caster.render(bad), parameter_error);
 }
+
+TEST_CASE("the ray caster's maps are bounce::rsm_layout's, less the cube faces that see nothing lit",
+          "[rsm][embree][layout]") {
+    auto s = closed_box(0.5f);
+    s.lights.push_back(point_light{{0.1f, 0.2f, -0.3f}, glm::vec3(1.f)});
+    s.lights.push_back(spot_light{{0.f, 0.f, 0.5f}, {0.3f, -0.2f, -1.f}, glm::vec3(1.f), 40.f});
+    s.lights.push_back(spot_light{{0.f, 0.9f, 0.f}, {0.f, -1.f, 0.f}, glm::vec3(1.f), 89.f});
+    s.lights.push_back(directional_light{{0.3f, 0.4f, -1.f}, glm::vec3(1.f)});
+    const embree::accel bvh(s.view());
+    const embree::rsm_ray_cast_settings settings{16, 60.f};
+    embree::rsm_ray_caster caster(bvh, s.view(), settings);
+    caster.render();
+    const auto [lo, hi] = s.view().bounds();
+    const auto layout = rsm_layout(s.lights, lo, hi, settings);
+    // Inside a closed box every face the layout keeps sees a lit wall.
+    REQUIRE(layout.size() == 6 + 1 + 5 + 1);
+    REQUIRE(caster.maps().size() == layout.size());
+    for (std::size_t k = 0; k < layout.size(); ++k) {
+        const auto& m = caster.maps()[k];
+        CHECK(m.light == layout[k].light);
+        CHECK(m.light_view_projection == layout[k].light_view_projection);
+        CHECK(m.texel_size == layout[k].texel_size);
+        CHECK(m.orthographic == layout[k].orthographic);
+    }
+}

@@ -1,7 +1,9 @@
 // The RSM kernels (include/bounce/rsm.hpp): convergence of the pixel-light sum to the
 // closed-form one-bounce irradiance, the texel fluxes, the disc pattern's weights, and the
-// numerical hard cases (coincident, grazing, behind, shared boundary, float accumulation).
+// numerical hard cases (coincident, grazing, behind, shared boundary, float accumulation);
+// the map layouts of rsm_layout.hpp.
 #include <bounce/rsm.hpp>
+#include <bounce/rsm_layout.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -279,4 +281,73 @@ TEST_CASE("the sum over a spot light's RSM converges to the closed-form irradian
         INFO("n " << n << " error " << std::abs(sum - exact) << " bound " << edge);
         CHECK(std::abs(sum - exact) <= edge + 10 * u32 * exact);
     }
+}
+
+// ---- map layouts (include/bounce/rsm_layout.hpp) ----------------------------------------
+
+TEST_CASE("rsm_layout: six faces per point light, one map or the reachable faces per spot, one "
+          "orthographic map per distant light",
+          "[rsm][layout]") {
+    const glm::vec3 lo(-1.f, -2.f, -1.f), hi(3.f, 2.f, 1.f);
+    const std::vector<light> lights{point_light{{0.f, 0.f, 0.f}, glm::vec3(1.f)},
+                                    spot_light{{0.f, 1.f, 0.f}, {0.f, -2.f, 0.f}, glm::vec3(1.f), 30.f},
+                                    spot_light{{0.f, 1.f, 0.f}, {0.f, -1.f, 0.f}, glm::vec3(1.f), 89.f},
+                                    spot_light{{0.f, 1.f, 0.f}, {0.f, -1.f, 0.f}, glm::vec3(1.f), 180.f},
+                                    directional_light{{0.f, 0.f, -1.f}, glm::vec3(1.f)}};
+    const rsm_layout_settings settings{64, 60.f};
+    const auto maps = rsm_layout(lights, lo, hi, settings);
+    REQUIRE(maps.size() == 6 + 1 + 5 + 6 + 1);
+    std::size_t k = 0;
+    for (int f = 0; f < 6; ++f, ++k) {  // point light: every face, in table order
+        CHECK(maps[k].light == 0);
+        CHECK(maps[k].cube_face == f);
+        CHECK(maps[k].forward == rsm_cube_faces[std::size_t(f)].forward);
+        CHECK(maps[k].fov_deg == 90.f);
+        CHECK(!maps[k].orthographic);
+        CHECK(std::abs(maps[k].texel_size - 2.f / 64.f) < 1e-7f);
+    }
+    // Narrow spot: one map along the (unit) axis, twice the cone.
+    CHECK(maps[k].light == 1);
+    CHECK(maps[k].cube_face == -1);
+    CHECK(maps[k].fov_deg == 60.f);
+    CHECK(glm::length(maps[k].forward - glm::vec3(0.f, -1.f, 0.f)) < 1e-7f);
+    CHECK(maps[k].up == glm::vec3(1.f, 0.f, 0.f));  // the axis is (anti)parallel to +y
+    ++k;
+    // An 89-degree spot looking down cannot reach the face looking up (+y, index 2).
+    for (int f : {0, 1, 3, 4, 5}) {
+        CHECK(maps[k].light == 2);
+        CHECK(maps[k].cube_face == f);
+        ++k;
+    }
+    for (int f = 0; f < 6; ++f, ++k) CHECK(maps[k].cube_face == f);  // a full sphere: every face
+    // Distant light: orthographic across the beam, over the bounds' sphere.
+    const rsm_map_layout& d = maps[k];
+    CHECK(d.light == 4);
+    CHECK(d.orthographic);
+    const float radius = 0.5f * glm::length(hi - lo) * 1.001f;
+    CHECK(d.radius == radius);
+    CHECK(d.texel_size == float(2.0 * double(radius) / 64.0));
+    CHECK(glm::length(d.position - (0.5f * (lo + hi) + glm::vec3(0.f, 0.f, 2.f * radius))) < 1e-5f);
+    // The centre of the bounds lands in the middle of the map, at mid depth.
+    const glm::vec4 c = d.light_view_projection * glm::vec4(0.5f * (lo + hi), 1.f);
+    CHECK(std::abs(c.x) < 1e-5f);
+    CHECK(std::abs(c.y) < 1e-5f);
+    CHECK(std::abs(c.z) < 1e-5f);
+
+    // Bad lights are refused by index.
+    const std::vector<light> bad{point_light{{0.f, 0.f, 0.f}, glm::vec3(-1.f)}};
+    CHECK_THROWS_AS(rsm_layout(bad, lo, hi, settings), parameter_error);
+    CHECK_THROWS_AS((rsm_layout_settings{0, 60.f}.validate()), parameter_error);
+    CHECK_THROWS_AS((rsm_layout_settings{64, 90.f}.validate()), parameter_error);
+}
+
+TEST_CASE("rsm_layout: the texel solid angles of a cube face sum to 4 pi / 6", "[rsm][layout]") {
+    const double t = std::tan(0.25 * std::numbers::pi);
+    double sum = 0;
+    for (std::size_t y = 0; y < 16; ++y)
+        for (std::size_t x = 0; x < 16; ++x) sum += rsm_texel_solid_angle(t, 16, x, y);
+    CHECK(std::abs(sum - 4 * std::numbers::pi / 6) < 1e-12);
+    // Symmetric about the centre: a corner texel is the smallest, the same at each corner.
+    CHECK(std::abs(rsm_texel_solid_angle(t, 16, 0, 0) / rsm_texel_solid_angle(t, 16, 15, 15) - 1) < 1e-12);
+    CHECK(rsm_texel_solid_angle(t, 16, 0, 0) < rsm_texel_solid_angle(t, 16, 7, 7));
 }

@@ -6,8 +6,8 @@
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/glsl/emit.hpp>
 #include <bounce/camera.hpp>
-#include <bounce/rectangle_solid_angle.hpp>
 #include <bounce/rsm.hpp>
+#include <bounce/rsm_layout.hpp>
 #include <bounce/surface.hpp>
 
 #include "saved_state.hpp"
@@ -49,12 +49,6 @@ rsm_images::rsm_images(const rsm_textures& t)
 }
 
 // ---- rsm_renderer -----------------------------------------------------------------------
-
-void rsm_render_options::validate() const {
-    require(resolution >= 1 && resolution <= 8192, "resolution", "must lie in [1, 8192]");
-    require(std::isfinite(max_single_map_cone_deg) && max_single_map_cone_deg > 0.f && max_single_map_cone_deg < 90.f,
-            "max_single_map_cone_deg", "must lie in (0, 90)");
-}
 
 namespace {
 
@@ -130,36 +124,6 @@ enum location : int {
     loc_texel_area = 7,
 };
 
-struct face {
-    glm::vec3 forward, up;
-};
-// +x, -x, +y, -y, +z, -z with embree::rsm_ray_caster's up vectors.
-constexpr std::array<face, 6> cube_faces{{{{1, 0, 0}, {0, 1, 0}},
-                                          {{-1, 0, 0}, {0, 1, 0}},
-                                          {{0, 1, 0}, {0, 0, -1}},
-                                          {{0, -1, 0}, {0, 0, 1}},
-                                          {{0, 0, 1}, {0, 1, 0}},
-                                          {{0, 0, -1}, {0, 1, 0}}}};
-
-rsm_map_layout perspective_map(std::size_t light, const glm::vec3& position, const glm::vec3& forward,
-                               const glm::vec3& up, float fov_deg, std::size_t r) {
-    camera cam;
-    cam.position = position;
-    cam.look_at = position + forward;
-    cam.up = up;
-    cam.fov_y_deg = fov_deg;
-    rsm_map_layout m;
-    m.light = light;
-    m.view = cam.view_matrix();
-    m.light_view_projection = cam.projection_matrix(r, r) * m.view;
-    m.position = position;
-    m.forward = forward;
-    m.up = up;
-    m.fov_deg = fov_deg;
-    m.texel_size = float(2.0 * std::tan(glm::radians(double(fov_deg)) * 0.5) / double(r));
-    return m;
-}
-
 // Corner `c` (0..7) of the box [lo, hi].
 glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
     return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
@@ -173,50 +137,8 @@ rsm_renderer::rsm_renderer(const scene_view& scene, const scene_mesh& mesh, cons
 }
 
 std::vector<rsm_map_layout> rsm_renderer::layout(std::span<const light> lights) const {
-    validate_lights(lights, "lights");
-    const std::size_t r = options_.resolution;
     const auto [lo, hi] = scene_.bounds();
-    const glm::vec3 centre = 0.5f * (lo + hi);
-    const float radius = std::max(0.5f * glm::length(hi - lo) * 1.001f, 1e-3f);
-    std::vector<rsm_map_layout> out;
-    for (std::size_t i = 0; i < lights.size(); ++i) {
-        const packed_light l = pack(lights[i]);
-        if (l.kind() == light_kind::directional) {
-            const glm::vec3 d = l.direction();
-            const glm::vec3 up = std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
-            const glm::vec3 eye = centre - d * (2.f * radius);
-            rsm_map_layout m;
-            m.light = i;
-            m.view = glm::lookAt(eye, centre, up);
-            m.light_view_projection = glm::ortho(-radius, radius, -radius, radius, 0.f, 4.f * radius) * m.view;
-            m.position = eye;
-            m.forward = d;
-            m.up = up;
-            m.orthographic = true;
-            m.texel_size = float(2.0 * double(radius) / double(r));
-            out.push_back(m);
-            continue;
-        }
-        const bool spot = l.kind() == light_kind::spot;
-        const auto* sl = std::get_if<spot_light>(&lights[i]);
-        if (spot && sl->cone_deg <= options_.max_single_map_cone_deg) {
-            const glm::vec3 axis = l.direction();
-            const glm::vec3 up = std::abs(axis.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
-            out.push_back(perspective_map(i, l.position(), axis, up, 2.f * sl->cone_deg, r));
-            continue;
-        }
-        for (const face& f : cube_faces) {
-            if (spot) {
-                // Every direction of a face lies within acos(1/sqrt 3) = 54.7 degrees of its
-                // axis: a cone farther than that from the face's axis cannot reach it.
-                const double angle = std::acos(std::clamp(double(glm::dot(l.direction(), f.forward)), -1.0, 1.0));
-                const double half_diagonal = std::acos(1.0 / std::sqrt(3.0));
-                if (angle - half_diagonal > glm::radians(double(sl->cone_deg))) continue;
-            }
-            out.push_back(perspective_map(i, l.position(), f.forward, f.up, 90.f, r));
-        }
-    }
-    return out;
+    return rsm_layout(lights, lo, hi, options_);
 }
 
 const texture& rsm_renderer::solid_angles(float fov_deg) {
@@ -224,16 +146,11 @@ const texture& rsm_renderer::solid_angles(float fov_deg) {
     if (it != solid_angles_.end()) return it->second;
     const std::size_t r = options_.resolution;
     const double t = std::tan(glm::radians(double(fov_deg)) * 0.5);
-    // Texel (x, y), row y from the top, spans [x0, x1] x [y0, y1] of the image plane at unit
-    // distance, as embree::rsm_ray_caster computes it; stored in GL row order.
+    // Texel (x, y), row y from the top, as embree::rsm_ray_caster computes it (the shared
+    // rsm_texel_solid_angle); stored in GL row order.
     std::vector<float> dw(r * r);
-    for (std::size_t y = 0; y < r; ++y) {
-        const double y1 = (1.0 - 2.0 * double(y) / double(r)) * t, y0 = (1.0 - 2.0 * double(y + 1) / double(r)) * t;
-        for (std::size_t x = 0; x < r; ++x) {
-            const double x0 = (2.0 * double(x) / double(r) - 1.0) * t, x1 = (2.0 * double(x + 1) / double(r) - 1.0) * t;
-            dw[(r - 1 - y) * r + x] = float(rectangle_solid_angle<double>(x0, y0, x1, y1));
-        }
-    }
+    for (std::size_t y = 0; y < r; ++y)
+        for (std::size_t x = 0; x < r; ++x) dw[(r - 1 - y) * r + x] = float(rsm_texel_solid_angle(t, r, x, y));
     texture table(texel_format::r32f, r, r);
     {
         const detail::unpack_state unpack;

@@ -6,12 +6,15 @@
 /// reflects. A renderer without a rasterizer, or a test that needs exact maps, calls this
 /// where a GL renderer would rasterize the maps; both fill the same `rsm_view`s.
 ///
-/// Map layouts (every map square, `resolution` texels per side, row 0 at the top):
-/// - point light: the six faces of a cube (90-degree perspective maps along +-x, +-y, +-z);
+/// Map layouts: those of bounce::rsm_layout (bounce/rsm_layout.hpp), shared with
+/// gl::rsm_renderer (every map square, `resolution` texels per side, row 0 at the top):
+/// - point light: the six faces of a cube (90-degree perspective maps along +-x, +-y, +-z),
+///   less those that see no lit surface;
 /// - spot light: one perspective map whose field of view is twice the cone when the cone's
 ///   half-angle is at most `max_single_map_cone_deg`; a wider cone (the Cornell box's
 ///   89-degree ceiling spot) would squeeze the centre of the beam into a few texels, so it
-///   gets the faces of a cube like a point light, less the faces its cone does not reach;
+///   gets the faces of a cube like a point light, less the faces its cone cannot reach
+///   (left out by the layout) and those that see no lit surface (dropped after casting);
 /// - directional light: an orthographic map across the beam covering the scene's bounding
 ///   sphere.
 /// A texel whose ray finds nothing, or a surface the light reaches from behind or outside
@@ -20,6 +23,7 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/image.hpp>
 #include <bounce/light.hpp>
+#include <bounce/rsm_layout.hpp>
 #include <bounce/scene_view.hpp>
 #include <bounce/vpl_sampling.hpp>
 
@@ -46,17 +50,9 @@ struct reflective_shadow_map {
     rsm_view view() const { return {position.view(), normal.view(), flux.view(), light_view_projection}; }
 };
 
-/// Settings of rsm_ray_caster.
-struct rsm_ray_cast_settings {
-    /// Texels per side of every map (and of every cube face); typical: 128-512.
-    std::size_t resolution = 256;
-    /// Widest spot cone (half-angle, degrees) cast into a single perspective map; wider ones
-    /// use cube faces. In (0, 90); typical: 60.
-    float max_single_map_cone_deg = 60.f;
-
-    /// Throws parameter_error naming the field.
-    void validate() const;
-};
+/// Settings of rsm_ray_caster (resolution, widest single-map spot cone): those of the shared
+/// layout, as gl::rsm_render_options.
+using rsm_ray_cast_settings = rsm_layout_settings;
 
 /// Renders the reflective shadow maps of a scene's lights by ray casting with Embree. Holds
 /// references to the BVH and the scene (they must outlive it) and keeps its maps between

@@ -5,15 +5,16 @@
 /// normal, reflected flux), the flux computed per fragment by the emitted texel-flux kernels
 /// of rsm.hpp, so a GL renderer gets the maps embree::rsm_ray_caster casts on the CPU.
 ///
-/// Map layouts, those of embree::rsm_ray_caster (adapters/embree/.../rsm_ray_cast.hpp), with
-/// the same light_view_projection matrices (every map square, `resolution` texels per side):
+/// Map layouts: those of bounce::rsm_layout (bounce/rsm_layout.hpp), which
+/// embree::rsm_ray_caster also follows, with the same light_view_projection matrices (every
+/// map square, `resolution` texels per side):
 /// - point light: the six faces of a cube (90-degree perspective maps along +x, -x, +y, -y,
-///   +z, -z, with the ray caster's up vectors);
+///   +z, -z, with the up vectors of bounce::rsm_cube_faces);
 /// - spot light with a cone half-angle up to `max_single_map_cone_deg`: one perspective map
 ///   of field of view twice the cone; a wider cone gets the cube faces its cone can reach
 ///   (a face is left out when the angle between the axis and the face's direction exceeds
 ///   the cone by more than the face's half-diagonal, 54.7 degrees; the ray caster also
-///   drops faces that happen to see no lit surface, which hold flux 0 here);
+///   drops cube faces that happen to see no lit surface, which hold flux 0 here);
 /// - directional light: an orthographic map across the beam covering the scene's bounding
 ///   sphere.
 /// Normals face the light (two-sided surfaces, surface.hpp's facing_normal), as the ray
@@ -32,6 +33,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/rsm_textures.hpp>
 #include <bounce/light.hpp>
+#include <bounce/rsm_layout.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cstddef>
@@ -45,32 +47,12 @@
 
 namespace bounce::gl {
 
-/// Settings of rsm_renderer (those of embree::rsm_ray_cast_settings).
-struct rsm_render_options {
-    /// Texels per side of every map (and of every cube face); typical: 128-512.
-    std::size_t resolution = 256;
-    /// Widest spot cone (half-angle, degrees) in a single perspective map; wider ones use
-    /// cube faces. In (0, 90); typical: 60.
-    float max_single_map_cone_deg = 60.f;
+/// Settings of rsm_renderer (resolution, widest single-map spot cone): those of the shared
+/// layout, as embree::rsm_ray_cast_settings.
+using rsm_render_options = bounce::rsm_layout_settings;
 
-    /// Throws parameter_error naming the field.
-    void validate() const;
-};
-
-/// One map a light needs: which light, how the map sees it.
-struct rsm_map_layout {
-    std::size_t light = 0;                 ///< index of the light in the span rendered
-    glm::mat4 light_view_projection{1.f};  ///< world to the map's clip space (as the ray caster's)
-    glm::mat4 view{1.f};                   ///< world to the map's view space
-    glm::vec3 position{0.f};               ///< the light's position (perspective maps)
-    glm::vec3 forward{0.f, 0.f, -1.f};     ///< the map's view direction
-    glm::vec3 up{0.f, 1.f, 0.f};           ///< the up vector of its view (glm::lookAt's)
-    float fov_deg = 90.f;                  ///< perspective maps: full field of view
-    bool orthographic = false;
-    /// World size of a texel's side at unit distance (perspective) or everywhere
-    /// (orthographic), as reflective_shadow_map::texel_size.
-    float texel_size = 0.f;
-};
+/// One map a light needs: which light, how the map sees it (bounce::rsm_map_layout).
+using rsm_map_layout = bounce::rsm_map_layout;
 
 class rsm_renderer {
 public:
