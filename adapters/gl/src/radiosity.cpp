@@ -8,6 +8,7 @@
 #include <bounce/lights.hpp>
 #include <bounce/radiosity.hpp>
 #include <bounce/sampling.hpp>
+#include <bounce/stereographic_tessellation.hpp>
 
 #include "saved_state.hpp"
 
@@ -107,35 +108,6 @@ private:
     std::array<storage, 6> storage_{};
     std::array<image, 4> images_{};
 };
-
-// ---- the CPU side of the item buffer: clipping and the sagitta tessellation ------------------
-// The same geometry as cpu::item_buffer_visibility (docs/radiosity.md section 3), restated here
-// because the GL adapter does not include the CPU adapter.
-
-// A convex polygon clipped in place to dot(p, plane) >= offset; an edge's intersection is
-// computed from its endpoints in a canonical order, so a shared edge clips alike from both sides.
-void clip_polygon(std::vector<glm::vec3>& poly, glm::vec3 plane, float offset, std::vector<glm::vec3>& scratch) {
-    scratch.clear();
-    const std::size_t n = poly.size();
-    for (std::size_t i = 0; i < n; ++i) {
-        const glm::vec3 a = poly[i], b = poly[(i + 1) % n];
-        const float da = glm::dot(a, plane) - offset, db = glm::dot(b, plane) - offset;
-        if (da >= 0.f) scratch.push_back(a);
-        if ((da >= 0.f) != (db >= 0.f)) {
-            const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
-            const glm::vec3 p = swap ? b : a, q = swap ? a : b;
-            const float dp = swap ? db : da, dq = swap ? da : db;
-            scratch.push_back(p + (q - p) * (dp / (dp - dq)));
-        }
-    }
-    poly.swap(scratch);
-}
-
-// The midpoint of a and b taken in a canonical order (a shared edge splits alike).
-glm::vec3 canonical_midpoint(glm::vec3 a, glm::vec3 b) {
-    const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
-    return swap ? b + (a - b) * 0.5f : a + (b - a) * 0.5f;
-}
 
 // One vertex of the item buffer's vertex stream: shooter-frame position, chart, triangle.
 struct item_vertex {
@@ -779,13 +751,8 @@ void progressive_radiosity::state::draw_item_buffer() {
     pieces.clear();
     const float res = float(options.resolution);
     const float z_min = 1e-6f * diagonal;
-    const auto pixel = [&](glm::vec3 l) { return stereographic_item_coords<float, glm::vec3, glm::vec2>(l) * res; };
+    const stereographic_tessellation how{res, options.tolerance_px, options.max_tessellation_depth};
     std::vector<glm::vec3> poly, scratch;
-    struct pending {
-        glm::vec3 a, b, c;
-        int depth;
-    };
-    std::vector<pending> stack;
     for (std::size_t k = 0; k < corners.size(); ++k) {
         if (float(triangle_chart[k]) == shot_chart) continue;
         std::array<glm::vec3, 3> l;
@@ -796,33 +763,12 @@ void progressive_radiosity::state::draw_item_buffer() {
                            glm::dot(glm::vec3(world_plane[k]), shot_axis));
         const float d = glm::dot(nl, l[0]);
         local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
-        poly.assign(l.begin(), l.end());
-        clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
         const float chart = float(triangle_chart[k]), id = float(k);
-        for (std::size_t f = 1; f + 1 < poly.size(); ++f) {
-            // Depth first, children in the CPU's order, so the pieces come out in its order.
-            stack.assign(1, pending{poly[0], poly[f], poly[f + 1], 0});
-            while (!stack.empty()) {
-                const pending p = stack.back();
-                stack.pop_back();
-                const glm::vec2 pa = pixel(p.a), pb = pixel(p.b), pc = pixel(p.c);
-                const glm::vec3 ab = canonical_midpoint(p.a, p.b), bc = canonical_midpoint(p.b, p.c),
-                                ca = canonical_midpoint(p.c, p.a);
-                const float s = std::max({glm::length(pixel(ab) - 0.5f * (pa + pb)),
-                                          glm::length(pixel(bc) - 0.5f * (pb + pc)),
-                                          glm::length(pixel(ca) - 0.5f * (pc + pa))});
-                if (!(s > options.tolerance_px) || p.depth >= options.max_tessellation_depth) {
-                    pieces.push_back({p.a, chart, id});
-                    pieces.push_back({p.b, chart, id});
-                    pieces.push_back({p.c, chart, id});
-                    continue;
-                }
-                stack.push_back({ab, bc, ca, p.depth + 1});
-                stack.push_back({ca, bc, p.c, p.depth + 1});
-                stack.push_back({ab, p.b, bc, p.depth + 1});
-                stack.push_back({p.a, ab, ca, p.depth + 1});
-            }
-        }
+        // The CPU's pieces in the CPU's order (stereographic_tessellation.hpp).
+        clip_and_tessellate_stereographic(l, z_min, how, poly, scratch,
+                                          [&](const std::array<glm::vec3, 3>& piece, const std::array<glm::vec2, 3>&) {
+                                              for (const glm::vec3& v : piece) pieces.push_back({v, chart, id});
+                                          });
     }
     drawn = pieces.size() / 3;
     planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));

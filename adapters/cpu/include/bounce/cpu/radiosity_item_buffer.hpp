@@ -19,6 +19,8 @@
 /// projection bends most (a wall through the shooter's corner). Neighbouring triangles may
 /// split a shared edge differently; the T-junctions this leaves open cracks narrower than
 /// the tolerance (the tests measure the pixels that differ from an exact per-pixel ray cast).
+/// The clipping and this tessellation are the core's (stereographic_tessellation.hpp), which
+/// gl::progressive_radiosity draws from too, so both backends rasterize the same pieces.
 /// The hemicube's faces are perspective projections, where straight edges stay straight and
 /// 1/depth is linear in screen space, so they need no tessellation and their depth is exact.
 ///
@@ -38,6 +40,7 @@
 #include <bounce/radiosity.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/scene_view.hpp>
+#include <bounce/stereographic_tessellation.hpp>
 
 #include <algorithm>
 #include <array>
@@ -189,36 +192,9 @@ inline void scan_triangle(item_buffer& buffer, raster_vertex a, raster_vertex b,
 }
 
 namespace detail {
-
-/// A convex polygon of points in some 3D frame, clipped in place to dot(p, plane) >= offset.
-/// Intersection points are computed from the edge's endpoints in a canonical order, so the
-/// same edge clipped from its two triangles gives the same point bit for bit.
-inline void clip_polygon(std::vector<glm::vec3>& poly, glm::vec3 plane, float offset, std::vector<glm::vec3>& scratch) {
-    scratch.clear();
-    const std::size_t n = poly.size();
-    for (std::size_t i = 0; i < n; ++i) {
-        const glm::vec3 a = poly[i], b = poly[(i + 1) % n];
-        const float da = glm::dot(a, plane) - offset, db = glm::dot(b, plane) - offset;
-        if (da >= 0.f) scratch.push_back(a);
-        if ((da >= 0.f) != (db >= 0.f)) {
-            const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
-            const glm::vec3 p = swap ? b : a, q = swap ? a : b;
-            const float dp = swap ? db : da, dq = swap ? da : db;
-            scratch.push_back(p + (q - p) * (dp / (dp - dq)));
-        }
-    }
-    poly.swap(scratch);
-}
-
-/// The point t of the way from a to b, with a and b taken in a canonical order so that a
-/// shared edge gives the same points from both of its triangles.
-inline glm::vec3 canonical_lerp(glm::vec3 a, glm::vec3 b, float t) {
-    if (t == 0.f) return a;  // the endpoints exactly, which a + (b - a) 1 need not give
-    if (t == 1.f) return b;
-    const bool swap = b.x < a.x || (b.x == a.x && (b.y < a.y || (b.y == a.y && b.z < a.z)));
-    return swap ? b + (a - b) * (1.f - t) : a + (b - a) * t;
-}
-
+// The clipping of stereographic_tessellation.hpp, shared with the GL solver.
+using bounce::canonical_lerp;
+using bounce::clip_polygon;
 }  // namespace detail
 
 /// The projections an item buffer can hold.
@@ -393,22 +369,21 @@ private:
         buf.reset(opt_.resolution, opt_.resolution);
         to_local();
         pieces_.clear();
-        const float res = float(opt_.resolution);
-        const auto project = [&](glm::vec3 l) {
-            const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
-            return raster_vertex{uv * res, glm::length(l)};
-        };
-        // Clip just above the shooter's plane: a surface through the shooter's centre sees it
-        // edge-on and neither occludes nor is seen.
+        // Clipped just above the shooter's plane and tessellated by the sagitta rule
+        // (stereographic_tessellation.hpp, which the GL solver draws from too).
+        const stereographic_tessellation how{float(opt_.resolution), opt_.tolerance_px, opt_.max_tessellation_depth};
         const float z_min = 1e-6f * diagonal_;
         std::vector<glm::vec3> poly, scratch;
-        for (std::size_t k = 0; k < local_.size(); ++k) {
-            if (local_[k][0].z < z_min && local_[k][1].z < z_min && local_[k][2].z < z_min) continue;
-            poly.assign(local_[k].begin(), local_[k].end());
-            detail::clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
-            for (std::size_t f = 1; f + 1 < poly.size(); ++f)
-                tessellate(poly[0], poly[f], poly[f + 1], std::uint32_t(k), project);
-        }
+        for (std::size_t k = 0; k < local_.size(); ++k)
+            clip_and_tessellate_stereographic(
+                local_[k], z_min, how, poly, scratch,
+                [&](const std::array<glm::vec3, 3>& l, const std::array<glm::vec2, 3>& px) {
+                    const float y0 = std::min({px[0].y, px[1].y, px[2].y}) - 1.f;
+                    const float y1 = std::max({px[0].y, px[1].y, px[2].y}) + 1.f;
+                    pieces_.push_back({{raster_vertex{px[0], glm::length(l[0])}, raster_vertex{px[1], glm::length(l[1])},
+                                        raster_vertex{px[2], glm::length(l[2])}},
+                                       std::uint32_t(k), y0, y1});
+                });
         drawn_ = pieces_.size();
         // Scan the pieces in bands of rows, one task per band: each pixel sees the pieces in
         // the same order whatever the thread count.
@@ -433,30 +408,6 @@ private:
                     pc.k, y0, y1);
             }
         });
-    }
-
-    // Adds (a, b, c) to the pieces, split in four at its edges' midpoints, recursively, while
-    // the sagitta of an edge exceeds the tolerance and the depth allows: pieces concentrate
-    // where the projection bends most, next to the shooter.
-    template <class Project>
-    void tessellate(glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t k, const Project& project, int depth = 0) {
-        const raster_vertex pa = project(a), pb = project(b), pc = project(c);
-        const glm::vec3 ab = detail::canonical_lerp(a, b, 0.5f), bc = detail::canonical_lerp(b, c, 0.5f),
-                        ca = detail::canonical_lerp(c, a, 0.5f);
-        const raster_vertex pab = project(ab), pbc = project(bc), pca = project(ca);
-        const float s = std::max({glm::length(pab.pixel - 0.5f * (pa.pixel + pb.pixel)),
-                                  glm::length(pbc.pixel - 0.5f * (pb.pixel + pc.pixel)),
-                                  glm::length(pca.pixel - 0.5f * (pc.pixel + pa.pixel))});
-        if (!(s > opt_.tolerance_px) || depth >= opt_.max_tessellation_depth) {
-            const float y0 = std::min({pa.pixel.y, pb.pixel.y, pc.pixel.y}) - 1.f;
-            const float y1 = std::max({pa.pixel.y, pb.pixel.y, pc.pixel.y}) + 1.f;
-            pieces_.push_back({{pa, pb, pc}, k, y0, y1});
-            return;
-        }
-        tessellate(a, ab, ca, k, project, depth + 1);
-        tessellate(ab, b, bc, k, project, depth + 1);
-        tessellate(ca, bc, c, k, project, depth + 1);
-        tessellate(ab, bc, ca, k, project, depth + 1);
     }
 
     void draw_hemicube() {

@@ -13,7 +13,8 @@
 ///     (at most block_texels^2 texels) is read back to build its near-field quadtree and then
 ///     cleared;
 ///  2. visibility: the scene's triangles, in the shooter's frame, clipped above its plane and
-///     tessellated on the CPU with the sagitta rule of cpu::item_buffer_visibility, are drawn
+///     tessellated on the CPU with the sagitta rule (stereographic_tessellation.hpp, the same
+///     code as cpu::item_buffer_visibility's), are drawn
 ///     by GL in the stereographic projection (stereographic_item_coords, emitted from
 ///     radiosity.hpp) into an item buffer holding chart id, triangle id and the exact depth at
 ///     each pixel centre (item_plane_depth), depth tested on a separate depth attachment;
