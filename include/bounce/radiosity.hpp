@@ -189,4 +189,86 @@ V hemicube_direction(T face, T u, T v) {
     return V(x, y, z);
 }
 
+// ---------------------------------------------------------------------------------------
+// Item-buffer depth and lookups, and the near-field test: the rules cpu::item_buffer_visibility
+// and cpu::progressive_radiosity apply and the GL passes emit as GLSL (docs/radiosity.md,
+// sections 3 and 4), written once.
+
+/// Depth (scene units) an item-buffer pixel stores for a surface: the distance from the
+/// shooter along the pixel centre's unit direction `w` (shooter frame) to the surface's
+/// plane n . x = d (shooter frame, d >= 0), exact at the pixel centre; where the plane is seen
+/// edge-on (n . w <= 1e-6) the radial distance `interpolated` across the drawn piece instead.
+template <real T, vec3_of<T> V>
+T item_plane_depth(const V& plane_normal, T plane_offset, const V& w, T interpolated) {
+    const T nw = dot(plane_normal, w);
+    const auto facing = nw > T(1e-6);
+    return select(facing, plane_offset / select(facing, nw, T(1)), interpolated);
+}
+
+/// The plane part of item_buffer_sees (a truth value: bool, or a GLSL boolean): whether the
+/// surface a pixel shows, taken as its plane n . x = d (shooter frame, unit n, d >= 0), met
+/// along the element's own ray from the shooter, lies beyond the element (shooter frame) less
+/// a slack of 1e-4 of the distance plus 1e-6 of the scene's `diagonal`; where that plane is
+/// seen edge-on from the element's direction, whether the pixel's stored depth `shown_depth`
+/// does.
+template <real T, vec3_of<T> V>
+auto item_plane_beyond(const V& element, const V& plane_normal, T plane_offset, T shown_depth, T diagonal) {
+    const T dist = length(element);
+    const T nw = dot(plane_normal, element) / dist;
+    const T slack = T(1e-4) * dist + T(1e-6) * diagonal;
+    const auto edge_on = nw <= T(1e-6);
+    const T met = plane_offset / select(edge_on, T(1), nw);
+    return (edge_on && shown_depth >= dist - slack) || (!edge_on && met >= dist - slack);
+}
+
+/// Whether an element is seen through its item-buffer pixel (1) or hidden (0): the pixel
+/// shows the element's own chart or nothing (`shown_chart` < 0), or item_plane_beyond holds
+/// for the surface it shows. The id test alone (Coombe and Harris 2005, Listing 39-3)
+/// darkens a row of elements along every concave corner, where the pixel's centre falls on the
+/// neighbouring wall at the same depth. `element`: the element's position in the shooter's
+/// frame.
+template <real T, vec3_of<T> V>
+T item_buffer_sees(const V& element, T element_chart, T shown_chart, const V& plane_normal, T plane_offset,
+                   T shown_depth, T diagonal) {
+    const auto beyond = item_plane_beyond<T, V>(element, plane_normal, plane_offset, shown_depth, diagonal);
+    const auto own = shown_chart == element_chart || shown_chart < T(0);
+    return select(own || beyond, T(1), T(0));
+}
+
+/// The plane part of parallel_item_sees (a truth value): for a directional light's
+/// orthographic buffer (rays along the unit `direction` the light travels), whether the shown
+/// surface's plane (world: unit `plane_normal`, n . x = `plane_offset`) is met downstream of
+/// the element at world position `element` along the light (less 1e-6 of the scene's
+/// `diagonal`); for a plane parallel to the light, whether the pixel's stored depth along the
+/// light `shown_depth` is not upstream of the element's.
+template <real T, vec3_of<T> V>
+auto parallel_plane_beyond(const V& element, const V& plane_normal, T plane_offset, T shown_depth, const V& direction,
+                           T diagonal) {
+    const T nd = dot(plane_normal, direction);
+    const auto parallel = abs(nd) <= T(1e-6);
+    const T s = (plane_offset - dot(plane_normal, element)) / select(parallel, T(1), nd);
+    const T slack = T(1e-6) * diagonal;
+    return (parallel && shown_depth >= dot(element, direction) - slack) || (!parallel && s >= -slack);
+}
+
+/// item_buffer_sees for a directional light's orthographic buffer: the element is seen when
+/// its pixel shows its chart or nothing, or when parallel_plane_beyond holds.
+template <real T, vec3_of<T> V>
+T parallel_item_sees(const V& element, T element_chart, T shown_chart, const V& plane_normal, T plane_offset,
+                     T shown_depth, const V& direction, T diagonal) {
+    const auto beyond = parallel_plane_beyond<T, V>(element, plane_normal, plane_offset, shown_depth, direction, diagonal);
+    const auto own = shown_chart == element_chart || shown_chart < T(0);
+    return select(own || beyond, T(1), T(0));
+}
+
+/// Whether a receiver at `receiver` sees a node of a block shooter's quadtree (centre
+/// `node_position`, area `node_area`) as its children (1) rather than as one disc (0): it lies
+/// within sqrt(`near2`) node sides of the node (the near field, a substructuring refinement of
+/// Cohen et al. 1986; near2 = near_field^2).
+template <real T, vec3_of<T> V>
+T near_field_opens(const V& receiver, const V& node_position, T node_area, T near2) {
+    const V r = node_position - receiver;
+    return select(dot(r, r) < near2 * node_area, T(1), T(0));
+}
+
 }  // namespace bounce

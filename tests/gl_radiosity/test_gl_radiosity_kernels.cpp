@@ -1,4 +1,4 @@
-// The GL radiosity passes' own kernels (gl/radiosity_kernels.hpp), printed as GLSL and run on
+// The GL radiosity passes' own kernels (include/bounce/radiosity.hpp), printed as GLSL and run on
 // llvmpipe, against their CPU float instantiation over random and hard inputs.
 //
 // Tolerance: item_plane_depth is d / (n . w), n . w off by a few ulps of 1: 1e-5 of its value
@@ -10,7 +10,7 @@
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/kernel_map.hpp>
-#include <bounce/gl/radiosity_kernels.hpp>
+#include <bounce/radiosity.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -58,8 +58,8 @@ TEST_CASE("item_plane_depth agrees on the GPU and the CPU, edge-on planes includ
         in.emplace_back(n, 0.01f + 3 * rng.next_float(), w, 0.01f + 3 * rng.next_float());
     }
     std::vector<float> cpu;
-    for (const auto& a : in) cpu.push_back(std::apply(gl::item_plane_depth<float, glm::vec3>, a));
-    const auto gpu = gl::map_kernel(gl::item_plane_depth<f32, vec3>, in);
+    for (const auto& a : in) cpu.push_back(std::apply(bounce::item_plane_depth<float, glm::vec3>, a));
+    const auto gpu = gl::map_kernel(bounce::item_plane_depth<f32, vec3>, in);
     // d / (n . w): the dot product of unit vectors is off by a few ulps of 1, absolutely, so the
     // quotient is off by that over n . w, relatively: the scale is |depth| / |n . w|.
     CHECK(worst_scaled(gpu, cpu, [&](std::size_t e) {
@@ -101,8 +101,8 @@ TEST_CASE("the item-buffer lookups and the near-field test decide alike on the G
             margin.push_back(shown == 1.f || shown < 0 ? 1.0 : m);
         }
         std::vector<float> cpu;
-        for (const auto& a : in) cpu.push_back(std::apply(gl::item_buffer_sees<float, glm::vec3>, a));
-        const auto gpu = gl::map_kernel(gl::item_buffer_sees<f32, vec3>, in);
+        for (const auto& a : in) cpu.push_back(std::apply(bounce::item_buffer_sees<float, glm::vec3>, a));
+        const auto gpu = gl::map_kernel(bounce::item_buffer_sees<f32, vec3>, in);
         CHECK(check_decisions(gpu, cpu, in, margin) <= in.size() / 100);
         CHECK(std::vector<float>(gpu.begin(), gpu.begin() + 6) == std::vector<float>{1, 1, 0, 1, 0, 1});
     }
@@ -125,8 +125,8 @@ TEST_CASE("the item-buffer lookups and the near-field test decide alike on the G
                                                                 : s + 1e-6 * diagonal);
         }
         std::vector<float> cpu;
-        for (const auto& a : in) cpu.push_back(std::apply(gl::parallel_item_sees<float, glm::vec3>, a));
-        const auto gpu = gl::map_kernel(gl::parallel_item_sees<f32, vec3>, in);
+        for (const auto& a : in) cpu.push_back(std::apply(bounce::parallel_item_sees<float, glm::vec3>, a));
+        const auto gpu = gl::map_kernel(bounce::parallel_item_sees<f32, vec3>, in);
         CHECK(check_decisions(gpu, cpu, in, margin) <= in.size() / 100);
         CHECK(std::vector<float>(gpu.begin(), gpu.begin() + 3) == std::vector<float>{0, 1, 0});
     }
@@ -142,8 +142,8 @@ TEST_CASE("the item-buffer lookups and the near-field test decide alike on the G
             margin.push_back((d2 - double(near2) * area) / (double(near2) * area));
         }
         std::vector<float> cpu;
-        for (const auto& a : in) cpu.push_back(std::apply(gl::near_field_opens<float, glm::vec3>, a));
-        const auto gpu = gl::map_kernel(gl::near_field_opens<f32, vec3>, in);
+        for (const auto& a : in) cpu.push_back(std::apply(bounce::near_field_opens<float, glm::vec3>, a));
+        const auto gpu = gl::map_kernel(bounce::near_field_opens<f32, vec3>, in);
         CHECK(check_decisions(gpu, cpu, in, margin) <= in.size() / 100);
         CHECK(std::count(cpu.begin(), cpu.end(), 1.f) > 10);  // both outcomes occur
         CHECK(std::count(cpu.begin(), cpu.end(), 0.f) > 10);

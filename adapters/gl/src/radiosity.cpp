@@ -2,7 +2,6 @@
 // 1988; Coombe and Harris 2005). See radiosity.hpp for the steps and docs/radiosity-gl.md.
 #include <bounce/gl/radiosity.hpp>
 
-#include <bounce/gl/radiosity_kernels.hpp>
 #include <bounce/glsl/emit.hpp>
 #include <bounce/light.hpp>
 #include <bounce/lights.hpp>

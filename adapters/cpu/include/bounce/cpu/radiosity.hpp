@@ -366,8 +366,7 @@ private:
             stack[top++] = root;
             while (top > 0) {
                 const near_node& node = near_[stack[--top]];
-                const vec r = node.position - pr;
-                if (node.child_count == 0 || !(dot(r, r) < near2 * node.area)) {
+                if (node.child_count == 0 || !(near_field_opens<Real, vec>(pr, node.position, node.area, near2) > Real(0.5))) {
                     const Real f = disc_form_factor<Real, vec>(pr, nr, node.position, ns, node.area);
                     if (!(f > Real(0))) continue;
                     incident += glm::dvec3(node.unshot) * double(f);

@@ -323,21 +323,16 @@ private:
     bool seen(const item_buffer& buf, int x, int y, std::uint32_t chart, glm::vec3 p, bool parallel) const {
         const std::size_t i = std::size_t(y) * std::size_t(buf.width) + std::size_t(x);
         if (buf.id[i] == chart || buf.id[i] == item_buffer::none) return true;
+        // The plane tests of radiosity.hpp (the GL passes emit the same kernels).
         const std::uint32_t k = buf.primitive[i];
         if (parallel) {
-            // Distance s along the light from p to the plane: upstream (s < 0) occludes.
+            // Distance along the light from p to the plane: upstream occludes.
             const glm::vec4 plane = world_plane_[k];
-            const float nd = glm::dot(glm::vec3(plane), shot_.axis);
-            if (std::abs(nd) <= 1e-6f) return buf.depth[i] >= glm::dot(p, shot_.axis) - 1e-6f * diagonal_;
-            const float s = (plane.w - glm::dot(glm::vec3(plane), p)) / nd;
-            return s >= -1e-6f * diagonal_;
+            return parallel_plane_beyond<float, glm::vec3>(p, glm::vec3(plane), plane.w, buf.depth[i], shot_.axis,
+                                                           diagonal_);
         }
         const glm::vec4 plane = local_plane_[k];
-        const float dist = glm::length(p);
-        const float nw = glm::dot(glm::vec3(plane), p) / dist;
-        const float slack = 1e-4f * dist + 1e-6f * diagonal_;
-        if (nw <= 1e-6f) return buf.depth[i] >= dist - slack;
-        return plane.w / nw >= dist - slack;
+        return item_plane_beyond<float, glm::vec3>(p, glm::vec3(plane), plane.w, buf.depth[i], diagonal_);
     }
 
     glm::vec3 n_local(glm::vec3 n) const { return {glm::dot(n, t_), glm::dot(n, b_), glm::dot(n, shot_.axis)}; }
@@ -401,9 +396,9 @@ private:
                 scan_triangle_with(
                     buf, pc.v[0], pc.v[1], pc.v[2], local_chart_[pc.k],
                     [&](int x, int y, double attr) {
-                        const float nw =
-                            glm::dot(n, pixel_direction_[std::size_t(y) * std::size_t(width) + std::size_t(x)]);
-                        return nw > 1e-6f ? plane.w / nw : float(attr);
+                        return item_plane_depth<float, glm::vec3>(
+                            n, plane.w, pixel_direction_[std::size_t(y) * std::size_t(width) + std::size_t(x)],
+                            float(attr));
                     },
                     pc.k, y0, y1);
             }
