@@ -1,13 +1,12 @@
 #pragma once
 // The multi-bounce reference view cached on disk, as study::cached_reference does for the
 // one-bounce reference: `<dir>/<key>.exr` (radiance) and `<key>.json` (each bounce's share),
-// the key ending in an FNV-1a hash of everything the image depends on (geometry, normals,
-// materials, lights, use_emission, camera, size, settings, the Embree configuration).
+// the key ending in an FNV-1a hash of everything the image depends on (study::hash_scene_view,
+// then the settings and the Embree configuration).
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/scene.hpp>
-#include <bounce/light.hpp>
-#include <bounce/study/content_hash.hpp>
+#include <bounce/study/reference_cache.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -22,25 +21,8 @@ namespace bounce::examples {
 inline std::string multi_bounce_key(const io::scene& s, const camera& cam, std::size_t w, std::size_t h,
                                     const embree::multi_bounce_settings& settings, const std::string& device_config) {
     study::fnv1a_hash hash;
-    hash.text("multi_bounce_reference v1");
-    for (const auto& p : s.positions) hash.value(p);
-    for (const auto& n : s.normals) hash.value(n);
-    for (const auto& t : s.triangles) hash.value(t);
-    for (const auto m : s.material_of) hash.value(m);
-    for (const auto& m : s.materials) {
-        hash.value(m.albedo);
-        hash.value(m.emission);
-    }
-    for (const auto& l : s.lights) hash.value(pack(l));
-    hash.value(s.use_emission);
-    hash.value(cam.position);
-    hash.value(cam.look_at);
-    hash.value(cam.up);
-    hash.value(cam.fov_y_deg);
-    hash.value(cam.near_plane);
-    hash.value(cam.far_plane);
-    hash.value(w);
-    hash.value(h);
+    hash.text("multi_bounce_reference v2");
+    study::hash_scene_view(hash, s, cam, w, h);
     hash.value(settings.paths);
     hash.value(settings.max_bounces);
     hash.value(settings.roulette_after);

@@ -64,11 +64,8 @@ std::filesystem::path default_cache_dir() {
     return std::filesystem::path("build") / "cache";
 }
 
-std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
-                                std::size_t height, const reference_settings& settings,
-                                std::string_view device_config) {
-    fnv1a_hash h;
-    h.text(integrator_version);
+void hash_scene_view(fnv1a_hash& h, const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                     std::size_t height) {
     h.value(scene.positions.size());
     for (const auto& p : scene.positions) h.value(p);
     h.value(scene.normals.size());
@@ -112,6 +109,14 @@ std::string reference_cache_key(const io::scene& scene, const bounce::camera& ca
     h.value(cam.far_plane);
     h.value(width);
     h.value(height);
+}
+
+std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                                std::size_t height, const reference_settings& settings,
+                                std::string_view device_config) {
+    fnv1a_hash h;
+    h.text(integrator_version);
+    hash_scene_view(h, scene, cam, width, height);
     h.value(settings.hemisphere_samples);
     h.value(settings.area_samples);
     h.value(settings.secondary_area_samples);

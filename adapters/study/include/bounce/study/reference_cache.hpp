@@ -15,6 +15,7 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
+#include <bounce/study/content_hash.hpp>
 
 #include <filesystem>
 #include <optional>
@@ -26,6 +27,12 @@ namespace bounce::study {
 /// $BOUNCE_CACHE when set; else `cache/` beside the `bin/` folder the running program lives
 /// in (build/bin/reference -> build/cache); else ./build/cache.
 std::filesystem::path default_cache_dir();
+
+/// Adds to `h` all that a rendered view of `scene` depends on: positions, normals, triangles,
+/// materials, lights, use_emission, the camera and the image size. Every cache key of a
+/// rendered reference starts from it (then adds its integrator's version and settings).
+void hash_scene_view(fnv1a_hash& h, const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                     std::size_t height);
 
 /// The cache key of a reference render of `scene` seen by `cam` at `width` x `height` with
 /// `settings` on a device configured with `device_config` (device::config()):
