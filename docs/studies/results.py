@@ -90,11 +90,23 @@ def runs_by_name(path):
     return {r["name"]: r for r in load(path)["runs"]}
 
 
+def dumps(value, depth=0):
+    """JSON with one key per line, but a list of plain values (a per-iteration series) on one
+    line: a study's curves stay readable in a diff without a line per number."""
+    pad = " " * (depth + 1)
+    if isinstance(value, dict) and value:
+        items = (f"{pad}{json.dumps(k)}: {dumps(v, depth + 1)}" for k, v in value.items())
+        return "{\n" + ",\n".join(items) + "\n" + " " * depth + "}"
+    if isinstance(value, list) and value and any(isinstance(v, (dict, list)) for v in value):
+        return "[\n" + ",\n".join(pad + dumps(v, depth + 1) for v in value) + "\n" + " " * depth + "]"
+    return json.dumps(value, separators=(",", ":"))
+
+
 def save(path, results):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
-        json.dump(results, f, indent=1)
+        f.write(dumps(results))
         f.write("\n")
     os.replace(tmp, path)
 
