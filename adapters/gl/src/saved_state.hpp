@@ -5,6 +5,8 @@
 #include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)
 
 #include <array>
+#include <initializer_list>
+#include <stdexcept>
 #include <vector>
 
 namespace bounce::gl::detail {
@@ -37,6 +39,8 @@ private:
 class program_and_storage_state {
 public:
     explicit program_and_storage_state(std::initializer_list<GLuint> storage_indices) {
+        if (storage_indices.size() > max_bindings)
+            throw std::logic_error("program_and_storage_state: more storage bindings than it can save");
         glGetIntegerv(GL_CURRENT_PROGRAM, &program_);
         glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
         for (GLuint i : storage_indices) {
@@ -65,8 +69,9 @@ private:
         GLint buffer = 0;
         GLint64 start = 0, size = 0;
     };
+    static constexpr std::size_t max_bindings = 8;
     GLint program_ = 0, generic_ = 0;
-    std::array<binding, 4> bindings_{};
+    std::array<binding, max_bindings> bindings_{};
     std::size_t count_ = 0;
 };
 
