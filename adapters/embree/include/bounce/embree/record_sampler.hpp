@@ -7,7 +7,13 @@
 /// It models bounce::record_sampler (record_sampler.hpp), as the GL single-plane rasterizer
 /// does, so a cache takes either; one record alone is
 ///   std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint).
+///
+/// With adaptive rays (bounce/adaptive_hemisphere.hpp) a record starts from a grid of about
+/// min_rays strata and adds rays to the strata next to uncertain ones until the estimated
+/// relative standard error of its irradiance is below the target or max_rays are cast.
+/// rays_cast() counts the rays and records of every call, adaptive or not.
 
+#include <bounce/adaptive_hemisphere.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/irradiance_gradients.hpp>
 #include <bounce/irradiance_record.hpp>
@@ -15,10 +21,13 @@
 #include <bounce/sampling.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
+#include <vector>
 
 #include <tbb/parallel_for.h>
 
@@ -34,13 +43,60 @@ public:
         require(grid.m > 0 && grid.n > 0, "grid", "need at least one stratum in each direction");
     }
 
+    /// Adaptive rays per record when `adaptive.enabled`: a first round on
+    /// adaptive_grid(min_rays), then up to max_rays (see the file comment); otherwise the
+    /// fixed grid hemisphere_grid_for(adaptive.max_rays), as the constructor above.
+    /// Throws parameter_error on bad settings (adaptive_rays::validate).
+    record_sampler(const reference_integrator& integrator, adaptive_rays adaptive, radius_limits limits,
+                   translation_gradient_kind kind = translation_gradient_kind::krivanek_2005, std::uint64_t seed = 7)
+        : integrator_(integrator), grid_(grid_for(adaptive)), limits_(limits), kind_(kind), seed_(seed),
+          adaptive_(adaptive) {}
+
+    /// What a record cost: every call since construction or reset_rays_cast(), adaptive or
+    /// not, including those that returned nullopt.
+    struct ray_tally {
+        std::uint64_t records = 0;  ///< hemispheres measured
+        std::uint64_t rays = 0;     ///< hemisphere rays cast for them (not counting shadow rays)
+        std::uint32_t fewest = 0;   ///< fewest rays of one record (0 when none)
+        std::uint32_t most = 0;     ///< most rays of one record
+        double mean() const noexcept { return records ? double(rays) / double(records) : 0.0; }
+    };
+    ray_tally rays_cast() const noexcept {
+        ray_tally t;
+        t.records = tally_.records.load();
+        t.rays = tally_.rays.load();
+        t.most = tally_.most.load();
+        t.fewest = t.records ? tally_.fewest.load() : 0u;
+        return t;
+    }
+    /// Restarts rays_cast() from zero. Not while records are being measured.
+    void reset_rays_cast() const noexcept { tally_.reset(); }
+
+    /// The adaptive settings in use (enabled = false for a fixed grid).
+    const adaptive_rays& adaptive() const noexcept { return adaptive_; }
+
     /// A record at (p, n); nullopt when the hemisphere yields no finite estimate.
     /// The rays are seeded by the bits of (p, n), so a record is a pure function of its
     /// point: the same whenever, and on whichever thread, it is asked for. That is what
     /// lets cpu::scan_cache_misses_batched measure records ahead of the scan. Thread-safe.
     std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint) const {
+        return measure(p, n, pixel_footprint, nullptr);
+    }
+
+    /// As operator(), and `*rays` (when not null) receives the hemisphere rays the record cast.
+    std::optional<irradiance_record> measure(glm::vec3 p, glm::vec3 n, double pixel_footprint,
+                                             std::uint32_t* rays) const {
         embree::hemisphere_samples samples;  // per call: nested TBB work may re-enter on this thread
-        integrator_.sample_hemisphere(p, n, grid_, derive_seed(seed_, 0x1c, point_key(p, n)), samples);
+        const std::uint64_t key = point_key(p, n);
+        integrator_.sample_hemisphere(p, n, grid_, derive_seed(seed_, 0x1c, key), samples);
+        if (adaptive_.enabled) {
+            const auto [est, cast] = adaptive_estimate(samples, key);
+            tally_.add(cast);
+            if (rays) *rays = cast;
+            return finish(p, samples, est, pixel_footprint);
+        }
+        tally_.add(grid_.count());
+        if (rays) *rays = grid_.count();
         bounce::hemisphere_samples local;
         local.rings = grid_.m;
         local.wedges = grid_.n;
@@ -55,11 +111,7 @@ public:
         // Distances are measured from p + eps n and can be 0 where another surface touches
         // p (a corner); no surface is nearer than the offset itself, so floor them there.
         for (float& d : local.distance) d = std::max(d, integrator_.ray_epsilon());
-        const hemisphere_estimate est = estimate_hemisphere(local, kind_);
-        irradiance_record rec = make_record(p, samples.normal, samples.tangent, samples.bitangent, est, limits_,
-                                            pixel_footprint);
-        if (!std::isfinite(rec.radius) || !(rec.radius > 0.f)) return std::nullopt;
-        return rec;
+        return finish(p, samples, estimate_hemisphere(local, kind_), pixel_footprint);
     }
 
     /// Records for points[k], normals[k], footprints[k] into out[k], the points on every
@@ -75,7 +127,8 @@ public:
 
     /// The hemisphere rays the records at points[k], normals[k] would cast, traced without
     /// shading, the points on every core; returns the rays cast. For comparing a record's
-    /// cost with Embree's raw rate on the same rays.
+    /// cost with Embree's raw rate on the same rays. With adaptive rays: the first round's
+    /// rays only (the later rounds' depend on the shading).
     std::size_t trace_only(std::span<const glm::vec3> points, std::span<const glm::vec3> normals) const {
         require(normals.size() == points.size(), "normals", "must have one entry per point");
         tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t k) {
@@ -92,6 +145,99 @@ private:
     radius_limits limits_;
     translation_gradient_kind kind_;
     std::uint64_t seed_;
+    adaptive_rays adaptive_{};
+
+    // Atomic totals (copies start from the original's counts).
+    struct tally {
+        std::atomic<std::uint64_t> records{0}, rays{0};
+        std::atomic<std::uint32_t> fewest{~0u}, most{0};
+        tally() = default;
+        tally(const tally& o) : records(o.records.load()), rays(o.rays.load()), fewest(o.fewest.load()), most(o.most.load()) {}
+        tally& operator=(const tally&) = delete;
+        void add(std::uint32_t cast) noexcept {
+            records.fetch_add(1);
+            rays.fetch_add(cast);
+            std::uint32_t f = fewest.load();
+            while (cast < f && !fewest.compare_exchange_weak(f, cast)) {}
+            std::uint32_t m = most.load();
+            while (cast > m && !most.compare_exchange_weak(m, cast)) {}
+        }
+        void reset() noexcept {
+            records = 0;
+            rays = 0;
+            fewest = ~0u;
+            most = 0;
+        }
+    };
+    mutable tally tally_;
+
+    static hemisphere_grid grid_for(const adaptive_rays& a) {
+        a.validate();
+        if (!a.enabled) return hemisphere_grid_for(a.max_rays);
+        const adaptive_grid_size g = adaptive_grid(a.min_rays);
+        return {g.rings, g.wedges};
+    }
+
+    std::optional<irradiance_record> finish(glm::vec3 p, const embree::hemisphere_samples& samples,
+                                     const hemisphere_estimate& est, double pixel_footprint) const {
+        irradiance_record rec = make_record(p, samples.normal, samples.tangent, samples.bitangent, est, limits_,
+                                            pixel_footprint);
+        if (!std::isfinite(rec.radius) || !(rec.radius > 0.f)) return std::nullopt;
+        return rec;
+    }
+
+    // The first round (the fixed grid's samples) and as many later rounds as the target
+    // needs: each round asks adaptive_hemisphere::plan for at most as many rays as were
+    // cast so far (at least an eighth of them), draws them inside their cells from a stream
+    // keyed by the point and the round, and shades them as sample_hemisphere does.
+    std::pair<hemisphere_estimate, std::uint32_t> adaptive_estimate(const embree::hemisphere_samples& samples,
+                                                                    std::uint64_t key) const {
+        adaptive_hemisphere h(grid_.m, grid_.n);
+        const float eps = integrator_.ray_epsilon();
+        auto local_of = [&](const glm::vec3& d) {
+            return glm::vec3(glm::dot(d, samples.tangent), glm::dot(d, samples.bitangent), glm::dot(d, samples.normal));
+        };
+        for (std::size_t i = 0; i < samples.direction.size(); ++i)
+            h.add(i, local_of(samples.direction[i]), samples.radiance[i], std::max(samples.distance[i], eps));
+        const std::uint64_t cap = std::max<std::uint64_t>(adaptive_.max_rays, grid_.count());
+        std::uint64_t used = grid_.count();
+        std::vector<std::size_t> cell_of;
+        std::vector<glm::vec3> local, radiance;
+        std::vector<float> distance;
+        for (std::uint64_t round = 1; used < cap && round <= 16; ++round) {
+            const double scale = std::max(h.luminance_irradiance(), adaptive_.irradiance_floor);
+            const double allowed = adaptive_.target * scale;
+            const double v = h.variance();
+            if (!(v > allowed * allowed)) break;
+            const std::uint64_t budget = std::min(cap - used, used);
+            const std::vector<std::uint32_t> extra = h.plan(budget, allowed * allowed, std::min(budget, used / 8));
+            if (extra.empty()) break;
+            const std::uint64_t stream = derive_seed(seed_, 0x1d, key ^ (round * 0x9e3779b97f4a7c15ULL));
+            pcg32 rng(stream);
+            cell_of.clear();
+            local.clear();
+            for (std::size_t c = 0; c < extra.size(); ++c)
+                for (std::uint32_t e = 0; e < extra[c]; ++e) {
+                    const float u = rng.next_float(), w = rng.next_float();
+                    cell_of.push_back(c);
+                    local.push_back(h.direction_in(c, glm::vec2(u, w)));
+                }
+            const std::size_t count = local.size();
+            radiance.resize(count);
+            distance.resize(count);
+            const glm::vec3 origin = samples.origin + eps * samples.normal;
+            tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
+                ray r;
+                r.origin = origin;
+                const glm::vec3 l = local[i];
+                r.direction = glm::normalize(l.x * samples.tangent + l.y * samples.bitangent + l.z * samples.normal);
+                radiance[i] = integrator_.incoming_radiance(r, derive_seed(stream, 0x2e, i), &distance[i]);
+            });
+            for (std::size_t i = 0; i < count; ++i) h.add(cell_of[i], local[i], radiance[i], std::max(distance[i], eps));
+            used += count;
+        }
+        return {estimate_hemisphere(h.cell_means(), kind_), std::uint32_t(used)};
+    }
 
     // Distinct points get independent streams, the same point the same stream.
     static std::uint64_t point_key(const glm::vec3& p, const glm::vec3& n) noexcept {
