@@ -6,22 +6,26 @@
 /// per record").
 ///
 /// Strata are the M x N cells of irradiance_gradients.hpp (M rings of equal projected solid
-/// angle, N wedges, N even). A first round puts one jittered sample in every cell; later
-/// rounds add samples, each drawn uniformly (in projected solid angle) inside its cell and
-/// independent of the others. A cell's radiance is the mean of its samples, so the irradiance
-/// E = pi / (M N) * sum over cells of the cell means stays an unbiased stratified estimate
-/// whatever the cells' sample counts are (each stratum weighted by its measure, not by how
-/// many samples it holds).
+/// angle, N wedges, N even). A first round puts one jittered sample in every cell. A cell is
+/// refined by splitting: from n = 2^l samples, one in each of its n sub-strata, to 2n, each
+/// sub-stratum halved (in phi on even levels, in theta on odd ones) and a new sample drawn
+/// uniformly in the half its old sample does not occupy. Given the half it fell in, the old
+/// sample is uniform there, so the cell mean (the average over its equal sub-strata) stays
+/// unbiased, and a cell refined everywhere is the finer stratified grid. The irradiance
+/// E = pi / (M N) * sum over cells of the cell means is then an unbiased stratified estimate
+/// whatever the cells' sample counts (each stratum weighted by its measure, not its count).
 ///
-/// Variance of E, from the record's own samples (luminance Y, Rec. 709):
+/// Variance of E, from the record's own samples (luminance Y, Rec. 709), all by collapsed
+/// strata (Cochran, Sampling Techniques, 5A.12): two strata of equal measure with one sample
+/// each give (Y_a - Y_b)^2, whose expectation sigma_a^2 + sigma_b^2 + (mu_a - mu_b)^2 is never
+/// below their true variance, and equals it where their means agree:
 ///  - cells are paired in phi, (j, 2i) with (j, 2i + 1); a pair is refined as a unit, so its
 ///    two cells always hold the same count n;
-///  - a pair with n >= 2 contributes s_a^2 / n + s_b^2 / n (each cell's unbiased sample
-///    variance): unbiased;
-///  - a pair with n = 1 contributes (Y_a - Y_b)^2, the collapsed-strata estimator, whose
-///    expectation sigma_a^2 + sigma_b^2 + (mu_a - mu_b)^2 is never below the pair's true
-///    variance: conservative, exact where the two cells have the same mean;
-///  - V = (pi / (M N))^2 * sum over pairs.
+///  - a pair with n = 1 contributes (Y_a - Y_b)^2;
+///  - a cell with n >= 2 contributes sum over sibling sub-strata (the two halves of the
+///    last split, samples i and i + n/2) of (Y_i - Y_{i+n/2})^2 / n^2;
+///  - V = (pi / (M N))^2 * sum over pairs: conservative, exact where paired strata have
+///    equal means.
 ///
 /// Which strata to refine: a pair's priority is the largest per-sample variance of its
 /// neighbouring pairs (same ring, next pair in phi either side; same wedges, the rings on
@@ -125,11 +129,28 @@ public:
         return glm::vec3(float(sin_t * std::cos(phi)), float(sin_t * std::sin(phi)), float(cos_t));
     }
 
-    /// One sample of cell `cell_index`: its local direction, incoming radiance (RGB) and hit
-    /// distance (+infinity where the ray escaped). The first sample of a cell gives the
-    /// direction that stands for the cell in cell_means(). Throws parameter_error on
-    /// non-finite radiance or a distance that is not positive.
-    void add(std::size_t cell_index, const glm::vec3& local_direction, const glm::vec3& radiance, float distance) {
+    /// The jitter u in [0,1)^2 of a local direction inside cell `cell_index` (the inverse of
+    /// direction_in, clamped into the cell).
+    glm::vec2 jitter_of(std::size_t cell_index, const glm::vec3& local_direction) const {
+        require(cell_index < cells_.size(), "cell", "outside the grid");
+        const double j = double(cell_index / n_), k = double(cell_index % n_);
+        const glm::dvec3 d(local_direction);
+        const double sin2 = d.x * d.x + d.y * d.y;
+        double phi = std::atan2(d.y, d.x);
+        if (phi < 0) phi += 2 * std::numbers::pi;
+        const double below_one = 0x1.fffffep-1;
+        const double ux = std::clamp(phi * n_ / (2 * std::numbers::pi) - k, 0.0, below_one);
+        const double uy = std::clamp(sin2 * m_ - j, 0.0, below_one);
+        return {float(ux), float(uy)};
+    }
+
+    /// One sample of cell `cell_index`: its jitter u (direction_in(cell_index, u) is its
+    /// direction), local direction, incoming radiance (RGB) and hit distance (+infinity where
+    /// the ray escaped). The first sample of a cell gives the direction that stands for the
+    /// cell in cell_means(). Throws parameter_error on non-finite radiance or a distance that
+    /// is not positive.
+    void add(std::size_t cell_index, glm::vec2 u, const glm::vec3& local_direction, const glm::vec3& radiance,
+             float distance) {
         require(cell_index < cells_.size(), "cell", "outside the grid");
         require(std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z), "radiance",
                 "non-finite radiance sample");
@@ -141,8 +162,38 @@ public:
         c.n += 1;
         c.sum += L;
         c.y += y;
-        c.y2 += y * y;
+        c.samples.push_back({u, y});
         c.inverse_distance += 1.0 / double(distance);  // 0 for escaped rays
+    }
+
+    /// The jitters of the samples that double cell `cell_index` (one per sample it holds, in
+    /// the half of that sample's sub-stratum it does not occupy), uniform from `next`, a
+    /// function returning uniform floats in [0, 1). Throws parameter_error unless the cell
+    /// holds a power of two samples.
+    template <class Uniform>
+    std::vector<glm::vec2> refinement_jitters(std::size_t cell_index, Uniform&& next) const {
+        require(cell_index < cells_.size(), "cell", "outside the grid");
+        const cell& c = cells_[cell_index];
+        require(c.n > 0 && (c.n & (c.n - 1)) == 0, "cell", "refines from a power of two samples");
+        unsigned level = 0;
+        while ((1u << level) < c.n) ++level;
+        std::vector<glm::vec2> out;
+        out.reserve(c.n);
+        for (const sample& s : c.samples) {
+            glm::dvec2 lo(0.0), hi(1.0);
+            for (unsigned t = 0; t < level; ++t) {  // the box of s's sub-stratum
+                const int d = int(t % 2);
+                const double mid = 0.5 * (lo[d] + hi[d]);
+                (double(s.u[d]) < mid ? hi[d] : lo[d]) = mid;
+            }
+            const int d = int(level % 2);
+            const double mid = 0.5 * (lo[d] + hi[d]);
+            (double(s.u[d]) < mid ? lo[d] : hi[d]) = mid;  // the other half
+            const double a = double(next()), b = double(next());
+            const glm::dvec2 u(lo.x + a * (hi.x - lo.x), lo.y + b * (hi.y - lo.y));
+            out.emplace_back(float(std::min(u.x, std::nextafter(hi.x, lo.x))), float(std::min(u.y, std::nextafter(hi.y, lo.y))));
+        }
+        return out;
     }
 
     /// pi / (M N): each cell's share of the irradiance integral.
@@ -162,21 +213,13 @@ public:
     }
 
     /// Per-sample variance of luminance in pair p (cells 2p and 2p + 1 of its ring, p =
-    /// j * N/2 + i): the mean of its cells' sample variances, or (Y_a - Y_b)^2 / 2 while
-    /// either holds a single sample.
-    double pair_sample_variance(std::size_t p) const {
-        const cell& a = cells_.at(2 * p);
-        const cell& b = cells_.at(2 * p + 1);
-        if (nonempty(a) < 2 || nonempty(b) < 2) {
-            const double d = a.y / a.n - b.y / b.n;
-            return 0.5 * d * d;
-        }
-        return 0.5 * (sample_variance(a) + sample_variance(b));
-    }
+    /// j * N/2 + i): pair_variance(p) * n / 2, n the pair's count; (Y_a - Y_b)^2 / 2 at n = 1.
+    double pair_sample_variance(std::size_t p) const { return pair_variance(p) * double(pair_count(p)) / 2; }
 
     /// The pair's share of the variance of E's luminance, before the factor (pi / (M N))^2:
-    /// s_a^2 / n_a + s_b^2 / n_b, or (Y_a - Y_b)^2 when either cell holds one sample (with
-    /// unequal counts, the single-sample cell's term is (Y_a - mean_b)^2, still conservative).
+    /// (Y_a - Y_b)^2 while both cells hold one sample, else the sum of its cells' sibling
+    /// terms (a single-sample cell beside a refined one takes (Y_a - mean_b)^2, still
+    /// conservative).
     double pair_variance(std::size_t p) const {
         const cell& a = cells_.at(2 * p);
         const cell& b = cells_.at(2 * p + 1);
@@ -186,7 +229,7 @@ public:
             return d * d;
         }
         auto term = [](const cell& c, const cell& other) {
-            if (c.n >= 2) return sample_variance(c) / c.n;
+            if (c.n >= 2) return sibling_variance(c);
             const double d = c.y - other.y / other.n;
             return d * d;
         };
@@ -214,8 +257,8 @@ public:
 
     /// Extra samples per cell for one round of at most `budget` rays. Pairs are taken in
     /// decreasing order of (their neighbours' largest per-sample variance + a quarter of the
-    /// mean over all pairs) / n; each taken pair has its count doubled (or raised by what is
-    /// left of the budget, split evenly between its two cells). The round stops once it has
+    /// mean over all pairs) / n; each taken pair has its count doubled (2n rays; pairs the
+    /// rest of the budget cannot double are passed over). The round stops once it has
     /// spent at least `min_spend` rays and the variance predicted from the pairs' own
     /// estimates has fallen to `target_variance` (in units of variance(), i.e. with the
     /// cell weight squared), or when the budget is spent. Empty where nothing can be added.
@@ -223,7 +266,7 @@ public:
         std::vector<std::uint32_t> extra(cells_.size(), 0);
         const std::size_t np = pairs();
         const std::uint32_t half_n = n_ / 2;
-        std::vector<double> own(np);
+        std::vector<double> own(np);  // per-sample variance of each pair
         double mean_own = 0;
         for (std::size_t p = 0; p < np; ++p) mean_own += own[p] = pair_sample_variance(p);
         mean_own /= double(np);
@@ -249,11 +292,12 @@ public:
             if (!(key[p] > 0) || budget - spent < 2) break;
             if (spent >= min_spend && predicted <= target_variance) break;
             const std::uint32_t n = pair_count(p);
-            const std::uint32_t add = std::uint32_t(std::min<std::uint64_t>(n, (budget - spent) / 2));
-            extra[2 * p] = extra[2 * p + 1] = add;
-            spent += 2 * std::uint64_t(add);
-            // The pair's own estimate says how much the doubling should remove.
-            predicted -= w2 * 2 * own[p] * (1.0 / n - 1.0 / (n + add));
+            if (2 * std::uint64_t(n) > budget - spent) continue;
+            extra[2 * p] = extra[2 * p + 1] = n;
+            spent += 2 * std::uint64_t(n);
+            // The pair's own estimate says how much the doubling should remove (at least
+            // half for independent samples; splitting strata removes more where they are smooth).
+            predicted -= w2 * 0.5 * pair_variance(p);
         }
         if (spent == 0) extra.clear();
         return extra;
@@ -283,11 +327,16 @@ public:
     }
 
 private:
+    struct sample {
+        glm::vec2 u;  // jitter inside the cell
+        double y;     // luminance
+    };
     struct cell {
         std::uint32_t n = 0;
         glm::vec3 direction{0, 0, 1};
         glm::dvec3 sum{0.0};
-        double y = 0, y2 = 0, inverse_distance = 0;
+        double y = 0, inverse_distance = 0;
+        std::vector<sample> samples;  // in the order added: i and i + n/2 are siblings
     };
     std::uint32_t m_, n_;
     std::vector<cell> cells_;
@@ -296,9 +345,15 @@ private:
         require(c.n > 0, "cell", "every cell needs at least one sample");
         return c.n;
     }
-    static double sample_variance(const cell& c) {
-        const double mean = c.y / c.n;
-        return std::max(0.0, (c.y2 - c.y * mean) / (c.n - 1));
+    // sum over the last split's sibling sub-strata of (Y_i - Y_{i+n/2})^2 / n^2.
+    static double sibling_variance(const cell& c) {
+        const std::size_t half = c.samples.size() / 2;
+        double v = 0;
+        for (std::size_t i = 0; i < half; ++i) {
+            const double d = c.samples[i].y - c.samples[i + half].y;
+            v += d * d;
+        }
+        return v / (double(c.n) * double(c.n));
     }
     std::uint32_t pair_count(std::size_t p) const { return std::min(cells_[2 * p].n, cells_[2 * p + 1].n); }
 };

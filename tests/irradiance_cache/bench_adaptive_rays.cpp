@@ -26,7 +26,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
+#include <mutex>
+#include <numeric>
+#include <span>
+
+#include <tbb/parallel_for.h>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -127,7 +133,19 @@ TEST_CASE("adaptive rays per record against fixed ones: error, records and rays 
         cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, o);
         image<glm::vec3> indirect(size, size);
         const auto t0 = std::chrono::steady_clock::now();
-        const cpu::cache_frame_stats st = cache.render(g.view(), scene.camera, *sampler, indirect.view());
+        // Every record's irradiance and rays, for their distribution.
+        std::mutex mutex;
+        std::vector<std::pair<double, std::uint32_t>> seen;
+        auto measuring = [&](std::span<const glm::vec3> points, std::span<const glm::vec3> normals,
+                             std::span<const double> footprints, std::span<std::optional<irradiance_record>> out) {
+            tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t k) {
+                std::uint32_t r = 0;
+                out[k] = sampler->measure(points[k], normals[k], footprints[k], &r);
+                const std::lock_guard lock(mutex);
+                seen.emplace_back(out[k] ? lum(out[k]->irradiance) : 0.0, r);
+            });
+        };
+        const cpu::cache_frame_stats st = cache.render(g.view(), scene.camera, measuring, indirect.view());
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         double err2 = 0;
         for (std::size_t y = 0; y < size; ++y)
@@ -145,6 +163,19 @@ TEST_CASE("adaptive rays per record against fixed ones: error, records and rays 
                     static_cast<unsigned long long>(t.rays), st.records_ms, ms, rel,
                     std::sqrt(std::max(0.0, rel * rel - ref_own2)));
         std::fflush(stdout);
+        // Rays against irradiance: quartiles of E, and the mean rays in each quarter.
+        std::sort(seen.begin(), seen.end());
+        const std::size_t q = seen.size() / 4;
+        std::printf("    E quartiles %.3g %.3g %.3g (mean %.3g); mean rays per quarter of E:", seen[q].first,
+                    seen[2 * q].first, seen[3 * q].first,
+                    std::accumulate(seen.begin(), seen.end(), 0.0, [](double t, const auto& e) { return t + e.first; }) /
+                        double(seen.size()));
+        for (int k = 0; k < 4; ++k) {
+            double sum = 0;
+            for (std::size_t i = std::size_t(k) * q; i < std::size_t(k + 1) * q; ++i) sum += seen[i].second;
+            std::printf(" %.0f", sum / double(q));
+        }
+        std::printf("\n");
         CHECK(std::isfinite(rel));
     }
 }

@@ -188,8 +188,9 @@ private:
 
     // The first round (the fixed grid's samples) and as many later rounds as the target
     // needs: each round asks adaptive_hemisphere::plan for at most as many rays as were
-    // cast so far (at least an eighth of them), draws them inside their cells from a stream
-    // keyed by the point and the round, and shades them as sample_hemisphere does.
+    // cast so far (at least an eighth of them), splits the chosen cells' sub-strata with
+    // jitters from a stream keyed by the point and the round, and shades the new rays as
+    // sample_hemisphere does.
     std::pair<hemisphere_estimate, std::uint32_t> adaptive_estimate(const embree::hemisphere_samples& samples,
                                                                     std::uint64_t key) const {
         adaptive_hemisphere h(grid_.m, grid_.n);
@@ -197,11 +198,14 @@ private:
         auto local_of = [&](const glm::vec3& d) {
             return glm::vec3(glm::dot(d, samples.tangent), glm::dot(d, samples.bitangent), glm::dot(d, samples.normal));
         };
-        for (std::size_t i = 0; i < samples.direction.size(); ++i)
-            h.add(i, local_of(samples.direction[i]), samples.radiance[i], std::max(samples.distance[i], eps));
+        for (std::size_t i = 0; i < samples.direction.size(); ++i) {
+            const glm::vec3 l = local_of(samples.direction[i]);
+            h.add(i, h.jitter_of(i, l), l, samples.radiance[i], std::max(samples.distance[i], eps));
+        }
         const std::uint64_t cap = std::max<std::uint64_t>(adaptive_.max_rays, grid_.count());
         std::uint64_t used = grid_.count();
         std::vector<std::size_t> cell_of;
+        std::vector<glm::vec2> jitter;
         std::vector<glm::vec3> local, radiance;
         std::vector<float> distance;
         for (std::uint64_t round = 1; used < cap && round <= 16; ++round) {
@@ -215,13 +219,16 @@ private:
             const std::uint64_t stream = derive_seed(seed_, 0x1d, key ^ (round * 0x9e3779b97f4a7c15ULL));
             pcg32 rng(stream);
             cell_of.clear();
+            jitter.clear();
             local.clear();
-            for (std::size_t c = 0; c < extra.size(); ++c)
-                for (std::uint32_t e = 0; e < extra[c]; ++e) {
-                    const float u = rng.next_float(), w = rng.next_float();
+            for (std::size_t c = 0; c < extra.size(); ++c) {
+                if (extra[c] == 0) continue;
+                for (const glm::vec2 u : h.refinement_jitters(c, [&] { return rng.next_float(); })) {
                     cell_of.push_back(c);
-                    local.push_back(h.direction_in(c, glm::vec2(u, w)));
+                    jitter.push_back(u);
+                    local.push_back(h.direction_in(c, u));
                 }
+            }
             const std::size_t count = local.size();
             radiance.resize(count);
             distance.resize(count);
@@ -233,7 +240,8 @@ private:
                 r.direction = glm::normalize(l.x * samples.tangent + l.y * samples.bitangent + l.z * samples.normal);
                 radiance[i] = integrator_.incoming_radiance(r, derive_seed(stream, 0x2e, i), &distance[i]);
             });
-            for (std::size_t i = 0; i < count; ++i) h.add(cell_of[i], local[i], radiance[i], std::max(distance[i], eps));
+            for (std::size_t i = 0; i < count; ++i)
+                h.add(cell_of[i], jitter[i], local[i], radiance[i], std::max(distance[i], eps));
             used += count;
         }
         return {estimate_hemisphere(h.cell_means(), kind_), std::uint32_t(used)};
