@@ -67,6 +67,10 @@ struct hemisphere_estimate {
     /// Translation Hessian per channel in the tangent plane (local x, y), occlusion-aware:
     /// see translation_hessian. Zero from samplers that do not estimate it.
     std::array<glm::dmat2, 3> hessian{glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    /// Mean hit distance of the rays that hit (each cell once: the cosine-weighted mean over
+    /// the hemisphere's geometry), +infinity if nothing was hit: the length over which the
+    /// Hessian radius budgets its error (hessian_radius). Set by add_translation_hessian.
+    double mean_distance = std::numeric_limits<double>::infinity();
 };
 
 /// The second derivative of irradiance under translation in the tangent plane, from the
@@ -188,9 +192,13 @@ inline void add_translation_hessian(const hemisphere_samples& s, hemisphere_esti
     const double d_omega = std::numbers::pi / double(s.size());
     const glm::dvec3 mean = e.irradiance / std::numbers::pi;
     glm::dmat2 h[3] = {glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    double distance_sum = 0;
+    std::size_t hits = 0;
     for (std::size_t i = 0; i < s.size(); ++i) {
         const double r = s.distance[i];
         if (!std::isfinite(r)) continue;
+        distance_sum += r;
+        ++hits;
         const glm::dvec3 w(s.direction[i]);
         const double xx = 15 * w.x * w.x - 3, yy = 15 * w.y * w.y - 3, xy = 15 * w.x * w.y;
         const glm::dvec3 dl = (glm::dvec3(s.radiance[i]) - mean) * (d_omega / (r * r));
@@ -204,6 +212,7 @@ inline void add_translation_hessian(const hemisphere_samples& s, hemisphere_esti
         h[c][1][0] = h[c][0][1];
         e.hessian[c] = h[c];
     }
+    e.mean_distance = hits > 0 ? distance_sum / double(hits) : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace bounce
