@@ -5,8 +5,10 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace bounce::study {
 
@@ -64,6 +66,82 @@ error_figures compare_luminance(image_view<const glm::vec3> x, image_view<const 
     e.rel_rms = size.rms_error > 0.0 ? diff.rms_error / size.rms_error
                 : diff.rms_error > 0.0 ? std::numeric_limits<double>::infinity()
                                        : 0.0;
+    return e;
+}
+
+namespace {
+double luminance(glm::vec3 c) { return 0.2126 * double(c.r) + 0.7152 * double(c.g) + 0.0722 * double(c.b); }
+}  // namespace
+
+noisy_reference_error compare_luminance_debiased(image_view<const glm::vec3> x, image_view<const glm::vec3> half_a,
+                                                 image_view<const glm::vec3> half_b, image_view<const float> mask) {
+    require(!x.empty() && !half_a.empty() && !half_b.empty(), "x/half_a/half_b", "empty image");
+    require(x.width() == half_a.width() && x.height() == half_a.height(), "x/half_a", "sizes differ");
+    require(x.width() == half_b.width() && x.height() == half_b.height(), "x/half_b", "sizes differ");
+    require(mask.empty() || (mask.width() == x.width() && mask.height() == x.height()), "mask",
+            "size differs from the images");
+    require_finite(x, "x");
+    require_finite(half_a, "half_a");
+    require_finite(half_b, "half_b");
+    if (!mask.empty()) require_finite(mask, "mask");
+
+    // Per pixel: raw squared error, the reference's noise term, and r^2.
+    struct terms {
+        double raw, noise, ref_sq, signed_diff, r;  // (x-r)^2, (a-b)^2/4, r^2, x-r, r
+    };
+    std::vector<terms> t;
+    t.reserve(x.width() * x.height());
+    for (std::size_t y = 0; y < x.height(); ++y)
+        for (std::size_t i = 0; i < x.width(); ++i) {
+            if (!mask.empty() && mask(i, y) == 0.f) continue;
+            const double lx = luminance(x(i, y)), la = luminance(half_a(i, y)), lb = luminance(half_b(i, y));
+            const double r = 0.5 * (la + lb);
+            t.push_back({(lx - r) * (lx - r), 0.25 * (la - lb) * (la - lb), r * r, lx - r, r});
+        }
+    require(!t.empty(), "mask", "selects no pixel");
+
+    const double n = double(t.size());
+    double raw = 0, noise = 0, ref_sq = 0;
+    for (const terms& p : t) {
+        raw += p.raw;
+        noise += p.noise;
+        ref_sq += p.ref_sq;
+    }
+    raw /= n;
+    noise /= n;
+    ref_sq /= n;
+    const double d = raw - noise, s = ref_sq - noise;  // mean d_i, mean s_i
+
+    noisy_reference_error e;
+    e.pixels = t.size();
+    const double inf = std::numeric_limits<double>::infinity();
+    if (!(s > 0.0)) {
+        const bool all_zero = raw == 0.0 && ref_sq == 0.0;
+        e.rel_rms = e.rel_sq_debiased = e.rel_rms_debiased = e.reference_noise_rel_rms = all_zero ? 0.0 : inf;
+        e.rel_sq_debiased_se = e.rel_rms_debiased_se = all_zero ? 0.0 : inf;
+        return e;
+    }
+    e.rel_rms = ref_sq > 0.0 ? std::sqrt(raw / ref_sq) : inf;
+    const double q = d / s;
+    // q's standard error given the images (the truth fixed; the references' noise is what
+    // varies): with r = t + u and v = (a - b) / 2, u and v independent with variance
+    // sigma_i^2 / 2 (exact for Gaussian noise), the fluctuation of d_i - q s_i is
+    // -2 u (delta_i + q t_i) + (1 - q)(u^2 - v^2), of variance
+    // 2 sigma_i^2 (delta_i + q t_i)^2 + (1 - q)^2 sigma_i^4, and
+    // (a_i - b_i)^2 (x_i - r_i + q r_i)^2 is an unbiased estimate of it from the pixel alone.
+    // The spread of the pixels' own errors over the image is no uncertainty about this
+    // image's error, so it is not in (a sample variance of d_i - q s_i would count it).
+    double var = 0;
+    for (const terms& p : t) {
+        const double g = p.signed_diff + q * p.r;
+        var += 4.0 * p.noise * g * g;  // (a - b)^2 = 4 noise
+    }
+    e.rel_sq_debiased = q;
+    e.rel_sq_debiased_se = std::sqrt(var) / (n * s);
+    const double q0 = std::max(0.0, q);
+    e.rel_rms_debiased = std::sqrt(q0);
+    e.rel_rms_debiased_se = std::sqrt(q0 + e.rel_sq_debiased_se) - e.rel_rms_debiased;
+    e.reference_noise_rel_rms = std::sqrt(noise / s);
     return e;
 }
 

@@ -210,4 +210,158 @@ reference_images cached_reference(const accel& bvh, const io::scene& scene, cons
     return r;
 }
 
+namespace {
+// The hash's first text: a halves entry never shares a key with a whole reference.
+constexpr const char* halves_tag = "reference-halves";
+constexpr std::uint64_t stage_halves = 0x68616c766573ull;  // "halves": derive_seed's stage tag
+
+reference_settings half_settings(const reference_settings& settings, int which) {
+    reference_settings s = settings;
+    s.hemisphere_samples = settings.hemisphere_samples / 2;
+    s.seed = half_seed(settings.seed, which);
+    return s;
+}
+
+image<glm::vec3> mean_of(const image<glm::vec3>& a, const image<glm::vec3>& b) {
+    image<glm::vec3> m(a.width(), a.height());
+    for (std::size_t y = 0; y < a.height(); ++y)
+        for (std::size_t x = 0; x < a.width(); ++x) m(x, y) = 0.5f * (a(x, y) + b(x, y));
+    return m;
+}
+
+void finish_whole(reference_halves& h) {
+    h.whole.indirect = mean_of(h.indirect_a, h.indirect_b);
+    const std::size_t w = h.whole.direct.width(), ht = h.whole.direct.height();
+    h.whole.combined = image<glm::vec3>(w, ht);
+    for (std::size_t y = 0; y < ht; ++y)
+        for (std::size_t x = 0; x < w; ++x) h.whole.combined(x, y) = h.whole.direct(x, y) + h.whole.indirect(x, y);
+}
+}  // namespace
+
+std::uint64_t half_seed(std::uint64_t seed, int which) {
+    require(which == 0 || which == 1, "which", "a reference has halves 0 and 1");
+    return embree::derive_seed(seed, stage_halves, std::uint64_t(which));
+}
+
+std::string reference_halves_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                                       std::size_t height, const reference_settings& settings,
+                                       std::string_view device_config) {
+    require(settings.hemisphere_samples >= 2, "hemisphere_samples", "a reference in halves needs at least 2 samples");
+    fnv1a_hash h;
+    h.text(halves_tag);
+    h.text(integrator_version);
+    hash_scene_view(h, scene, cam, width, height);
+    h.value(settings.hemisphere_samples);
+    h.value(settings.area_samples);
+    h.value(settings.secondary_area_samples);
+    h.value(settings.environment);
+    h.value(settings.ray_epsilon);
+    h.value(settings.seed);
+    if (!device_config.empty()) h.text(device_config);
+
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
+    return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
+           std::to_string(settings.hemisphere_samples) + "spp-halves-" + hex;
+}
+
+std::optional<reference_halves> load_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
+                                                             std::size_t width, std::size_t height,
+                                                             const reference_settings& settings) {
+    const auto direct_file = entry(dir, key, ".direct.exr"), a_file = entry(dir, key, ".indirect-a.exr"),
+               b_file = entry(dir, key, ".indirect-b.exr");
+    std::error_code ec;
+    if (!std::filesystem::exists(direct_file, ec) || !std::filesystem::exists(a_file, ec) ||
+        !std::filesystem::exists(b_file, ec))
+        return std::nullopt;
+    reference_halves h;
+    try {
+        h.whole.direct = io::read_rgb(direct_file);
+        h.indirect_a = io::read_rgb(a_file);
+        h.indirect_b = io::read_rgb(b_file);
+    } catch (const bounce::error&) {
+        return std::nullopt;
+    }
+    for (const image<glm::vec3>* i : {&h.whole.direct, &h.indirect_a, &h.indirect_b})
+        if (i->width() != width || i->height() != height) return std::nullopt;
+    h.half_samples = settings.hemisphere_samples / 2;
+    h.whole.grid = embree::hemisphere_grid_for(h.half_samples);
+    finish_whole(h);
+    return h;
+}
+
+void store_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
+                                   const reference_halves& halves, const io::scene& scene, const bounce::camera& cam,
+                                   const reference_settings& settings, std::string_view device_config) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw bounce::error("bounce::study: cannot create the cache directory " + dir.string() + ": " + ec.message());
+    write_atomically(entry(dir, key, ".direct.exr"), ".exr",
+                     [&](const std::filesystem::path& p) { io::write_exr(p, halves.whole.direct.view()); });
+    write_atomically(entry(dir, key, ".indirect-a.exr"), ".exr",
+                     [&](const std::filesystem::path& p) { io::write_exr(p, halves.indirect_a.view()); });
+    write_atomically(entry(dir, key, ".indirect-b.exr"), ".exr",
+                     [&](const std::filesystem::path& p) { io::write_exr(p, halves.indirect_b.view()); });
+    nlohmann::json description = {
+        {"key", key},
+        {"kind", "halves: indirect = (indirect-a + indirect-b) / 2, direct computed with half a's seed"},
+        {"integrator", integrator_version},
+        {"scene", scene.name},
+        {"source", scene.source.string()},
+        {"triangles", scene.triangles.size()},
+        {"width", halves.whole.direct.width()},
+        {"height", halves.whole.direct.height()},
+        {"camera",
+         {{"position", json_of(cam.position)},
+          {"look_at", json_of(cam.look_at)},
+          {"up", json_of(cam.up)},
+          {"fov_y_deg", cam.fov_y_deg}}},
+        {"hemisphere_samples", settings.hemisphere_samples},
+        {"half_samples", settings.hemisphere_samples / 2},
+        {"grid", {halves.whole.grid.m, halves.whole.grid.n}},
+        {"area_samples", settings.area_samples},
+        {"secondary_area_samples", settings.secondary_area_samples},
+        {"environment", json_of(settings.environment)},
+        {"ray_epsilon", settings.ray_epsilon},
+        {"seed", settings.seed},
+        {"half_seeds", {half_seed(settings.seed, 0), half_seed(settings.seed, 1)}},
+    };
+    if (!device_config.empty()) description["embree_config"] = std::string(device_config);
+    write_atomically(entry(dir, key, ".json"), ".json", [&](const std::filesystem::path& p) {
+        std::ofstream f(p);
+        f << description.dump(2) << '\n';
+        if (!f) throw bounce::error("bounce::study: cannot write " + p.string());
+    });
+}
+
+reference_halves render_reference_halves(const accel& bvh, const scene_view& scene, const gbuffer_view<float>& g,
+                                         const reference_settings& settings) {
+    require(settings.hemisphere_samples >= 2, "hemisphere_samples", "a reference in halves needs at least 2 samples");
+    reference_halves h;
+    h.half_samples = settings.hemisphere_samples / 2;
+    embree::reference_images a = embree::render_reference(bvh, scene, g, half_settings(settings, 0));
+    h.whole.direct = std::move(a.direct);
+    h.whole.grid = a.grid;
+    h.indirect_a = std::move(a.indirect);
+    h.indirect_b = embree::reference_integrator(bvh, scene, half_settings(settings, 1)).indirect_image(g);
+    finish_whole(h);
+    return h;
+}
+
+reference_halves cached_reference_halves(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
+                                         std::size_t width, std::size_t height, const reference_settings& settings,
+                                         const std::filesystem::path& dir, bool* from_cache) {
+    const std::string& config = bvh.owner().config();
+    const std::string key = reference_halves_cache_key(scene, cam, width, height, settings, config);
+    if (auto cached = load_cached_reference_halves(dir, key, width, height, settings)) {
+        if (from_cache) *from_cache = true;
+        return std::move(*cached);
+    }
+    auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
+    reference_halves h = render_reference_halves(bvh, scene, g.view(), settings);
+    store_cached_reference_halves(dir, key, h, scene, cam, settings, config);
+    if (from_cache) *from_cache = false;
+    return h;
+}
+
 }  // namespace bounce::study

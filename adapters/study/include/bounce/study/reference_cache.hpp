@@ -17,6 +17,11 @@
 #include <bounce/io/scene.hpp>
 #include <bounce/study/content_hash.hpp>
 
+#include <bounce/gbuffer.hpp>
+#include <bounce/image.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -62,5 +67,59 @@ void store_cached_reference(const std::filesystem::path& dir, const std::string&
 embree::reference_images cached_reference(const embree::accel& bvh, const io::scene& scene, const bounce::camera& cam,
                                   std::size_t width, std::size_t height, const embree::reference_settings& settings,
                                   const std::filesystem::path& dir = default_cache_dir(), bool* from_cache = nullptr);
+
+// ---- References in two independent halves ------------------------------------------------
+//
+// A reference of `settings.hemisphere_samples` = S samples per pixel computed as two halves A
+// and B of S / 2 samples each, with unrelated seeds (half_seed(settings.seed, 0) and
+// (seed, 1)): R = (A + B) / 2 costs what a whole S-sample reference costs, and mean |A - B|^2 / 4
+// measures R's own noise, which compare_luminance_debiased takes out of an error measured
+// against R. The direct image is computed once (with half A's seed). An entry is
+// `<key>.direct.exr`, `<key>.indirect-a.exr`, `<key>.indirect-b.exr` and `<key>.json`;
+// its key reads "<scene>-<W>x<H>-<S>spp-halves-<hash>" and its hash starts from another
+// tag than a whole reference's, so the two kinds never share an entry.
+
+/// A reference made of two independent halves, and their mean.
+struct reference_halves {
+    /// direct (half A's seed), indirect = (A + B) / 2, combined = direct + indirect; grid is
+    /// one half's M x N grid.
+    embree::reference_images whole;
+    image<glm::vec3> indirect_a, indirect_b;  ///< the halves' indirect images
+    std::uint32_t half_samples = 0;           ///< hemisphere samples per pixel of each half
+};
+
+/// The seed of half `which` (0: A, 1: B) of a reference with base seed `seed`: a SplitMix64
+/// hash (embree::derive_seed), unrelated to `seed` itself and to the Monte Carlo runs' seeds.
+std::uint64_t half_seed(std::uint64_t seed, int which);
+
+/// The cache key of the halves of a reference with `settings` (hemisphere_samples: both
+/// halves together; at least 2).
+std::string reference_halves_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                                       std::size_t height, const embree::reference_settings& settings,
+                                       std::string_view device_config = {});
+
+/// The cached halves under `key`, or nothing when a file is missing, unreadable or of
+/// another size.
+std::optional<reference_halves> load_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
+                                                             std::size_t width, std::size_t height,
+                                                             const embree::reference_settings& settings);
+
+/// Writes `halves` under `key` in `dir` as store_cached_reference does.
+void store_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
+                                   const reference_halves& halves, const io::scene& scene, const bounce::camera& cam,
+                                   const embree::reference_settings& settings, std::string_view device_config = {});
+
+/// Computes the halves over the G-buffer `g` (no cache): A and B with S / 2 samples each.
+/// Throws parameter_error when settings.hemisphere_samples < 2.
+reference_halves render_reference_halves(const embree::accel& bvh, const scene_view& scene,
+                                         const gbuffer_view<float>& g, const embree::reference_settings& settings);
+
+/// The halves of the reference of `scene` through `cam`: from the cache when present, else
+/// ray cast G-buffer + render_reference_halves, stored for next time.
+reference_halves cached_reference_halves(const embree::accel& bvh, const io::scene& scene, const bounce::camera& cam,
+                                         std::size_t width, std::size_t height,
+                                         const embree::reference_settings& settings,
+                                         const std::filesystem::path& dir = default_cache_dir(),
+                                         bool* from_cache = nullptr);
 
 }  // namespace bounce::study
