@@ -146,9 +146,8 @@ public:
 
     /// One sample of cell `cell_index`: its jitter u (direction_in(cell_index, u) is its
     /// direction), local direction, incoming radiance (RGB) and hit distance (+infinity where
-    /// the ray escaped). The first sample of a cell gives the direction that stands for the
-    /// cell in cell_means(). Throws parameter_error on non-finite radiance or a distance that
-    /// is not positive.
+    /// the ray escaped). Throws parameter_error on non-finite radiance or a distance that is
+    /// not positive.
     void add(std::size_t cell_index, glm::vec2 u, const glm::vec3& local_direction, const glm::vec3& radiance,
              float distance) {
         require(cell_index < cells_.size(), "cell", "outside the grid");
@@ -156,13 +155,12 @@ public:
                 "non-finite radiance sample");
         require(distance > 0.f && !std::isnan(distance), "distance", "hit distance must be positive");
         cell& c = cells_[cell_index];
-        if (c.n == 0) c.direction = local_direction;
         const glm::dvec3 L(radiance);
         const double y = rec709_luminance<double, glm::dvec3>(L);
         c.n += 1;
         c.sum += L;
         c.y += y;
-        c.samples.push_back({u, y});
+        c.samples.push_back({u, y, L, 1.0 / double(distance), local_direction});
         c.inverse_distance += 1.0 / double(distance);  // 0 for escaped rays
     }
 
@@ -303,37 +301,68 @@ public:
         return extra;
     }
 
-    /// One representative sample per cell for estimate_hemisphere: the cell's first
-    /// direction, its mean radiance and the harmonic mean of its hit distances (+infinity
-    /// where every ray escaped). Irradiance, rotation gradient and the harmonic mean distance
-    /// are linear in these (the latter in the inverse distances); the translation gradient
-    /// and Hessian take them as the per-cell constants their formulas assume. Throws
+    /// The samples as a 2M x 2N grid for estimate_hemisphere: each cell's quadrants (the
+    /// sub-strata of its first two splits, phi then theta) at fine cell (2j + hy, 2k + hx).
+    /// A quadrant takes the mean radiance of the samples inside it, or, where it holds none,
+    /// of those in its phi half, or of the whole cell; likewise the harmonic mean of their
+    /// hit distances (+infinity where every ray escaped) and the direction of its first
+    /// sample (its centre where it holds none). Each sample's value thus covers exactly its
+    /// sub-stratum's measure, so the irradiance is the cell-mean estimate above, and the
+    /// gradients and Hessian see the refined strata at twice the first round's resolution
+    /// (a 256-ray first round grows gradients on the grid of a 1024-ray record). Throws
     /// parameter_error if a cell is empty.
-    hemisphere_samples cell_means() const {
+    hemisphere_samples fine_samples() const {
         hemisphere_samples s;
-        s.rings = m_;
-        s.wedges = n_;
-        s.direction.reserve(cells_.size());
-        s.radiance.reserve(cells_.size());
-        s.distance.reserve(cells_.size());
-        for (const cell& c : cells_) {
-            const double n = double(nonempty(c));
-            s.direction.push_back(c.direction);
-            s.radiance.push_back(glm::vec3(c.sum / n));
-            s.distance.push_back(c.inverse_distance > 0 ? float(n / c.inverse_distance)
-                                                        : std::numeric_limits<float>::infinity());
+        s.rings = 2 * m_;
+        s.wedges = 2 * n_;
+        const std::size_t fine = std::size_t(s.rings) * s.wedges;
+        s.direction.resize(fine);
+        s.radiance.resize(fine);
+        s.distance.resize(fine);
+        for (std::size_t index = 0; index < cells_.size(); ++index) {
+            const cell& c = cells_[index];
+            nonempty(c);
+            const std::size_t j = index / n_, k = index % n_;
+            for (int hx = 0; hx < 2; ++hx)
+                for (int hy = 0; hy < 2; ++hy) {
+                    auto in_quadrant = [&](const sample& x) { return (x.u.x >= 0.5f) == (hx == 1) && (x.u.y >= 0.5f) == (hy == 1); };
+                    auto in_half = [&](const sample& x) { return (x.u.x >= 0.5f) == (hx == 1); };
+                    glm::dvec3 sum(0.0);
+                    double inverse = 0;
+                    std::size_t count = 0;
+                    const glm::vec3* first = nullptr;
+                    auto gather = [&](auto&& keep) {
+                        for (const sample& x : c.samples)
+                            if (keep(x)) {
+                                sum += x.radiance;
+                                inverse += x.inverse_distance;
+                                ++count;
+                                if (!first) first = &x.direction;
+                            }
+                    };
+                    gather(in_quadrant);
+                    const bool own = count > 0;
+                    if (!count) gather(in_half);
+                    if (!count) gather([](const sample&) { return true; });
+                    const std::size_t f = (2 * j + std::size_t(hy)) * s.wedges + 2 * k + std::size_t(hx);
+                    s.radiance[f] = glm::vec3(sum / double(count));
+                    s.distance[f] = inverse > 0 ? float(double(count) / inverse) : std::numeric_limits<float>::infinity();
+                    s.direction[f] = own ? *first : direction_in(index, {0.25f + 0.5f * float(hx), 0.25f + 0.5f * float(hy)});
+                }
         }
         return s;
     }
 
 private:
     struct sample {
-        glm::vec2 u;  // jitter inside the cell
-        double y;     // luminance
+        glm::vec2 u;                 // jitter inside the cell
+        double y;                    // luminance
+        glm::dvec3 radiance;
+        double inverse_distance;     // 0 for escaped rays
+        glm::vec3 direction;         // local
     };
     struct cell {
         std::uint32_t n = 0;
-        glm::vec3 direction{0, 0, 1};
         glm::dvec3 sum{0.0};
         double y = 0, inverse_distance = 0;
         std::vector<sample> samples;  // in the order added: i and i + n/2 are siblings

@@ -175,7 +175,15 @@ TEST_CASE("adaptive rays per record against fixed ones: error, records and rays 
             for (std::size_t i = std::size_t(k) * q; i < std::size_t(k + 1) * q; ++i) sum += seen[i].second;
             std::printf(" %.0f", sum / double(q));
         }
-        std::printf("\n");
+        std::size_t early = 0;
+        double early_e = 0;
+        for (const auto& [e, r] : seen)
+            if (r < t.most / 2) {
+                ++early;
+                early_e += e;
+            }
+        std::printf("; %zu stopped below half the most (mean E %.3g)\n", early, early ? early_e / double(early) : 0.0);
         CHECK(std::isfinite(rel));
     }
 }
+

@@ -144,6 +144,52 @@ TEST_CASE("the first round's grid pairs up in phi", "[adaptive_rays]") {
         // About `rays` strata: within one ring of wedges rounded to an even number.
         CHECK(std::abs(double(g.count()) - double(rays)) <= double(g.rings) + 2);
     }
+    // jitter_of inverts direction_in inside every cell (to float rounding of the direction).
+    const adaptive_grid_size g = adaptive_grid(256);
+    const adaptive_hemisphere h(g.rings, g.wedges);
+    pcg32 rng(5);
+    for (std::size_t c = 0; c < h.cells(); ++c) {
+        const glm::vec2 u(rng.next_float(), rng.next_float());
+        const glm::vec2 back = h.jitter_of(c, h.direction_in(c, u));
+        CHECK(std::abs(back.x - u.x) < 1e-4f * float(g.wedges));
+        CHECK(std::abs(back.y - u.y) < 1e-4f * float(g.rings));
+    }
+}
+
+TEST_CASE("the fine grid for the gradients keeps the cell-mean irradiance", "[adaptive_rays]") {
+    // Cells with one, two and four samples (split once, twice) side by side: every sample's
+    // value covers its sub-stratum's share of the 2M x 2N grid.
+    const adaptive_grid_size g = adaptive_grid(64);
+    adaptive_hemisphere h(g.rings, g.wedges);
+    pcg32 rng(9);
+    auto next = [&] { return rng.next_float(); };
+    auto add = [&](std::size_t c, glm::vec2 u) {
+        const glm::vec3 w = h.direction_in(c, u);
+        h.add(c, u, w, edge_field(w), 1.f + w.x * w.x);
+    };
+    for (std::size_t c = 0; c < h.cells(); ++c) add(c, {next(), next()});
+    for (std::size_t c = 0; c < h.cells(); c += 3)
+        for (const glm::vec2 u : h.refinement_jitters(c, next)) add(c, u);
+    for (std::size_t c = 0; c < h.cells(); c += 6)
+        for (const glm::vec2 u : h.refinement_jitters(c, next)) add(c, u);
+    const hemisphere_samples fine = h.fine_samples();
+    REQUIRE(fine.rings == 2 * g.rings);
+    REQUIRE(fine.wedges == 2 * g.wedges);
+    const hemisphere_estimate e = estimate_hemisphere(fine);
+    CHECK(e.irradiance.x == Approx(h.irradiance().x).epsilon(1e-6));
+    CHECK(rec709_luminance<double, glm::dvec3>(e.irradiance) == Approx(h.luminance_irradiance()).epsilon(1e-6));
+    // Cell 1 (one sample): four equal quadrants. Cell 3 (split once, in phi): equal within
+    // each phi half, different across. Cell 0 (split twice): a sample of its own in each.
+    const std::size_t W = fine.wedges;
+    CHECK(fine.radiance[2] == fine.radiance[3]);
+    CHECK(fine.radiance[2] == fine.radiance[W + 2]);
+    CHECK(fine.radiance[2] == fine.radiance[W + 3]);
+    CHECK(fine.radiance[6] == fine.radiance[W + 6]);
+    CHECK(fine.radiance[7] == fine.radiance[W + 7]);
+    CHECK(fine.radiance[6] != fine.radiance[7]);
+    CHECK(fine.radiance[0] != fine.radiance[1]);
+    CHECK(fine.radiance[0] != fine.radiance[W]);
+    CHECK(fine.radiance[1] != fine.radiance[W + 1]);
 }
 
 TEST_CASE("the variance estimator matches the spread of the estimate over seeds (a hard edge)", "[adaptive_rays][variance]") {

@@ -244,7 +244,7 @@ private:
                 h.add(cell_of[i], jitter[i], local[i], radiance[i], std::max(distance[i], eps));
             used += count;
         }
-        return {estimate_hemisphere(h.cell_means(), kind_), std::uint32_t(used)};
+        return {estimate_hemisphere(h.fine_samples(), kind_), std::uint32_t(used)};
     }
 
     // Distinct points get independent streams, the same point the same stream.
