@@ -313,6 +313,80 @@ void accel::occluded(std::span<const ray> rays, std::span<std::uint8_t> blocked,
     }
 }
 
+namespace {
+
+// Embree's packet width for the packet queries: eight lanes, one AVX register (SSE CPUs
+// run them as two halves inside Embree).
+constexpr std::size_t packet_width = 8;
+
+// Lane `i` of `ray8` from `r`.
+void set_lane(RTCRay8& ray8, std::size_t i, const ray& r) {
+    ray8.org_x[i] = r.origin.x;
+    ray8.org_y[i] = r.origin.y;
+    ray8.org_z[i] = r.origin.z;
+    ray8.tnear[i] = r.tnear;
+    ray8.dir_x[i] = r.direction.x;
+    ray8.dir_y[i] = r.direction.y;
+    ray8.dir_z[i] = r.direction.z;
+    ray8.time[i] = 0.f;
+    ray8.tfar[i] = r.tfar;
+    ray8.mask[i] = ~0u;
+    ray8.id[i] = 0;
+    ray8.flags[i] = 0;
+}
+
+// Fills the valid mask (-1: lane in use) and the lanes of rays[base, base + n); lanes past n
+// repeat the packet's first ray, so every lane holds finite values even where masked off.
+void fill_packet(std::span<const ray> rays, std::size_t base, std::size_t n, int* valid, RTCRay8& ray8) {
+    for (std::size_t i = 0; i < packet_width; ++i) {
+        valid[i] = i < n ? -1 : 0;
+        set_lane(ray8, i, rays[base + (i < n ? i : 0)]);
+    }
+}
+
+}  // namespace
+
+void accel::intersect_packets(std::span<const ray> rays, std::span<hit> hits) const {
+    require_sizes(rays.size(), hits.size());
+    RTCIntersectContext c = context(true);
+    for (std::size_t base = 0; base < rays.size(); base += packet_width) {
+        const std::size_t n = std::min(packet_width, rays.size() - base);
+        alignas(32) int valid[packet_width];
+        RTCRayHit8 rh;
+        fill_packet(rays, base, n, valid, rh.ray);
+        for (std::size_t i = 0; i < packet_width; ++i) {
+            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect8(valid, state_->handle, &c, &rh);
+        for (std::size_t i = 0; i < n; ++i) {
+            hit h;
+            if (rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) {
+                h.t = rh.ray.tfar[i];
+                h.triangle = rh.hit.primID[i];
+                h.u = rh.hit.u[i];
+                h.v = rh.hit.v[i];
+            }
+            hits[base + i] = h;
+        }
+    }
+}
+
+void accel::occluded_packets(std::span<const ray> rays, std::span<std::uint8_t> blocked) const {
+    require_sizes(rays.size(), blocked.size());
+    RTCIntersectContext c = context(true);
+    for (std::size_t base = 0; base < rays.size(); base += packet_width) {
+        const std::size_t n = std::min(packet_width, rays.size() - base);
+        alignas(32) int valid[packet_width];
+        RTCRay8 r8;
+        fill_packet(rays, base, n, valid, r8);
+        rtcOccluded8(valid, state_->handle, &c, &r8);
+        // rtcOccluded8 sets a lane's tfar to -inf when it finds an occluder.
+        for (std::size_t i = 0; i < n; ++i) blocked[base + i] = r8.tfar[i] < 0.f && std::isinf(r8.tfar[i]) ? 1 : 0;
+    }
+}
+
 std::size_t accel::triangle_count() const noexcept { return state_->triangles; }
 float accel::diagonal() const noexcept { return state_->diagonal; }
 float accel::ray_epsilon() const noexcept {

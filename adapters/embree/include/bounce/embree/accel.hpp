@@ -124,6 +124,14 @@ public:
     void intersect(std::span<const ray> rays, std::span<hit> hits, bool coherent = false) const;
     /// Occlusion of a stream of rays (rtcOccluded1M): 1 where blocked, 0 where free.
     void occluded(std::span<const ray> rays, std::span<std::uint8_t> blocked, bool coherent = false) const;
+    /// Closest hits as packets of eight (rtcIntersect8 on rays 8i ... 8i + 7, the last packet
+    /// masked where the span ends): Embree traverses a packet's rays together, which pays
+    /// when neighbours in the span travel nearly together (one record's hemisphere rays in
+    /// stratum order share their origin and are neighbours in direction). The same hits as
+    /// the single-ray and stream queries. Sizes must match.
+    void intersect_packets(std::span<const ray> rays, std::span<hit> hits) const;
+    /// Occlusion as packets of eight (rtcOccluded8): 1 where blocked, 0 where free.
+    void occluded_packets(std::span<const ray> rays, std::span<std::uint8_t> blocked) const;
 
     /// Number of triangles it was built from (to check it matches a scene).
     std::size_t triangle_count() const noexcept;
