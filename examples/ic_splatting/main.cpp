@@ -39,11 +39,14 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <system_error>
 #include <functional>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 using namespace bounce;
 using namespace bounce::examples;
@@ -82,8 +85,73 @@ struct gl_frames {
 };
 #endif
 
-nlohmann::ordered_json error_json(const study::error_figures& e) {
-    return {{"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}, {"sum_sq", e.sum_sq}, {"pixels", e.pixels}};
+// A frame's indirect error against a reference in halves: the raw figures against their
+// mean, and the error with the reference's own noise taken out.
+struct frame_error {
+    study::error_figures raw;
+    study::noisy_reference_error debiased;
+    // The error the equal-error searches compare.
+    double target(bool raw_measure) const { return raw_measure ? raw.rel_rms : debiased.rel_rms_debiased; }
+};
+
+frame_error measure_error(const image<glm::vec3>& indirect, const study::reference_halves& ref, const image<float>& mask) {
+    return {study::compare_luminance(indirect.view(), ref.whole.indirect.view(), mask.view()),
+            study::compare_luminance_debiased(indirect.view(), ref.indirect_a.view(), ref.indirect_b.view(), mask.view())};
+}
+
+// JSON has no infinity: null says "no finite value".
+nlohmann::ordered_json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nullptr; }
+
+// The debiased figures beside the raw rel_rms (frames[], fresh, the report's error).
+void add_debiased(nlohmann::ordered_json& j, const study::noisy_reference_error& d) {
+    j["rel_rms_debiased"] = finite_or_null(d.rel_rms_debiased);
+    j["rel_rms_debiased_se"] = finite_or_null(d.rel_rms_debiased_se);
+    j["rel_sq_debiased"] = finite_or_null(d.rel_sq_debiased);
+    j["rel_sq_debiased_se"] = finite_or_null(d.rel_sq_debiased_se);
+    j["debiased_resolved"] = d.resolved();
+    j["reference_noise_rel_rms"] = finite_or_null(d.reference_noise_rel_rms);
+}
+
+nlohmann::ordered_json error_json(const frame_error& e) {
+    nlohmann::ordered_json j = {{"rel_rms", finite_or_null(e.raw.rel_rms)},
+                                {"max_abs", finite_or_null(e.raw.max_abs)},
+                                {"sum_sq", finite_or_null(e.raw.sum_sq)},
+                                {"pixels", e.raw.pixels}};
+    add_debiased(j, e.debiased);
+    return j;
+}
+
+// "0.0312 (debiased 0.0290 +- 0.0011)", or "(debiased < 0.0050, unresolved)" when the
+// debiased error is within two standard errors of 0.
+std::string error_text(const frame_error& e) {
+    const auto& d = e.debiased;
+    if (d.resolved()) return fmt::format("{:.4f} (debiased {:.4f} +- {:.4f})", e.raw.rel_rms, d.rel_rms_debiased, d.rel_rms_debiased_se);
+    return fmt::format("{:.4f} (debiased < {:.4f}, unresolved)", e.raw.rel_rms,
+                       std::sqrt(std::max(0.0, d.rel_sq_debiased) + 2.0 * d.rel_sq_debiased_se));
+}
+
+// Before any minutes of work: every output file must be writable where it is to go (its
+// folder exists or can be made, and the file, when present, may be overwritten), and the
+// records to start from must be readable. Throws parameter_error naming the option.
+void check_paths(const options& o) {
+    const std::pair<const char*, const std::filesystem::path*> outputs[] = {
+        {"--json", &o.json},         {"--out", &o.out},
+        {"--exr", &o.exr},           {"--indirect-out", &o.indirect_out},
+        {"--indirect-exr", &o.indirect_exr}, {"--cache-out", &o.cache_out}};
+    for (const auto& [name, path] : outputs) {
+        if (path->empty()) continue;
+        std::error_code ec;
+        if (std::filesystem::is_directory(*path, ec)) throw parameter_error(name, path->string() + " is a folder");
+        const std::filesystem::path dir = path->has_parent_path() ? path->parent_path() : std::filesystem::path(".");
+        std::filesystem::create_directories(dir, ec);
+        if (ec || !std::filesystem::is_directory(dir, ec))
+            throw parameter_error(name, "cannot make the folder " + dir.string());
+        if (::access(dir.c_str(), W_OK) != 0) throw parameter_error(name, "the folder " + dir.string() + " is not writable");
+        if (std::filesystem::exists(*path, ec) && ::access(path->c_str(), W_OK) != 0)
+            throw parameter_error(name, path->string() + " exists and is not writable");
+    }
+    if (!o.cache_in.empty() && ::access(o.cache_in.c_str(), R_OK) != 0)
+        throw parameter_error("--cache-in", o.cache_in.string() + " is missing or not readable");
 }
 
 embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64_t seed) {
@@ -91,6 +159,12 @@ embree::reference_settings reference_settings_for(std::uint32_t spp, std::uint64
     s.hemisphere_samples = spp;
     s.seed = seed;
     return s;
+}
+
+// The largest spp Monte Carlo at equal error runs (--mc-max-spp, or its default).
+std::uint32_t monte_carlo_max_spp(const options& o) {
+    if (o.mc_max_spp > 0) return o.mc_max_spp;
+    return o.raw_equal_error ? std::max(1u, o.ref_spp / 2) : 4u * o.ref_spp;
 }
 
 template <class W>
@@ -101,6 +175,9 @@ int run_with(const options& o) {
         throw parameter_error("--walkthrough", "renders its own frames: not with --progressive or --a-sweep");
     if ((o.plane_turn != 0.0 || o.hashed_turn) && o.sampler != "raster")
         throw parameter_error("--plane-turn/--hashed-turn", "apply to --sampler raster only");
+    if (o.ref_spp % 2 != 0)
+        throw parameter_error("--ref-spp", "must be even: the reference is two independent halves of N/2 samples");
+    check_paths(o);
     study::stage_timer setup;
     const io::scene scene = io::load_scene_arg(o.scene);
     std::optional<embree::accel> bvh_storage;
@@ -247,15 +324,26 @@ int run_with(const options& o) {
                          {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
                          {"scan", o.scan}, {"scan_batch", cache_options.batch.max_records},
                          {"scan_order", cache_options.order == cpu::scan_order::linear ? "linear" : "coarse-to-fine"},
-                         {"embree_config", bvh.owner().config()}};
+                         {"embree_config", bvh.owner().config()},
+                         {"equal_error_measure", o.raw_equal_error ? "raw" : "debiased"},
+                         {"mc_max_spp", monte_carlo_max_spp(o)}};
 
+    // Every reference is two independent halves of ref_spp / 2 samples (the debiased error
+    // needs their difference); as costly as one of ref_spp.
     auto reference_for = [&](const camera& cam) {
         bool hit = false;
-        auto ref = study::cached_reference(bvh, scene, cam, o.width, o.height, reference_settings_for(o.ref_spp, 1),
-                                            study::default_cache_dir(), &hit);
-        fmt::print(stderr, "reference {}x{} at {} spp: {}\n", o.width, o.height, o.ref_spp, hit ? "from cache" : "computed");
+        auto ref = study::cached_reference_halves(bvh, scene, cam, o.width, o.height,
+                                                  reference_settings_for(o.ref_spp, 1), study::default_cache_dir(), &hit);
+        fmt::print(stderr, "reference {}x{} at {} spp (two halves of {}): {}\n", o.width, o.height, o.ref_spp,
+                   ref.half_samples, hit ? "from cache" : "computed");
         return ref;
     };
+    // Monte Carlo at equal error: on the debiased error it may go past the reference's
+    // samples (an error below the reference's noise is still measured, to its standard
+    // error); on the raw error only to half of them, beyond which it would meet that noise.
+    const std::uint32_t mc_max_spp = monte_carlo_max_spp(o);
+    const study::error_measure mc_measure = o.raw_equal_error ? study::error_measure::raw : study::error_measure::debiased;
+    double reference_noise = 0;  // the last reference's own rel_rms (of the single frame, or the walkthrough's mean)
 
     // Error is measured where the frame's G-buffer sees what the reference saw.
     const float scene_size = glm::length(scene.bounds().second - scene.bounds().first);
@@ -267,7 +355,7 @@ int run_with(const options& o) {
 
     // --indirect-exr and --indirect-out: the indirect image, and it beside the reference's
     // with one exposure (the walkthrough's last frame, or the single frame).
-    auto write_indirect = [&](const image<glm::vec3>& indirect, const embree::reference_images& ref,
+    auto write_indirect = [&](const image<glm::vec3>& indirect, const study::reference_halves& ref,
                               const image<float>& mask) {
         if (!o.indirect_exr.empty()) io::write_exr(o.indirect_exr, indirect.view());
         if (o.indirect_out.empty()) return;
@@ -275,9 +363,9 @@ int run_with(const options& o) {
         for (std::size_t y = 0; y < o.height; ++y)
             for (std::size_t x = 0; x < o.width; ++x) {
                 pair(x, y) = indirect(x, y);
-                pair(o.width + x, y) = ref.indirect(x, y);
+                pair(o.width + x, y) = ref.whole.indirect(x, y);
             }
-        io::write_png(o.indirect_out, pair.view(), io::auto_exposure(ref.indirect.view(), mask.view()));
+        io::write_png(o.indirect_out, pair.view(), io::auto_exposure(ref.whole.indirect.view(), mask.view()));
     };
 
     nlohmann::ordered_json extra = nlohmann::ordered_json::object();
@@ -290,8 +378,8 @@ int run_with(const options& o) {
         // for every frame).
         nlohmann::ordered_json frames = nlohmann::ordered_json::array();
         const study::camera_path path(bvh, scene.camera, o.walkthrough);
-        double cache_total_ms = 0, error_sum = 0, mc_ms_sum = 0, mc_error_sum = 0;
-        std::size_t mc_frames = 0, mc_unreached = 0;
+        double cache_total_ms = 0, error_sum = 0, debiased_sum = 0, noise_sum = 0, mc_ms_sum = 0, mc_error_sum = 0;
+        std::size_t mc_frames = 0, mc_unreached = 0, mc_skipped = 0, unresolved = 0;
         for (std::size_t f = 0; f < o.walkthrough; ++f) {
             const camera cam = path.at(f);
             study::stage_timer ft;
@@ -301,13 +389,17 @@ int run_with(const options& o) {
             cache_total_ms += frame_ms;
             const auto ref = reference_for(cam);
             const image<float> mask = mask_for(fr.g, cam);
-            const auto err = study::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
-            error_sum += err.rel_rms;
+            const frame_error err = measure_error(fr.indirect, ref, mask);
+            error_sum += err.raw.rel_rms;
+            debiased_sum += err.debiased.rel_rms_debiased;
+            noise_sum += err.debiased.reference_noise_rel_rms;
+            if (!err.debiased.resolved()) ++unresolved;
             nlohmann::ordered_json entry = {{"frame", f},         {"records", cache.records().size()},
                                             {"new_records", fr.new_records}, {"ms", frame_ms},
-                                            {"rel_rms", err.rel_rms}};
-            fmt::print("frame {:2}: {:6} records (+{:5}), {:8.1f} ms, indirect rel_rms {:.4f}", f, cache.records().size(),
-                       fr.new_records, frame_ms, err.rel_rms);
+                                            {"rel_rms", err.raw.rel_rms}};
+            add_debiased(entry, err.debiased);
+            fmt::print("frame {:2}: {:6} records (+{:5}), {:8.1f} ms, indirect rel_rms {}", f, cache.records().size(),
+                       fr.new_records, frame_ms, error_text(err));
             if (o.walkthrough_fresh) {
                 // The same camera from an empty cache: what the grown cache must not lose to.
                 const std::vector<irradiance_record> kept = cache.records();
@@ -319,25 +411,34 @@ int run_with(const options& o) {
                 const auto t1 = clock_type::now();
                 const auto fresh = frame(cam, o.a, fresh_t);
                 const double fresh_ms = ms_since(t1);
-                const auto fresh_err =
-                    study::compare_luminance(fresh.indirect.view(), ref.indirect.view(), mask_for(fresh.g, cam).view());
-                entry["fresh"] = {{"records", cache.records().size()}, {"ms", fresh_ms}, {"rel_rms", fresh_err.rel_rms}};
-                fmt::print("; fresh: {:6} records, {:8.1f} ms, rel_rms {:.4f}", cache.records().size(), fresh_ms,
-                           fresh_err.rel_rms);
+                const frame_error fresh_err = measure_error(fresh.indirect, ref, mask_for(fresh.g, cam));
+                entry["fresh"] = {{"records", cache.records().size()}, {"ms", fresh_ms}, {"rel_rms", fresh_err.raw.rel_rms}};
+                add_debiased(entry["fresh"], fresh_err.debiased);
+                fmt::print("; fresh: {:6} records, {:8.1f} ms, rel_rms {}", cache.records().size(), fresh_ms,
+                           error_text(fresh_err));
                 cache.assign(kept);
 #ifdef BOUNCE_IC_WITH_GL
                 if (gl_state) gl_state->splatter.reset();
 #endif
             }
             if (o.walkthrough_mc_stride > 0 && f % o.walkthrough_mc_stride == 0) {
-                const auto mc = study::monte_carlo_at_equal_error(bvh, scene, fr.g.view(), ref.indirect.view(),
-                                                                  mask.view(), err.rel_rms, o.ref_spp / 2);
-                entry["mc_equal_error"] = mc.equal_error_json(frame_ms);
-                mc_ms_sum += mc.ms;
-                mc_error_sum += err.rel_rms;
-                ++mc_frames;
-                if (!mc.reached) ++mc_unreached;
-                fmt::print("; monte carlo {}{:.0f} spp, {:.1f} ms", mc.reached ? "~" : ">", mc.spp, mc.ms);
+                const double target = err.target(o.raw_equal_error);
+                if (target > 0.0) {
+                    const auto mc = study::monte_carlo_at_equal_error(bvh, scene, fr.g.view(), ref.indirect_a.view(),
+                                                                      ref.indirect_b.view(), mask.view(), target,
+                                                                      mc_measure, mc_max_spp);
+                    entry["mc_equal_error"] = mc.equal_error_json(frame_ms);
+                    mc_ms_sum += mc.ms;
+                    mc_error_sum += target;
+                    ++mc_frames;
+                    if (!mc.reached) ++mc_unreached;
+                    fmt::print("; monte carlo {}{:.0f} spp, {:.1f} ms", mc.reached ? "~" : ">", mc.spp, mc.ms);
+                } else {
+                    // The debiased error came out at or below 0: no error to match.
+                    entry["mc_equal_error"] = {{"skipped", "the frame's debiased error is not above 0"}};
+                    ++mc_skipped;
+                    fmt::print("; monte carlo skipped (debiased error <= 0)");
+                }
             }
             fmt::print("\n");
             if (f + 1 == o.walkthrough) write_indirect(fr.indirect, ref, mask);
@@ -345,27 +446,34 @@ int run_with(const options& o) {
             for (const auto& s : ft.stages()) timer.add_sample(s, ft.median_ms(s));
             timer.add_sample("total", frame_ms);
         }
+        reference_noise = noise_sum / double(o.walkthrough);
         nlohmann::ordered_json walk = {{"frames_count", o.walkthrough},
                                        {"path", "study::camera_path: forward a tenth of the way to the target "
                                                 "(at most half way to the first surface), panning -10 to +10 degrees"},
                                        {"total_ms", cache_total_ms},
                                        {"mean_rel_rms", error_sum / double(o.walkthrough)},
+                                       {"mean_rel_rms_debiased", debiased_sum / double(o.walkthrough)},
+                                       {"frames_debiased_unresolved", unresolved},
+                                       {"mean_reference_noise_rel_rms", reference_noise},
                                        {"frames", frames}};
         if (mc_frames > 0) {
             const double mc_total = mc_ms_sum / double(mc_frames) * double(o.walkthrough);
-            walk["mc_equal_error"] = {{"frames_measured", mc_frames},
+            walk["mc_equal_error"] = {{"measure", o.raw_equal_error ? "raw" : "debiased"},
+                                      {"frames_measured", mc_frames},
                                       {"stride", o.walkthrough_mc_stride},
                                       {"frames_not_reached", mc_unreached},
+                                      {"frames_skipped", mc_skipped},
                                       // Monte Carlo stopped short of a frame's error: its time, and the
                                       // speedup, are lower bounds.
                                       {"lower_bound", mc_unreached > 0},
                                       {"mean_rel_rms_measured", mc_error_sum / double(mc_frames)},
                                       {"total_ms", mc_total},
                                       {"speedup", mc_total / cache_total_ms}};
-            fmt::print("walkthrough: cache {:.1f} ms over {} frames, mean rel_rms {:.4f}; Monte Carlo at equal per-frame "
-                       "error {}{:.1f} ms: {:.1f}x\n",
-                       cache_total_ms, o.walkthrough, error_sum / double(o.walkthrough), mc_unreached ? ">" : "~",
-                       mc_total, mc_total / cache_total_ms);
+            fmt::print("walkthrough: cache {:.1f} ms over {} frames, mean rel_rms {:.4f} (debiased {:.4f}, {} of {} frames "
+                       "unresolved; references' own {:.4f}); Monte Carlo at equal per-frame {} error {}{:.1f} ms: {:.1f}x\n",
+                       cache_total_ms, o.walkthrough, error_sum / double(o.walkthrough),
+                       debiased_sum / double(o.walkthrough), unresolved, o.walkthrough, reference_noise,
+                       o.raw_equal_error ? "raw" : "debiased", mc_unreached ? ">" : "~", mc_total, mc_total / cache_total_ms);
         }
         extra["walkthrough"] = walk;
         report.set_timings(timer);
@@ -382,11 +490,14 @@ int run_with(const options& o) {
             const auto fr = frame(cam, o.a, ft);
             const double frame_ms = ms_since(t0);
             const auto ref = reference_for(cam);
-            const auto err = study::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask_for(fr.g, cam).view());
-            fmt::print("frame {:2}: {:5} records (+{:3}), {:8.1f} ms ({:5.2f} fps), indirect rel_rms {:.4f}\n", f,
-                       cache.records().size(), fr.new_records, frame_ms, 1000.0 / frame_ms, err.rel_rms);
-            frames.push_back({{"frame", f}, {"records", cache.records().size()}, {"new_records", fr.new_records},
-                              {"ms", frame_ms}, {"fps", 1000.0 / frame_ms}, {"rel_rms", err.rel_rms}});
+            const frame_error err = measure_error(fr.indirect, ref, mask_for(fr.g, cam));
+            reference_noise = err.debiased.reference_noise_rel_rms;
+            fmt::print("frame {:2}: {:5} records (+{:3}), {:8.1f} ms ({:5.2f} fps), indirect rel_rms {}\n", f,
+                       cache.records().size(), fr.new_records, frame_ms, 1000.0 / frame_ms, error_text(err));
+            nlohmann::ordered_json entry = {{"frame", f}, {"records", cache.records().size()}, {"new_records", fr.new_records},
+                                            {"ms", frame_ms}, {"fps", 1000.0 / frame_ms}, {"rel_rms", err.raw.rel_rms}};
+            add_debiased(entry, err.debiased);
+            frames.push_back(entry);
             for (const auto& s : ft.stages()) timer.add_sample(s, ft.median_ms(s));
             timer.add_sample("total", frame_ms);
         }
@@ -400,6 +511,7 @@ int run_with(const options& o) {
         const std::vector<float> as = o.a_sweep.empty() ? std::vector<float>{o.a} : o.a_sweep;
         nlohmann::ordered_json sweep = nlohmann::ordered_json::array();
         image<float> mask;
+        std::optional<frame_error> last_error;
         for (float a : as) {
             study::stage_timer at;
             // Each repeat starts from the same cache: what was loaded, or what earlier
@@ -415,19 +527,23 @@ int run_with(const options& o) {
                 at.add_sample("total", ms_since(t0));
             }
             mask = mask_for(fr.g, cam);
-            const auto err = study::compare_luminance(fr.indirect.view(), ref.indirect.view(), mask.view());
+            const frame_error err = measure_error(fr.indirect, ref, mask);
             fmt::print("a = {:.3f}: {:6} records (+{:5}), total {:9.1f} ms (interpolate {:8.2f}, records {:9.1f}), "
-                       "indirect rel_rms {:.4f}\n",
+                       "indirect rel_rms {}\n",
                        a, cache.records().size(), fr.new_records, at.median_ms("total"), at.median_ms("interpolate"),
-                       at.median_ms("compute_records"), err.rel_rms);
+                       at.median_ms("compute_records"), error_text(err));
             nlohmann::ordered_json entry = {{"a", a}, {"records", cache.records().size()}, {"new_records", fr.new_records},
                                             {"timings_ms", nlohmann::ordered_json::object()}, {"error", error_json(err)}};
             for (const auto& s : at.stages()) entry["timings_ms"][s] = at.median_ms(s);
             sweep.push_back(entry);
             timer = at;
-            report.error = err;
+            report.error = err.raw;
+            last_error = err;
         }
+        reference_noise = last_error->debiased.reference_noise_rel_rms;
         if (!o.a_sweep.empty()) extra["a_sweep"] = sweep;
+        extra["error_debiased"] = nlohmann::ordered_json::object();
+        add_debiased(extra["error_debiased"], last_error->debiased);
         report.set_timings(timer);
         report.set_count("records", cache.records().size());
         if (fr.measured > 0) {
@@ -439,16 +555,26 @@ int run_with(const options& o) {
         if (o.mc_compare) {
             // Brute-force Monte Carlo at doubling sample counts until it reaches this run's
             // error (up to half the reference's samples: beyond, it would meet its own noise).
+            // On the debiased error by default, up to the reference's samples (--raw-equal-error:
+            // the raw error, up to half of them).
             const double ms = timer.median_ms("total");
+            const double target = last_error->target(o.raw_equal_error);
+            if (!(target > 0.0))
+                throw bounce::error("ic_splatting: --mc-compare: the debiased error is not above 0 (lost in the "
+                                    "reference's noise): raise --ref-spp or pass --raw-equal-error");
+            if (!o.raw_equal_error && !last_error->debiased.resolved())
+                fmt::print("warning: the debiased error is within two standard errors of 0; the ratio below means little\n");
             const auto mc = study::monte_carlo_at_equal_error(
-                bvh, scene, fr.g.view(), ref.indirect.view(), mask.view(), report.error->rel_rms, o.ref_spp / 2,
-                [](const study::monte_carlo_step& s) {
-                    fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f}\n", s.spp, s.ms, s.rel_rms);
+                bvh, scene, fr.g.view(), ref.indirect_a.view(), ref.indirect_b.view(), mask.view(), target, mc_measure,
+                mc_max_spp, [](const study::monte_carlo_step& s) {
+                    fmt::print("monte carlo {:4} spp: {:9.1f} ms, indirect rel_rms {:.4f} (debiased {:.4f} +- {:.4f})\n",
+                               s.spp, s.ms, s.rel_rms, s.rel_rms_debiased, s.rel_rms_debiased_se);
                 });
             extra["mc_equal_error"] = mc.equal_error_json(ms);
             extra["mc_sweep"] = mc.sweep_json();
-            fmt::print("at equal error Monte Carlo needs {}{:.0f} spp, {:.1f} ms: {}{:.1f}x the cache's {:.1f} ms\n",
-                       mc.reached ? "~" : "more than ", mc.spp, mc.ms, mc.reached ? "" : "at least ", mc.ms / ms, ms);
+            fmt::print("at equal {} error Monte Carlo needs {}{:.0f} spp, {:.1f} ms: {}{:.1f}x the cache's {:.1f} ms\n",
+                       o.raw_equal_error ? "raw" : "debiased", mc.reached ? "~" : "more than ", mc.spp, mc.ms,
+                       mc.reached ? "" : "at least ", mc.ms / ms, ms);
         }
 
         if (o.ray_rates) {
@@ -482,7 +608,7 @@ int run_with(const options& o) {
         if (!o.out.empty() || !o.exr.empty()) {
             image<glm::vec3> combined(o.width, o.height);
             if (fr.combined) combined = *fr.combined;
-            else cpu::compose(ref.direct.view(), fr.indirect.view(), combined.view());
+            else cpu::compose(ref.whole.direct.view(), fr.indirect.view(), combined.view());
             if (!o.exr.empty()) io::write_exr(o.exr, combined.view());
             if (!o.out.empty()) io::write_png(o.out, combined.view(), io::auto_exposure(combined.view(), mask.view()));
         }
@@ -497,8 +623,25 @@ int run_with(const options& o) {
     if (!o.json.empty()) {
         auto j = report.to_json();
         j["timings_ms"]["bvh"] = setup.median_ms("bvh");
+        // The debiased figures join `error` (the single frame's), and `reference` says what
+        // the errors were measured against.
+        if (extra.contains("error_debiased") && j.contains("error")) {
+            for (auto it = extra["error_debiased"].begin(); it != extra["error_debiased"].end(); ++it)
+                j["error"][it.key()] = it.value();
+        }
+        extra.erase("error_debiased");
+        j["reference"] = {{"spp", o.ref_spp},
+                          {"halves", 2},
+                          {"half_spp", o.ref_spp / 2},
+                          {"noise_rel_rms", finite_or_null(reference_noise)},
+                          {"noise_of", o.walkthrough > 0 ? "mean over the walkthrough's frames"
+                                       : o.progressive > 0 ? "the last frame"
+                                                           : "the frame"}};
         for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
-        std::ofstream(o.json) << j.dump(2) << '\n';
+        std::ofstream out(o.json);
+        out << j.dump(2) << '\n';
+        out.flush();
+        if (!out) throw bounce::error("ic_splatting: cannot write " + o.json.string());
     }
     return 0;
 }

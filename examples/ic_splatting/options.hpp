@@ -48,6 +48,8 @@ struct options {
     float min_weight = 0.f;  // 0: a, as the seed's Eq. 8.8
     int repeat = 1;
     bool mc_compare = false;
+    bool raw_equal_error = false;  // equal-error searches on the raw error (default: debiased)
+    std::uint32_t mc_max_spp = 0;  // Monte Carlo's largest spp at equal error (0: 4 ref_spp debiased, ref_spp / 2 raw)
     bool ray_rates = false;  // time records against Embree's raw rate for the same rays
     std::filesystem::path json, out, exr, indirect_out, indirect_exr, cache_in, cache_out;
 };
@@ -132,7 +134,11 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
         ->delimiter(',')
         ->check(examples::finite_positive);
     app.add_option("--record-samples", o.record_samples, "hemisphere rays per record")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
-    app.add_option("--ref-spp", o.ref_spp, "reference integrator samples per pixel")->check(CLI::Range(1u, 1u << 20))->capture_default_str();
+    app.add_option("--ref-spp", o.ref_spp,
+                   "reference integrator samples per pixel, as two independent halves of N/2 (even; their difference "
+                   "measures the reference's own noise, which the debiased error takes out)")
+        ->check(CLI::Range(2u, 1u << 20))
+        ->capture_default_str();
     app.add_option("--radius", o.radius,
                    "record radius: split-sphere (harmonic mean distance, Ward et al. 1988) | hessian (occlusion Hessian, "
                    "Schwarzhaupt et al. 2012: a is the relative error at the zone's edge)")
@@ -168,6 +174,14 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--min-weight", o.min_weight, "cache-miss threshold on the weight sum (default: a, the seed's Eq. 8.8)")->check(examples::finite_non_negative);
     app.add_option("--repeat", o.repeat, "repeats per measurement (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
     app.add_flag("--mc-compare", o.mc_compare, "also time brute-force Monte Carlo indirect light at equal error");
+    app.add_flag("--raw-equal-error", o.raw_equal_error,
+                 "Monte Carlo at equal error on the raw rel_rms against the reference (default: on the debiased "
+                 "error, the reference's own noise taken out)");
+    app.add_option("--mc-max-spp", o.mc_max_spp,
+                   "Monte Carlo at equal error stops doubling here (0: 4x --ref-spp on the debiased error, whose "
+                   "reference noise is taken out; --ref-spp / 2 on the raw error, beyond which it meets that noise)")
+        ->check(CLI::Range(0u, 1u << 24))
+        ->capture_default_str();
     app.add_flag("--ray-rates", o.ray_rates,
                  "Embree sampler: re-measure up to 2048 of the frame's records, and trace their hemisphere rays alone, "
                  "reporting record_rays_per_s and embree_rays_per_s");
