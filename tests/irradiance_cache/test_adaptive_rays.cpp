@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <vector>
 
 using namespace bounce;
@@ -386,6 +387,15 @@ TEST_CASE("adaptive records stop at the first round where nothing varies and go 
     CHECK(tally.mean() == Approx(double(tally.rays) / 3));
     sampler.reset_rays_cast();
     CHECK(sampler.rays_cast().records == 0);
+
+    // The scale for an irradiance floor: above everything it is the sky's pi L, exactly;
+    // under the square it is less. Not counted as records.
+    const std::vector<glm::vec3> up{{8.f, 8.f, 1.f}, {-8.f, 5.f, 1.f}}, under{{0.1f, -0.2f, 0.f}}, normals{{0, 0, 1}, {0, 0, 1}};
+    CHECK(sampler.mean_irradiance(up, normals) == Approx(pi * luminance(s.sky)).epsilon(1e-5));
+    CHECK(sampler.mean_irradiance(under, std::span(normals).first(1)) < 0.7 * pi * luminance(s.sky));
+    CHECK(sampler.mean_irradiance({}, {}) == 0.0);
+    CHECK(sampler.rays_cast().records == 0);
+    CHECK_THROWS_WITH(sampler.mean_irradiance(up, std::span(normals).first(1)), Catch::Contains("normals"));
 }
 
 TEST_CASE("adaptive records are unbiased: their mean over seeds is the exact irradiance", "[adaptive_rays][embree]") {

@@ -17,6 +17,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/irradiance_gradients.hpp>
 #include <bounce/irradiance_record.hpp>
+#include <bounce/luminance.hpp>
 #include <bounce/record_sampler.hpp>
 #include <bounce/sampling.hpp>
 
@@ -135,6 +136,24 @@ public:
             integrator_.trace_hemisphere(points[k], normals[k], grid_, derive_seed(seed_, 0x1c, point_key(points[k], normals[k])));
         });
         return points.size() * grid_.count();
+    }
+
+    /// Mean luminance of the irradiance at points[k], normals[k] from this sampler's first
+    /// round alone (the fixed grid when adaptive rays are off), the points on every core, not
+    /// counted in rays_cast(). For an adaptive_rays::irradiance_floor on the scene's scale:
+    /// a few hundred points of the frame's G-buffer suffice. 0 for no points.
+    double mean_irradiance(std::span<const glm::vec3> points, std::span<const glm::vec3> normals) const {
+        require(normals.size() == points.size(), "normals", "must have one entry per point");
+        std::vector<double> e(points.size());
+        tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t k) {
+            embree::hemisphere_samples samples;
+            integrator_.sample_hemisphere(points[k], normals[k], grid_, derive_seed(seed_, 0x1e, point_key(points[k], normals[k])),
+                                          samples);
+            e[k] = rec709_luminance<double, glm::dvec3>(glm::dvec3(samples.irradiance()));
+        });
+        double sum = 0;
+        for (const double x : e) sum += x;
+        return points.empty() ? 0.0 : sum / double(points.size());
     }
 
     hemisphere_grid grid() const noexcept { return grid_; }
