@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <string>
@@ -24,6 +25,24 @@ constexpr double pi = std::numbers::pi;
 
 // Stage tags for derive_seed: the direct and indirect images use unrelated streams.
 constexpr std::uint64_t stage_direct = 1, stage_indirect = 2, stage_secondary = 3;
+// The stream that picks a hit's light under secondary_light_choice (keyed by the hit's seed).
+constexpr std::uint64_t stage_light_choice = 4;
+
+// Rays shaded together: one batch of hemisphere rays is traced with one batched query, and
+// its hits' shadow rays with batched queries of at most shadow_batch rays.
+constexpr std::size_t shade_batch_rays = 64;
+constexpr std::size_t shadow_batch = 256;
+
+// The queries, chosen by measurement (docs/irradiance-splatting.md, "Record cost against
+// Embree"): a batch of one record's hemisphere rays as packets of eight (they share their
+// origin and neighbours in the batch are neighbours in direction; faster than single rays
+// or streams on the Cornell box and the bunny, as fast on Sponza), shadow rays as an
+// incoherent stream (their origins are scattered over the hits; packets were slower).
+void trace_rays(const accel& bvh, std::span<const ray> rays, std::span<hit> hits) { bvh.intersect_packets(rays, hits); }
+
+void trace_shadows(const accel& bvh, std::span<const ray> rays, std::span<std::uint8_t> blocked) {
+    bvh.occluded(rays, blocked, /*coherent=*/false);
+}
 
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 bool non_negative3(glm::vec3 v) { return finite3(v) && v.x >= 0.f && v.y >= 0.f && v.z >= 0.f; }
@@ -98,6 +117,26 @@ reference_integrator::reference_integrator(const accel& bvh, const scene_view& s
             "must be finite and non-negative");
     epsilon_ = settings_.ray_epsilon > 0.f ? settings_.ray_epsilon : bvh.ray_epsilon();
 
+    shading_.resize(scene.triangles.size());
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+        // surface_at's geometric normal, computed as it computes it.
+        const glm::uvec3 tri = scene.triangles[t];
+        const glm::vec3 p0 = scene.positions[tri.x], p1 = scene.positions[tri.y], p2 = scene.positions[tri.z];
+        const glm::vec3 ng = glm::cross(p1 - p0, p2 - p0);
+        const float ng_len = glm::length(ng);
+        shading_triangle& st = shading_[t];
+        st.degenerate = ng_len > 0.f ? 0u : 1u;
+        st.geometric_normal = ng_len > 0.f ? ng / ng_len : glm::vec3(0.f);
+        if (!scene.normals.empty()) {
+            st.n0 = scene.normals[tri.x];
+            st.n1 = scene.normals[tri.y];
+            st.n2 = scene.normals[tri.z];
+        } else {
+            st.n0 = st.n1 = st.n2 = glm::vec3(0.f);
+        }
+        st.albedo = scene.materials[scene.material_of[t]].albedo;
+    }
+
     validate_lights(scene.lights);
     for (const light& l : scene.lights) lights_.push_back(pack(l));
 
@@ -135,30 +174,51 @@ reference_integrator::reference_integrator(const accel& bvh, const scene_view& s
     }
 }
 
+surface reference_integrator::surface_of(const ray& r, const hit& h) const {
+    // surface_at's steps, in its arithmetic, on the packed triangle.
+    const shading_triangle& st = shading_[h.triangle];
+    surface s;
+    s.triangle = h.triangle;
+    s.position = r.origin + h.t * r.direction;
+    glm::vec3 ng = st.degenerate ? -glm::normalize(r.direction) : st.geometric_normal;
+    if (glm::dot(ng, r.direction) > 0.f) ng = -ng;
+    s.geometric_normal = ng;
+    glm::vec3 n = ng;
+    if (!scene_.normals.empty()) {
+        const float w0 = 1.f - h.u - h.v;
+        const glm::vec3 blend = w0 * st.n0 + h.u * st.n1 + h.v * st.n2;
+        const float len = glm::length(blend);
+        if (len > 0.f && std::isfinite(len)) n = blend / len;
+    }
+    if (glm::dot(n, r.direction) > 0.f) n = -n;
+    s.normal = n;
+    s.albedo = st.albedo;
+    return s;
+}
+
 void reference_integrator::check_point(glm::vec3 p, glm::vec3 n) const {
     require(finite3(p), "p", "must be finite");
     require(finite3(n) && std::abs(glm::length(n) - 1.f) < 1e-3f, "n", "must be a finite unit vector");
 }
 
-glm::dvec3 reference_integrator::direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal, std::uint32_t area_grid,
-                                           std::uint64_t seed) const {
+template <class Term>
+void reference_integrator::direct_terms(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal, std::uint32_t area_grid,
+                                        std::uint64_t seed, bool choose_light, Term&& term) const {
     const glm::vec3 origin = p + epsilon_ * offset_normal;
-    glm::dvec3 e(0.0);
-    for (const auto& l : lights_) {
-        glm::vec3 contribution(0.f);
+    // Unshadowed irradiance from light l, and the shadow ray that tests it.
+    auto unshadowed = [&](const packed_light& l) {
+        const light_kind kind = l.kind();
+        if (kind == light_kind::point)
+            return point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
+        if (kind == light_kind::spot)
+            return spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
+                                                            l.cos_cone(), l.cosine_falloff());
+        return directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
+    };
+    auto shadow_ray = [&](const packed_light& l) {
         ray shadow;
         shadow.origin = origin;
-        const light_kind kind = l.kind();
-        if (kind == light_kind::point) {
-            contribution = point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
-        } else if (kind == light_kind::spot) {
-            contribution = spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
-                                                                    l.cos_cone(), l.cosine_falloff());
-        } else {
-            contribution = directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
-        }
-        if (!(contribution.x > 0.f || contribution.y > 0.f || contribution.z > 0.f)) continue;
-        if (kind == light_kind::directional) {
+        if (l.kind() == light_kind::directional) {
             shadow.direction = -l.direction();
         } else {
             // Towards the light; stop short of it by epsilon so geometry at the light's
@@ -167,7 +227,38 @@ glm::dvec3 reference_integrator::direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 o
             const float d = glm::length(shadow.direction);
             shadow.tfar = std::max(0.f, 1.f - epsilon_ / std::max(d, epsilon_));
         }
-        if (!bvh_.occluded(shadow)) e += glm::dvec3(contribution);
+        return shadow;
+    };
+    auto weight = [](glm::vec3 c) { return c.x + c.y + c.z; };
+
+    if (choose_light && lights_.size() > 1) {
+        // One light, drawn with probability w_l / W (w_l: its unshadowed irradiance summed
+        // over channels, W: their total), its term divided by that probability.
+        float total = 0.f;
+        for (const auto& l : lights_) total += weight(unshadowed(l));
+        if (total > 0.f) {
+            pcg32 pick(derive_seed(seed, stage_light_choice, 0));
+            const float target = pick.next_float() * total;
+            float below = 0.f;
+            std::size_t chosen = lights_.size();
+            glm::vec3 chosen_term(0.f);
+            for (std::size_t i = 0; i < lights_.size(); ++i) {
+                const glm::vec3 c = unshadowed(lights_[i]);
+                const float w = weight(c);
+                if (!(w > 0.f)) continue;
+                chosen = i;  // rounding may leave target above the last sum: the last lit light takes it
+                chosen_term = c * (total / w);
+                below += w;
+                if (target < below) break;
+            }
+            term(chosen_term, shadow_ray(lights_[chosen]), false);
+        }
+    } else {
+        for (const auto& l : lights_) {
+            const glm::vec3 contribution = unshadowed(l);
+            if (!(contribution.x > 0.f || contribution.y > 0.f || contribution.z > 0.f)) continue;
+            term(contribution, shadow_ray(l), false);
+        }
     }
 
     if (!emitters_.empty()) {
@@ -176,7 +267,6 @@ glm::dvec3 reference_integrator::direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 o
         // uniform_triangle places the point. pdf_A = 1 / total area.
         const std::uint32_t s = area_grid;
         pcg32 rng(seed);
-        glm::dvec3 sum(0.0);
         const float inv_pdf = float(emitter_area_);
         for (std::uint32_t j = 0; j < s; ++j)
             for (std::uint32_t i = 0; i < s; ++i) {
@@ -197,10 +287,20 @@ glm::dvec3 reference_integrator::direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 o
                 shadow.direction = q - origin;
                 const float d = glm::length(shadow.direction);
                 shadow.tfar = std::max(0.f, 1.f - epsilon_ / std::max(d, epsilon_));
-                if (!bvh_.occluded(shadow)) sum += glm::dvec3(c);
+                term(c, shadow, true);
             }
-        e += sum / double(s * s);
     }
+}
+
+glm::dvec3 reference_integrator::direct_at(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal, std::uint32_t area_grid,
+                                           std::uint64_t seed, bool choose_light) const {
+    // Lights' terms summed into e, the emitters' samples into their own sum, which enters
+    // as its mean (shade_batch sums the same terms in the same order).
+    glm::dvec3 e(0.0), sum(0.0);
+    direct_terms(p, n, offset_normal, area_grid, seed, choose_light, [&](glm::vec3 c, const ray& shadow, bool emitter) {
+        if (!bvh_.occluded(shadow)) (emitter ? sum : e) += glm::dvec3(c);
+    });
+    if (!emitters_.empty()) e += sum / double(area_grid * area_grid);
     return e;
 }
 
@@ -208,7 +308,7 @@ glm::vec3 reference_integrator::direct_irradiance(glm::vec3 p, glm::vec3 n, std:
                                                   std::uint64_t seed) const {
     check_point(p, n);
     require(area_samples > 0, "area_samples", "must be positive");
-    return glm::vec3(direct_at(p, n, n, square_side(area_samples), seed));
+    return glm::vec3(direct_at(p, n, n, square_side(area_samples), seed, false));
 }
 
 glm::vec3 reference_integrator::incoming_radiance(const ray& r, std::uint64_t seed, float* distance) const {
@@ -217,13 +317,81 @@ glm::vec3 reference_integrator::incoming_radiance(const ray& r, std::uint64_t se
         if (distance) *distance = std::numeric_limits<float>::infinity();
         return settings_.environment;
     }
-    const surface s = surface_at(scene_, r, h);
+    const surface s = surface_of(r, h);
     if (distance) *distance = h.t * glm::length(r.direction);
     // Offset along the geometric normal: the shading normal may point into the surface's
     // own plane at grazing angles and let the shadow ray re-hit the triangle it left.
     const glm::dvec3 e = direct_at(s.position, s.normal, s.geometric_normal,
-                                   square_side(settings_.secondary_area_samples), seed);
+                                   square_side(settings_.secondary_area_samples), seed,
+                                   settings_.secondary_light_choice);
     return glm::vec3(glm::dvec3(s.albedo) * (1.0 / pi) * e);
+}
+
+void reference_integrator::shade_batch(const ray* rays, const std::uint64_t* seeds, std::size_t count,
+                                       glm::vec3* radiance, float* distance) const {
+    // incoming_radiance for each ray, its queries batched: the rays' nearest hits in one
+    // query, the hits' shadow rays queued and tested shadow_batch at a time. Each ray's
+    // unblocked terms are summed in the order direct_at sums them, so the results are
+    // bitwise those of incoming_radiance (Embree's batched queries return the same hits).
+    hit hits[shade_batch_rays];
+    trace_rays(bvh_, std::span<const ray>(rays, count), std::span<hit>(hits, count));
+
+    glm::dvec3 lit[shade_batch_rays], emitted[shade_batch_rays];  // unblocked terms per ray
+    ray shadow[shadow_batch];
+    glm::vec3 term[shadow_batch];
+    std::uint8_t owner[shadow_batch], from_emitter[shadow_batch], blocked[shadow_batch];
+    static_assert(shade_batch_rays <= 256, "owner holds a ray's index in one byte");
+    std::size_t pending = 0;
+    auto flush = [&] {
+        trace_shadows(bvh_, std::span<const ray>(shadow, pending), std::span<std::uint8_t>(blocked, pending));
+        for (std::size_t k = 0; k < pending; ++k)
+            if (!blocked[k]) (from_emitter[k] ? emitted : lit)[owner[k]] += glm::dvec3(term[k]);
+        pending = 0;
+    };
+    // The hits' triangles are scattered in memory: ask for all of them before shading the
+    // first, so their cache misses overlap instead of following one another.
+#if defined(__GNUC__) || defined(__clang__)
+    for (std::size_t i = 0; i < count; ++i)
+        if (hits[i].found()) __builtin_prefetch(&shading_[hits[i].triangle]);
+#endif
+    const std::uint32_t area_grid = square_side(settings_.secondary_area_samples);
+    for (std::size_t i = 0; i < count; ++i) {
+        lit[i] = emitted[i] = glm::dvec3(0.0);
+        if (!hits[i].found()) continue;
+        const surface s = surface_of(rays[i], hits[i]);
+        direct_terms(s.position, s.normal, s.geometric_normal, area_grid, seeds[i], settings_.secondary_light_choice,
+                     [&](glm::vec3 c, const ray& r, bool emitter) {
+                         if (pending == shadow_batch) flush();
+                         shadow[pending] = r;
+                         term[pending] = c;
+                         owner[pending] = std::uint8_t(i);
+                         from_emitter[pending] = emitter ? 1 : 0;
+                         ++pending;
+                     });
+    }
+    if (pending > 0) flush();
+    for (std::size_t i = 0; i < count; ++i) {
+        const hit& h = hits[i];
+        if (!h.found()) {
+            distance[i] = std::numeric_limits<float>::infinity();
+            radiance[i] = settings_.environment;
+            continue;
+        }
+        distance[i] = h.t * glm::length(rays[i].direction);
+        glm::dvec3 e = lit[i];
+        if (!emitters_.empty()) e += emitted[i] / double(area_grid * area_grid);
+        radiance[i] = glm::vec3(glm::dvec3(shading_[h.triangle].albedo) * (1.0 / pi) * e);
+    }
+}
+
+void reference_integrator::incoming_radiance(std::span<const ray> rays, std::span<const std::uint64_t> seeds,
+                                             std::span<glm::vec3> radiance, std::span<float> distance) const {
+    require(seeds.size() == rays.size() && radiance.size() == rays.size() && distance.size() == rays.size(), "rays",
+            "rays, seeds, radiance and distance must have one entry per ray");
+    for (std::size_t b = 0; b < rays.size(); b += shade_batch_rays) {
+        const std::size_t count = std::min(shade_batch_rays, rays.size() - b);
+        shade_batch(rays.data() + b, seeds.data() + b, count, radiance.data() + b, distance.data() + b);
+    }
 }
 
 void reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid, std::uint64_t seed,
@@ -254,39 +422,51 @@ void reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemispher
             out.phi[i] = float(2 * pi) * (float(k) + v) / nn;
             out.direction[i] = glm::normalize(local.x * out.tangent + local.y * out.bitangent + local.z * n);
         }
-    // Each ray has its own stream, so splitting them across threads (one record's rays are
-    // the unit of work of the irradiance cache's sequential scan) changes no bit. Nested
-    // in an image pass it only adds tasks to the same TBB pool.
+    // Each ray has its own stream, so the batches' order changes no bit. One record's rays
+    // run on the calling thread: the irradiance cache measures records in parallel, and a
+    // parallel loop per record measured no faster there (the 64-ray batches are small).
     const glm::vec3 origin = p + epsilon_ * n;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 64), [&](const tbb::blocked_range<std::size_t>& b) {
-        ray r;
-        r.origin = origin;
-        for (std::size_t i = b.begin(); i != b.end(); ++i) {
-            r.direction = out.direction[i];
-            out.radiance[i] = incoming_radiance(r, derive_seed(seed, stage_secondary, i), &out.distance[i]);
+    ray rays[shade_batch_rays];
+    std::uint64_t seeds[shade_batch_rays];
+    for (std::size_t b = 0; b < count; b += shade_batch_rays) {
+        const std::size_t batch = std::min(shade_batch_rays, count - b);
+        for (std::size_t i = 0; i < batch; ++i) {
+            rays[i].origin = origin;
+            rays[i].direction = out.direction[b + i];
+            seeds[i] = derive_seed(seed, stage_secondary, b + i);
         }
-    });
+        shade_batch(rays, seeds, batch, &out.radiance[b], &out.distance[b]);
+    }
 }
 
 std::size_t reference_integrator::trace_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid,
                                                   std::uint64_t seed) const {
     check_point(p, n);
     require(grid.m > 0 && grid.n > 0, "grid", "needs at least one stratum in theta and in phi");
-    // The directions of sample_hemisphere: the same stream, drawn in the same order.
+    // The directions of sample_hemisphere: the same stream, drawn in the same order, and
+    // traced in the same batches with the same query.
     const auto tb = orthonormal_basis<float, glm::vec3>(n);
     pcg32 rng(seed);
     const float m = float(grid.m), nn = float(grid.n);
-    ray r;
-    r.origin = p + epsilon_ * n;
-    std::size_t hits = 0;
-    for (std::uint32_t j = 0; j < grid.m; ++j)
-        for (std::uint32_t k = 0; k < grid.n; ++k) {
+    const glm::vec3 origin = p + epsilon_ * n;
+    const std::size_t count = std::size_t(grid.m) * grid.n;
+    ray rays[shade_batch_rays];
+    hit hits[shade_batch_rays];
+    std::size_t found = 0;
+    for (std::size_t b = 0; b < count; b += shade_batch_rays) {
+        const std::size_t batch = std::min(shade_batch_rays, count - b);
+        for (std::size_t i = 0; i < batch; ++i) {
+            const std::size_t index = b + i;
+            const auto j = std::uint32_t(index / grid.n), k = std::uint32_t(index % grid.n);
             const float u = rng.next_float(), v = rng.next_float();
             const glm::vec3 local = stratified_cosine_direction<float, glm::vec3>(float(j), float(k), m, nn, u, v);
-            r.direction = glm::normalize(local.x * tb[0] + local.y * tb[1] + local.z * n);
-            hits += bvh_.intersect(r).found() ? 1 : 0;
+            rays[i].origin = origin;
+            rays[i].direction = glm::normalize(local.x * tb[0] + local.y * tb[1] + local.z * n);
         }
-    return hits;
+        trace_rays(bvh_, std::span<const ray>(rays, batch), std::span<hit>(hits, batch));
+        for (std::size_t i = 0; i < batch; ++i) found += hits[i].found() ? 1 : 0;
+    }
+    return found;
 }
 
 hemisphere_samples reference_integrator::sample_hemisphere(glm::vec3 p, glm::vec3 n, hemisphere_grid grid,
@@ -311,7 +491,7 @@ image<glm::vec3> reference_integrator::direct_image(const gbuffer_view<float>& g
             if (!g.covered(x, y)) continue;
             require_pixel(g, x, y);
             const glm::vec3 p = g.position(x, y), n = g.normal(x, y);
-            const glm::dvec3 e = direct_at(p, n, n, side, derive_seed(settings_.seed, stage_direct, y * w + x));
+            const glm::dvec3 e = direct_at(p, n, n, side, derive_seed(settings_.seed, stage_direct, y * w + x), false);
             out(x, y) = glm::vec3(glm::dvec3(g.albedo(x, y)) * (1.0 / pi) * e);
         }
     });
