@@ -301,53 +301,48 @@ public:
         return extra;
     }
 
-    /// The samples as a 2M x 2N grid for estimate_hemisphere: each cell's quadrants (the
-    /// sub-strata of its first two splits, phi then theta) at fine cell (2j + hy, 2k + hx).
-    /// A quadrant takes the mean radiance of the samples inside it, or, where it holds none,
-    /// of those in its phi half, or of the whole cell; likewise the harmonic mean of their
-    /// hit distances (+infinity where every ray escaped) and the direction of its first
-    /// sample (its centre where it holds none). Each sample's value thus covers exactly its
-    /// sub-stratum's measure, so the irradiance is the cell-mean estimate above, and the
-    /// gradients and Hessian see the refined strata at twice the first round's resolution
-    /// (a 256-ray first round grows gradients on the grid of a 1024-ray record). Throws
-    /// parameter_error if a cell is empty.
+    /// The samples as one grid for estimate_hemisphere, fine enough for the most refined
+    /// cell: with L = max(2, the deepest split level), every cell is cut into 2^ceil(L/2)
+    /// wedges by 2^floor(L/2) rings (the kd splits alternate phi, theta), and each fine cell
+    /// takes the one sample of the cell's sub-stratum that contains it: its radiance and hit
+    /// distance, and its direction where the sample lies inside the fine cell (the fine cell's
+    /// centre otherwise). Each sample's value thus covers exactly its sub-stratum's measure,
+    /// so the irradiance is the cell-mean estimate, and the gradients see every split at its
+    /// own resolution (walls inside one sub-stratum carry no difference). No two samples are
+    /// averaged into one fine cell: the translation gradient's wall term takes the nearer of
+    /// two distances, and a mean of distances there would shrink it. Throws parameter_error
+    /// if a cell is empty.
     hemisphere_samples fine_samples() const {
+        unsigned deepest = 2;
+        for (const cell& c : cells_) deepest = std::max(deepest, level_of(nonempty(c)));
+        const unsigned lx = (deepest + 1) / 2, ly = deepest / 2;
+        const std::uint32_t sx = 1u << lx, sy = 1u << ly;
         hemisphere_samples s;
-        s.rings = 2 * m_;
-        s.wedges = 2 * n_;
+        s.rings = m_ * sy;
+        s.wedges = n_ * sx;
         const std::size_t fine = std::size_t(s.rings) * s.wedges;
         s.direction.resize(fine);
         s.radiance.resize(fine);
         s.distance.resize(fine);
+        std::vector<std::int32_t> owner;
         for (std::size_t index = 0; index < cells_.size(); ++index) {
             const cell& c = cells_[index];
-            nonempty(c);
+            const unsigned level = level_of(c.n);
+            // The sample in each of the cell's 2^level sub-strata (kd path bits, first split highest).
+            owner.assign(std::size_t(1) << level, -1);
+            for (std::size_t i = 0; i < c.samples.size(); ++i) owner[box_of(c.samples[i].u, level)] = std::int32_t(i);
             const std::size_t j = index / n_, k = index % n_;
-            for (int hx = 0; hx < 2; ++hx)
-                for (int hy = 0; hy < 2; ++hy) {
-                    auto in_quadrant = [&](const sample& x) { return (x.u.x >= 0.5f) == (hx == 1) && (x.u.y >= 0.5f) == (hy == 1); };
-                    auto in_half = [&](const sample& x) { return (x.u.x >= 0.5f) == (hx == 1); };
-                    glm::dvec3 sum(0.0);
-                    double inverse = 0;
-                    std::size_t count = 0;
-                    const glm::vec3* first = nullptr;
-                    auto gather = [&](auto&& keep) {
-                        for (const sample& x : c.samples)
-                            if (keep(x)) {
-                                sum += x.radiance;
-                                inverse += x.inverse_distance;
-                                ++count;
-                                if (!first) first = &x.direction;
-                            }
-                    };
-                    gather(in_quadrant);
-                    const bool own = count > 0;
-                    if (!count) gather(in_half);
-                    if (!count) gather([](const sample&) { return true; });
-                    const std::size_t f = (2 * j + std::size_t(hy)) * s.wedges + 2 * k + std::size_t(hx);
-                    s.radiance[f] = glm::vec3(sum / double(count));
-                    s.distance[f] = inverse > 0 ? float(double(count) / inverse) : std::numeric_limits<float>::infinity();
-                    s.direction[f] = own ? *first : direction_in(index, {0.25f + 0.5f * float(hx), 0.25f + 0.5f * float(hy)});
+            for (std::uint32_t b = 0; b < sy; ++b)
+                for (std::uint32_t a = 0; a < sx; ++a) {
+                    const glm::vec2 centre((float(a) + 0.5f) / float(sx), (float(b) + 0.5f) / float(sy));
+                    const std::int32_t who = owner[box_of(centre, level)];
+                    require(who >= 0, "cell", "samples must come from refinement_jitters (one per sub-stratum)");
+                    const sample& x = c.samples[std::size_t(who)];
+                    const std::size_t f = (j * sy + b) * s.wedges + k * sx + a;
+                    s.radiance[f] = glm::vec3(x.radiance);
+                    s.distance[f] = x.inverse_distance > 0 ? float(1.0 / x.inverse_distance) : std::numeric_limits<float>::infinity();
+                    const bool inside = std::uint32_t(x.u.x * float(sx)) == a && std::uint32_t(x.u.y * float(sy)) == b;
+                    s.direction[f] = inside ? x.direction : direction_in(index, centre);
                 }
         }
         return s;
@@ -370,6 +365,24 @@ private:
     std::uint32_t m_, n_;
     std::vector<cell> cells_;
 
+    static unsigned level_of(std::uint32_t n) {
+        unsigned level = 0;
+        while ((1u << level) < n) ++level;
+        return level;
+    }
+    // The kd path of u down `level` splits (phi first, then theta, alternately).
+    static std::size_t box_of(glm::vec2 u, unsigned level) {
+        glm::dvec2 lo(0.0), hi(1.0);
+        std::size_t path = 0;
+        for (unsigned t = 0; t < level; ++t) {
+            const int d = int(t % 2);
+            const double mid = 0.5 * (lo[d] + hi[d]);
+            const bool upper = double(u[d]) >= mid;
+            (upper ? lo[d] : hi[d]) = mid;
+            path = 2 * path + (upper ? 1 : 0);
+        }
+        return path;
+    }
     static std::uint32_t nonempty(const cell& c) {
         require(c.n > 0, "cell", "every cell needs at least one sample");
         return c.n;
