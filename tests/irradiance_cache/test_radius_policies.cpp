@@ -13,6 +13,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <random>
 #include <vector>
@@ -189,4 +190,148 @@ TEST_CASE("the Hessian radius puts the second-order error a at the zone's edge",
     lim.hessian_a = 0.f;
     CHECK_THROWS_WITH(make_record(glm::vec3(0.f), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), est, lim, 0.0),
                       Catch::Contains("hessian_a"));
+}
+
+TEST_CASE("without gradients the Hessian radius puts the first- plus second-order error a at the zone's edge",
+          "[irradiance_record][hessian]") {
+    // Eigenvalues 3 and -5 (largest magnitude 5), E = 2, |grad E| = 1 on channel 0.
+    std::array<glm::dmat2, 3> h{glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    h[0] = glm::dmat2(3.0, 0.0, 0.0, -5.0);
+    const std::array<glm::dvec3, 3> g{glm::dvec3(0.6, 0.8, 0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+    const glm::dvec3 e(2.0, 0.0, 0.0);
+    const double a = 0.2;
+    const double d = a * hessian_radius(e, h, a, &g);
+    CHECK(1.0 * d + 0.5 * 5 * d * d == Approx(a * 2).epsilon(1e-12));
+    // No curvature: the first-order bound alone, d = a E / |grad E|.
+    const std::array<glm::dmat2, 3> flat{glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    CHECK(a * hessian_radius(e, flat, a, &g) == Approx(a * 2 / 1.0).epsilon(1e-12));
+    // No gradient: the same as the radius for a cache that extrapolates with gradients.
+    const std::array<glm::dvec3, 3> none{};
+    CHECK(hessian_radius(e, h, a, &none) == Approx(hessian_radius(e, h, a)).epsilon(1e-12));
+    // The first-order term only ever shrinks the zone.
+    CHECK(hessian_radius(e, h, a, &g) < hessian_radius(e, h, a));
+}
+
+TEST_CASE("with a length the Hessian radius spends the error of a over a disc of that radius on its zone",
+          "[irradiance_record][hessian]") {
+    // Relative curvature lambda / E = 5 / 2 on channel 0 (channels 1, 2 dark: skipped).
+    std::array<glm::dmat2, 3> h{glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    h[0] = glm::dmat2(-5.0, 0.0, 0.0, 1.0);
+    const glm::dvec3 e(2.0, 0.0, 0.0);
+    const double a = 0.15, ell = 3.0, lambda_rel = 2.5;
+    const double d = a * hessian_radius(e, h, a, nullptr, ell);
+    // The zone's integrated second-order relative error, int_0^d int_0^2pi 1/2 lambda_rel r^2 r dphi dr
+    // = pi lambda_rel d^4 / 4, equals a spread over a disc of radius ell.
+    CHECK(std::numbers::pi * lambda_rel * std::pow(d, 4) / 4 == Approx(a * std::numbers::pi * ell * ell).epsilon(1e-12));
+    // The same integral by the midpoint rule in r (the integrand r^3 is smooth; error ~ 1/n^2).
+    double integral = 0;
+    const int n = 2000;
+    for (int i = 0; i < n; ++i) {
+        const double r = (i + 0.5) * d / n;
+        integral += 2 * std::numbers::pi * 0.5 * lambda_rel * r * r * r * (d / n);
+    }
+    CHECK(integral == Approx(a * std::numbers::pi * ell * ell).epsilon(1e-5));
+    // The zone is the geometric mean of sqrt(2) ell and the pointwise zone sqrt(2 a / lambda_rel).
+    const double pointwise = a * hessian_radius(e, h, a);
+    CHECK(pointwise == Approx(std::sqrt(2 * a / lambda_rel)).epsilon(1e-12));
+    CHECK(d == Approx(std::sqrt(std::sqrt(2.0) * ell * pointwise)).epsilon(1e-12));
+    // Fourth root: 16 times the curvature halves the zone (the pointwise zone would shrink 4x).
+    std::array<glm::dmat2, 3> h16 = h;
+    h16[0] = 16.0 * h[0];
+    CHECK(a * hessian_radius(e, h16, a, nullptr, ell) == Approx(d / 2).epsilon(1e-12));
+    // No curvature anywhere: the zone is the length itself (not unbounded).
+    const std::array<glm::dmat2, 3> flat{glm::dmat2(0.0), glm::dmat2(0.0), glm::dmat2(0.0)};
+    CHECK(a * hessian_radius(e, flat, a, nullptr, ell) == Approx(ell));
+    CHECK(std::isinf(hessian_radius(e, flat, a)));
+}
+
+TEST_CASE("the occlusion Hessian turns with the hemisphere", "[irradiance_gradients][hessian]") {
+    // With N divisible by 4 and centred jitter, turning the radiance and distances by 90
+    // degrees about the normal moves every cell onto another: H' = Q H Q^T exactly but for
+    // the rounding of the cells' float directions.
+    auto radiance = [](glm::vec3 d) { return glm::vec3(1.f + 3.f * std::max(0.f, d.x - 0.2f * d.y), 0.5f, 2.f * d.z); };
+    auto distance = [](glm::vec3 d) { return d.y > 0.4f ? std::numeric_limits<float>::infinity() : 0.5f + d.x * d.x + 0.3f * d.y; };
+    auto turned = [](glm::vec3 d) { return glm::vec3(d.y, -d.x, d.z); };  // Q^T d for Q a +90 degree turn
+    const auto e0 = estimate_hemisphere(hemisphere_of(12, 40, radiance, distance));
+    const auto e1 = estimate_hemisphere(hemisphere_of(12, 40, [&](glm::vec3 d) { return radiance(turned(d)); },
+                                                      [&](glm::vec3 d) { return distance(turned(d)); }));
+    const glm::dmat2 q(0.0, 1.0, -1.0, 0.0);  // columns: (0, 1), (-1, 0)
+    for (int c = 0; c < 3; ++c) {
+        const glm::dmat2 expected = q * e0.hessian[c] * glm::transpose(q);
+        const double scale = largest_abs_eigenvalue(e0.hessian[c]);
+        for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j) CHECK(std::abs(e1.hessian[c][i][j] - expected[i][j]) <= 1e-5 * scale);
+        CHECK(e1.hessian[c][0][1] == e1.hessian[c][1][0]);
+        CHECK(largest_abs_eigenvalue(e1.hessian[c]) == Approx(scale).epsilon(1e-5));
+    }
+    CHECK(e1.mean_distance == Approx(e0.mean_distance).epsilon(1e-6));
+}
+
+TEST_CASE("the mean hit distance averages the cells that hit", "[irradiance_gradients][hessian]") {
+    auto distance = [](glm::vec3 d) { return d.x > 0.5f ? std::numeric_limits<float>::infinity() : 1.f + d.z; };
+    const auto s = hemisphere_of(8, 25, [](glm::vec3) { return glm::vec3(1.f); }, distance);
+    double sum = 0;
+    int hits = 0;
+    for (float r : s.distance)
+        if (std::isfinite(r)) sum += r, ++hits;
+    REQUIRE(hits > 0);
+    REQUIRE(hits < int(s.size()));
+    CHECK(estimate_hemisphere(s).mean_distance == Approx(sum / hits).epsilon(1e-12));
+    // Nothing hit: no length.
+    const auto sky = hemisphere_of(8, 25, [](glm::vec3) { return glm::vec3(1.f); },
+                                   [](glm::vec3) { return std::numeric_limits<float>::infinity(); });
+    CHECK(std::isinf(estimate_hemisphere(sky).mean_distance));
+}
+
+TEST_CASE("the Hessian policy's radius on hard hemispheres", "[irradiance_record][hessian]") {
+    radius_limits lim;
+    lim.policy = radius_policy::hessian;
+    lim.hessian_a = 0.2f;
+    const glm::vec3 p(0.f), n(0, 0, 1), t(1, 0, 0), b(0, 1, 0);
+    SECTION("zero irradiance: a black enclosure gets the zone of its own size, not an unbounded one") {
+        const auto s = hemisphere_of(8, 25, [](glm::vec3) { return glm::vec3(0.f); }, [](glm::vec3) { return 2.f; });
+        const auto est = estimate_hemisphere(s);
+        const auto rec = make_record(p, n, t, b, est, lim, 0.0);
+        CHECK(rec.radius * lim.hessian_a == Approx(2.f));
+    }
+    SECTION("a hit at distance ~epsilon at a grazing direction: finite, and shrinking as the fourth root") {
+        // A bright sky with one dark speck of geometry in the outermost ring (theta ~ 80 degrees).
+        auto make = [&](float r_near) {
+            auto s = hemisphere_of(16, 50, [](glm::vec3) { return glm::vec3(1.f); },
+                                   [](glm::vec3) { return std::numeric_limits<float>::infinity(); });
+            const std::size_t i = 15 * 50 + 7;
+            REQUIRE(s.direction[i].z < 0.2f);
+            s.radiance[i] = glm::vec3(0.f);
+            s.distance[i] = r_near;
+            return estimate_hemisphere(s);
+        };
+        const auto e1 = make(1e-6f), e2 = make(16e-6f);
+        for (const auto* e : {&e1, &e2}) {
+            const float r = make_record(p, n, t, b, *e, lim, 0.0).radius;
+            CHECK(std::isfinite(r));
+            CHECK(r > 0.f);
+        }
+        // The speck is the only hit, so the length is its distance and the zone
+        // sqrt(sqrt(2) ell d_pointwise) with d_pointwise ~ r: 16x the distance, 16x the zone.
+        const double r1 = hessian_radius(e1.irradiance, e1.hessian, 0.2, nullptr, e1.mean_distance);
+        const double r2 = hessian_radius(e2.irradiance, e2.hessian, 0.2, nullptr, e2.mean_distance);
+        CHECK(r2 / r1 == Approx(16.0).epsilon(1e-4));
+    }
+    SECTION("the gradient limit bounds the zone, not R, when the cache extrapolates with gradients") {
+        hemisphere_estimate est;
+        est.irradiance = glm::dvec3(2.0);
+        est.translation = {glm::dvec3(4.0, 0, 0), glm::dvec3(4.0, 0, 0), glm::dvec3(4.0, 0, 0)};  // E / |g| = 0.5
+        est.hessian = {glm::dmat2(1e-6), glm::dmat2(1e-6), glm::dmat2(1e-6)};  // nearly flat: a large Hessian radius
+        est.harmonic_mean_distance = 10.0;
+        CHECK(make_record(p, n, t, b, est, lim, 0.0).radius * lim.hessian_a == Approx(0.5f));
+        lim.gradient_limit = false;
+        CHECK(make_record(p, n, t, b, est, lim, 0.0).radius * lim.hessian_a > 100.f);
+        // Without gradients the first-order term is in the error model itself: g d <= a E.
+        lim.hessian_gradients = false;
+        CHECK(make_record(p, n, t, b, est, lim, 0.0).radius * lim.hessian_a <= Approx(lim.hessian_a * 0.5f));
+        // The split sphere keeps R <= E / |g|.
+        lim.policy = radius_policy::split_sphere;
+        lim.gradient_limit = true;
+        CHECK(make_record(p, n, t, b, est, lim, 0.0).radius == Approx(0.5f));
+    }
 }
