@@ -552,16 +552,19 @@ int run_with(const options& o) {
             report.set_count("records_wasted", fr.wasted);
         }
 
-        if (o.mc_compare) {
+        const double mc_target = o.mc_compare ? last_error->target(o.raw_equal_error) : 0.0;
+        if (o.mc_compare && !(mc_target > 0.0)) {
+            // The debiased error came out at or below 0 (lost in the reference's noise): no
+            // error to match; the run's figures are still reported.
+            extra["mc_equal_error"] = {{"skipped", "the debiased error is not above 0: raise --ref-spp"}};
+            fmt::print("monte carlo at equal error skipped: the debiased error is not above 0 (raise --ref-spp)\n");
+        } else if (o.mc_compare) {
             // Brute-force Monte Carlo at doubling sample counts until it reaches this run's
-            // error (up to half the reference's samples: beyond, it would meet its own noise).
-            // On the debiased error by default, up to the reference's samples (--raw-equal-error:
-            // the raw error, up to half of them).
+            // error: the debiased one by default, up to monte_carlo_max_spp (4x the reference's
+            // spp); with --raw-equal-error the raw one, up to half the reference's spp, beyond
+            // which it would meet the reference's noise.
             const double ms = timer.median_ms("total");
-            const double target = last_error->target(o.raw_equal_error);
-            if (!(target > 0.0))
-                throw bounce::error("ic_splatting: --mc-compare: the debiased error is not above 0 (lost in the "
-                                    "reference's noise): raise --ref-spp or pass --raw-equal-error");
+            const double target = mc_target;
             if (!o.raw_equal_error && !last_error->debiased.resolved())
                 fmt::print("warning: the debiased error is within two standard errors of 0; the ratio below means little\n");
             const auto mc = study::monte_carlo_at_equal_error(
