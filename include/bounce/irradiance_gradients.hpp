@@ -87,9 +87,44 @@ struct hemisphere_estimate {
 /// Needs e.irradiance already estimated.
 void add_translation_hessian(const hemisphere_samples& s, hemisphere_estimate& e);
 
+/// What estimate_hemisphere needs of an M x N grid alone: the trigonometry of its ring and
+/// wedge boundaries, O(M + N) square roots, arcsines, sines and cosines. A sampler that
+/// measures many hemispheres on one grid builds it once (estimating from it is bitwise the
+/// same as without it, and costs no trigonometry per cell).
+struct hemisphere_strata {
+    struct ring {
+        double sin2_integral;  ///< int over the ring of sin^2(theta) dtheta (the rotation weight's theta part)
+        double wall_rate;      ///< sin cos^2 at its lower wall theta_j^- (0 for j = 0)
+        double sin_step;       ///< sin(theta_j^+) - sin(theta_j^-) (= int cos(theta) dtheta)
+        double cos_step;       ///< cos(theta_j^-) - cos(theta_j^+)
+    };
+    struct wedge {
+        glm::dvec3 v_integral;  ///< int over the wedge of (-sin phi, cos phi, 0) dphi
+        glm::dvec3 centre;      ///< (cos, sin, 0) of the wedge's middle azimuth
+        glm::dvec3 wall;        ///< (-sin, cos, 0) of its lower wall phi_k^- (the wall's normal)
+    };
+    std::uint32_t rings = 0, wedges = 0;
+    double cell_weight = 0;      ///< pi / (M N)
+    double azimuth_krivanek = 0; ///< 2 sin(dphi / 2) = |int u(phi) dphi| over a wedge
+    double dphi = 0;             ///< 2 pi / N
+    std::vector<ring> ring_terms;    ///< M entries
+    std::vector<wedge> wedge_terms;  ///< N entries
+
+    /// Throws parameter_error unless rings and wedges are positive.
+    hemisphere_strata(std::uint32_t m, std::uint32_t n);
+};
+
 /// Irradiance, gradients and harmonic mean distance of one hemisphere (see file comment).
+/// Throws parameter_error on the samples validate() rejects.
 hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s,
                                         translation_gradient_kind kind = translation_gradient_kind::krivanek_2005);
+/// As above (bitwise) with the grid's trigonometry precomputed; throws parameter_error also
+/// when `strata` is not of the samples' grid. `hessian` false skips add_translation_hessian,
+/// leaving hessian zero and mean_distance infinite, for callers whose radius needs neither
+/// (every radius_policy but hessian).
+hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, const hemisphere_strata& strata,
+                                        translation_gradient_kind kind = translation_gradient_kind::krivanek_2005,
+                                        bool hessian = true);
 
 // ---------------------------------------------------------------------------------------
 // Definitions
@@ -122,30 +157,81 @@ inline std::vector<glm::vec3> stratified_cosine_directions(std::uint32_t rings, 
     return dirs;
 }
 
+inline hemisphere_strata::hemisphere_strata(std::uint32_t m, std::uint32_t n) : rings(m), wedges(n) {
+    require(m > 0 && n > 0, "rings/wedges", "need at least one stratum in each direction");
+    const double pi = std::numbers::pi;
+    cell_weight = pi / (double(m) * n);
+    dphi = 2 * pi / n;
+    azimuth_krivanek = 2 * std::sin(dphi / 2);
+    // Ring boundaries: sin^2(theta_j^-) = j / M.
+    auto sin_lo = [&](std::uint32_t j) { return std::sqrt(double(j) / m); };
+    auto cos_lo = [&](std::uint32_t j) { return std::sqrt(1.0 - double(j) / m); };
+    auto theta_lo = [&](std::uint32_t j) { return std::asin(sin_lo(j)); };
+    ring_terms.resize(m);
+    for (std::uint32_t j = 0; j < m; ++j) {
+        ring& r = ring_terms[j];
+        // int_{theta^-}^{theta^+} sin^2 = [theta/2 - sin(2 theta)/4], sin(2t) = 2 sin cos.
+        const double t0 = theta_lo(j), t1 = theta_lo(j + 1);
+        r.sin2_integral = (t1 - t0) / 2 - (sin_lo(j + 1) * cos_lo(j + 1) - sin_lo(j) * cos_lo(j)) / 2;
+        const double sl = sin_lo(j), cl = cos_lo(j);
+        r.wall_rate = sl * cl * cl;
+        r.sin_step = sin_lo(j + 1) - sin_lo(j);
+        r.cos_step = cos_lo(j) - cos_lo(j + 1);
+    }
+    wedge_terms.resize(n);
+    for (std::uint32_t k = 0; k < n; ++k) {
+        wedge& w = wedge_terms[k];
+        // int v(phi) dphi with v = (-sin phi, cos phi, 0): (cos phi+ - cos phi-, sin phi+ - sin phi-).
+        const double p0 = dphi * k, p1 = dphi * (k + 1);
+        w.v_integral = glm::dvec3(std::cos(p1) - std::cos(p0), std::sin(p1) - std::sin(p0), 0);
+        const double phi_lo = dphi * k, phi_c = dphi * (k + 0.5);
+        w.centre = glm::dvec3(std::cos(phi_c), std::sin(phi_c), 0);   // into wedge k, horizontal
+        w.wall = glm::dvec3(-std::sin(phi_lo), std::cos(phi_lo), 0);  // normal to the wall at phi_k^-
+    }
+}
+
 inline hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, translation_gradient_kind kind) {
-    s.validate();
+    return estimate_hemisphere(s, hemisphere_strata(s.rings, s.wedges), kind);
+}
+
+inline hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, const hemisphere_strata& strata,
+                                               translation_gradient_kind kind, bool hessian) {
+    require(s.rings > 0 && s.wedges > 0, "rings/wedges", "need at least one stratum in each direction");
+    require(s.direction.size() == s.size() && s.radiance.size() == s.size() && s.distance.size() == s.size(), "samples",
+            "direction, radiance and distance must hold rings * wedges entries");
+    require(strata.rings == s.rings && strata.wedges == s.wedges && strata.ring_terms.size() == s.rings &&
+                strata.wedges == strata.wedge_terms.size(),
+            "strata", "must be of the samples' grid (rings x wedges)");
     const std::uint32_t M = s.rings, N = s.wedges;
-    const double pi = std::numbers::pi, dphi = 2 * pi / N;
     auto L = [&](std::uint32_t j, std::uint32_t k) { return glm::dvec3(s.radiance[j * N + k]); };
     auto r = [&](std::uint32_t j, std::uint32_t k) { return double(s.distance[j * N + k]); };
-    // Ring boundaries: sin^2(theta_j^-) = j / M.
-    auto sin_lo = [&](std::uint32_t j) { return std::sqrt(double(j) / M); };
-    auto cos_lo = [&](std::uint32_t j) { return std::sqrt(1.0 - double(j) / M); };
-    auto theta_lo = [&](std::uint32_t j) { return std::asin(sin_lo(j)); };
+    const hemisphere_strata::ring* rings = strata.ring_terms.data();
+    const hemisphere_strata::wedge* wedges = strata.wedge_terms.data();
 
+    // What hemisphere_samples::validate checks of each sample, in one branch-free pass.
+    bool valid = true;
+    constexpr float largest = std::numeric_limits<float>::max();
+    for (const glm::vec3& x : s.radiance)  // false for infinities and NaN
+        valid &= (std::abs(x.x) <= largest) & (std::abs(x.y) <= largest) & (std::abs(x.z) <= largest);
+    for (const float d : s.distance) valid &= d > 0.f;
+    if (!valid) s.validate();  // throws, naming the first bad sample's field
+
+    // The z components of the rotation and translation gradients stay exactly 0 (every
+    // term's direction lies in the tangent plane, times a finite number), so only x and y
+    // are summed.
     hemisphere_estimate e;
     double inverse_distance_sum = 0;
     for (std::uint32_t j = 0; j < M; ++j) {
-        // int_{theta^-}^{theta^+} sin^2 = [theta/2 - sin(2 theta)/4], sin(2t) = 2 sin cos.
-        const double t0 = theta_lo(j), t1 = theta_lo(j + 1);
-        const double sin2_integral = (t1 - t0) / 2 - (sin_lo(j + 1) * cos_lo(j + 1) - sin_lo(j) * cos_lo(j)) / 2;
+        const double sin2_integral = rings[j].sin2_integral;
         for (std::uint32_t k = 0; k < N; ++k) {
             const glm::dvec3 Ljk = L(j, k);
-            e.irradiance += Ljk * (pi / (double(M) * N));
-            // int v(phi) dphi with v = (-sin phi, cos phi, 0): (cos phi+ - cos phi-, sin phi+ - sin phi-).
-            const double p0 = dphi * k, p1 = dphi * (k + 1);
-            const glm::dvec3 v_integral(std::cos(p1) - std::cos(p0), std::sin(p1) - std::sin(p0), 0);
-            for (int c = 0; c < 3; ++c) e.rotation[c] += v_integral * (sin2_integral * Ljk[c]);
+            e.irradiance += Ljk * strata.cell_weight;
+            const glm::dvec3& v_integral = wedges[k].v_integral;
+            for (int c = 0; c < 3; ++c) {
+                const double w = sin2_integral * Ljk[c];
+                e.rotation[c].x += v_integral.x * w;
+                e.rotation[c].y += v_integral.y * w;
+            }
             inverse_distance_sum += 1.0 / r(j, k);  // 0 for escaped rays
         }
     }
@@ -154,37 +240,43 @@ inline hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, tran
     // Translation: each wall between neighbouring cells sweeps over the geometry at the
     // nearer of the two hit distances as the point moves; the radiance difference across the
     // wall times the rate of change of projected solid angle gives the gradient.
+    const bool krivanek = kind == translation_gradient_kind::krivanek_2005;
+    const double azimuth = krivanek ? strata.azimuth_krivanek  // |int u(phi) dphi| over the wedge
+                                    : strata.dphi;
     for (std::uint32_t k = 0; k < N; ++k) {
-        const double phi_lo = dphi * k, phi_c = dphi * (k + 0.5);
-        const glm::dvec3 u_c(std::cos(phi_c), std::sin(phi_c), 0);        // into wedge k, horizontal
-        const glm::dvec3 v_lo(-std::sin(phi_lo), std::cos(phi_lo), 0);   // normal to the wall at phi_k^-
+        const glm::dvec3& u_c = wedges[k].centre;
+        const glm::dvec3& v_lo = wedges[k].wall;
         const std::uint32_t km = (k + N - 1) % N;
         // Walls between rings j-1 and j (at theta_j^-): rate sin cos^2 / r per unit azimuth.
         for (std::uint32_t j = 1; j < M; ++j) {
-            const double sl = sin_lo(j), cl = cos_lo(j);
-            const double rate = sl * cl * cl / std::min(r(j, k), r(j - 1, k));
-            const double azimuth = kind == translation_gradient_kind::krivanek_2005
-                                       ? 2 * std::sin(dphi / 2)  // |int u(phi) dphi| over the wedge
-                                       : dphi;
+            const double rate = rings[j].wall_rate / std::min(r(j, k), r(j - 1, k));
             const glm::dvec3 dL = L(j, k) - L(j - 1, k);
-            for (int c = 0; c < 3; ++c) e.translation[c] += u_c * (azimuth * rate * dL[c]);
+            for (int c = 0; c < 3; ++c) {
+                const double w = azimuth * rate * dL[c];
+                e.translation[c].x += u_c.x * w;
+                e.translation[c].y += u_c.y * w;
+            }
         }
         // Walls between wedges k-1 and k (at phi_k^-), one per ring.
         for (std::uint32_t j = 0; j < M; ++j) {
             const double rmin = std::min(r(j, k), r(j, km));
             double rate;
-            if (kind == translation_gradient_kind::krivanek_2005) {
-                rate = (sin_lo(j + 1) - sin_lo(j)) / rmin;  // int cos(theta) dtheta / r
+            if (krivanek) {
+                rate = rings[j].sin_step / rmin;  // int cos(theta) dtheta / r
             } else {
                 const auto& d = s.direction[j * N + k];
                 const double sin_t = std::max(std::sqrt(double(d.x) * d.x + double(d.y) * d.y), 1e-12);
-                rate = (cos_lo(j) - cos_lo(j + 1)) / (sin_t * rmin);
+                rate = rings[j].cos_step / (sin_t * rmin);
             }
             const glm::dvec3 dL = L(j, k) - L(j, km);
-            for (int c = 0; c < 3; ++c) e.translation[c] += v_lo * (rate * dL[c]);
+            for (int c = 0; c < 3; ++c) {
+                const double w = rate * dL[c];
+                e.translation[c].x += v_lo.x * w;
+                e.translation[c].y += v_lo.y * w;
+            }
         }
     }
-    add_translation_hessian(s, e);
+    if (hessian) add_translation_hessian(s, e);
     return e;
 }
 
