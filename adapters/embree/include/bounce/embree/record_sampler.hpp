@@ -12,6 +12,11 @@
 /// min_rays strata and adds rays to the strata next to uncertain ones until the estimated
 /// relative standard error of its irradiance is below the target or max_rays are cast.
 /// rays_cast() counts the rays and records of every call, adaptive or not.
+///
+/// What a record costs beyond its rays is kept small: the grid's trigonometry
+/// (hemisphere_strata) is computed once per grid size, the per-record buffers are reused from
+/// one record to the next on each thread (so measuring a record allocates nothing once they
+/// have grown), and the adaptive rounds' rays go through the integrator's batched queries.
 
 #include <bounce/adaptive_hemisphere.hpp>
 #include <bounce/embree/reference.hpp>
@@ -25,6 +30,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <utility>
@@ -40,9 +46,8 @@ public:
     /// `kind`: translation-gradient formula; `seed`: base of the per-record streams (each keyed by its point).
     record_sampler(const reference_integrator& integrator, hemisphere_grid grid, radius_limits limits,
                    translation_gradient_kind kind = translation_gradient_kind::krivanek_2005, std::uint64_t seed = 7)
-        : integrator_(integrator), grid_(grid), limits_(limits), kind_(kind), seed_(seed) {
-        require(grid.m > 0 && grid.n > 0, "grid", "need at least one stratum in each direction");
-    }
+        : integrator_(integrator), grid_(checked(grid)), limits_(limits), kind_(kind), seed_(seed),
+          strata_(std::make_shared<const hemisphere_strata>(grid_.m, grid_.n)) {}
 
     /// Adaptive rays per record when `adaptive.enabled`: a first round on
     /// adaptive_grid(min_rays), then up to max_rays (see the file comment); otherwise the
@@ -51,7 +56,7 @@ public:
     record_sampler(const reference_integrator& integrator, adaptive_rays adaptive, radius_limits limits,
                    translation_gradient_kind kind = translation_gradient_kind::krivanek_2005, std::uint64_t seed = 7)
         : integrator_(integrator), grid_(grid_for(adaptive)), limits_(limits), kind_(kind), seed_(seed),
-          adaptive_(adaptive) {}
+          adaptive_(adaptive), strata_(std::make_shared<const hemisphere_strata>(grid_.m, grid_.n)) {}
 
     /// What a record cost: every call since construction or reset_rays_cast(), adaptive or
     /// not, including those that returned nullopt.
@@ -87,18 +92,20 @@ public:
     /// As operator(), and `*rays` (when not null) receives the hemisphere rays the record cast.
     std::optional<irradiance_record> measure(glm::vec3 p, glm::vec3 n, double pixel_footprint,
                                              std::uint32_t* rays) const {
-        embree::hemisphere_samples samples;  // per call: nested TBB work may re-enter on this thread
+        const scratch_lease lease;  // this thread's buffers (another set if nested work re-enters)
+        scratch& w = lease.get();
+        embree::hemisphere_samples& samples = w.world;
         const std::uint64_t key = point_key(p, n);
         integrator_.sample_hemisphere(p, n, grid_, derive_seed(seed_, 0x1c, key), samples);
         if (adaptive_.enabled) {
-            const auto [est, cast] = adaptive_estimate(samples, key);
+            const auto [est, cast] = adaptive_estimate(samples, key, w);
             tally_.add(cast);
             if (rays) *rays = cast;
             return finish(p, samples, est, pixel_footprint);
         }
         tally_.add(grid_.count());
         if (rays) *rays = grid_.count();
-        bounce::hemisphere_samples local;
+        bounce::hemisphere_samples& local = w.local;
         local.rings = grid_.m;
         local.wedges = grid_.n;
         const std::size_t count = samples.direction.size();
@@ -107,12 +114,14 @@ public:
             const glm::vec3 d = samples.direction[i];
             local.direction[i] = {glm::dot(d, samples.tangent), glm::dot(d, samples.bitangent), glm::dot(d, samples.normal)};
         }
-        local.radiance = std::move(samples.radiance);
-        local.distance = std::move(samples.distance);
+        // Swapped, not copied: both sides keep a buffer of the grid's size for the next record.
+        local.radiance.swap(samples.radiance);
+        local.distance.swap(samples.distance);
         // Distances are measured from p + eps n and can be 0 where another surface touches
         // p (a corner); no surface is nearer than the offset itself, so floor them there.
-        for (float& d : local.distance) d = std::max(d, integrator_.ray_epsilon());
-        return finish(p, samples, estimate_hemisphere(local, kind_), pixel_footprint);
+        const float eps = integrator_.ray_epsilon();
+        for (float& d : local.distance) d = std::max(d, eps);
+        return finish(p, samples, estimate_hemisphere(local, *strata_, kind_, needs_hessian()), pixel_footprint);
     }
 
     /// Records for points[k], normals[k], footprints[k] into out[k], the points on every
@@ -165,6 +174,61 @@ private:
     translation_gradient_kind kind_;
     std::uint64_t seed_;
     adaptive_rays adaptive_{};
+    std::shared_ptr<const hemisphere_strata> strata_;  // of grid_ (shared by copies)
+
+    // One record's buffers, kept per thread between records: the hemisphere as traced and in
+    // the local frame, the adaptive rounds' rays and results, and the strata of the adaptive
+    // fine grids met so far (a few sizes; the most recent first).
+    struct scratch {
+        embree::hemisphere_samples world;
+        bounce::hemisphere_samples local;
+        std::vector<std::size_t> cell_of;
+        std::vector<glm::vec2> jitter;
+        std::vector<glm::vec3> directions, radiance;
+        std::vector<float> distance;
+        std::vector<ray> rays;
+        std::vector<std::uint64_t> seeds;
+        std::vector<std::shared_ptr<const hemisphere_strata>> fine_strata;
+
+        const hemisphere_strata& strata_for(std::uint32_t rings, std::uint32_t wedges) {
+            for (std::size_t i = 0; i < fine_strata.size(); ++i)
+                if (fine_strata[i]->rings == rings && fine_strata[i]->wedges == wedges) {
+                    std::rotate(fine_strata.begin(), fine_strata.begin() + std::ptrdiff_t(i),
+                                fine_strata.begin() + std::ptrdiff_t(i) + 1);
+                    return *fine_strata.front();
+                }
+            if (fine_strata.size() == 8) fine_strata.pop_back();
+            fine_strata.insert(fine_strata.begin(), std::make_shared<const hemisphere_strata>(rings, wedges));
+            return *fine_strata.front();
+        }
+    };
+    // The calling thread's scratch while a record is measured. A record's own work spawns no
+    // parallel work, but should a caller's nested TBB work re-enter measure() on this thread,
+    // the inner call takes the next set, so no two records share one.
+    class scratch_lease {
+    public:
+        scratch_lease() : depth_(depth()++) {
+            auto& sets = pool();
+            while (sets.size() <= depth_) sets.push_back(std::make_unique<scratch>());
+            set_ = sets[depth_].get();
+        }
+        ~scratch_lease() { --depth(); }
+        scratch_lease(const scratch_lease&) = delete;
+        scratch_lease& operator=(const scratch_lease&) = delete;
+        scratch& get() const noexcept { return *set_; }
+
+    private:
+        static std::size_t& depth() {
+            thread_local std::size_t d = 0;
+            return d;
+        }
+        static std::vector<std::unique_ptr<scratch>>& pool() {
+            thread_local std::vector<std::unique_ptr<scratch>> sets;
+            return sets;
+        }
+        std::size_t depth_;
+        scratch* set_;
+    };
 
     // Atomic totals (copies start from the original's counts).
     struct tally {
@@ -190,6 +254,14 @@ private:
     };
     mutable tally tally_;
 
+    // Only the Hessian radius reads the estimate's Hessian and mean distance.
+    bool needs_hessian() const noexcept { return limits_.policy == radius_policy::hessian; }
+
+    static hemisphere_grid checked(hemisphere_grid grid) {
+        require(grid.m > 0 && grid.n > 0, "grid", "need at least one stratum in each direction");
+        return grid;
+    }
+
     static hemisphere_grid grid_for(const adaptive_rays& a) {
         a.validate();
         if (!a.enabled) return hemisphere_grid_for(a.max_rays);
@@ -209,9 +281,9 @@ private:
     // needs: each round asks adaptive_hemisphere::plan for at most as many rays as were
     // cast so far (at least an eighth of them), splits the chosen cells' sub-strata with
     // jitters from a stream keyed by the point and the round, and shades the new rays as
-    // sample_hemisphere does.
+    // sample_hemisphere does, in one batched query (bitwise the single-ray incoming_radiance).
     std::pair<hemisphere_estimate, std::uint32_t> adaptive_estimate(const embree::hemisphere_samples& samples,
-                                                                    std::uint64_t key) const {
+                                                                    std::uint64_t key, scratch& w) const {
         adaptive_hemisphere h(grid_.m, grid_.n);
         const float eps = integrator_.ray_epsilon();
         auto local_of = [&](const glm::vec3& d) {
@@ -223,10 +295,11 @@ private:
         }
         const std::uint64_t cap = std::max<std::uint64_t>(adaptive_.max_rays, grid_.count());
         std::uint64_t used = grid_.count();
-        std::vector<std::size_t> cell_of;
-        std::vector<glm::vec2> jitter;
-        std::vector<glm::vec3> local, radiance;
-        std::vector<float> distance;
+        std::vector<std::size_t>& cell_of = w.cell_of;
+        std::vector<glm::vec2>& jitter = w.jitter;
+        std::vector<glm::vec3>& local = w.directions;
+        std::vector<glm::vec3>& radiance = w.radiance;
+        std::vector<float>& distance = w.distance;
         for (std::uint64_t round = 1; used < cap && round <= 16; ++round) {
             const double scale = std::max(h.luminance_irradiance(), adaptive_.irradiance_floor);
             const double allowed = adaptive_.target * scale;
@@ -251,19 +324,24 @@ private:
             const std::size_t count = local.size();
             radiance.resize(count);
             distance.resize(count);
+            w.rays.resize(count);
+            w.seeds.resize(count);
             const glm::vec3 origin = samples.origin + eps * samples.normal;
-            tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
-                ray r;
+            for (std::size_t i = 0; i < count; ++i) {
+                ray& r = w.rays[i];
+                r = ray{};
                 r.origin = origin;
                 const glm::vec3 l = local[i];
                 r.direction = glm::normalize(l.x * samples.tangent + l.y * samples.bitangent + l.z * samples.normal);
-                radiance[i] = integrator_.incoming_radiance(r, derive_seed(stream, 0x2e, i), &distance[i]);
-            });
+                w.seeds[i] = derive_seed(stream, 0x2e, i);
+            }
+            integrator_.incoming_radiance(w.rays, w.seeds, radiance, distance);
             for (std::size_t i = 0; i < count; ++i)
                 h.add(cell_of[i], jitter[i], local[i], radiance[i], std::max(distance[i], eps));
             used += count;
         }
-        return {estimate_hemisphere(h.fine_samples(), kind_), std::uint32_t(used)};
+        const bounce::hemisphere_samples fine = h.fine_samples();
+        return {estimate_hemisphere(fine, w.strata_for(fine.rings, fine.wedges), kind_, needs_hessian()), std::uint32_t(used)};
     }
 
     // Distinct points get independent streams, the same point the same stream.
