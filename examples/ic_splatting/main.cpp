@@ -167,6 +167,44 @@ std::uint32_t monte_carlo_max_spp(const options& o) {
     return o.raw_equal_error ? std::max(1u, o.ref_spp / 2) : 4u * o.ref_spp;
 }
 
+// The adaptive-rays settings the options ask for (enabled = false without --adaptive-rays).
+// The floor is in units of the scene's mean irradiance, measured from the first rounds of
+// 256 points of the camera's view (timed as the setup stage "irradiance_scale").
+adaptive_rays adaptive_settings(const options& o, const embree::accel& bvh, const io::scene& scene,
+                                const embree::reference_integrator& integrator, const radius_limits& limits,
+                                study::stage_timer& setup) {
+    adaptive_rays a;
+    if (!o.adaptive_rays) return a;
+    if (o.sampler != "embree") throw parameter_error("--adaptive-rays", "needs the Embree sampler");
+    if (o.ray_rates)
+        throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --adaptive-rays");
+    if (!o.a_sweep.empty())
+        throw parameter_error("--a-sweep", "adaptive rays aim at a standard error tied to a: sweep a over separate runs");
+    a.enabled = true;
+    a.min_rays = o.min_record_samples;
+    a.max_rays = o.record_samples;
+    a.target = double(o.record_error) * o.a;
+    if (o.record_error_floor > 0.f) {
+        setup.time("irradiance_scale", [&] {
+            gbuffer<float> frame = embree::ray_cast_gbuffer(bvh, scene, scene.camera, 64, 64);
+            const gbuffer_view<float> g = frame.view();
+            std::vector<glm::vec3> p, n;
+            for (std::size_t y = 0; y < g.height(); y += 4)
+                for (std::size_t x = 0; x < g.width(); x += 4)
+                    if (g.covered(x, y)) {
+                        p.push_back(g.position(x, y));
+                        n.push_back(g.normal(x, y));
+                    }
+            adaptive_rays first = a;
+            first.irradiance_floor = 0.0;
+            const embree::record_sampler probe(integrator, first, limits);
+            a.irradiance_floor = double(o.record_error_floor) * probe.mean_irradiance(p, n);
+        });
+    }
+    a.validate();
+    return a;
+}
+
 template <class W>
 int run_with(const options& o) {
     if (o.falloff_kappa != 1.f && o.sampler != "raster")
@@ -195,8 +233,12 @@ int run_with(const options& o) {
             throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
         limits.policy = radius_policy::hessian;
         limits.hessian_a = o.a;
+        limits.hessian_gradients = o.gradients;  // the error model follows the interpolation in use
     }
-    const embree::record_sampler embree_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
+    const adaptive_rays adaptive = adaptive_settings(o, bvh, scene, integrator, limits, setup);
+    const embree::record_sampler embree_sampler = o.adaptive_rays
+        ? embree::record_sampler(integrator, adaptive, limits)
+        : embree::record_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     chosen_sampler sampler = std::cref(embree_sampler);
     cpu::irradiance_cache_options cache_options = cache_options_for(o, o.a);
     const auto [lo, hi] = scene.bounds();
@@ -317,6 +359,8 @@ int run_with(const options& o) {
                          {"shadow_resolution", o.shadow_resolution},
                          {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
                          {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"radius", o.radius},
+                         {"adaptive_rays", o.adaptive_rays}, {"min_record_samples", o.min_record_samples},
+                         {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
                          {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
                          {"max_extrapolation", o.max_extrapolation},
                          {"front_tolerance", o.front_tolerance},
@@ -619,6 +663,14 @@ int run_with(const options& o) {
     }
 
     if (!o.cache_out.empty()) study::save_records(o.cache_out, cache.records(), cache_params);
+    if (o.sampler == "embree") {
+        // Hemisphere rays per record measured in this run (adaptive or fixed; --ray-rates' re-measures included).
+        const auto t = embree_sampler.rays_cast();
+        extra["rays_per_record"] = {{"mean", t.mean()}, {"fewest", t.fewest}, {"most", t.most}, {"records", t.records},
+                                    {"irradiance_floor", adaptive.irradiance_floor}};
+        fmt::print("rays per record: mean {:.0f} (fewest {}, most {}) over {} records measured\n", t.mean(), t.fewest,
+                   t.most, t.records);
+    }
     if (loaded) report.set_count("records_loaded", loaded);
     fmt::print("{} records; total {:.1f} ms", cache.records().size(), timer.median_ms("total"));
     if (report.error) fmt::print("; indirect rel_rms {:.4f}", report.error->rel_rms);

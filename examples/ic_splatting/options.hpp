@@ -38,6 +38,10 @@ struct options {
     std::uint32_t record_samples = 1024, ref_spp = 1024;
     float min_pixels = 1.5f, max_pixels = 64.f;
     std::string radius = "split-sphere";  // split-sphere | hessian (radius_policy)
+    bool adaptive_rays = false;              // records from min_record_samples up to record_samples rays
+    std::uint32_t min_record_samples = 256;  // adaptive: the first round's rays
+    float record_error = 0.2f;               // adaptive: target relative standard error of E, times a
+    float record_error_floor = 1.f;          // adaptive: irradiance floor, times the scene's mean irradiance
     bool neighbour_clamp = true;
     std::string scan = "batched";
     std::string scan_order;  // linear | coarse-to-fine; empty: linear, coarse-to-fine when progressive
@@ -93,7 +97,11 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
             {"shadow_resolution", o.sampler == "raster" ? o.shadow_resolution : 0},  // the raster's records see the maps
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
             {"gradient_limit", o.gradient_limit}, {"height", o.height}, {"radius", o.radius},
-            {"hessian_a", o.radius == "hessian" ? o.a : 0.f}};
+            {"hessian_a", o.radius == "hessian" ? o.a : 0.f},
+            {"hessian_rule", o.radius == "hessian" ? "total-error" : ""},  // radii of the first, edge-bound rule differ {"adaptive_rays", o.adaptive_rays},
+            {"min_record_samples", o.adaptive_rays ? o.min_record_samples : 0u},
+            {"record_error", o.adaptive_rays ? o.record_error * o.a : 0.f},
+            {"record_error_floor", o.adaptive_rays ? o.record_error_floor : 0.f}};
 }
 
 /// Declares every option on `app`, writing into `o` (and `gradients`: "on" or "off").
@@ -133,7 +141,22 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--a-sweep", o.a_sweep, "comma-separated a values rendered from one growing cache")
         ->delimiter(',')
         ->check(examples::finite_positive);
-    app.add_option("--record-samples", o.record_samples, "hemisphere rays per record")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
+    app.add_option("--record-samples", o.record_samples, "hemisphere rays per record (--adaptive-rays: the most)")->check(CLI::Range(4u, 1u << 20))->capture_default_str();
+    app.add_flag("--adaptive-rays,!--no-adaptive-rays", o.adaptive_rays,
+                 "records refine their strata until the standard error of E is below --record-error * a * max(E, floor) "
+                 "(docs/irradiance-splatting.md, \"Adaptive rays per record\")")
+        ->capture_default_str();
+    app.add_option("--min-record-samples", o.min_record_samples, "adaptive rays: the first round's rays per record")
+        ->check(CLI::Range(4u, 1u << 20))
+        ->capture_default_str();
+    app.add_option("--record-error", o.record_error, "adaptive rays: target relative standard error of a record's E, in units of a")
+        ->check(examples::finite_positive)
+        ->capture_default_str();
+    app.add_option("--record-error-floor", o.record_error_floor,
+                   "adaptive rays: irradiance below which the target is absolute, in units of the scene's mean irradiance "
+                   "(from 256 points of the camera's view)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
     app.add_option("--ref-spp", o.ref_spp,
                    "reference integrator samples per pixel, as two independent halves of N/2 (even; their difference "
                    "measures the reference's own noise, which the debiased error takes out)")
