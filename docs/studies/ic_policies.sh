@@ -40,9 +40,9 @@ scene() {  # scene TAG SCENE REFSPP MC_A A...: each configuration over the a val
 }
 
 walkthrough() {  # the 30-frame Sponza walkthrough: one cache grown along the camera path, Monte Carlo at
-  # each measured frame's error (every 6th frame; 512-spp references in halves, debiased errors)
-  run "sponza-$size-walkthrough30" --scene sponza --width "$size" --height "$size" --walkthrough 30 --ref-spp 512 \
-    --walkthrough-mc-stride 6
+  # each measured frame's error (every 10th frame; 512-spp references in halves, debiased errors)
+  run "sponza-$size-walkthrough30" --scene sponza --width "$size" --height "$size" --a 0.15 --walkthrough 30 \
+    --ref-spp 512 --walkthrough-mc-stride 10
 }
 
 case "$which" in

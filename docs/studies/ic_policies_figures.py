@@ -82,6 +82,8 @@ def main(results_path, outdir):
 
     os.makedirs(outdir, exist_ok=True)
     for scene, s in sorted(scenes.items()):
+        if not s["series"]:
+            continue  # a walkthrough's run alone: no curve to draw
         fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=100)
         any_debiased = False
         for name, points in sorted(s["series"].items()):
