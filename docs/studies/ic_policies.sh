@@ -18,12 +18,7 @@ size="${SIZE:-512}"
 which="${1:-all}"
 mkdir -p build/runs docs/figures
 
-run() {  # run NAME ARGS...: one measured run, added to the results file under NAME
-  local name=$1; shift
-  echo "== $name: $*"
-  "$bin" "$@" --json "build/runs/$name.json"
-  python3 docs/studies/results.py add "$results" "$name" "build/runs/$name.json"
-}
+source docs/studies/run.sh  # run NAME ARGS...: one measured run, added to the results file
 
 scene() {  # scene TAG SCENE REFSPP MC_A A...: each configuration over the a values; Monte Carlo's
   # spp sweep with the split sphere's 1024-ray run at MC_A (every run's equal-error time is read

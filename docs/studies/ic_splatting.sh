@@ -11,12 +11,7 @@ which="${1:-all}"
 results=docs/results/ic_splatting.json
 mkdir -p build/runs docs/figures
 
-run() {  # run NAME ARGS...: one measured run, added to the results file under NAME
-  local name=$1; shift
-  echo "== $name: $*"
-  "$bin" "$@" --json "build/runs/$name.json"
-  python3 docs/studies/results.py add "$results" "$name" "build/runs/$name.json"
-}
+source docs/studies/run.sh  # run NAME ARGS...: one measured run, added to the results file
 
 rays() {  # rays TAG ARGS...: gradients on/off and Ward's weight with 4096 rays per record (less record noise)
   local tag=$1; shift
