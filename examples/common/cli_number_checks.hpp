@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
@@ -38,15 +39,17 @@ inline CLI::Validator finite_number_at_least_zero(bool zero_allowed) {
         zero_allowed ? "FINITE >= 0" : "FINITE > 0");
 }
 
-/// A number in [lo, hi] (or [lo, hi) when `hi` is excluded), called `what` in refusals.
-inline CLI::Validator number_in(double lo, double hi, bool hi_included, const std::string& what) {
+/// A number in [lo, hi] (or with `lo` or `hi` excluded: (lo, hi], [lo, hi)), called `what`
+/// in refusals, which print the bounds as given ("'1' is not a support in (1, 16]").
+inline CLI::Validator number_in(double lo, double hi, bool hi_included, const std::string& what,
+                                bool lo_included = true) {
     std::ostringstream text;
-    text << '[' << lo << ", " << hi << (hi_included ? ']' : ')');
+    text << std::setprecision(15) << (lo_included ? '[' : '(') << lo << ", " << hi << (hi_included ? ']' : ')');
     const std::string range = text.str();
     return CLI::Validator(
         [=](std::string& s) -> std::string {
             const double v = parse_number(s);
-            if (v >= lo && (v < hi || (hi_included && v == hi))) return {};
+            if ((v > lo || (lo_included && v == lo)) && (v < hi || (hi_included && v == hi))) return {};
             return "'" + s + "' is not " + what + " in " + range;
         },
         "IN " + range);

@@ -8,6 +8,7 @@
 #include "../common/cli_number_checks.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -25,7 +26,7 @@ struct options {
     std::size_t rsm_resolution = 256;  // texels per side of each map (cube face)
     std::string selection = "warping"; // SII VPLs: warping (DS06 section 3.3) | grid
     float r_max = 1.5f;                // RSM gather disc radius, map units
-    float clamp = -1.f;                // d^2 clamped at clamp^2 (m); < 0: 1% of the scene's diagonal
+    float clamp = -1.f;                // d^2 clamped at clamp^2 (scene units); unset (< 0): scene_clamp_distance
     float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
     bool blur = true;
     bool thesis_weights = false;       // interleaved lights at weight 1 (Hahn 2012), not N M
@@ -60,9 +61,11 @@ inline light_assignment parse_assign(const std::string& s) {
     throw parameter_error("--assign", "unknown assignment '" + s + "'");
 }
 
-/// The renderer's options for a run of `technique` with `count` lights and `pattern`.
+/// The renderer's options for a run of `technique` with `count` lights and `pattern`,
+/// validated; a refusal names the flag that set the field (--vpls, --pattern, --r-max,
+/// --clamp, --offset, --seed) rather than the library's field.
 inline indirect_options indirect_options_for(const options& o, const std::string& technique, std::size_t count,
-                                                  interleave_pattern pattern, float clamp_distance) {
+                                             interleave_pattern pattern, float clamp_distance) {
     indirect_options c;
     c.technique = technique == "rsm" ? indirect_technique::rsm_gather : indirect_technique::sii;
     c.count = count;
@@ -75,9 +78,44 @@ inline indirect_options indirect_options_for(const options& o, const std::string
     c.light.offset = o.offset;
     c.light.min_distance2 = clamp_distance * clamp_distance;
     c.seed = o.seed;
-    c.validate();
+    try {
+        c.validate();
+    } catch (const parameter_error& e) {
+        const std::string& f = e.parameter();
+        const std::string flag = f == "count"                      ? "--vpls"
+                                 : f.rfind("pattern", 0) == 0      ? "--pattern"
+                                 : f == "r_max"                    ? "--r-max"
+                                 : f == "min_distance2"            ? "--clamp"
+                                 : f == "offset"                   ? "--offset"
+                                                                   : f;
+        const std::string what = e.what();
+        const auto at = what.find("': ");
+        throw parameter_error(flag, at == std::string::npos ? what : what.substr(at + 3));
+    }
     return c;
 }
+
+/// A whole number in [0, 2^64), spelled in decimal digits only (CLI11 would take "-1" and
+/// wrap it to 2^64 - 1).
+inline const CLI::Validator unsigned_64 = CLI::Validator(
+    [](std::string& s) -> std::string {
+        const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) {
+            return c >= '0' && c <= '9';
+        });
+        if (digits && (s.size() < 20 || s <= "18446744073709551615")) return {};
+        return "'" + s + "' is not a whole number in [0, 18446744073709551615]";
+    },
+    "UINT64");
+
+/// An even number of rays per pixel in [2, 2^20] (the unoccluded reference is two halves).
+inline const CLI::Validator even_ref_spp = CLI::Validator(
+    [](std::string& s) -> std::string {
+        const double v = examples::detail::parse_number(s);
+        if (v >= 2 && v <= double(1u << 20) && v == std::floor(v) && std::fmod(v, 2.0) == 0) return {};
+        return "'" + s + "' is not an even number of rays in [2, 1048576] (the unoccluded reference is two halves of "
+               "equal size)";
+    },
+    "EVEN IN [2, 1048576]");
 
 inline void add_options(CLI::App& app, options& o) {
     app.add_option("--technique", o.technique, "rsm (the RSM gather, DS05) | sii (splatting indirect illumination, DS06)")
@@ -102,19 +140,21 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(CLI::IsMember({"warping", "grid"}))
         ->capture_default_str();
     app.add_option("--r-max", o.r_max, "RSM gather disc radius in map units, (0, 2]; 1.5 reaches the whole map")
-        ->check(examples::detail::number_in(0, 2, true, "a radius"))
+        ->check(examples::detail::number_in(0, 2, true, "a radius", /*lo_included=*/false))
         ->capture_default_str();
     app.add_option("--clamp", o.clamp,
-                   "sender-receiver distance below which 1/d^2 is clamped (scene units); default 1% of the scene's diagonal");
+                   "sender-receiver distance below which 1/d^2 is clamped (scene units, >= 0; 0: no clamp); "
+                   "default 1% of the scene's bounding-box diagonal (scene_clamp_distance)")
+        ->check(examples::finite_non_negative);
     app.add_option("--offset", o.offset, "senders moved this far along -n_p (scene units; DS05's remedy)")
         ->check(examples::finite_non_negative)
         ->capture_default_str();
     app.add_flag("!--no-blur", o.blur, "skip the geometry-aware blur after interleaving");
     app.add_flag("--thesis-weights", o.thesis_weights,
                  "interleaved lights at weight 1 as in Hahn 2012 (loses 1 - 1/(N M) of the energy), not N M");
-    app.add_option("--seed", o.seed, "seed of the VPLs and of the disc pattern")->capture_default_str();
+    app.add_option("--seed", o.seed, "seed of the VPLs and of the disc pattern")->check(unsigned_64)->capture_default_str();
     app.add_option("--ref-spp", o.ref_spp, "rays per pixel of the references (with and without indirect visibility)")
-        ->check(CLI::Range(2u, 1u << 20))
+        ->check(even_ref_spp)
         ->capture_default_str();
     app.add_option("--repeat", o.repeat, "renders per run (timings are medians)")->check(CLI::Range(1, 1000))->capture_default_str();
     app.add_flag("--study", o.study,

@@ -9,10 +9,15 @@
 
 #include <bounce/errors.hpp>
 #include <bounce/interleaved_sampling.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 
 namespace bounce {
 
@@ -38,6 +43,8 @@ struct pixel_light_params {
     float offset = 0.f;         ///< sender moved along -n_p (m, >= 0; typical: half a texel footprint)
     float min_distance2 = 0.f;  ///< d^2 clamped below at this (m^2, >= 0; typical: texel footprint^2)
 
+    bool operator==(const pixel_light_params&) const = default;
+
     void validate() const {
         require(std::isfinite(offset) && offset >= 0.f, "offset", "must be finite and >= 0");
         require(std::isfinite(min_distance2) && min_distance2 >= 0.f, "min_distance2", "must be finite and >= 0");
@@ -48,6 +55,8 @@ struct pixel_light_params {
 struct discontinuity_params {
     float relative_depth = 0.05f;  ///< depth step, relative to the nearer depth (typical: 0.02-0.1)
     float cos_normal = 0.9f;       ///< smallest cosine between normals of one surface (typical: 0.9, 25 deg)
+
+    bool operator==(const discontinuity_params&) const = default;
 
     void validate() const {
         require(std::isfinite(relative_depth) && relative_depth >= 0.f, "relative_depth", "must be finite and >= 0");
@@ -61,6 +70,15 @@ struct upsample_params {
     float cos_normal = 0.9f;       ///< smallest cosine between a sample's normal and the pixel's (typical: 0.9)
     float plane_footprints = 2.f;  ///< largest distance to the pixel's tangent plane, in low-resolution pixel
                                    ///< footprints at the pixel's depth (typical: 1-4)
+
+    bool operator==(const upsample_params&) const = default;
+
+    void validate() const {
+        require(std::isfinite(cos_normal) && cos_normal >= -1.f && cos_normal <= 1.f, "upsample.cos_normal",
+                "must lie in [-1, 1]");
+        require(std::isfinite(plane_footprints) && plane_footprints > 0.f, "upsample.plane_footprints",
+                "must be finite and > 0");
+    }
 };
 
 /// What an indirect renderer does per frame.
@@ -89,10 +107,24 @@ struct indirect_options {
     upsample_params upsample;
     std::uint64_t seed = 1;  ///< disc pattern and VPL sampling
 
-    /// Throws parameter_error naming the first bad field.
+    /// Field by field: two option sets that compare equal make the same frames (a caller
+    /// keeps its renderer between them; gl::offscreen_indirect_renderer does).
+    bool operator==(const indirect_options&) const = default;
+
+    /// Throws parameter_error naming the first bad field. `count` must be at least the
+    /// pattern's N M sub-buffers: each sub-buffer shades with count / (N M) lights or disc
+    /// samples, so fewer would leave sub-buffers (and the whole image, after the gather)
+    /// without light.
     void validate() const {
         require(count > 0 && count <= (std::size_t(1) << 24), "count", "must lie in [1, 2^24]");
         pattern.validate();
+        if (count < std::size_t(pattern.cells()))
+            throw parameter_error("count", std::to_string(count) + (technique == indirect_technique::sii
+                                                                        ? " VPLs are fewer than the "
+                                                                        : " disc samples are fewer than the ") +
+                                               std::to_string(pattern.cells()) + " sub-buffers of the " +
+                                               std::to_string(pattern.n) + "x" + std::to_string(pattern.m) +
+                                               " interleave pattern: each sub-buffer needs at least one");
         require(shift >= 0 && shift < pattern.cells(), "shift", "must lie in [0, N M)");
         discontinuity.validate();
         require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
@@ -101,8 +133,19 @@ struct indirect_options {
         require(low_resolution >= 1 && low_resolution <= 8, "low_resolution", "must lie in [1, 8]");
         require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
                 "applies to the RSM gather only");
+        upsample.validate();
     }
 };
+
+/// The default distance below which the pixel-light irradiance's 1/d^2 is clamped for a
+/// scene (pixel_light_params::min_distance2 = its square): 1% of the diagonal of the scene's
+/// bounding box, so that the clamp scales with the scene (the same in millimetres as in
+/// metres); 0 for an empty scene. rsm_sii's default and the benchmark's.
+inline float scene_clamp_distance(const scene_view& scene) {
+    if (scene.positions.empty()) return 0.f;
+    const auto [lo, hi] = scene.bounds();
+    return 0.01f * float(glm::length(glm::dvec3(hi) - glm::dvec3(lo)));
+}
 
 /// Per-stage wall-clock times of one frame (milliseconds) and its counts. On GL the times
 /// are the GPU's only when the renderer finishes after each stage (gl::indirect_renderer's

@@ -201,6 +201,7 @@ struct interleave_pattern {
     int n = 4, m = 4;
 
     int cells() const noexcept { return n * m; }
+    bool operator==(const interleave_pattern&) const = default;
     /// Throws parameter_error unless 1 <= n, m <= 64 (the range the float maps are exact
     /// for; see the file comment).
     void validate() const {

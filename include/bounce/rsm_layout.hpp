@@ -170,8 +170,13 @@ inline std::vector<rsm_map_layout> rsm_layout(std::span<const light> lights, con
     validate_lights(lights, "lights");
     const std::size_t r = settings.resolution;
     const glm::vec3 centre = 0.5f * (lo + hi);
-    // A little beyond the bounding sphere, so that rays start outside the scene.
-    const float radius = std::max(0.5f * glm::length(hi - lo) * 1.001f, 1e-3f);
+    // A little beyond the bounding sphere, so that rays start outside the scene. The floor is
+    // relative to where the scene lies (a map smaller than float's rounding of its positions
+    // would say nothing) and only an all-in-one-point scene meets the absolute 1e-15 (the
+    // smallest radius whose squared eye distance float still holds): a scene of a tenth of a
+    // millimetre gets a map of its own size, not one of 1e-3 units (the former floor).
+    const float far_corner = std::max(glm::length(lo), glm::length(hi));
+    const float radius = std::max(0.5f * glm::length(hi - lo) * 1.001f, std::max(1e-6f * far_corner, 1e-15f));
     std::vector<rsm_map_layout> out;
     for (std::size_t i = 0; i < lights.size(); ++i) {
         const packed_light l = pack(lights[i]);

@@ -432,3 +432,89 @@ TEST_CASE("bad options and sizes raise parameter_error naming the parameter", "[
     auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
     CHECK(name_of([&] { r.render(gbv, s.cam, maps, wrong.view()); }) == "irradiance");
 }
+
+TEST_CASE("more sub-buffers than lights is refused by the options, naming both numbers", "[indirect]") {
+    // 16 VPLs over 64 x 64 sub-buffers left 4080 sub-buffers dark: a black image, no error.
+    const auto message_of = [](const indirect_options& o) {
+        try {
+            o.validate();
+        } catch (const parameter_error& e) {
+            return e.parameter() + ": " + e.what();
+        }
+        return std::string("(nothing thrown)");
+    };
+    indirect_options o;
+    o.count = 16;
+    o.pattern = {64, 64};
+    const std::string sii = message_of(o);
+    CHECK_THAT(sii, Catch::StartsWith("count: "));
+    CHECK_THAT(sii, Catch::Contains("16 VPLs") && Catch::Contains("4096 sub-buffers") && Catch::Contains("64x64"));
+    o.technique = indirect_technique::rsm_gather;
+    o.count = 15;
+    o.pattern = {4, 4};
+    CHECK_THAT(message_of(o), Catch::Contains("15 disc samples") && Catch::Contains("16 sub-buffers"));
+    // Every renderer gets it: the CPU renderer's constructor and set_options.
+    CHECK_THROWS_AS(cpu::indirect_renderer(o), parameter_error);
+    cpu::indirect_renderer r;
+    CHECK_THROWS_AS(r.set_options(o), parameter_error);
+    CHECK(r.options() == indirect_options{});  // the old options stay
+    o.count = 16;  // one per sub-buffer is enough
+    CHECK(message_of(o) == "(nothing thrown)");
+    CHECK_NOTHROW(r.set_options(o));
+}
+
+TEST_CASE("options compare field by field, and a renderer given new options renders as a new one", "[indirect]") {
+    const indirect_options a;
+    CHECK(a == indirect_options{});
+    // Each field, nested ones included, makes two option sets differ.
+    const std::vector<void (*)(indirect_options&)> changes = {
+        [](indirect_options& o) { o.technique = indirect_technique::rsm_gather; },
+        [](indirect_options& o) { o.count = 401; },
+        [](indirect_options& o) { o.pattern.n = 2; },
+        [](indirect_options& o) { o.pattern.m = 2; },
+        [](indirect_options& o) { o.assignment = light_assignment::blocked; },
+        [](indirect_options& o) { o.shift = 1; },
+        [](indirect_options& o) { o.blur = false; },
+        [](indirect_options& o) { o.energy_correct = false; },
+        [](indirect_options& o) { o.discontinuity.relative_depth = 0.1f; },
+        [](indirect_options& o) { o.discontinuity.cos_normal = 0.8f; },
+        [](indirect_options& o) { o.selection = vpl_selection::grid; },
+        [](indirect_options& o) { o.r_max = 1.f; },
+        [](indirect_options& o) { o.disc = disc_weighting::xi1_squared; },
+        [](indirect_options& o) { o.light.offset = 0.1f; },
+        [](indirect_options& o) { o.light.min_distance2 = 0.1f; },
+        [](indirect_options& o) { o.sii_cutoff = 1.f; },
+        [](indirect_options& o) { o.low_resolution = 2; },
+        [](indirect_options& o) { o.upsample.cos_normal = 0.8f; },
+        [](indirect_options& o) { o.upsample.plane_footprints = 3.f; },
+        [](indirect_options& o) { o.seed = 2; },
+    };
+    for (std::size_t i = 0; i < changes.size(); ++i) {
+        indirect_options b;
+        changes[i](b);
+        INFO("change " << i);
+        CHECK_FALSE(a == b);
+    }
+    // One renderer switched between option sets gives what a fresh renderer gives for each
+    // (the disc pattern is redrawn when r_max or the seed change, not only the count).
+    const corner_scene s(24, 18);
+    const rsm_view maps[] = {s.map()};
+    auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
+    cpu::indirect_renderer shared;
+    image<glm::vec3> out(s.gb.width(), s.gb.height());
+    for (const auto technique : {indirect_technique::rsm_gather, indirect_technique::sii})
+        for (const std::uint64_t seed : {1u, 7u})
+            for (const float r_max : {1.5f, 0.5f}) {
+                indirect_options o;
+                o.technique = technique;
+                o.count = 64;
+                o.seed = seed;
+                o.r_max = r_max;
+                shared.render(o, gbv, s.cam, maps, out.view());
+                const image<glm::vec3> fresh = render(s, o);
+                bool same = true;
+                for (std::size_t y = 0; y < out.height(); ++y)
+                    for (std::size_t x = 0; x < out.width(); ++x) same = same && out(x, y) == fresh(x, y);
+                CHECK(same);
+            }
+}

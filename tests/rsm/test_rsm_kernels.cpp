@@ -341,6 +341,26 @@ TEST_CASE("rsm_layout: six faces per point light, one map or the reachable faces
     CHECK_THROWS_AS((rsm_layout_settings{64, 90.f}.validate()), parameter_error);
 }
 
+TEST_CASE("rsm_layout: a directional light's map has the scene's size at any scale", "[rsm][layout]") {
+    // A scene of 1e-4 units (a tenth of a millimetre in metres) had a map of radius 1e-3 (a
+    // fixed floor): the scene covered 1% of its texels. The map follows the bounds now.
+    const std::vector<light> sun{directional_light{{0.f, -1.f, 0.f}, glm::vec3(1.f)}};
+    for (const float size : {1e-6f, 1e-4f, 1.f, 1e4f, 1e12f}) {
+        const glm::vec3 lo(0.f), hi(size);
+        const auto maps = rsm_layout(sun, lo, hi, rsm_layout_settings{64, 60.f});
+        REQUIRE(maps.size() == 1);
+        const float bounding = 0.5f * std::sqrt(3.f) * size;
+        INFO("scene size " << size);
+        CHECK(maps[0].radius >= bounding);
+        CHECK(maps[0].radius <= 1.01f * bounding);
+    }
+    // A scene in one point still gets a usable (finite, non-degenerate) map.
+    const auto point = rsm_layout(sun, glm::vec3(0.f), glm::vec3(0.f), rsm_layout_settings{64, 60.f});
+    CHECK(point[0].radius > 0.f);
+    CHECK(std::isfinite(point[0].light_view_projection[0][0]));
+    CHECK(std::isfinite(point[0].light_view_projection[3][2]));
+}
+
 TEST_CASE("rsm_layout: the texel solid angles of a cube face sum to 4 pi / 6", "[rsm][layout]") {
     const double t = std::tan(0.25 * std::numbers::pi);
     double sum = 0;

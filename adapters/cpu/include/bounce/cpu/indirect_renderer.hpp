@@ -39,6 +39,25 @@ public:
 
     const indirect_options& options() const noexcept { return options_; }
 
+    /// Validates and takes `options` for the next frames; the scratch buffers stay (they
+    /// depend on the image size and pattern only), the disc pattern is redrawn when the
+    /// options differ. Throws parameter_error naming the bad field (the old options stay).
+    void set_options(const indirect_options& options) {
+        options.validate();
+        if (options == options_) return;
+        options_ = options;
+        full_pattern_.clear();
+        pattern_texels_ = 0;
+    }
+
+    /// set_options(options), then render(gb, cam, maps, irradiance): the call
+    /// gl::offscreen_indirect_renderer offers too, so a caller switches backends by type.
+    indirect_timings render(const indirect_options& options, const gbuffer_view<float>& gb, const camera& cam,
+                            std::span<const rsm_view> maps, image_view<glm::vec3> irradiance) {
+        set_options(options);
+        return render(gb, cam, maps, irradiance);
+    }
+
     /// Fills `irradiance` (the G-buffer's size) with the one-bounce indirect irradiance that
     /// `maps` (one per spot or directional light, six per point light) reflect onto the
     /// G-buffer's pixels, unoccluded; 0 where the G-buffer sees nothing.
@@ -139,7 +158,7 @@ private:
         }
         // One pattern for every map, sized for the first (maps of one light share a size).
         const std::size_t texels = maps[0].width() * maps[0].height();
-        if (full_pattern_.size() != options_.count || pattern_texels_ != texels) {
+        if (full_pattern_.empty() || pattern_texels_ != texels) {
             full_pattern_ = rsm_disc_pattern(options_.count, options_.r_max, texels, options_.seed, options_.disc);
             pattern_texels_ = texels;
         }
