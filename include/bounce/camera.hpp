@@ -28,6 +28,13 @@ struct camera {
     void validate() const {
         require(std::isfinite(fov_y_deg) && fov_y_deg > 0.f && fov_y_deg < 180.f, "fov_y_deg",
                 "must lie in (0, 180)");
+        const auto bounded = [](glm::vec3 v) {
+            return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::abs(v.x) <= 1e18f &&
+                   std::abs(v.y) <= 1e18f && std::abs(v.z) <= 1e18f;
+        };
+        // 1e18: max_world_coordinate (light.hpp), what float32 rays carry.
+        require(bounded(position), "camera.position", "must be finite with coordinates within +-1e18");
+        require(bounded(look_at), "camera.look_at", "must be finite with coordinates within +-1e18");
         require(glm::length(look_at - position) > 0.f, "look_at", "coincides with the camera position");
         require(glm::length(glm::cross(look_at - position, up)) > 0.f, "up", "parallel to the view axis");
         require(near_plane > 0.f && far_plane > near_plane, "near_plane/far_plane", "need 0 < near < far");

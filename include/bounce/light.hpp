@@ -64,14 +64,28 @@ struct packed_light {
 };
 static_assert(sizeof(packed_light) == 48, "packed_light is three std430 vec4s");
 
+/// The largest magnitude of a world coordinate (vertices, lights, cameras) that every backend
+/// carries: Embree's rays need |origin| and |direction| components below 1.844e18, and with
+/// coordinates up to 1e18 a squared distance (at most 12e36) still fits a float32.
+inline constexpr float max_world_coordinate = 1e18f;
+
+/// The largest light intensity (W/sr) or irradiance (W/m^2) accepted: float32 ends at 3.4e38,
+/// and 1e30 leaves eight orders of magnitude for inverse-square gains and sums of many lights.
+inline constexpr float max_light_value = 1e30f;
+
 namespace detail {
 inline bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 inline bool non_negative3(glm::vec3 v) { return finite3(v) && v.x >= 0.f && v.y >= 0.f && v.z >= 0.f; }
+/// Finite, every component's magnitude at most `bound`.
+inline bool bounded3(glm::vec3 v, float bound) {
+    return finite3(v) && std::abs(v.x) <= bound && std::abs(v.y) <= bound && std::abs(v.z) <= bound;
+}
+inline bool light_value3(glm::vec3 v) { return non_negative3(v) && bounded3(v, max_light_value); }
 }  // namespace detail
 
 /// Throws parameter_error naming `<name>[i]` and the field unless every light can be rendered:
-/// finite positions, finite non-negative intensities and irradiances, finite non-zero
-/// directions, spot cones in (0, 180] degrees.
+/// positions within max_world_coordinate, intensities and irradiances finite, non-negative
+/// and at most max_light_value, finite non-zero directions, spot cones in (0, 180] degrees.
 inline void validate_lights(std::span<const light> lights, const std::string& name = "scene.lights") {
     for (std::size_t i = 0; i < lights.size(); ++i) {
         const std::string at = name + "[" + std::to_string(i) + "]";
@@ -79,18 +93,25 @@ inline void validate_lights(std::span<const light> lights, const std::string& na
         const auto check_direction = [&](glm::vec3 d) {
             if (!detail::finite3(d) || glm::length(d) == 0.f) fail("direction must be finite and non-zero");
         };
+        const auto check_position = [&](glm::vec3 p) {
+            if (!detail::bounded3(p, max_world_coordinate))
+                fail("position must be finite with coordinates within +-1e18 (what float32 rays carry)");
+        };
+        const auto check_value = [&](glm::vec3 v, const char* what) {
+            if (!detail::light_value3(v)) fail(what);
+        };
         if (const auto* pl = std::get_if<point_light>(&lights[i])) {
-            if (!detail::finite3(pl->position)) fail("position is not finite");
-            if (!detail::non_negative3(pl->intensity)) fail("intensity must be finite and non-negative");
+            check_position(pl->position);
+            check_value(pl->intensity, "intensity must be finite, non-negative and at most 1e30 W/sr");
         } else if (const auto* sl = std::get_if<spot_light>(&lights[i])) {
-            if (!detail::finite3(sl->position)) fail("position is not finite");
-            if (!detail::non_negative3(sl->intensity)) fail("intensity must be finite and non-negative");
+            check_position(sl->position);
+            check_value(sl->intensity, "intensity must be finite, non-negative and at most 1e30 W/sr");
             check_direction(sl->direction);
             if (!(std::isfinite(sl->cone_deg) && sl->cone_deg > 0.f && sl->cone_deg <= 180.f))
                 fail("cone_deg must lie in (0, 180]");
         } else {
             const auto& dl = std::get<directional_light>(lights[i]);
-            if (!detail::non_negative3(dl.irradiance)) fail("irradiance must be finite and non-negative");
+            check_value(dl.irradiance, "irradiance must be finite, non-negative and at most 1e30 W/m^2");
             check_direction(dl.direction);
         }
     }

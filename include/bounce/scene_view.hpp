@@ -38,17 +38,21 @@ struct scene_view {
     bool use_emission = false;  ///< triangles whose material has emission > 0 are area lights too
 
     /// Throws parameter_error naming the span at fault ("scene.positions", "scene.triangles"
-    /// ...) unless the mesh is consistent and finite: finite positions and normals, normals
+    /// ...) unless the mesh is consistent and finite: positions within max_world_coordinate
+    /// (light.hpp), finite normals, normals
     /// empty or one per position, indices in range, one material index per triangle and each
-    /// in range, albedo and emission finite and non-negative, and fewer than 2^32 - 1
+    /// in range, albedo and emission finite and non-negative (emission at most max_light_value), and fewer than 2^32 - 1
     /// vertices and triangles (32-bit indices on every backend). Degenerate (zero-area)
     /// triangles are allowed: backends give them no hits and no light.
     void validate_mesh() const {
         using detail::finite3;
         const std::size_t nv = positions.size(), nt = triangles.size();
         for (std::size_t i = 0; i < nv; ++i)
-            if (!finite3(positions[i]))
-                throw parameter_error("scene.positions", "vertex " + std::to_string(i) + " is not finite");
+            if (!detail::bounded3(positions[i], max_world_coordinate))
+                throw parameter_error("scene.positions", "vertex " + std::to_string(i) +
+                                                             (finite3(positions[i]) ? " has a coordinate beyond +-1e18 "
+                                                                                      "(what float32 rays carry)"
+                                                                                    : " is not finite"));
         if (!normals.empty() && normals.size() != nv)
             throw parameter_error("scene.normals", "has " + std::to_string(normals.size()) + " entries for " +
                                                        std::to_string(nv) + " positions");
@@ -76,9 +80,9 @@ struct scene_view {
             if (!detail::non_negative3(materials[m].albedo))
                 throw parameter_error("scene.materials", "material " + std::to_string(m) +
                                                              " has a negative or non-finite albedo");
-            if (!detail::non_negative3(materials[m].emission))
+            if (!detail::light_value3(materials[m].emission))
                 throw parameter_error("scene.materials", "material " + std::to_string(m) +
-                                                             " has a negative or non-finite emission");
+                                                             " has a negative, non-finite or above-1e30 emission");
         }
     }
 

@@ -91,6 +91,9 @@ std::vector<bad_case> bad_cases() {
     c.push_back(obj_case("coordinate with a tail", "v 0 0 0\nv 1 0 0\nv 0 1x 0\nf 1 2 3\n", 3, "v: expected 3"));
     c.push_back(obj_case("NaN coordinate", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 1, "finite"));
     c.push_back(obj_case("coordinate beyond float", "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 1, "finite"));
+    // A vertex at 1e30 was dropped as "degenerate" before: it is out of range, and said so.
+    c.push_back(obj_case("coordinate beyond what rays carry", "v 0 0 0\nv 1e30 0 0\nv 0 1 0\nf 1 2 3\n", 2,
+                         "v: coordinate 1e30 beyond +-1e18"));
     c.push_back(obj_case("face index past the end", good_obj + "f 1 2 4\n", 5, "refers to vertex 4 but the file has 3"));
     c.push_back(obj_case("face index zero", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 4, "index 0"));
     c.push_back(obj_case("relative index before the first vertex", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", 4,
@@ -114,12 +117,13 @@ std::vector<bad_case> bad_cases() {
         for (int i = 0; i < 300; ++i) big.append(" ").append(std::to_string(1 + i % 3));
         c.push_back(obj_case("face with 300 vertices", big + "\n", 4, "at most 256"));
     }
-    c.push_back({"OBJ alone too large to frame in float",
+    // Refused at its first vertex (before, only when framing it overflowed float).
+    c.push_back({"OBJ alone too large for float32 rays",
                  {{"m.obj", "v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n"}},
                  "m.obj",
                  "m.obj",
-                 0,
-                 "too large"});
+                 1,
+                 "v: coordinate -3e38 beyond +-1e18"});
     // --- MTL files ---
     c.push_back({"missing MTL",
                  {{"m.obj", "# header\nmtllib missing.mtl\n" + good_obj}},
@@ -176,7 +180,16 @@ std::vector<bad_case> bad_cases() {
     c.push_back(json_case("position of length 2", [](json& j) { j["camera"]["position"] = {1, 2}; },
                           "camera.position: expected 3 numbers"));
     c.push_back(json_case("position beyond float", [](json& j) { j["camera"]["position"] = {1e39, 2, 3}; },
-                          "camera.position: expected 3 numbers, finite"));
+                          "camera.position: expected 3 numbers within +-1e18"));
+    // Finite in float, but beyond what Embree's rays carry (an assertion inside Embree before).
+    c.push_back(json_case("camera at 1e19", [](json& j) { j["camera"]["position"] = {1e19, 0, 3}; },
+                          "camera.position: expected 3 numbers within +-1e18"));
+    c.push_back(json_case("look_at at -1e19", [](json& j) { j["camera"]["look_at"] = {0, -1e19, 0}; },
+                          "camera.look_at: expected 3 numbers within +-1e18"));
+    c.push_back(json_case("light at 1e19", [](json& j) { j["lights"][0]["position"] = {0, 0, 1e19}; },
+                          "lights[0].position: expected 3 numbers within +-1e18"));
+    c.push_back(json_case("intensity of 1e38", [](json& j) { j["lights"][0]["intensity"] = {1e38, 1, 1}; },
+                          "lights[0].intensity: expected 3 numbers in [0, 1e30]"));
     c.push_back(json_case("up along the view", [](json& j) { j["camera"]["up"] = {0, 0, 1}; }, "camera.up:"));
     c.push_back(json_case("look_at on the eye", [](json& j) { j["camera"]["look_at"] = {0, 0, 3}; }, "camera.look_at:"));
     c.push_back(json_case("lights not an array", [](json& j) { j["lights"] = json::object(); },
@@ -195,7 +208,7 @@ std::vector<bad_case> bad_cases() {
     c.push_back(json_case("intensity of length 4", [](json& j) { j["lights"][0]["intensity"] = {1, 1, 1, 1}; },
                           "lights[0].intensity: expected 3 numbers"));
     c.push_back(json_case("negative intensity", [](json& j) { j["lights"][0]["intensity"] = {1, -1, 1}; },
-                          "lights[0].intensity: expected 3 numbers >= 0"));
+                          "lights[0].intensity: expected 3 numbers in [0, 1e30]"));
     c.push_back(json_case("cone of zero", [](json& j) { j["lights"][0]["cone_deg"] = 0; },
                           "lights[0].cone_deg: must lie in (0, 180]"));
     c.push_back(json_case("unknown falloff", [](json& j) { j["lights"][0]["falloff"] = "linear"; },

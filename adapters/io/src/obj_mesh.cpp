@@ -129,6 +129,10 @@ obj_survey survey_obj(const fs::path& file, std::string_view text) {
         if (kw == "v") {
             // Three coordinates; a fourth (w) or three more (vertex colour) may follow.
             if (!all_numbers(tok, 1, 3)) throw scene_error(file, ln, "v: expected 3 finite numbers (x y z)");
+            for (std::size_t i = 1; i < 4; ++i)
+                if (std::abs(*parse_float(tok[i])) > max_world_coordinate)
+                    throw scene_error(file, ln, "v: coordinate " + std::string(tok[i]) +
+                                                    " beyond +-1e18, what float32 rays carry (scale the mesh)");
             ++s.positions;
         } else if (kw == "vn") {
             // Zero or overflowing normals are repaired later (face normal), not refused.

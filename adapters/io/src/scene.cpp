@@ -89,8 +89,17 @@ scene load_scene_arg(std::string_view arg) {
     fs::path p{std::string(arg)};
     std::error_code ec;
     // A bare name that is nothing here is a scene folder under scenes_dir() ("sponza").
-    if (!fs::exists(p, ec) && p.has_filename() && p == p.filename() && fs::is_directory(scenes_dir() / p, ec))
-        p = scenes_dir() / p;
+    if (!fs::exists(p, ec) && p.has_filename() && p == p.filename()) {
+        const fs::path under = scenes_dir() / p;
+        if (!fs::is_directory(under, ec)) {
+            const char* env = std::getenv("BOUNCE_SCENES");
+            throw scene_error(under, 0,
+                              "--scene " + p.string() + ": neither cornell, a file here, nor a scene folder under " +
+                                  scenes_dir().string() +
+                                  (env && *env ? " (BOUNCE_SCENES)" : " (the default; set BOUNCE_SCENES to look elsewhere)"));
+        }
+        p = under;
+    }
     if (fs::is_directory(p, ec)) p /= "scene.json";
     std::string ext = p.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });

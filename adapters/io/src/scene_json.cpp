@@ -67,10 +67,13 @@ public:
         return static_cast<float>(d);
     }
 
-    enum class range { any, non_negative, unit };
+    // position: within +-max_world_coordinate; light: in [0, max_light_value] (light.hpp).
+    enum class range { any, non_negative, unit, position, light };
     glm::vec3 vec3(const json& v, const std::string& field, range r = range::any) const {
         const char* what = r == range::unit           ? "expected 3 numbers in [0, 1]"
                            : r == range::non_negative ? "expected 3 numbers >= 0"
+                           : r == range::position     ? "expected 3 numbers within +-1e18 (what float32 rays carry)"
+                           : r == range::light        ? "expected 3 numbers in [0, 1e30]"
                                                       : "expected 3 numbers";
         if (!v.is_array() || v.size() != 3) fail(field, what);
         glm::vec3 out;
@@ -79,7 +82,10 @@ public:
             const double d = v[std::size_t(i)].get<double>();
             if (!std::isfinite(d) || std::abs(d) > double(std::numeric_limits<float>::max()))
                 fail(field, std::string(what) + ", finite");
-            if ((r != range::any && d < 0.0) || (r == range::unit && d > 1.0)) fail(field, what);
+            if (((r == range::non_negative || r == range::unit || r == range::light) && d < 0.0) ||
+                (r == range::unit && d > 1.0) || (r == range::light && d > double(max_light_value)) ||
+                (r == range::position && std::abs(d) > double(max_world_coordinate)))
+                fail(field, what);
             out[i] = static_cast<float>(d);
         }
         return out;
@@ -133,16 +139,16 @@ light read_light(const field_reader& r, const json& j, const std::string& field)
     if (type == "point") {
         r.only_keys(j, {"type", "position", "intensity"}, field);
         point_light l;
-        l.position = r.vec3(r.member(j, "position", field), f("position"));
-        l.intensity = r.vec3(r.member(j, "intensity", field), f("intensity"), field_reader::range::non_negative);
+        l.position = r.vec3(r.member(j, "position", field), f("position"), field_reader::range::position);
+        l.intensity = r.vec3(r.member(j, "intensity", field), f("intensity"), field_reader::range::light);
         return l;
     }
     if (type == "spot") {
         r.only_keys(j, {"type", "position", "direction", "intensity", "cone_deg", "falloff"}, field);
         spot_light l;
-        l.position = r.vec3(r.member(j, "position", field), f("position"));
+        l.position = r.vec3(r.member(j, "position", field), f("position"), field_reader::range::position);
         l.direction = r.direction(r.member(j, "direction", field), f("direction"));
-        l.intensity = r.vec3(r.member(j, "intensity", field), f("intensity"), field_reader::range::non_negative);
+        l.intensity = r.vec3(r.member(j, "intensity", field), f("intensity"), field_reader::range::light);
         l.cone_deg = r.number(r.member(j, "cone_deg", field), f("cone_deg"));
         if (!(l.cone_deg > 0.f && l.cone_deg <= 180.f)) r.fail(f("cone_deg"), "must lie in (0, 180]");
         const std::string falloff = r.string(r.member(j, "falloff", field), f("falloff"));
@@ -155,7 +161,7 @@ light read_light(const field_reader& r, const json& j, const std::string& field)
         r.only_keys(j, {"type", "direction", "irradiance"}, field);
         directional_light l;
         l.direction = r.direction(r.member(j, "direction", field), f("direction"));
-        l.irradiance = r.vec3(r.member(j, "irradiance", field), f("irradiance"), field_reader::range::non_negative);
+        l.irradiance = r.vec3(r.member(j, "irradiance", field), f("irradiance"), field_reader::range::light);
         return l;
     }
     r.fail(f("type"), "unknown light type '" + type.substr(0, 40) + "' (expected point, spot or directional)");
@@ -188,8 +194,8 @@ scene load_scene(const fs::path& file) {
     const json& cam = r.member(root, "camera", "");
     r.expect_object(cam, "camera");
     r.only_keys(cam, {"position", "look_at", "up", "fov_y_deg"}, "camera");
-    s.camera.position = r.vec3(r.member(cam, "position", "camera"), "camera.position");
-    s.camera.look_at = r.vec3(r.member(cam, "look_at", "camera"), "camera.look_at");
+    s.camera.position = r.vec3(r.member(cam, "position", "camera"), "camera.position", field_reader::range::position);
+    s.camera.look_at = r.vec3(r.member(cam, "look_at", "camera"), "camera.look_at", field_reader::range::position);
     s.camera.up = r.vec3(r.member(cam, "up", "camera"), "camera.up");
     s.camera.fov_y_deg = r.number(r.member(cam, "fov_y_deg", "camera"), "camera.fov_y_deg");
     try {
