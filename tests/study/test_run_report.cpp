@@ -1,6 +1,7 @@
 // The run report: the stage timer's medians, and the JSON object every example writes.
 #include "../io/scratch_folder.hpp"
 
+#include <bounce/io/output_files.hpp>
 #include <bounce/study/run_report.hpp>
 #include <bounce/sampling.hpp>
 
@@ -138,7 +139,7 @@ TEST_CASE("the run report writes valid JSON, null for non-finite figures, and no
     CHECK_FALSE(r.to_json().contains("error"));
 }
 
-TEST_CASE("an incomplete or clashing report is refused and an unwritable file raises report_error",
+TEST_CASE("an incomplete or clashing report is refused and an unwritable file raises io::output_error",
           "[study][report][bad-input]") {
     auto r = sample_report();
     r.technique.clear();
@@ -159,7 +160,9 @@ TEST_CASE("an incomplete or clashing report is refused and an unwritable file ra
     try {
         sample_report().write(target);
         FAIL("wrote under a regular file");
-    } catch (const study::report_error& e) {
+    } catch (const io::output_error& e) {
         CHECK(e.file() == target);
     }
+    // A device that takes the open but fails the write: the failure must not pass as success.
+    if (std::filesystem::exists("/dev/full")) CHECK_THROWS_AS(sample_report().write("/dev/full"), io::output_error);
 }

@@ -64,6 +64,22 @@ std::filesystem::path default_cache_dir() {
     return std::filesystem::path("build") / "cache";
 }
 
+void check_cache_dir(const std::filesystem::path& dir) {
+    const char* env = std::getenv("BOUNCE_CACHE");
+    const std::string name = (env && *env && std::filesystem::path(env) == dir) ? "BOUNCE_CACHE" : "cache";
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (!std::filesystem::is_directory(dir, ec))
+        throw parameter_error(name, "cannot make the cache folder " + dir.string() +
+                                        (ec ? " (" + ec.message() + ")" : std::string(" (a file is in the way)")));
+    const std::filesystem::path probe = dir / (".write-test-" + std::to_string(::getpid()));
+    {
+        std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+        if (!out) throw parameter_error(name, "cannot write into the cache folder " + dir.string());
+    }
+    std::filesystem::remove(probe, ec);
+}
+
 void hash_scene_view(fnv1a_hash& h, const io::scene& scene, const bounce::camera& cam, std::size_t width,
                      std::size_t height) {
     h.value(scene.positions.size());
@@ -203,6 +219,7 @@ reference_images cached_reference(const accel& bvh, const io::scene& scene, cons
         if (from_cache) *from_cache = true;
         return std::move(*cached);
     }
+    check_cache_dir(dir);  // before minutes of rendering, not at the store
     auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
     reference_images r = render_reference(bvh, scene, g.view(), settings);
     store_cached_reference(dir, key, r, scene, cam, settings, config);
@@ -357,6 +374,7 @@ reference_halves cached_reference_halves(const accel& bvh, const io::scene& scen
         if (from_cache) *from_cache = true;
         return std::move(*cached);
     }
+    check_cache_dir(dir);
     auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
     reference_halves h = render_reference_halves(bvh, scene, g.view(), settings);
     store_cached_reference_halves(dir, key, h, scene, cam, settings, config);

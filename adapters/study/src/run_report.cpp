@@ -1,17 +1,15 @@
 // The run report every example writes with --json.
 #include <bounce/study/run_report.hpp>
 
+#include <bounce/io/output_files.hpp>
+
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 namespace bounce::study {
 
 namespace fs = std::filesystem;
 using ojson = nlohmann::ordered_json;
-
-report_error::report_error(fs::path file, const std::string& what)
-    : bounce::error("bounce: " + file.string() + ": " + what), file_(std::move(file)) {}
 
 void run_report::set_timings(const stage_timer& timer) {
     timings_ms.clear();
@@ -63,14 +61,7 @@ ojson run_report::to_json() const {
 }
 
 void run_report::write(const fs::path& file) const {
-    const ojson j = to_json();
-    std::error_code ec;
-    if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    if (!out) throw report_error(file, "cannot open for writing");
-    out << j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
-    out.flush();
-    if (!out) throw report_error(file, "write failed");
+    io::write_text_file(file, to_json().dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + '\n');
 }
 
 }  // namespace bounce::study

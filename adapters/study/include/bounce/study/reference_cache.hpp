@@ -33,6 +33,12 @@ namespace bounce::study {
 /// in (build/bin/reference -> build/cache); else ./build/cache.
 std::filesystem::path default_cache_dir();
 
+/// Throws parameter_error naming "BOUNCE_CACHE" (when `dir` came from it) or "cache" unless
+/// `dir` is a folder that exists or can be made and in which a file can be created (tried,
+/// then removed). Call it before the work whose result is to be cached: a cache that cannot
+/// be written is a mistake to report at once, not after the reference has been computed.
+void check_cache_dir(const std::filesystem::path& dir = default_cache_dir());
+
 /// Adds to `h` all that a rendered view of `scene` depends on: positions, normals, triangles,
 /// materials, lights, use_emission, the camera and the image size. Every cache key of a
 /// rendered reference starts from it (then adds its integrator's version and settings).

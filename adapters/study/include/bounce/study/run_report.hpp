@@ -32,15 +32,6 @@
 
 namespace bounce::study {
 
-/// A report file that cannot be written; `file()` names it.
-struct report_error : bounce::error {
-    report_error(std::filesystem::path file, const std::string& what);
-    const std::filesystem::path& file() const noexcept { return file_; }
-
-private:
-    std::filesystem::path file_;
-};
-
 /// The measurement record of one run of one technique.
 struct run_report {
     std::string technique;  ///< the program, e.g. "ic_splatting", "reference"
@@ -69,7 +60,7 @@ struct run_report {
     /// empty, a size is 0, or a count's name is one of the other keys.
     nlohmann::ordered_json to_json() const;
     /// Writes to_json() to `file`, indented, creating its parent folder.
-    /// Throws report_error when the file cannot be written.
+    /// Throws io::output_error when the file cannot be written (io::write_text_file).
     void write(const std::filesystem::path& file) const;
 };
 

@@ -13,6 +13,12 @@
 
 namespace bounce::study {
 
+/// Milliseconds of wall-clock time (std::chrono::steady_clock) since `t0`: the one stopwatch
+/// of the programs and studies, for spans that are not a stage_timer stage.
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 /// Wall-clock samples per named stage (std::chrono::steady_clock, milliseconds); the
 /// report takes their medians, which a single slow repeat (page faults, a shader compile)
 /// does not move.
