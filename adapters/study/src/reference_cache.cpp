@@ -4,11 +4,16 @@
 #include <bounce/study/content_hash.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/image_io.hpp>
+#include <bounce/io/output_files.hpp>
 
 #include <cstdio>
 #include <cstdlib>
 #include <cctype>
 #include <fstream>
+#include <initializer_list>
+#include <optional>
+#include <utility>
+#include <vector>
 #include <system_error>
 
 #include <nlohmann/json.hpp>
@@ -52,6 +57,97 @@ void write_atomically(const std::filesystem::path& final_path, const char* exten
         std::filesystem::remove(tmp, ec);
         throw bounce::error("bounce::study: cannot move " + tmp.string() + " to " + final_path.string());
     }
+}
+
+// The key of a reference render: "<scene>-<W>x<H>-<S>spp-<kind><16 hex digits>", hashing
+// `tag` (when not empty), the integrator's version, the scene's view and the settings.
+std::string settings_key(std::string_view tag, std::string_view kind, const io::scene& scene, const bounce::camera& cam,
+                         std::size_t width, std::size_t height, const reference_settings& settings,
+                         std::string_view device_config) {
+    fnv1a_hash h;
+    if (!tag.empty()) h.text(tag);
+    h.text(integrator_version);
+    hash_scene_view(h, scene, cam, width, height);
+    h.value(settings.hemisphere_samples);
+    h.value(settings.area_samples);
+    h.value(settings.secondary_area_samples);
+    h.value(settings.environment);
+    h.value(settings.ray_epsilon);
+    h.value(settings.seed);
+    if (!device_config.empty()) h.text(device_config);  // Embree's default: the keys of earlier versions
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
+    return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
+           std::to_string(settings.hemisphere_samples) + "spp-" + std::string(kind) + hex;
+}
+
+// The entry's images `<key><suffix>` for each suffix, or nothing when one is missing,
+// unreadable or not `width` x `height` (the caller then recomputes and overwrites).
+std::optional<std::vector<image<glm::vec3>>> load_entry(const std::filesystem::path& dir, const std::string& key,
+                                                        std::initializer_list<const char*> suffixes,
+                                                        std::size_t width, std::size_t height) {
+    std::vector<image<glm::vec3>> images;
+    std::error_code ec;
+    for (const char* suffix : suffixes) {
+        const auto file = entry(dir, key, suffix);
+        if (!std::filesystem::exists(file, ec)) return std::nullopt;
+        try {
+            images.push_back(io::read_rgb(file));
+        } catch (const bounce::error&) {
+            return std::nullopt;  // unreadable or truncated
+        }
+        if (images.back().width() != width || images.back().height() != height) return std::nullopt;
+    }
+    return images;
+}
+
+// Writes the entry's images and its JSON description, each atomically.
+void store_entry(const std::filesystem::path& dir, const std::string& key,
+                 std::initializer_list<std::pair<const char*, const image<glm::vec3>*>> images,
+                 const nlohmann::json& description) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw bounce::error("bounce::study: cannot create the cache directory " + dir.string() + ": " + ec.message());
+    for (const auto& [suffix, img] : images)
+        write_atomically(entry(dir, key, suffix), ".exr", [&](const std::filesystem::path& p) { io::write_exr(p, img->view()); });
+    write_atomically(entry(dir, key, ".json"), ".json",
+                     [&](const std::filesystem::path& p) { io::write_text_file(p, description.dump(2) + '\n'); });
+}
+
+// What every entry's JSON says of its source: the scene, the view and the settings.
+nlohmann::json describe(const std::string& key, const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                        std::size_t height, const embree::hemisphere_grid& grid, const reference_settings& settings,
+                        std::string_view device_config) {
+    nlohmann::json d = {
+        {"key", key},
+        {"integrator", integrator_version},
+        {"scene", scene.name},
+        {"source", scene.source.string()},
+        {"triangles", scene.triangles.size()},
+        {"width", width},
+        {"height", height},
+        {"camera",
+         {{"position", json_of(cam.position)},
+          {"look_at", json_of(cam.look_at)},
+          {"up", json_of(cam.up)},
+          {"fov_y_deg", cam.fov_y_deg}}},
+        {"hemisphere_samples", settings.hemisphere_samples},
+        {"grid", {grid.m, grid.n}},
+        {"area_samples", settings.area_samples},
+        {"secondary_area_samples", settings.secondary_area_samples},
+        {"environment", json_of(settings.environment)},
+        {"ray_epsilon", settings.ray_epsilon},
+        {"seed", settings.seed},
+    };
+    if (!device_config.empty()) d["embree_config"] = std::string(device_config);
+    return d;
+}
+
+image<glm::vec3> sum_of(const image<glm::vec3>& a, const image<glm::vec3>& b) {
+    image<glm::vec3> s(a.width(), a.height());
+    for (std::size_t y = 0; y < a.height(); ++y)
+        for (std::size_t x = 0; x < a.width(); ++x) s(x, y) = a(x, y) + b(x, y);
+    return s;
 }
 
 }  // namespace
@@ -130,42 +226,18 @@ void hash_scene_view(fnv1a_hash& h, const io::scene& scene, const bounce::camera
 std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
                                 std::size_t height, const reference_settings& settings,
                                 std::string_view device_config) {
-    fnv1a_hash h;
-    h.text(integrator_version);
-    hash_scene_view(h, scene, cam, width, height);
-    h.value(settings.hemisphere_samples);
-    h.value(settings.area_samples);
-    h.value(settings.secondary_area_samples);
-    h.value(settings.environment);
-    h.value(settings.ray_epsilon);
-    h.value(settings.seed);
-    if (!device_config.empty()) h.text(device_config);  // Embree's default: the keys of earlier versions
-
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
-    return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
-           std::to_string(settings.hemisphere_samples) + "spp-" + hex;
+    return settings_key({}, {}, scene, cam, width, height, settings, device_config);
 }
 
 std::optional<reference_images> load_cached_reference(const std::filesystem::path& dir, const std::string& key,
                                                       std::size_t width, std::size_t height,
                                                       const reference_settings& settings) {
-    const auto direct_file = entry(dir, key, ".direct.exr"), indirect_file = entry(dir, key, ".indirect.exr");
-    std::error_code ec;
-    if (!std::filesystem::exists(direct_file, ec) || !std::filesystem::exists(indirect_file, ec)) return std::nullopt;
+    auto images = load_entry(dir, key, {".direct.exr", ".indirect.exr"}, width, height);
+    if (!images) return std::nullopt;
     reference_images r;
-    try {
-        r.direct = io::read_rgb(direct_file);
-        r.indirect = io::read_rgb(indirect_file);
-    } catch (const bounce::error&) {
-        return std::nullopt;  // unreadable or truncated: recompute and overwrite
-    }
-    if (r.direct.width() != width || r.direct.height() != height || r.indirect.width() != width ||
-        r.indirect.height() != height)
-        return std::nullopt;
-    r.combined = image<glm::vec3>(width, height);
-    for (std::size_t y = 0; y < height; ++y)
-        for (std::size_t x = 0; x < width; ++x) r.combined(x, y) = r.direct(x, y) + r.indirect(x, y);
+    r.direct = std::move((*images)[0]);
+    r.indirect = std::move((*images)[1]);
+    r.combined = sum_of(r.direct, r.indirect);
     r.grid = embree::hemisphere_grid_for(settings.hemisphere_samples);
     return r;
 }
@@ -173,41 +245,9 @@ std::optional<reference_images> load_cached_reference(const std::filesystem::pat
 void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
                             const io::scene& scene, const bounce::camera& cam, const reference_settings& settings,
                             std::string_view device_config) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw bounce::error("bounce::embree: cannot create the cache directory " + dir.string() + ": " + ec.message());
-    write_atomically(entry(dir, key, ".direct.exr"), ".exr",
-                     [&](const std::filesystem::path& p) { io::write_exr(p, images.direct.view()); });
-    write_atomically(entry(dir, key, ".indirect.exr"), ".exr",
-                     [&](const std::filesystem::path& p) { io::write_exr(p, images.indirect.view()); });
-
-    nlohmann::json description = {
-        {"key", key},
-        {"integrator", integrator_version},
-        {"scene", scene.name},
-        {"source", scene.source.string()},
-        {"triangles", scene.triangles.size()},
-        {"width", images.direct.width()},
-        {"height", images.direct.height()},
-        {"camera",
-         {{"position", json_of(cam.position)},
-          {"look_at", json_of(cam.look_at)},
-          {"up", json_of(cam.up)},
-          {"fov_y_deg", cam.fov_y_deg}}},
-        {"hemisphere_samples", settings.hemisphere_samples},
-        {"grid", {images.grid.m, images.grid.n}},
-        {"area_samples", settings.area_samples},
-        {"secondary_area_samples", settings.secondary_area_samples},
-        {"environment", json_of(settings.environment)},
-        {"ray_epsilon", settings.ray_epsilon},
-        {"seed", settings.seed},
-    };
-    if (!device_config.empty()) description["embree_config"] = std::string(device_config);
-    write_atomically(entry(dir, key, ".json"), ".json", [&](const std::filesystem::path& p) {
-        std::ofstream f(p);
-        f << description.dump(2) << '\n';
-        if (!f) throw bounce::error("bounce::embree: cannot write " + p.string());
-    });
+    store_entry(dir, key, {{".direct.exr", &images.direct}, {".indirect.exr", &images.indirect}},
+                describe(key, scene, cam, images.direct.width(), images.direct.height(), images.grid, settings,
+                         device_config));
 }
 
 reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
@@ -248,10 +288,7 @@ image<glm::vec3> mean_of(const image<glm::vec3>& a, const image<glm::vec3>& b) {
 
 void finish_whole(reference_halves& h) {
     h.whole.indirect = mean_of(h.indirect_a, h.indirect_b);
-    const std::size_t w = h.whole.direct.width(), ht = h.whole.direct.height();
-    h.whole.combined = image<glm::vec3>(w, ht);
-    for (std::size_t y = 0; y < ht; ++y)
-        for (std::size_t x = 0; x < w; ++x) h.whole.combined(x, y) = h.whole.direct(x, y) + h.whole.indirect(x, y);
+    h.whole.combined = sum_of(h.whole.direct, h.whole.indirect);
 }
 }  // namespace
 
@@ -264,43 +301,18 @@ std::string reference_halves_cache_key(const io::scene& scene, const bounce::cam
                                        std::size_t height, const reference_settings& settings,
                                        std::string_view device_config) {
     require(settings.hemisphere_samples >= 2, "hemisphere_samples", "a reference in halves needs at least 2 samples");
-    fnv1a_hash h;
-    h.text(halves_tag);
-    h.text(integrator_version);
-    hash_scene_view(h, scene, cam, width, height);
-    h.value(settings.hemisphere_samples);
-    h.value(settings.area_samples);
-    h.value(settings.secondary_area_samples);
-    h.value(settings.environment);
-    h.value(settings.ray_epsilon);
-    h.value(settings.seed);
-    if (!device_config.empty()) h.text(device_config);
-
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
-    return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
-           std::to_string(settings.hemisphere_samples) + "spp-halves-" + hex;
+    return settings_key(halves_tag, "halves-", scene, cam, width, height, settings, device_config);
 }
 
 std::optional<reference_halves> load_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
                                                              std::size_t width, std::size_t height,
                                                              const reference_settings& settings) {
-    const auto direct_file = entry(dir, key, ".direct.exr"), a_file = entry(dir, key, ".indirect-a.exr"),
-               b_file = entry(dir, key, ".indirect-b.exr");
-    std::error_code ec;
-    if (!std::filesystem::exists(direct_file, ec) || !std::filesystem::exists(a_file, ec) ||
-        !std::filesystem::exists(b_file, ec))
-        return std::nullopt;
+    auto images = load_entry(dir, key, {".direct.exr", ".indirect-a.exr", ".indirect-b.exr"}, width, height);
+    if (!images) return std::nullopt;
     reference_halves h;
-    try {
-        h.whole.direct = io::read_rgb(direct_file);
-        h.indirect_a = io::read_rgb(a_file);
-        h.indirect_b = io::read_rgb(b_file);
-    } catch (const bounce::error&) {
-        return std::nullopt;
-    }
-    for (const image<glm::vec3>* i : {&h.whole.direct, &h.indirect_a, &h.indirect_b})
-        if (i->width() != width || i->height() != height) return std::nullopt;
+    h.whole.direct = std::move((*images)[0]);
+    h.indirect_a = std::move((*images)[1]);
+    h.indirect_b = std::move((*images)[2]);
     h.half_samples = settings.hemisphere_samples / 2;
     h.whole.grid = embree::hemisphere_grid_for(h.half_samples);
     finish_whole(h);
@@ -310,45 +322,16 @@ std::optional<reference_halves> load_cached_reference_halves(const std::filesyst
 void store_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
                                    const reference_halves& halves, const io::scene& scene, const bounce::camera& cam,
                                    const reference_settings& settings, std::string_view device_config) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw bounce::error("bounce::study: cannot create the cache directory " + dir.string() + ": " + ec.message());
-    write_atomically(entry(dir, key, ".direct.exr"), ".exr",
-                     [&](const std::filesystem::path& p) { io::write_exr(p, halves.whole.direct.view()); });
-    write_atomically(entry(dir, key, ".indirect-a.exr"), ".exr",
-                     [&](const std::filesystem::path& p) { io::write_exr(p, halves.indirect_a.view()); });
-    write_atomically(entry(dir, key, ".indirect-b.exr"), ".exr",
-                     [&](const std::filesystem::path& p) { io::write_exr(p, halves.indirect_b.view()); });
-    nlohmann::json description = {
-        {"key", key},
-        {"kind", "halves: indirect = (indirect-a + indirect-b) / 2, direct computed with half a's seed"},
-        {"integrator", integrator_version},
-        {"scene", scene.name},
-        {"source", scene.source.string()},
-        {"triangles", scene.triangles.size()},
-        {"width", halves.whole.direct.width()},
-        {"height", halves.whole.direct.height()},
-        {"camera",
-         {{"position", json_of(cam.position)},
-          {"look_at", json_of(cam.look_at)},
-          {"up", json_of(cam.up)},
-          {"fov_y_deg", cam.fov_y_deg}}},
-        {"hemisphere_samples", settings.hemisphere_samples},
-        {"half_samples", settings.hemisphere_samples / 2},
-        {"grid", {halves.whole.grid.m, halves.whole.grid.n}},
-        {"area_samples", settings.area_samples},
-        {"secondary_area_samples", settings.secondary_area_samples},
-        {"environment", json_of(settings.environment)},
-        {"ray_epsilon", settings.ray_epsilon},
-        {"seed", settings.seed},
-        {"half_seeds", {half_seed(settings.seed, 0), half_seed(settings.seed, 1)}},
-    };
-    if (!device_config.empty()) description["embree_config"] = std::string(device_config);
-    write_atomically(entry(dir, key, ".json"), ".json", [&](const std::filesystem::path& p) {
-        std::ofstream f(p);
-        f << description.dump(2) << '\n';
-        if (!f) throw bounce::error("bounce::study: cannot write " + p.string());
-    });
+    nlohmann::json d = describe(key, scene, cam, halves.whole.direct.width(), halves.whole.direct.height(),
+                                halves.whole.grid, settings, device_config);
+    d["kind"] = "halves: indirect = (indirect-a + indirect-b) / 2, direct computed with half a's seed";
+    d["half_samples"] = settings.hemisphere_samples / 2;
+    d["half_seeds"] = {half_seed(settings.seed, 0), half_seed(settings.seed, 1)};
+    store_entry(dir, key,
+                {{".direct.exr", &halves.whole.direct},
+                 {".indirect-a.exr", &halves.indirect_a},
+                 {".indirect-b.exr", &halves.indirect_b}},
+                d);
 }
 
 reference_halves render_reference_halves(const accel& bvh, const scene_view& scene, const gbuffer_view<float>& g,
