@@ -6,6 +6,8 @@
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 
+#include <epoxy/gl.h>  // the renderer's own GL calls: libepoxy comes with bounce::gl
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -36,6 +38,10 @@ int main() {
     bounce::gl::gbuffer_pass pass;
     pass.render(mesh, cam, w, h);
     const auto raster = pass.read();
+    // A GL call of the renderer's own, through the loader bounce::gl passes on.
+    const auto* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    if (!version) return 1;
+    std::printf("GL %s\n", version);
 
     const float dt = traced.depth(w / 2, h / 2), dr = raster.depth(w / 2, h / 2);
     const glm::vec3 albedo = raster.albedo(w / 2, h / 2);
