@@ -1,14 +1,17 @@
 #pragma once
-// ic_splatting's options: what the command line sets, how it is spelled and checked, and the
-// library settings it makes (the program's main.cpp runs and reports).
+// ic_splatting's options: what the command line sets, how it is spelled and checked (alone
+// and against each other, before any work), and the library settings they spell (the
+// program's main.cpp runs and reports).
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/errors.hpp>
+#include <bounce/irradiance_record.hpp>
 #include <bounce/weighting.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include "../common/cli_number_checks.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -102,6 +105,76 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
             {"min_record_samples", o.adaptive_rays ? o.min_record_samples : 0u},
             {"record_error", o.adaptive_rays ? o.record_error * o.a : 0.f},
             {"record_error_floor", o.adaptive_rays ? o.record_error_floor : 0.f}};
+}
+
+/// The record radius limits the options ask for.
+inline radius_limits radius_limits_for(const options& o) {
+    radius_limits limits;
+    limits.min_pixels = o.min_pixels;
+    limits.max_pixels = o.max_pixels;
+    limits.gradient_limit = o.gradient_limit;
+    if (o.radius == "hessian") {
+        limits.policy = radius_policy::hessian;
+        limits.hessian_a = o.a;
+        limits.hessian_gradients = o.gradients;  // the error model follows the interpolation in use
+    }
+    return limits;
+}
+
+/// The largest spp Monte Carlo at equal error runs (--mc-max-spp, or its default).
+inline std::uint32_t monte_carlo_max_spp(const options& o) {
+    if (o.mc_max_spp > 0) return o.mc_max_spp;
+    return o.raw_equal_error ? std::max(1u, o.ref_spp / 2) : 4u * o.ref_spp;
+}
+
+/// Options that do not go together, refused before any work (parameter_error naming one).
+/// `with_gl`: whether this build has the GL adapter.
+inline void check_combinations(const options& o, bool with_gl) {
+    if (o.falloff_kappa != 1.f && o.sampler != "raster")
+        throw parameter_error("--falloff-kappa", "applies to --sampler raster only");
+    if (o.walkthrough > 0 && (o.progressive > 0 || !o.a_sweep.empty()))
+        throw parameter_error("--walkthrough", "renders its own frames: not with --progressive or --a-sweep");
+    if ((o.plane_turn != 0.0 || o.hashed_turn) && o.sampler != "raster")
+        throw parameter_error("--plane-turn/--hashed-turn", "apply to --sampler raster only");
+    if (o.ref_spp % 2 != 0)
+        throw parameter_error("--ref-spp", "must be even: the reference is two independent halves of N/2 samples");
+    if (o.radius == "hessian" && o.sampler != "embree")
+        throw parameter_error("--radius", "'hessian' needs the Embree sampler (the raster's reduction has no Hessian)");
+    if (o.radius == "hessian" && !o.a_sweep.empty())
+        throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
+    if (o.adaptive_rays && o.sampler != "embree") throw parameter_error("--adaptive-rays", "needs the Embree sampler");
+    if (o.adaptive_rays && o.ray_rates)
+        throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --adaptive-rays");
+    if (o.adaptive_rays && !o.a_sweep.empty())
+        throw parameter_error("--a-sweep", "adaptive rays aim at a standard error tied to a: sweep a over separate runs");
+    if (o.ray_rates && o.sampler != "embree") throw parameter_error("--ray-rates", "applies to --sampler embree only");
+    if (!with_gl && o.sampler != "embree")
+        throw parameter_error("--sampler", "'raster' needs the GL adapter, which this build does not have");
+    if (!with_gl && o.interp == "splat-gl")
+        throw parameter_error("--interp", "'splat-gl' needs the GL adapter, which this build does not have");
+}
+
+/// The run report's `parameters`: the options as run (`cache` the cache's options, with the
+/// raster sampler's batch; `embree_config` the device's; `mc_max_spp` monte_carlo_max_spp).
+inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irradiance_cache_options& cache,
+                                                const std::string& embree_config, std::uint32_t mc_max_spp) {
+    return {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
+            {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
+            {"shadow_resolution", o.shadow_resolution},
+            {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
+            {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"radius", o.radius},
+            {"adaptive_rays", o.adaptive_rays}, {"min_record_samples", o.min_record_samples},
+            {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
+            {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
+            {"max_extrapolation", o.max_extrapolation},
+            {"front_tolerance", o.front_tolerance},
+            {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
+            {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
+            {"scan", o.scan}, {"scan_batch", cache.batch.max_records},
+            {"scan_order", cache.order == cpu::scan_order::linear ? "linear" : "coarse-to-fine"},
+            {"embree_config", embree_config},
+            {"equal_error_measure", o.raw_equal_error ? "raw" : "debiased"},
+            {"mc_max_spp", mc_max_spp}};
 }
 
 /// Declares every option on `app`, writing into `o` (and `gradients`: "on" or "off").
@@ -215,6 +288,15 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--indirect-exr", o.indirect_exr, "write the indirect image alone as EXR (linear, for error maps)");
     app.add_option("--cache-in", o.cache_in, "start from the records saved in this file");
     app.add_option("--cache-out", o.cache_out, "save the records to this file");
+}
+
+/// What the parsed command line implies: `gradients` read, and a walkthrough's radius floor.
+inline void finish_options(const CLI::App& app, options& o, const std::string& gradients) {
+    o.gradients = gradients == "on";
+    // A radius floor of pixel footprints ties a record to the camera that made it: another
+    // camera's pixels take its inflated zone as coverage (docs/irradiance-splatting.md,
+    // "Many frames"), so a walkthrough has none unless asked.
+    if (o.walkthrough > 0 && app.count("--min-pixels") == 0) o.min_pixels = 0.f;
 }
 
 }  // namespace bounce::examples

@@ -133,7 +133,14 @@ public:
         records_ = std::move(records);
         clamp_ = neighbour_index(lo_, hi_);
         settled_ = 0;
+        ++generation_;
     }
+
+    /// Changes whenever records are replaced (assign) or shrunk (clamp_to_neighbours
+    /// returning more than 0), and only then: a copy of the records kept elsewhere (the GPU's,
+    /// gl::irradiance_splatter::frame) that saw the same generation needs only the records
+    /// appended since.
+    std::uint64_t generation() const noexcept { return generation_; }
 
     /// Neighbour clamping both ways over the whole cache: every radius becomes
     /// min_j (R_j + |p_i - p_j|) over every record j (itself included), so the radius field
@@ -168,6 +175,7 @@ public:
         } else {
             clamp_ = neighbour_index(lo_, hi_);  // `index` holds the radii before the clamp
             clamp_.sync(records_);
+            ++generation_;
         }
         settled_ = records_.size();
         return shrunk;
@@ -353,6 +361,7 @@ private:
     std::vector<irradiance_record> records_;
     neighbour_index clamp_;
     std::size_t settled_ = 0;  // records_.size() at the last clamp_to_neighbours
+    std::uint64_t generation_ = 0;
     std::vector<std::uint32_t> order_;
     std::pair<std::size_t, std::size_t> order_size_{0, 0};
 };

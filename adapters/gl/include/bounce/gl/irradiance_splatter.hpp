@@ -13,16 +13,29 @@
 ///      `compose` adds the caller's direct radiance.
 /// The splatter keeps the GPU copy of the cache in step with the caller's record list. It
 /// restores the GL state it changes (as splat_pass and compose_pass do).
+///
+/// `frame` is a whole frame as a renderer runs it: its G-buffer (gl::gbuffer_pass), its
+/// direct light (gl::direct_light), the steps above with a cpu::irradiance_cache's scan and
+/// any record sampler, and the indirect and composed images read back, as a
+/// bounce::cache_frame (what cpu::walkthrough and the cache studies take).
 
+#include <bounce/cache_frame.hpp>
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
+#include <bounce/gl/direct_light.hpp>
+#include <bounce/gl/gbuffer_pass.hpp>
+#include <bounce/gl/objects.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/image.hpp>
 #include <bounce/irradiance_record.hpp>
+#include <bounce/record_sampler.hpp>
 #include <bounce/weighting.hpp>
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace bounce::gl {
@@ -49,6 +62,19 @@ struct splatter_frame_stats {
     double interpolate_ms = 0;     ///< step 4 (and the wide splat for hole filling)
     double normalize_ms = 0;       ///< step 5
     std::size_t new_records = 0;
+};
+
+/// The renderer's passes a whole frame (irradiance_splatter::frame) draws with besides the
+/// splatter: the scene on the GPU, its G-buffer pass and its direct light. Borrowed.
+struct splatting_passes {
+    const scene_mesh& mesh;
+    gbuffer_pass& gbuffer;
+    direct_light& light;
+};
+
+/// irradiance_splatter::frame's default: records are measured at the rasterized points.
+struct raster_record_points {
+    void operator()(gbuffer_view<float>) const noexcept {}
 };
 
 class irradiance_splatter {
@@ -80,6 +106,73 @@ public:
         return stats;
     }
 
+    /// A whole frame of `cache` (a cpu::irradiance_cache with splatting: any type with its
+    /// options(), records(), generation(), clamp_to_neighbours() and scan()) seen by `cam` at
+    /// `width` x `height`:
+    ///   - the splatter takes the cache's splat parameters and hole filling (its a included;
+    ///     the weighting stays this splatter's, which must be the cache's Weight), clamps the
+    ///     cache's older records to its neighbours and restarts the GPU's copy of the records
+    ///     when the cache replaced or shrank them (its generation changed) or is another cache;
+    ///   - passes.gbuffer renders the G-buffer of passes.mesh, passes.light its direct light;
+    ///   - render() with cache.scan(g, cam, sampler, splat) as the scan. `record_points(points)`
+    ///     may first move the read-back G-buffer's points to where `sampler` should measure the
+    ///     records (a ray tracer's own hits of the pixels: embree::snap_to_ray_hits); its time
+    ///     counts as record computation;
+    ///   - the indirect image and direct + indirect (compose) are read back.
+    /// The frame's stages (cache_frame::stages_ms): gbuffer, direct, splat_existing,
+    /// readback, scan, compute_records, interpolate, normalize (the read-backs and compose).
+    /// Stage times are the GPU's only with options().time_stages. Throws parameter_error as
+    /// render() and the cache's scan do.
+    template <class Cache, record_sampler Sampler, class RecordPoints = raster_record_points>
+    cache_frame frame(const splatting_passes& passes, Cache& cache, const camera& cam, std::size_t width,
+                      std::size_t height, Sampler& sampler, RecordPoints&& record_points = {}) {
+        follow(cache);
+        cache_frame f;
+        auto t0 = clock::now();
+        passes.gbuffer.render(passes.mesh, cam, width, height);
+        if (options_.time_stages) finish();
+        f.stages_ms.emplace_back("gbuffer", ms_since(t0));
+        const gbuffer_textures tex = textures_of(passes.gbuffer);
+        t0 = clock::now();
+        passes.light.render(tex);
+        if (options_.time_stages) finish();
+        f.stages_ms.emplace_back("direct", ms_since(t0));
+        double scan_ms = 0, records_ms = 0;
+        const splatter_frame_stats st =
+            render(tex, cam, cache.records(), [&](gbuffer_view<float> g, image_view<glm::vec4> splat) {
+                const auto took = [&](const auto& s) {
+                    scan_ms += s.scan_ms;
+                    records_ms += s.records_ms;
+                    f.measured = s.measured;
+                    f.wasted = s.wasted;
+                };
+                if constexpr (std::is_same_v<std::remove_cvref_t<RecordPoints>, raster_record_points>) {
+                    took(cache.scan(g, cam, sampler, splat));
+                } else {
+                    const auto t1 = clock::now();
+                    gbuffer<float> points = gbuffer_;
+                    record_points(points.view());
+                    records_ms += ms_since(t1);
+                    const gbuffer_view<float> where = points.view();
+                    took(cache.scan(g, cam, sampler, splat, &where));
+                }
+            });
+        f.new_records = st.new_records;
+        f.stages_ms.emplace_back("splat_existing", st.splat_existing_ms);
+        f.stages_ms.emplace_back("readback", st.readback_ms);
+        f.stages_ms.emplace_back("scan", scan_ms);
+        f.stages_ms.emplace_back("compute_records", records_ms);
+        f.stages_ms.emplace_back("interpolate", st.interpolate_ms);
+        t0 = clock::now();
+        f.indirect = image<glm::vec3>(width, height);
+        f.combined.emplace(width, height);
+        read_indirect(f.indirect.view());
+        read_texture(compose(passes.light.radiance()), f.combined->view());
+        f.stages_ms.emplace_back("normalize", ms_since(t0));
+        f.g = gbuffer_;
+        return f;
+    }
+
     /// The G-buffer and the splat buffer the last frame's scan saw (row 0 at the top).
     const gbuffer<float>& scanned_gbuffer() const noexcept { return gbuffer_; }
     /// The last frame's indirect radiance (RGBA32F, rgb; alpha 1).
@@ -93,6 +186,20 @@ public:
     /// (after the caller replaced or shrank its records, as when
     /// cpu::irradiance_cache::clamp_to_neighbours returns more than 0).
     void reset() noexcept { on_gpu_ = wide_on_gpu_ = 0; }
+
+    /// frame()'s first step: this splatter takes `cache`'s splat parameters and hole filling,
+    /// and its GPU copy follows the cache's records (reset when they were replaced or shrunk).
+    template <class Cache>
+    void follow(Cache& cache) {
+        irradiance_splatter_options o = options_;
+        o.splat = cache.options().splat;
+        o.fill_holes = cache.options().fills_holes() ? cache.options().fill_holes : 0.f;
+        set_options(o);
+        const std::size_t shrunk = cache.clamp_to_neighbours();
+        if (shrunk > 0 || followed_ != static_cast<const void*>(&cache) || generation_ != cache.generation()) reset();
+        followed_ = &cache;
+        generation_ = cache.generation();
+    }
 
 private:
     using clock = std::chrono::steady_clock;
@@ -108,6 +215,8 @@ private:
     splat_pass splats_, wide_splats_;
     compose_pass compose_;
     std::size_t on_gpu_ = 0, wide_on_gpu_ = 0;
+    const void* followed_ = nullptr;  // the cache frame() followed last, and its generation then
+    std::uint64_t generation_ = 0;
     gbuffer<float> gbuffer_;
     image<glm::vec4> splat_;
 };
