@@ -1,0 +1,88 @@
+// The benchmark's radiosity: cpu::progressive_radiosity with the stereographic item buffer,
+// seen through embree::lightmap_view, against the all-bounce reference.
+#include <bounce/study/benchmark_parts.hpp>
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/cpu/radiosity_item_buffer.hpp>
+#include <bounce/embree/lightmap_view.hpp>
+#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity_options.hpp>
+#include <bounce/study/stage_timer.hpp>
+
+#include <fmt/core.h>
+
+#include <algorithm>
+
+namespace bounce::study::bench {
+
+technique_run run_radiosity(const scene_setup& s) {
+    // radiosity's defaults (examples/radiosity/options.hpp): 10,000 elements shot in 8 x 8
+    // blocks with the near-field rule at 4 sides, visibility from the stereographic item
+    // buffer of 128^2 pixels (edges within 0.25 px), uniform elements, until 90% of the
+    // emitted power is shot.
+    constexpr std::size_t elements = 10000;
+    constexpr int block = 8, resolution = 128;
+    constexpr float tolerance_px = 0.25f;
+    constexpr double converge = 0.9;
+    const std::string name(technique_name(bench_technique::radiosity));
+
+    s.clock.report(name, "atlas");
+    const auto t0 = std::chrono::steady_clock::now();
+    atlas_options ao;
+    ao.elements = elements;
+    ao.block_texels = block;
+    ao.padding = 1;
+    const lightmap_atlas atlas = build_lightmap_atlas(s.scene, ao);
+    const double atlas_ms = ms_since(t0);
+    cpu::item_buffer_visibility::options vo;
+    vo.projection = cpu::item_projection::stereographic;
+    vo.resolution = resolution;
+    vo.tolerance_px = tolerance_px;
+    radiosity_options ro;
+    ro.shoot_blocks = block > 1;
+    ro.near_field = 4;
+    s.clock.report(name, "lights");
+    cpu::progressive_radiosity solver(s.scene, atlas, cpu::item_buffer_visibility(s.scene, atlas, vo), ro);
+    bool capped = false;
+    auto last_report = std::chrono::steady_clock::now();
+    solver.solve(1.0 - converge, [&](const radiosity_progress& p) {
+        if (ms_since(last_report) > 2000) {
+            last_report = std::chrono::steady_clock::now();
+            s.clock.report(name, fmt::format("solve: {:.1f}% shot, {} shots", 100.0 * (1.0 - p.unshot_fraction), p.shots));
+        }
+        capped = ms_since(t0) > s.settings.radiosity_max_seconds * 1e3;
+        return !capped;
+    });
+    const double solve_ms = ms_since(t0);
+
+    s.clock.report(name, "view");
+    technique_run r;
+    r.technique = bench_technique::radiosity;
+    r.quantity = bench_quantity::all_bounces;
+    const auto tv = std::chrono::steady_clock::now();
+    const image<glm::vec3> lightmap = solver.lightmap(0);
+    r.radiance = embree::lightmap_view(s.bvh, s.scene, solver.atlas(), lightmap.view(), 0, s.scene.camera,
+                                       s.g.width(), s.g.height());
+    const double view_ms = ms_since(tv);
+    // The solve is the technique's work; the view from the lightmap is a texture lookup in
+    // a renderer's raster pass (here a ray cast), reported beside, as the shared G-buffer is.
+    r.ms = solve_ms;
+    const radiosity_timings& t = solver.timings();
+    r.timings_ms = {{"atlas", atlas_ms},           {"lights", t.lights_ms},     {"visibility", t.visibility_ms},
+                    {"shooter_choice", t.choice_ms}, {"reconstruction", t.distribution_ms},
+                    {"total", solve_ms},           {"lightmap_view", view_ms}};
+    const glm::dvec3 emitted = solver.emitted_power();
+    r.counts = {{"elements", solver.atlas().size()},
+                {"charts", solver.atlas().charts.size()},
+                {"shots", solver.progress().shots},
+                {"steps", solver.progress().steps},
+                {"shot_fraction", 1.0 - solver.unshot_fraction()},
+                {"emitted_w", emitted.x + emitted.y + emitted.z},
+                {"stopped_at_time_cap", capped}};
+    r.parameters = {{"elements", elements},      {"block", block},       {"visibility", "stereo"},
+                    {"resolution", resolution},  {"tolerance_px", tolerance_px}, {"adaptive", false},
+                    {"converge", converge},      {"max_seconds", s.settings.radiosity_max_seconds}};
+    return r;
+}
+
+}  // namespace bounce::study::bench

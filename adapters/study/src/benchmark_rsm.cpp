@@ -1,0 +1,93 @@
+// The benchmark's reflective-shadow-map techniques: the RSM gather, SII and SII interleaved
+// through cpu::indirect_renderer on maps embree::rsm_ray_caster casts.
+#include <bounce/study/benchmark_parts.hpp>
+
+#include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/embree/rsm_ray_cast.hpp>
+#include <bounce/lights.hpp>
+#include <bounce/study/stage_timer.hpp>
+
+#include <algorithm>
+#include <string>
+
+namespace bounce::study::bench {
+
+namespace {
+
+// rsm_sii's defaults (examples/rsm_sii/options.hpp): 1,024 lights (SII: VPLs by flux
+// warping; the gather: disc samples per pixel and map over a disc of radius 1.5 map units),
+// 256^2 texels per map, d^2 clamped at 1% of the scene's diagonal, the geometry-aware blur
+// after interleaving, energy-correct weights, seed 1.
+constexpr std::size_t lights_per_frame = 1024;
+constexpr std::size_t map_resolution = 256;
+constexpr float clamp_fraction = 0.01f;
+
+indirect_options options_for(bench_technique t, float clamp_distance) {
+    indirect_options o;
+    o.technique = t == bench_technique::rsm_gather ? indirect_technique::rsm_gather : indirect_technique::sii;
+    o.count = lights_per_frame;
+    o.pattern = t == bench_technique::sii_interleaved ? interleave_pattern{4, 4} : interleave_pattern{1, 1};
+    o.light.min_distance2 = clamp_distance * clamp_distance;
+    o.validate();
+    return o;
+}
+
+}  // namespace
+
+technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
+    require(t == bench_technique::rsm_gather || t == bench_technique::sii || t == bench_technique::sii_interleaved,
+            "technique", "is not an RSM technique");
+    require(!s.scene.lights.empty(), "scene", "has no point, spot or directional light: reflective shadow maps need one");
+    const std::string name(technique_name(t));
+    const float clamp_distance = clamp_fraction * s.diagonal;
+    const indirect_options options = options_for(t, clamp_distance);
+
+    // The maps are part of every frame's cost (the lights may move); cast once timed.
+    s.clock.report(name, "maps");
+    embree::rsm_ray_cast_settings rs;
+    rs.resolution = map_resolution;
+    embree::rsm_ray_caster caster(s.bvh, s.scene, rs);
+    const auto t0 = std::chrono::steady_clock::now();
+    caster.render();
+    const double maps_ms = ms_since(t0);
+
+    s.clock.report(name, "frames");
+    cpu::indirect_renderer renderer(options);
+    image<glm::vec3> e(s.g.width(), s.g.height());
+    stage_timer timer;
+    indirect_timings last;
+    for (int i = 0; i < std::max(1, s.settings.repeat); ++i) {
+        last = renderer.render(s.g.view(), s.scene.camera, caster.views(), e.view());
+        timer.add_sample("split", last.split_ms);
+        timer.add_sample("shade", last.shade_ms);
+        timer.add_sample("gather", last.gather_ms);
+        timer.add_sample("blur", last.blur_ms);
+        timer.add_sample("frame", last.total_ms());
+    }
+
+    technique_run r;
+    r.technique = t;
+    r.quantity = bench_quantity::one_bounce;
+    r.ms = maps_ms + timer.median_ms("frame");
+    r.timings_ms = {{"maps", maps_ms}};
+    for (const auto& stage : timer.stages()) r.timings_ms[stage] = timer.median_ms(stage);
+    r.timings_ms["total"] = r.ms;
+    // The renderer gives irradiance; the references hold radiance rho / pi E.
+    const gbuffer_view<float> g = s.g.view();
+    r.radiance = image<glm::vec3>(g.width(), g.height());
+    for (std::size_t y = 0; y < g.height(); ++y)
+        for (std::size_t x = 0; x < g.width(); ++x)
+            r.radiance(x, y) = lambertian_radiance<float, glm::vec3>(g.albedo(x, y), e(x, y));
+    r.counts = {{"vpls", last.vpls}, {"maps", caster.maps().size()}};
+    r.parameters = {{"count", lights_per_frame},
+                    {"pattern", t == bench_technique::sii_interleaved ? "4x4" : "1x1"},
+                    {"rsm_resolution", map_resolution},
+                    {"clamp", clamp_distance},
+                    {"r_max", options.r_max},
+                    {"blur", options.blur},
+                    {"selection", "warping"},
+                    {"repeat", std::max(1, s.settings.repeat)}};
+    return r;
+}
+
+}  // namespace bounce::study::bench
