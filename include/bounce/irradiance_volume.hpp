@@ -104,6 +104,12 @@ struct irradiance_volume_settings {
     /// luminance of the root's probes, so that dark regions do not split on noise.
     /// Typical: 0.02.
     float absolute_floor = 0.02f;
+    /// Memory the build may use, in bytes (irradiance_volume::estimated_bytes); 0: no limit.
+    /// Before baking a level the build counts the probes and nodes the volume will hold
+    /// after it and throws parameter_error naming "settings.max_depth", with the figures,
+    /// when their estimated_bytes exceed the limit. Programs pass
+    /// the memory available (study::available_memory_bytes).
+    std::uint64_t memory_limit_bytes = 0;
 };
 
 /// Counts of a build: which heuristic split how many cells, how many were culled.
@@ -164,6 +170,26 @@ public:
     /// Deepest level a build may reach (lattice coordinates fit 32 bits).
     static constexpr int depth_limit = 10;
 
+    /// Probes of a uniform grid of depth `depth`: (2^depth + 1)^3, the most any build of
+    /// that max_depth can hold.
+    static constexpr double uniform_probe_count(int depth) {
+        const double n = double(std::uint64_t(1) << std::clamp(depth, 0, 62)) + 1;
+        return n * n * n;
+    }
+    /// Bytes a build holding `probes` probes and `nodes` nodes needs at its peak (the probe
+    /// store and its lattice index, the final probes, owners and nodes), an estimate good
+    /// to a few tens of percent; the triangle lists of the cells under construction come on
+    /// top, at most one index per triangle and overlapped cell.
+    static constexpr double estimated_bytes(double probes, double nodes) {
+        return probes * (2 * double(sizeof(irradiance_probe)) + 64 + 4) + nodes * double(sizeof(node) + 4);
+    }
+    /// estimated_bytes of the uniform grid of depth `depth`: the bound for any max_depth.
+    static constexpr double estimated_bytes(int depth) {
+        double nodes = 0;
+        for (int d = 0; d <= depth; ++d) nodes += double(std::uint64_t(1) << std::clamp(3 * d, 0, 62));
+        return estimated_bytes(uniform_probe_count(depth), nodes);
+    }
+
     struct node {
         glm::vec3 lo{0.f}, size{0.f};
         int depth = 0;
@@ -177,7 +203,11 @@ public:
     /// Throws parameter_error naming "scene" when it has no triangles, "lo"/"hi" for an
     /// empty or non-finite box, "settings.max_depth"/"settings.min_depth" outside
     /// 0 .. depth_limit or min > max, a negative or non-finite threshold by its name, and
-    /// "probes" when the source returns a non-finite value or an out-of-place probe.
+    /// "probes" when the source returns a non-finite value or an out-of-place probe,
+    /// "settings.max_depth" when a level would exceed settings.memory_limit_bytes, and
+    /// "scene" when every probe of the finished volume is inside geometry (the volume would
+    /// light nothing: typically a scene whose triangles all face away from the volume,
+    /// wound the wrong way, so that every probe's rays hit their backs).
     template <probe_source Source>
     static irradiance_volume build(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
                                    const irradiance_volume_settings& settings, Source&& source,
@@ -320,6 +350,15 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
                 positions.push_back(lattice_position(x, y, z));
             }
         if (positions.empty()) return;
+        if (s.memory_limit_bytes > 0) {
+            const double probes = double(all.size() + positions.size()), nodes = double(v.nodes_.size() + cells.size()),
+                         need = estimated_bytes(probes, nodes);
+            if (need > double(s.memory_limit_bytes))
+                throw parameter_error("settings.max_depth",
+                                      "depth " + std::to_string(depth) + " would hold " + std::to_string(std::uint64_t(probes)) +
+                                          " probes, about " + std::to_string(std::uint64_t(need / 1e6)) + " MB, more than the " +
+                                          std::to_string(s.memory_limit_bytes / 1000000) + " MB allowed; choose a smaller max_depth");
+        }
         std::vector<irradiance_probe> baked(positions.size());
         source(std::span<const glm::vec3>(positions), std::span<irradiance_probe>(baked));
         for (std::size_t i = 0; i < baked.size(); ++i) {
@@ -533,6 +572,11 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
         for (auto& idx : nd.corner) idx = remap[idx] == std::numeric_limits<std::uint32_t>::max() ? 0u : remap[idx];
     }
     for (const auto& p : v.probes_) stats.probes_inside += p.inside ? 1 : 0;
+    if (stats.probes_inside == v.probes_.size())
+        throw parameter_error("scene", "every one of the " + std::to_string(v.probes_.size()) +
+                                           " probes is inside geometry (its rays hit the backs of triangles), so the volume "
+                                           "would light nothing; are the scene's triangles wound the wrong way, facing away "
+                                           "from the volume and the lights?");
     // Reach and owner: the largest leaf each probe is a corner of.
     v.owner_.assign(v.probes_.size(), 0);
     for (auto& p : v.probes_) p.reach = 0.f;

@@ -96,3 +96,82 @@ TEST_CASE("the probe baker refuses bad settings and positions", "[irradiance_vol
     const embree::probe_baker baker(light, bvh, s, {});
     CHECK_THROWS_AS(baker.bake(glm::vec3(std::nanf(""), 0.f, 0.f)), parameter_error);
 }
+
+namespace {
+
+// A closed box [-1, 1]^3 of six quads with a point light inside. `inward`: each quad wound
+// counter-clockwise seen from inside (a room); otherwise seen from outside (the room wound
+// the wrong way: every triangle faces away from the light and the volume).
+hand_built::scene lit_box(bool inward) {
+    hand_built::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.6f));
+    for (int k = 0; k < 3; ++k)
+        for (const float side : {-1.f, 1.f}) {
+            glm::vec3 e(0.f), u(0.f), v(0.f);
+            e[k] = 1.f;
+            u[(k + 1) % 3] = 1.f;
+            v[(k + 2) % 3] = 1.f;
+            const glm::vec3 c = side * e;
+            glm::vec3 q[4] = {c - u - v, c + u - v, c + u + v, c - u + v};  // counter-clockwise seen from +e
+            const bool seen_from_plus_e = inward ? side < 0 : side > 0;
+            if (!seen_from_plus_e) std::swap(q[1], q[3]);
+            hand_built::add_quad(s, q[0], q[1], q[2], q[3], seen_from_plus_e ? e : -e, m);
+        }
+    s.lights.push_back(bounce::point_light{{0.f, 0.5f, 0.f}, glm::vec3(5.f)});
+    return s;
+}
+
+irradiance_volume build_in_box(const hand_built::scene& s) {
+    const embree::accel bvh(s);
+    const embree::reference_integrator light(bvh, s);
+    embree::probe_baker_settings bs;
+    bs.rays = 64;
+    const embree::probe_baker baker(light, bvh, s, bs);
+    irradiance_volume_settings vs;
+    vs.min_depth = 1;
+    vs.max_depth = 2;
+    return irradiance_volume::build(s, glm::vec3(-0.9f), glm::vec3(0.9f), vs, baker);
+}
+
+}  // namespace
+
+TEST_CASE("a volume whose every probe is inside geometry (reversed winding) is refused", "[irradiance_volume][embree]") {
+    // The same box wound as a room: every probe sees the fronts of the walls and lights.
+    const irradiance_volume room = build_in_box(lit_box(true));
+    std::size_t inside = 0;
+    for (const auto& p : room.probes()) inside += p.inside ? 1 : 0;
+    CHECK(inside == 0);
+    CHECK(room.trilinear(glm::vec3(0.f), glm::vec3(0, -1, 0)).x > 0.f);
+    // Wound the wrong way: every ray of every probe hits the back of a wall.
+    try {
+        (void)build_in_box(lit_box(false));
+        FAIL("no exception for a volume whose probes are all inside");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "scene");
+        CHECK(std::string(e.what()).find("probes is inside geometry") != std::string::npos);
+        CHECK(std::string(e.what()).find("wound the wrong way") != std::string::npos);
+    }
+}
+
+TEST_CASE("a build that would exceed its memory limit is refused before the bake", "[irradiance_volume][embree]") {
+    const auto s = lit_box(true);
+    const embree::accel bvh(s);
+    const embree::reference_integrator light(bvh, s);
+    std::size_t baked = 0;
+    const auto source = [&](std::span<const glm::vec3> positions, std::span<irradiance_probe> out) {
+        for (std::size_t i = 0; i < positions.size(); ++i) out[i].position = positions[i];
+        baked += positions.size();
+    };
+    irradiance_volume_settings vs;
+    vs.min_depth = vs.max_depth = 6;  // 274,625 probes: about 270 MB
+    vs.memory_limit_bytes = std::uint64_t(irradiance_volume::estimated_bytes(3));
+    try {
+        (void)irradiance_volume::build(s, glm::vec3(-0.9f), glm::vec3(0.9f), vs, source);
+        FAIL("no exception for a build over its memory limit");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "settings.max_depth");
+        CHECK(std::string(e.what()).find("depth 4 would hold 4913 probes") != std::string::npos);
+    }
+    CHECK(baked == 729);  // levels 0 .. 3 (9^3 probes), nothing of level 4
+    CHECK(irradiance_volume::uniform_probe_count(6) == 274625.0);
+}
