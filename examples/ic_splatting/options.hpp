@@ -205,12 +205,14 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--interp", o.interp,
                    "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
         ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();
-    app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)");
+    // Unsigned counts get a range: CLI11 reads "-1" into a std::size_t as its largest value.
+    app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)")
+        ->check(CLI::Range(0, 1 << 24));
     app.add_option("--fill-holes", o.fill_holes,
                    "progressive: fill pixels no zone reaches from a splat with a this many times wider (0: off)")
         ->check(examples::finite_non_negative)
         ->capture_default_str();
-    app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--frames", o.frames, "frames of the progressive camera path")->check(CLI::Range(1, 100000))->capture_default_str();
     app.add_option("--a-sweep", o.a_sweep, "comma-separated a values rendered from one growing cache")
         ->delimiter(',')
         ->check(examples::finite_positive);
@@ -255,12 +257,14 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                  "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|), new records and, each frame, older ones (default on)");
     app.add_option("--walkthrough", o.walkthrough,
                    "render N frames along the camera path (docs/irradiance-splatting.md) with one growing cache, "
-                   "reporting per-frame error and time and Monte Carlo at equal per-frame error");
+                   "reporting per-frame error and time and Monte Carlo at equal per-frame error")
+        ->check(CLI::Range(0, 100000));
     app.add_flag("--walkthrough-fresh", o.walkthrough_fresh,
                  "walkthrough: also render every frame from an empty cache (its error and records, not timed in the total)");
     app.add_option("--walkthrough-mc-stride", o.walkthrough_mc_stride,
                    "walkthrough: Monte Carlo at equal error on every k-th frame, its mean time standing for every frame "
                    "(0: none)")
+        ->check(CLI::Range(0, 100000))
         ->capture_default_str();
     app.add_flag("!--no-gradient-limit", o.gradient_limit, "do not limit R by E / |grad_t E|");
     app.add_option("--max-extrapolation", o.max_extrapolation, "gradient term clamped to this times E_k")->check(examples::finite_non_negative)->capture_default_str();
