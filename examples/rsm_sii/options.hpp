@@ -107,15 +107,16 @@ inline const CLI::Validator unsigned_64 = CLI::Validator(
     },
     "UINT64");
 
-/// An even number of rays per pixel in [2, 2^20] (the unoccluded reference is two halves).
+/// An even number of rays per pixel in [4, 2^20] (the unoccluded reference is two halves of
+/// at least 2 rays each).
 inline const CLI::Validator even_ref_spp = CLI::Validator(
     [](std::string& s) -> std::string {
         const double v = examples::detail::parse_number(s);
-        if (v >= 2 && v <= double(1u << 20) && v == std::floor(v) && std::fmod(v, 2.0) == 0) return {};
-        return "'" + s + "' is not an even number of rays in [2, 1048576] (the unoccluded reference is two halves of "
+        if (v >= 4 && v <= double(1u << 20) && v == std::floor(v) && std::fmod(v, 2.0) == 0) return {};
+        return "'" + s + "' is not an even number of rays in [4, 1048576] (the unoccluded reference is two halves of "
                "equal size)";
     },
-    "EVEN IN [2, 1048576]");
+    "EVEN IN [4, 1048576]");
 
 inline void add_options(CLI::App& app, options& o) {
     app.add_option("--technique", o.technique, "rsm (the RSM gather, DS05) | sii (splatting indirect illumination, DS06)")

@@ -235,6 +235,11 @@ TEST_CASE("the unoccluded reference image reports its measured noise, and bad se
     CHECK(many.noise_rel_rms < few.noise_rel_rms / 4);
     CHECK(many.indirect(0, 0) == glm::vec3(0.f));
     CHECK_THROWS_AS(embree::unoccluded_reference(bvh, s.view(), {1, 256, 0.f, 1}), parameter_error);
+    // Two halves of equal size, at least 2 rays each: an odd count or 2 is refused up front.
+    for (const std::uint32_t bad : {2u, 3u, 65u})
+        CHECK_THROWS_AS(embree::render_unoccluded_reference(bvh, s.view(), g.view(), {bad, 256, 0.f, 3}),
+                        parameter_error);
+    CHECK(embree::render_unoccluded_reference(bvh, s.view(), g.view(), {4, 256, 0.f, 3}).samples == 4);
     CHECK_THROWS_AS(embree::rsm_ray_caster(bvh, s.view(), {0, 60.f}), parameter_error);
     CHECK_THROWS_AS(embree::rsm_ray_caster(bvh, s.view(), {64, 90.f}), parameter_error);
     embree::rsm_ray_caster caster(bvh, s.view(), {16, 60.f});

@@ -121,6 +121,8 @@ unoccluded_reference_image render_unoccluded_reference(const accel& bvh, const s
                                                        const gbuffer_view<float>& g,
                                                        const unoccluded_reference_settings& settings) {
     settings.validate();
+    require(settings.hemisphere_samples >= 4 && settings.hemisphere_samples % 2 == 0, "hemisphere_samples",
+            "must be even and at least 4: two halves of equal size, each of at least 2 rays");
     unoccluded_reference_settings half = settings;
     half.hemisphere_samples = settings.hemisphere_samples / 2;
     const image<glm::vec3> a = unoccluded_reference(bvh, scene, half).indirect_image(g);

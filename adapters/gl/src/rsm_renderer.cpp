@@ -204,7 +204,9 @@ void rsm_renderer::render_map(const rsm_map_layout& m, const packed_light& l, co
         auto [lo, hi] = scene_.bounds();
         float far_depth = 0.f;
         for (int c = 0; c < 8; ++c) far_depth = std::max(far_depth, glm::length(box_corner(lo, hi, c) - m.position));
-        far_depth = std::max(far_depth * 1.01f, 1e-3f);
+        // No absolute floor beyond what keeps the planes apart in float (a scene within a
+        // millimetre of the light had its depth range stretched to 1e-3 units before).
+        far_depth = std::max(far_depth * 1.01f, 1e-15f);
         raster = glm::perspective(glm::radians(m.fov_deg), 1.f, far_depth * 1e-4f, far_depth) * m.view;
     }
     const float texel_area = m.orthographic ? m.texel_size * m.texel_size : 0.f;

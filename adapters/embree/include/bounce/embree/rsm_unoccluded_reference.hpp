@@ -95,7 +95,8 @@ struct unoccluded_reference_image {
 };
 
 /// Renders the two halves (hemisphere_samples / 2 each, seeds settings.seed and
-/// settings.seed + 1) and returns their mean with its noise figure.
+/// settings.seed + 1) and returns their mean with its noise figure. Throws parameter_error
+/// naming hemisphere_samples unless it is even and at least 4 (before any ray).
 unoccluded_reference_image render_unoccluded_reference(const accel& bvh, const scene_view& scene,
                                                        const gbuffer_view<float>& g,
                                                        const unoccluded_reference_settings& settings);

@@ -31,6 +31,8 @@
 /// blend, depth and dither state).
 
 #include <bounce/camera.hpp>
+#include <bounce/gbuffer.hpp>
+#include <bounce/gl/context.hpp>
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/rsm_textures.hpp>
 #include <bounce/gl/splat_pass.hpp>
@@ -95,6 +97,38 @@ private:
     bool time_stages_ = false;
     std::unique_ptr<passes> passes_;
     std::vector<vpl> splatted_;
+};
+
+/// `gl::indirect_renderer` in an EGL context of its own, on a G-buffer and maps held in host
+/// images (what the CPU renderer takes: a ray-cast G-buffer, embree::rsm_ray_caster's
+/// maps), for programs and studies that run both backends on the same inputs. It has the
+/// call of cpu::indirect_renderer (`render(options, gb, cam, maps, irradiance)`): each
+/// call uploads the G-buffer and maps as RGBA32F textures, renders with `options` (the
+/// renderer and its programs are kept while the options compare equal) and reads the
+/// irradiance back. The stage times are the GPU's (time_stages); neither the uploads nor
+/// the read-back are timed. The context is made current on construction and by each
+/// render; use the object from one thread.
+class offscreen_indirect_renderer {
+public:
+    /// Creates the context (throws gl_error when EGL gives none).
+    explicit offscreen_indirect_renderer(const context_options& context = {});
+    ~offscreen_indirect_renderer();
+    offscreen_indirect_renderer(const offscreen_indirect_renderer&) = delete;
+    offscreen_indirect_renderer& operator=(const offscreen_indirect_renderer&) = delete;
+
+    /// Fills `irradiance` (the G-buffer's size) as cpu::indirect_renderer::render does.
+    /// Throws parameter_error for bad options (before any GL work) or inputs.
+    indirect_timings render(const indirect_options& options, const gbuffer_view<float>& gb, const camera& cam,
+                            std::span<const rsm_view> maps, image_view<glm::vec3> irradiance);
+
+    /// GL_RENDERER of the context ("llvmpipe (LLVM 15.0.6, 256 bits)" ...).
+    std::string gl_renderer() const { return context_.renderer(); }
+
+private:
+    struct uploads;
+    context context_;  // first: everything below needs it current
+    std::unique_ptr<uploads> uploads_;
+    std::optional<indirect_renderer> renderer_;
 };
 
 }  // namespace bounce::gl
