@@ -399,8 +399,16 @@ def technique_paragraph(tech, results):
     def comparison(measure, key, what):
         groups = {"pays": [], "loses": [], "level": [], "open": [], None: []}
         for n, t in ok:
-            v = verdict(get(t, key, measure))
-            groups[v[0] if v else None].append(f"{n} ({v[1]})" if v else n)
+            entry = get(t, key, measure)
+            v = verdict(entry)
+            if v and v[0] == "open":
+                run = "largest run" if bound_prefix(entry) == "≥ " else "first run"
+                did = "did not reach its error" if run == "largest run" else "already did better"
+                most = "at least" if run == "largest run" else "at most"
+                groups["open"].append(f"{n} (Monte Carlo's {run}, {fmt_ms(entry.get('ms'))}, {did}: "
+                                      f"the speed-up is {most} {v[1].lstrip('≥≤ ')})")
+            else:
+                groups[v[0] if v else None].append(f"{n} ({v[1]})" if v else n)
         baseline = "its Monte Carlo baseline" if key == "mc_equal_error" else "unoccluded Monte Carlo"
         if ok and len(groups["pays"]) == len(ok):
             return [f"At equal {what} it beats {baseline} on every scene it ran on: {join_scenes(groups['pays'])}."]
@@ -414,8 +422,7 @@ def technique_paragraph(tech, results):
         if groups["level"]:
             clauses.append(f"is level with Monte Carlo on {join_scenes(groups['level'])}")
         if groups["open"]:
-            clauses.append(f"is not settled on {join_scenes(groups['open'])} (Monte Carlo's sweep bounds the "
-                           "speed-up only on the other side of 1)")
+            clauses.append(f"is not settled by the sweep on {join_scenes(groups['open'])}")
         out = [f"At equal {what} it " + "; it ".join(clauses) + "."] if clauses else []
         if groups[None]:
             out.append(f"No equal-{what} figure on {join_scenes(groups[None])}.")
