@@ -1,0 +1,127 @@
+// The moving-sphere measurement of irradiance volumes (study/volume_sphere.hpp): the default
+// path lies in free space (checked against the exact distances to a room and a pillar),
+// a camera with no free space around it is refused, and in a uniform environment every
+// lookup agrees with the reference on the sphere with no popping.
+#include "../embree/hand_built_scenes.hpp"
+
+#include <bounce/embree/probe_baker.hpp>
+#include <bounce/study/volume_sphere.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace bounce;
+
+namespace {
+
+// Axis-aligned box [lo, hi], every face wound counter-clockwise seen from outside
+// (`outward`) or from inside.
+void add_box(hand_built::scene& s, glm::vec3 lo, glm::vec3 hi, bool outward, std::uint32_t m) {
+    const glm::vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
+    for (int k = 0; k < 3; ++k)
+        for (const float side : {-1.f, 1.f}) {
+            glm::vec3 e(0.f), u(0.f), v(0.f);
+            e[k] = 1.f;
+            u[(k + 1) % 3] = h[(k + 1) % 3];
+            v[(k + 2) % 3] = h[(k + 2) % 3];
+            const glm::vec3 f = c + side * h[k] * e;
+            glm::vec3 q[4] = {f - u - v, f + u - v, f + u + v, f - u + v};  // counter-clockwise seen from +e
+            const bool seen_from_plus_e = outward ? side > 0 : side < 0;
+            if (!seen_from_plus_e) std::swap(q[1], q[3]);
+            hand_built::add_quad(s, q[0], q[1], q[2], q[3], seen_from_plus_e ? e : -e, m);
+        }
+}
+
+float distance_to_box(glm::vec3 p, glm::vec3 lo, glm::vec3 hi) {
+    const glm::vec3 d = glm::max(glm::max(lo - p, p - hi), glm::vec3(0.f));
+    return glm::length(d);
+}
+
+camera looking(glm::vec3 from, glm::vec3 to) {
+    camera c;
+    c.position = from;
+    c.look_at = to;
+    c.up = {0, 1, 0};
+    c.fov_y_deg = 45;
+    return c;
+}
+
+}  // namespace
+
+TEST_CASE("the default sphere path lies in the free space along the view", "[irradiance_volume][study]") {
+    hand_built::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
+    add_box(s, glm::vec3(-1.f), glm::vec3(1.f), false, m);  // the room
+    const glm::vec3 pillar_lo(-0.2f, -1.f, -0.5f), pillar_hi(0.2f, 0.3f, -0.3f);
+    add_box(s, pillar_lo, pillar_hi, true, m);  // a pillar across the view axis
+    const embree::accel bvh(s);
+    const glm::vec3 lo(-0.98f), hi(0.98f);
+    const auto path = study::default_sphere_path(bvh, looking({0.f, 0.f, 0.9f}, {0.f, 0.f, -1.f}), lo, hi);
+    CHECK(path.radius > 0.f);
+    CHECK(path.radius <= 0.02f * glm::length(hi - lo) * 1.0001f);
+    CHECK(glm::length(path.b - path.a) >= 4 * path.radius);
+    CHECK(study::sphere_path_is_clear(bvh, path));
+    // Exact free distances along the path: the room's walls and the pillar.
+    for (int k = 0; k <= 200; ++k) {
+        const glm::vec3 c = path.centre(std::size_t(k), 201);
+        CHECK(glm::all(glm::greaterThanEqual(c, lo)));
+        CHECK(glm::all(glm::lessThanEqual(c, hi)));
+        const float walls = 1.f - std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)});
+        CHECK(std::min(walls, distance_to_box(c, pillar_lo, pillar_hi)) >= path.radius);
+    }
+    // A radius asked for is kept.
+    const auto fixed = study::default_sphere_path(bvh, looking({0.f, 0.f, 0.9f}, {0.f, 0.f, -1.f}), lo, hi, 0.05f);
+    CHECK(fixed.radius == 0.05f);
+    CHECK(study::sphere_path_is_clear(bvh, fixed));
+}
+
+TEST_CASE("a camera with no free space around it gets no default path", "[irradiance_volume][study]") {
+    hand_built::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
+    add_box(s, glm::vec3(-1.f), glm::vec3(1.f), false, m);
+    add_box(s, glm::vec3(-0.001f), glm::vec3(0.001f), false, m);  // a closed cell around the camera
+    const embree::accel bvh(s);
+    try {
+        (void)study::default_sphere_path(bvh, looking({0.f, 0.f, 0.f}, {0.f, 0.f, -1.f}), glm::vec3(-0.98f), glm::vec3(0.98f));
+        FAIL("no exception");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "path");
+    }
+}
+
+TEST_CASE("in a uniform environment every lookup matches the reference on the sphere", "[irradiance_volume][study]") {
+    hand_built::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
+    hand_built::add_icosphere(s, {50, 50, 50}, 0.01, 0, m);  // far and tiny: a volume needs a triangle
+    const embree::accel bvh(s);
+    embree::reference_settings rs;
+    rs.environment = glm::vec3(1.f, 2.f, 3.f);
+    const embree::reference_integrator light(bvh, s, rs);
+    embree::probe_baker_settings bs;
+    bs.rays = 256;
+    bs.gradient_step = 0.05f;
+    const embree::probe_baker baker(light, bvh, s, bs);
+    irradiance_volume_settings vs;
+    vs.min_depth = vs.max_depth = 2;
+    const irradiance_volume volume = irradiance_volume::build(s, glm::vec3(-1.f), glm::vec3(1.f), vs, baker);
+    study::volume_sphere_settings ss;
+    ss.frames = 4;
+    ss.sphere_points = 32;
+    ss.popping_steps = 16;
+    ss.reference_samples = 64;
+    ss.repeat = 1;
+    const study::volume_sphere_study sphere(light, {{-0.6f, 0.1f, 0.2f}, {0.7f, -0.1f, 0.3f}, 0.1f}, ss);
+    CHECK(sphere.reference_popping() == Approx(0).margin(1e-6));
+    for (const auto interpolation : {cpu::volume_interpolation::trilinear, cpu::volume_interpolation::weighted}) {
+        const auto f = sphere.measure(volume, "x", {interpolation, {2.f, true, 1.5f}});
+        CHECK(f.error.pixels == 4 * 32);
+        // Probes hold E = pi L within the Fibonacci set's ~1/N quadrature error (1% allowed).
+        CHECK(f.error.rel_rms < 0.01);
+        CHECK(f.popping < 0.01);
+        CHECK(f.popping_series.size() == 16);
+        CHECK(f.lookup_ns > 0);
+    }
+    CHECK_THROWS_AS(study::volume_sphere_study(light, {{0, 0, 0}, {1, 0, 0}, 0.f}, ss), parameter_error);
+}
