@@ -9,9 +9,11 @@
 #include <bounce/study/stage_timer.hpp>
 
 #include <fmt/core.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <optional>
 
@@ -56,6 +58,20 @@ double scene_work(const benchmark_settings& s) {
     return w;
 }
 
+// The one-minute load average (/proc/loadavg), or -1 when unknown: how busy the machine was.
+double load_average() {
+    std::ifstream in("/proc/loadavg");
+    double l = -1;
+    return in >> l ? l : -1.0;
+}
+
+// User plus system time of this process so far, seconds.
+double cpu_seconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 }  // namespace
 
 std::string_view technique_name(bench_technique t) { return technique_names[std::size_t(t)]; }
@@ -88,10 +104,10 @@ benchmark_settings benchmark_settings::defaults(bool quick, std::size_t width, s
     s.height = height;
     s.quick = quick;
     if (quick) {
-        s.one_bounce = {1024, 512};
-        s.unoccluded = {1024, 512};
-        s.all_bounces = {256, 128};
-        s.volume_points = {1024, 512};
+        s.one_bounce = {256, 128};
+        s.unoccluded = {256, 128};
+        s.all_bounces = {64, 32};
+        s.volume_points = {256, 128};
         s.radiosity_max_seconds = 20;
     }
     return s;
@@ -330,6 +346,7 @@ nlohmann::ordered_json run_benchmark(const std::vector<std::string>& scene_args,
         clock.report("setup", "loading");
         scenes.push_back(io::load_scene_arg(scene_args[k]));
     }
+    const double load_start = load_average(), cpu_start = cpu_seconds();
     const provenance p = collect_provenance();
     ojson results = {{"provenance",
                       {{"commit", p.commit},
@@ -343,6 +360,12 @@ nlohmann::ordered_json run_benchmark(const std::vector<std::string>& scene_args,
     for (std::size_t k = 0; k < scenes.size(); ++k) {
         clock.begin_scene(scenes[k].name, k);
         results["scenes"].push_back(scene_with(scenes[k], settings, clock));
+        // How much of the machine the run had: CPU time over wall time near the core count
+        // means the timings are the machine's; far below it, others shared the cores.
+        results["provenance"]["machine_use"] = {{"wall_s", clock.elapsed_s()},
+                                                {"cpu_s", cpu_seconds() - cpu_start},
+                                                {"load_average_start", load_start},
+                                                {"load_average_end", load_average()}};
         if (after_scene) after_scene(results);
     }
     return results;

@@ -136,11 +136,24 @@ ojson point_json(const equal_error_point& p, double target, double technique_ms)
 
 ojson mc_equal_error_json(const mc_sweep& sweep, const measured_error& technique, double technique_ms) {
     ojson j = ojson::object();
-    if (technique.rel_rms_debiased > 0.0 && std::isfinite(technique.rel_rms_debiased))
-        j["rel_rms"] = point_json(equal_error_by_rel_rms(sweep, technique.rel_rms_debiased), technique.rel_rms_debiased,
-                                  technique_ms);
-    else
+    const double target = technique.rel_rms_debiased;
+    if (target > 0.0 && std::isfinite(target)) {
+        const equal_error_point p = equal_error_by_rel_rms(sweep, target);
+        j["rel_rms"] = point_json(p, target, technique_ms);
+        // Outside the sweep, Monte Carlo's error ~ spp^-1/2 from its nearest run says about
+        // where it would meet the target: an estimate beside the measured bound.
+        const sweep_step& nearest = p.reached ? sweep.front() : sweep.back();
+        const double e = nearest.error.rel_rms_debiased;
+        if ((!p.reached || p.at_first_step) && e > 0.0 && std::isfinite(e)) {
+            const double spp = double(nearest.spp) * (e / target) * (e / target);
+            const double ms = nearest.ms * spp / double(nearest.spp);
+            j["rel_rms"]["spp_extrapolated"] = number_or_null(spp);
+            j["rel_rms"]["ms_extrapolated"] = number_or_null(ms);
+            j["rel_rms"]["speedup_extrapolated"] = number_or_null(ms / technique_ms);
+        }
+    } else {
         j["rel_rms"] = {{"skipped", "the debiased error is not above 0: lost in the reference's noise"}};
+    }
     if (std::isfinite(technique.ssim) && technique.ssim > -1.0)
         j["ssim"] = point_json(equal_error_by_ssim(sweep, technique.ssim), technique.ssim, technique_ms);
     else

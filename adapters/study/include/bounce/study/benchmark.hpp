@@ -24,7 +24,8 @@
 /// The results file (run_benchmark):
 /// ```
 /// { "provenance": {"commit", "date", "cpu", "cores", "embree", "command",
-///                  "settings": {"width", "height", "quick", "reference_spp": {...}, ...}},
+///                  "settings": {"width", "height", "quick", "reference_spp": {...}, ...},
+///                  "machine_use": {"wall_s", "cpu_s", "load_average_start", "load_average_end"}},
 ///   "scenes": [ { "scene", "triangles", "lights", "bounds_diagonal",
 ///       "references": { "<quantity>": {"spp", "ms", "cached", "noise_rel_rms"} },
 ///       "techniques": [ { "technique", "quantity", "ms", "parameters", "counts", "timings_ms",
@@ -94,7 +95,7 @@ struct benchmark_settings {
     std::size_t width = 256, height = 256;
     bool quick = false;  ///< the settings of quick_settings (recorded in the results)
     std::vector<bench_technique> techniques{all_bench_techniques.begin(), all_bench_techniques.end()};
-    quantity_samples one_bounce{256, 256}, unoccluded{256, 256}, all_bounces{64, 64}, volume_points{256, 256};
+    quantity_samples one_bounce{1024, 512}, unoccluded{512, 256}, all_bounces{256, 128}, volume_points{512, 256};
     /// The volume's points: each surface point moved this fraction of the scene's bounding
     /// diagonal along its normal (at most half the free distance along it).
     double volume_offset = 0.02;

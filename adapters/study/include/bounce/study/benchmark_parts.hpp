@@ -91,9 +91,12 @@ equal_error_point equal_error_by_rel_rms(const mc_sweep& sweep, double target);
 /// linearly in log spp between the runs around it. Throws parameter_error for an empty
 /// sweep or a target outside (-1, 1].
 equal_error_point equal_error_by_ssim(const mc_sweep& sweep, double target);
-/// {"rel_rms": {"spp", "ms", "reached", "speedup", "target", ...}, "ssim": {...}}, the
-/// speedup being Monte Carlo's ms over `technique_ms`. A debiased error not above 0 (no
-/// error to match) gives {"skipped": why} for rel_rms.
+/// {"rel_rms": {"spp", "ms", "reached", "speedup", "target", "bound"}, "ssim": {...}}, the
+/// speedup being Monte Carlo's ms over `technique_ms` and "bound" ("lower" / "upper") present
+/// when the sweep did not bracket the target. rel_rms then also has "spp_extrapolated",
+/// "ms_extrapolated" and "speedup_extrapolated": error ~ spp^-1/2 from the sweep's nearest
+/// run, an estimate. A debiased error not above 0 (no error to match) gives
+/// {"skipped": why} for rel_rms.
 ojson mc_equal_error_json(const mc_sweep& sweep, const measured_error& technique, double technique_ms);
 
 // ---- one scene ----------------------------------------------------------------------------------
