@@ -423,6 +423,27 @@ plane_batch hemisphere_raster::finish_read() {
     return out;
 }
 
+void hemisphere_raster::read_planes(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                                    const plane_batch_consumer& consume) {
+    require(normals.size() == positions.size(), "normals", "must have one entry per position");
+    require(bool(consume), "consume", "must be a callable");
+    require(pending_.empty(), "hemisphere_raster", "has reads pending; read_planes would collect them");
+    try {
+        std::optional<std::size_t> previous;  // the first record of the batch being copied
+        for (std::size_t first = 0; first < positions.size(); first += capacity()) {
+            const std::size_t count = std::min(capacity(), positions.size() - first);
+            render(positions.subspan(first, count), normals.subspan(first, count));
+            start_read();
+            if (previous) consume(*previous, finish_read());
+            previous = first;
+        }
+        if (previous) consume(*previous, finish_read());
+    } catch (...) {
+        pending_.clear();  // the fences and buffers are reused; nothing waits on them
+        throw;
+    }
+}
+
 void hemisphere_raster::set_weights(const plane_weights& weights) {
     require(weights.camera.resolution == options_.camera.resolution &&
                 weights.camera.aperture_deg == options_.camera.aperture_deg,

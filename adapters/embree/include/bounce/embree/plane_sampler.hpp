@@ -8,7 +8,12 @@
 #include <bounce/plane_camera.hpp>
 
 #include <algorithm>
+#include <cstddef>
+#include <functional>
+#include <span>
 #include <utility>
+
+#include <glm/vec3.hpp>
 
 namespace bounce::embree {
 
@@ -34,5 +39,18 @@ inline void sample_plane(const reference_integrator& ref, const plane_camera& ca
         },
         radiance, distance);
 }
+
+/// Called with a record's index in the batch and its plane (valid during the call only).
+using plane_consumer = std::function<void(std::size_t record, plane_view plane)>;
+
+/// The planes of records (points[k], normals[k]), cast in parallel (TBB, one plane buffer
+/// per thread): sample_plane for each, then `consume(k, plane)` on the thread that cast
+/// it, so `consume` must be safe to call concurrently for different k (summing each into
+/// its own slot, or into per-thread accumulators). The ray-cast counterpart of
+/// gl::hemisphere_raster::read_planes, without its batches: memory is one plane per thread.
+/// Throws parameter_error when the spans' sizes differ or the camera is invalid; an
+/// exception from `consume` propagates (after the other threads stop).
+void sample_planes(const reference_integrator& ref, const plane_camera& camera, std::span<const glm::vec3> points,
+                   std::span<const glm::vec3> normals, const plane_consumer& consume);
 
 }  // namespace bounce::embree

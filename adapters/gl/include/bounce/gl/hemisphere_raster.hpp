@@ -76,7 +76,17 @@ struct plane_batch {
     std::size_t size() const noexcept { return radiance.size(); }
     /// Record k's plane for cpu::estimate_plane.
     plane_view view(std::size_t k) const { return {radiance.at(k).view(), distance.at(k).view()}; }
+    /// Every record's plane, in order.
+    std::vector<plane_view> views() const {
+        std::vector<plane_view> v;
+        for (std::size_t k = 0; k < size(); ++k) v.push_back(view(k));
+        return v;
+    }
 };
+
+/// Called with the index of a batch's first record among all those passed to
+/// hemisphere_raster::read_planes and the batch's planes (valid during the call only).
+using plane_batch_consumer = std::function<void(std::size_t first, const plane_batch& planes)>;
 
 /// What a plane_drawer is given for one record: where the record is, the camera it must
 /// draw with, and the tile of the atlas it draws into.
@@ -192,6 +202,18 @@ public:
     /// Waits for the oldest pending read and returns its planes. Throws parameter_error when
     /// none is pending.
     plane_batch finish_read();
+
+    /// The planes of every record (positions[k], normals[k]), any number of them, rendered
+    /// capacity() per batch and read back through the two pixel buffers in turn: batch b + 1
+    /// renders while batch b is copied, then `consume(first of b, planes of b)` runs (on
+    /// the calling thread) while b + 1 is copied, and so on; the CPU's work on a batch
+    /// overlaps the GPU's on the next (Gautron 2008's read-back with CPU sums). Throws
+    /// parameter_error when the spans' sizes differ, `consume` is empty, or reads are pending
+    /// (it would collect another caller's); render's errors for bad points. When `consume` or
+    /// the GL throws, the reads it started are dropped before the exception propagates, so
+    /// the raster can be used again.
+    void read_planes(std::span<const glm::vec3> positions, std::span<const glm::vec3> normals,
+                     const plane_batch_consumer& consume);
 
     /// Uploads the weight table the GPU reduction uses (its camera must be options().camera).
     void set_weights(const plane_weights& weights);
