@@ -149,6 +149,7 @@ sphere_path default_sphere_path(const embree::accel& bvh, const camera& cam, glm
     // Each ray's segment inside the box up to its first surface, and the free distances on it.
     struct candidate {
         glm::vec3 a, b;
+        float from_camera;  // distance from the camera to a
         std::vector<float> free;
     };
     std::vector<candidate> candidates;
@@ -163,10 +164,11 @@ sphere_path default_sphere_path(const embree::accel& bvh, const camera& cam, glm
         const float end = h.found() ? t0 + h.t : t1;
         if (!(end > t0)) continue;
         const glm::vec3 a = cam.position + t0 * d, b = cam.position + end * d;
-        candidates.push_back({a, b, free_distances(bvh, a, b, samples, probe_dirs)});
+        candidates.push_back({a, b, t0, free_distances(bvh, a, b, samples, probe_dirs)});
     }
     // The largest radius (halving from `largest`) for which some ray has a run of points
-    // whose free distance is at least 1.5 radii and which is at least four radii long; the
+    // whose free distance is at least 1.5 radii, at least four radii from the camera, and
+    // which is at least four radii long; the
     // longest such run. The sparse rays of the free distances can miss thin geometry, so
     // the path is checked with sphere_path_is_clear before it is taken.
     for (int halvings = 0; halvings <= (radius > 0 ? 0 : 6); ++halvings) {
@@ -176,7 +178,8 @@ sphere_path default_sphere_path(const embree::accel& bvh, const camera& cam, glm
             const float step = glm::length(c.b - c.a) / float(samples - 1);
             std::size_t begin = 0;
             for (std::size_t k = 0; k <= samples; ++k) {
-                if (k < samples && c.free[k] >= 1.5f * r) continue;
+                // Free, and not in the camera's face (a sphere there would fill the frame).
+                if (k < samples && c.free[k] >= 1.5f * r && c.from_camera + float(k) * step >= 4 * r) continue;
                 if (k > begin && float(k - 1 - begin) * step >= 4 * r) {
                     const glm::vec3 dir = (c.b - c.a) / float(samples - 1);
                     found.push_back({c.a + float(begin) * dir, c.a + float(k - 1) * dir, r});

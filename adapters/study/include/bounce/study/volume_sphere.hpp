@@ -9,7 +9,8 @@
 ///   volume's box up to the first surface, measures at 64 points along each the distance to
 ///   the nearest surface (64 rays each), and keeps the longest run of points whose free
 ///   distance holds a sphere of the largest radius that fits (at most 2% of the box's
-///   diagonal), checked by sphere_path_is_clear.
+///   diagonal), at least four radii from the camera (so that the sphere does not fill its
+///   frames), checked by sphere_path_is_clear.
 /// - `volume_sphere_study` holds the sphere's points in every frame and the reference
 ///   there (reference_integrator::indirect_irradiance: the one-bounce indirect light the
 ///   probe baker's probes hold), and the popping series: the point facing down (-y) at
