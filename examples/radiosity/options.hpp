@@ -1,16 +1,23 @@
 #pragma once
-// radiosity's options: what the command line sets, how it is spelled and checked, and the
-// library settings it makes (main.cpp runs and reports).
+// radiosity's options: what the command line sets, how it is spelled and checked, the
+// library settings it makes, and how the report lists them (main.cpp runs and reports).
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/errors.hpp>
 #include <bounce/lightmap_atlas.hpp>
+#include <bounce/luminance.hpp>
 #include <bounce/radiosity_options.hpp>
 #include <bounce/radiosity_subdivision.hpp>
 
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+#include <bounce/gl/radiosity.hpp>
+#endif
+
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include "../common/cli_number_checks.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -38,13 +45,29 @@ struct options {
     std::size_t width = 256, height = 256;
     bool reference = true;
     std::uint32_t reference_paths = 256;
+    std::uint64_t seed = 1;           // the reference's base seed
     int curve_points = 16;            // error checkpoints along the solve (0: none)
     bool quiet = false;
     std::filesystem::path json, out, lightmaps, versus, reference_out;
 };
 
-inline void add_options(CLI::App& app, options& o, std::string& adaptive, std::string& ambient,
-                        std::string& reference) {
+/// A whole number in [0, 2^64), in decimal digits only (CLI11 would wrap "-1" to 2^64 - 1).
+inline const CLI::Validator seed_64 = CLI::Validator(
+    [](std::string& s) -> std::string {
+        const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) {
+            return c >= '0' && c <= '9';
+        });
+        if (digits && (s.size() < 20 || s <= "18446744073709551615")) return {};
+        return "'" + s + "' is not a whole number in [0, 18446744073709551615]";
+    },
+    "UINT64");
+
+inline void add_options(CLI::App& app, options& o) {
+    const auto on_off = [&app](const char* name, bool& flag, const char* what) {
+        app.add_option_function<std::string>(name, [&flag](const std::string& v) { flag = v == "on"; }, what)
+            ->check(CLI::IsMember({"on", "off"}))
+            ->default_str(flag ? "on" : "off");
+    };
     app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--elements", o.elements, "target number of elements (lightmap texels)")
@@ -57,8 +80,7 @@ inline void add_options(CLI::App& app, options& o, std::string& adaptive, std::s
         ->check(CLI::Range(8, 8192))->capture_default_str();
     app.add_option("--tolerance-px", o.tolerance_px, "stereographic tessellation: largest edge sagitta, pixels")
         ->check(examples::finite_positive)->capture_default_str();
-    app.add_option("--adaptive", adaptive, "adaptive subdivision: on | off")->check(CLI::IsMember({"on", "off"}))
-        ->capture_default_str();
+    on_off("--adaptive", o.adaptive, "adaptive subdivision: on | off");
     app.add_option("--max-level", o.max_level, "adaptive: deepest quadtree level")->check(CLI::Range(0, 8))
         ->capture_default_str();
     app.add_option("--threshold", o.threshold, "adaptive: second-difference threshold (times the leaf's mean)")
@@ -68,22 +90,22 @@ inline void add_options(CLI::App& app, options& o, std::string& adaptive, std::s
     app.add_option("--backend", o.backend, "cpu | gl")->check(CLI::IsMember({"cpu", "gl"}))->capture_default_str();
     app.add_option("--converge", o.converge, "stop when this fraction of the emitted power has been shot, in [0, 1)")
         ->check(examples::detail::number_in(0, 1, false, "a fraction"))->capture_default_str();
-    app.add_option("--max-seconds", o.max_seconds, "also stop after this many seconds of solving (0: no limit)")
+    app.add_option("--max-seconds", o.max_seconds, "also stop after this many seconds of shooting (0: no limit)")
         ->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--shooters-per-step", o.shooters_per_step, "shooters taken from one choice")
         ->check(CLI::Range(1, 4096))->capture_default_str();
     app.add_option("--near-field", o.near_field, "a block shoots as its quadrants within this many sides (0: one disc)")
         ->check(examples::finite_non_negative)->capture_default_str();
-    app.add_option("--ambient", ambient, "show the ambient term (Cohen et al. 1988): on | off")
-        ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+    on_off("--ambient", o.ambient, "show the ambient term (Cohen et al. 1988): on | off");
     app.add_option("--repeat", o.repeat, "solve N times; timings are medians")->check(CLI::Range(1, 100))
         ->capture_default_str();
     app.add_option("--width", o.width, "view width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "view height")->check(CLI::Range(1, 16384))->capture_default_str();
-    app.add_option("--reference", reference, "compare with the multi-bounce reference: on | off")
-        ->check(CLI::IsMember({"on", "off"}))->capture_default_str();
+    on_off("--reference", o.reference, "compare with the multi-bounce reference: on | off");
     app.add_option("--reference-paths", o.reference_paths, "reference paths per pixel")
         ->check(CLI::Range(1u, 1u << 20))->capture_default_str();
+    app.add_option("--seed", o.seed, "base seed of the reference's paths, 0 .. 2^64 - 1")->check(seed_64)
+        ->capture_default_str();
     app.add_option("--curve-points", o.curve_points, "error checkpoints along the solve (0: none)")
         ->check(CLI::Range(0, 1000))->capture_default_str();
     app.add_flag("--quiet", o.quiet, "no progress line");
@@ -123,7 +145,71 @@ inline subdivision_options subdivision_options_for(const options& o) {
 inline embree::multi_bounce_settings reference_settings_for(const options& o) {
     embree::multi_bounce_settings s;
     s.paths = o.reference_paths;
+    s.seed = o.seed;
     return s;
+}
+
+/// What the chosen backend and visibility do not offer, refused before any work.
+inline void check_options(const options& o) {
+    if (o.visibility == "hemicube" && o.resolution % 2 != 0)
+        throw parameter_error("--resolution", "a hemicube needs an even resolution");
+    if (o.backend != "gl") return;
+    // What the GL solver does not offer (docs/radiosity-gl.md).
+    if (o.visibility == "rays") throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
+    if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
+    if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
+}
+
+inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
+    cpu::item_buffer_visibility::options v;
+    v.projection = o.visibility == "hemicube" ? cpu::item_projection::hemicube : cpu::item_projection::stereographic;
+    v.resolution = o.resolution;
+    v.tolerance_px = o.tolerance_px;
+    return v;
+}
+
+#ifdef BOUNCE_RADIOSITY_WITH_GL
+inline gl::radiosity_options gl_options_for(const options& o) {
+    gl::radiosity_options g;
+    g.shooting = solver_options_for(o);  // --shooters-per-step is refused unless 1
+    g.visibility = o.visibility == "hemicube" ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic;
+    g.resolution = o.resolution;
+    g.tolerance_px = o.tolerance_px;
+    return g;
+}
+#endif
+
+/// The run's parameters as the report lists them.
+inline nlohmann::ordered_json parameters_json(const options& o) {
+    return {{"elements", o.elements}, {"block", o.block}, {"visibility", o.visibility},
+            {"resolution", o.resolution}, {"tolerance_px", o.tolerance_px},
+            {"adaptive", o.adaptive ? "on" : "off"}, {"max_level", o.max_level},
+            {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
+            {"converge", o.converge}, {"max_seconds", o.max_seconds},
+            {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
+            {"ambient", o.ambient ? "on" : "off"}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
+}
+
+/// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),
+/// and how many bounces reach 1% and 0.1% of it (the rest of the series after them).
+inline nlohmann::ordered_json reference_json(const options& o, const embree::multi_bounce_image& ref) {
+    const auto luminance = [](const glm::dvec3& c) { return rec709_luminance<double, glm::dvec3>(c); };
+    double total = 0;
+    for (const auto& b : ref.per_bounce) total += luminance(b);
+    nlohmann::ordered_json shares = nlohmann::ordered_json::array();
+    for (const auto& b : ref.per_bounce) shares.push_back(total > 0 ? luminance(b) / total : 0.0);
+    const auto needed = [&](double tol) {
+        double rest = total;
+        for (std::size_t k = 0; k < ref.per_bounce.size(); ++k) {
+            rest -= luminance(ref.per_bounce[k]);
+            if (rest <= tol * total) return int(k);
+        }
+        return int(ref.per_bounce.size());
+    };
+    const auto s = reference_settings_for(o);
+    return {{"kind", "multi-bounce path tracing"}, {"paths", s.paths}, {"max_bounces", s.max_bounces},
+            {"roulette_after", s.roulette_after}, {"area_samples", s.area_samples}, {"seed", s.seed},
+            {"bounce_share", shares}, {"bounces_for_1pct", needed(1e-2)}, {"bounces_for_0.1pct", needed(1e-3)}};
 }
 
 }  // namespace bounce::examples

@@ -2,13 +2,21 @@
 /// \file radiosity_options.hpp
 /// What the progressive radiosity solvers share whatever their backend: how they shoot
 /// (radiosity_options), the time they spent per stage (radiosity_timings) and where a solve
-/// stands (radiosity_progress). cpu::progressive_radiosity takes these as they are;
-/// gl::radiosity_options extends radiosity_options with its item-buffer options.
+/// stands (radiosity_progress), and the finest stereographic tolerance worth asking for
+/// (stereographic_tolerance_floor). cpu::progressive_radiosity takes these as they are;
+/// gl::radiosity_options extends radiosity_options with its item-buffer options. A solve to
+/// a target with checkpoints: radiosity_solve.hpp.
 
 #include <bounce/errors.hpp>
+#include <bounce/scene_view.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
+#include <string>
+
+#include <glm/geometric.hpp>
 
 namespace bounce {
 
@@ -48,6 +56,43 @@ struct radiosity_timings {
 struct radiosity_progress {
     std::size_t steps = 0, shots = 0;
     double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
+    double elapsed_ms = 0;       ///< time of the running solve(radiosity_solve_options) so far,
+                                 ///< its checkpoints excluded (radiosity_solve.hpp); 0 outside one
 };
+
+namespace detail {
+/// `v` with 4 significant digits (%.4g), for messages: std::to_string(1e-7f) reads 0.000000.
+inline std::string radiosity_number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", v);
+    return text;
+}
+}  // namespace detail
+
+/// The smallest `tolerance_px` (the sagitta rule of stereographic_tessellation.hpp) that can
+/// still change a stereographic item buffer of `resolution` pixels over `scene` cut into
+/// about `elements` elements: the larger of
+///  - 1/256 pixel, the scan converter's vertex snap (cpu::scan_triangle_with keeps 8
+///    sub-pixel bits; GL rasterizers keep at least 4), below which a tessellated vertex lands
+///    on the same snapped position as the chord's, and
+///  - what float32 positions resolve at the scene's scale: a coordinate of magnitude M (the
+///    scene's largest) carries 2^-24 M of rounding, which, seen from a shooter one element
+///    side s away (sqrt of the scene's area / elements), moves its projection by about
+///    resolution * 2^-24 M / s pixels.
+/// Below it the tessellation only splits deeper (4^depth pieces, up to its depth cap)
+/// without changing what is drawn: `--tolerance-px 1e-7` took a minute for 63 elements.
+inline float stereographic_tolerance_floor(const scene_view& scene, std::size_t elements, int resolution) {
+    double magnitude = 0, area = 0;
+    for (const glm::vec3& p : scene.positions)
+        magnitude = std::max({magnitude, double(std::abs(p.x)), double(std::abs(p.y)), double(std::abs(p.z))});
+    for (const glm::uvec3& t : scene.triangles) {
+        if (t.x >= scene.positions.size() || t.y >= scene.positions.size() || t.z >= scene.positions.size()) continue;
+        const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
+        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+    const double side = std::sqrt(area / double(std::max<std::size_t>(elements, 1)));
+    const double position_px = side > 0 ? double(resolution) * std::ldexp(magnitude, -24) / side : 0.0;
+    return float(std::max(1.0 / 256.0, position_px));
+}
 
 }  // namespace bounce

@@ -6,6 +6,7 @@
 #include <bounce/light.hpp>
 #include <bounce/lights.hpp>
 #include <bounce/radiosity.hpp>
+#include <bounce/radiosity_solve.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/stereographic_tessellation.hpp>
 
@@ -195,7 +196,7 @@ struct progressive_radiosity::state {
     std::size_t drawn = 0;
 
     // Bookkeeping (double, per channel), from the reductions.
-    glm::dvec3 emitted{0.0}, absorbed{0.0}, escaped{0.0};
+    glm::dvec3 emitted{0.0}, absorbed{0.0}, escaped{0.0}, intercepted_power{0.0};
     double unshot_total = 0;
     std::uint32_t next = 0;
     double next_power = 0;
@@ -1050,6 +1051,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     const reduction got = reduce();
     absorbed += got.absorbed;
     escaped += power - got.intercepted;
+    intercepted_power += got.intercepted;
     ++shots;
 }
 
@@ -1093,6 +1095,7 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
         }
         const reduction got = reduce();
         emitted += got.intercepted;
+        intercepted_power += got.intercepted;
         absorbed += got.absorbed;
         return;
     }
@@ -1137,6 +1140,7 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
         }
         const reduction got = reduce();
         emitted += got.intercepted;
+        intercepted_power += got.intercepted;
         absorbed += got.absorbed;
     }
 }
@@ -1156,12 +1160,22 @@ progressive_radiosity::progressive_radiosity(const scene_view& scene, const ligh
     require(atlas.block_texels >= 1 && atlas.block_texels <= 16, "atlas.block_texels",
             "must lie in [1, 16] for the GL backend (its near-field tree is a fixed-size array)");
     require(atlas.width <= 65535 && atlas.height <= 65535, "atlas", "is wider or taller than 65535 texels");
+    if (options.visibility == radiosity_visibility::stereographic) {
+        const float finest = stereographic_tolerance_floor(scene, atlas.size(), options.resolution);
+        if (options.tolerance_px < finest)
+            throw parameter_error("radiosity_options.tolerance_px",
+                                  bounce::detail::radiosity_number(options.tolerance_px) +
+                                      " px is below what the item buffer resolves here (" + bounce::detail::radiosity_number(finest) +
+                                      " px: the rasterizer's vertex snap, or float32 positions at this scene's scale), so "
+                                      "it would only tessellate deeper for nothing");
+    }
     s_ = std::make_unique<state>(scene, atlas, options);
     const auto start = clock_type::now();
     for (const light& l : scene.lights) s_->shoot_light(pack(l));
     finish();
     s_->timings.lights_ms = ms_since(start);
     s_->reduce();
+    check_lights_reach_surfaces(scene, s_->atlas, s_->emitted);
 }
 
 progressive_radiosity::~progressive_radiosity() = default;
@@ -1177,12 +1191,14 @@ bool progressive_radiosity::step() {
 
 std::size_t progressive_radiosity::solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress) {
     require(fraction >= 0 && fraction < 1, "fraction", "must lie in [0, 1)");
-    std::size_t taken = 0;
-    while (unshot_fraction() > fraction && step()) {
-        ++taken;
-        if (progress && !progress(this->progress())) break;
-    }
-    return taken;
+    radiosity_solve_options o;
+    o.converge = 1.0 - fraction;
+    o.progress = progress;
+    return solve(o).steps;
+}
+
+radiosity_solve_report progressive_radiosity::solve(const radiosity_solve_options& options) {
+    return bounce::detail::run_radiosity_solve(*this, options, [](std::size_t) { return std::size_t(0); });
 }
 
 double progressive_radiosity::unshot_fraction() const noexcept {
@@ -1190,7 +1206,7 @@ double progressive_radiosity::unshot_fraction() const noexcept {
     return e > 0 ? s_->unshot_total / e : 0.0;
 }
 radiosity_progress progressive_radiosity::progress() const noexcept {
-    return {s_->steps, s_->shots, unshot_fraction()};
+    return {s_->steps, s_->shots, unshot_fraction(), 0.0};
 }
 std::uint32_t progressive_radiosity::next_shooter() const noexcept { return s_->next; }
 double progressive_radiosity::next_shooter_power() const noexcept { return s_->next_power; }
@@ -1199,6 +1215,7 @@ std::uint32_t progressive_radiosity::shooter_first(std::size_t k) const { return
 glm::dvec3 progressive_radiosity::emitted_power() const noexcept { return s_->emitted; }
 glm::dvec3 progressive_radiosity::absorbed_power() const noexcept { return s_->absorbed; }
 glm::dvec3 progressive_radiosity::escaped_power() const noexcept { return s_->escaped; }
+glm::dvec3 progressive_radiosity::intercepted_power() const noexcept { return s_->intercepted_power; }
 glm::dvec3 progressive_radiosity::unshot_power() const {
     const auto u = unshot();
     glm::dvec3 sum(0.0);

@@ -2,7 +2,8 @@
 /// \file radiosity.hpp
 /// Progressive refinement radiosity on the CPU (Cohen et al. 1988, on textures as in Coombe
 /// and Harris 2005, GPU Gems 2 ch. 39): `cpu::progressive_radiosity`, the solver a program or
-/// a renderer drives with step() / solve().
+/// a renderer drives with step() / solve() (a solve to a target with checkpoints, a time limit
+/// and its checks: radiosity_solve.hpp).
 ///
 /// One step: choose the shooter with the largest unshot power (a parallel reduction over the
 /// shooters), prepare visibility from it (the caller's shot_visibility: an item buffer, ray
@@ -37,6 +38,7 @@
 #include <bounce/lights.hpp>
 #include <bounce/radiosity.hpp>
 #include <bounce/radiosity_options.hpp>
+#include <bounce/radiosity_solve.hpp>
 #include <bounce/radiosity_subdivision.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -64,6 +66,24 @@ using bounce::radiosity_options;
 using bounce::radiosity_progress;
 using bounce::radiosity_timings;
 
+/// Bytes that building an atlas (build_lightmap_atlas(scene, options)) and then a
+/// progressive_radiosity<V, float> over it hold at their peak, with the solver's lightmap()
+/// and the unshot radiosity laid out as texels at the end: an estimate from the element budget
+/// and the triangle count made before anything is allocated, so a caller can refuse a budget
+/// that cannot fit (`--elements 50000000`) instead of dying in std::bad_alloc or the OOM
+/// killer. Per element: the atlas's arrays (64 bytes), twice while the solver copies it, and
+/// the solver's radiosity, unshot and direct arrays (36); per texel of the atlas (elements
+/// plus each chart's padding ring and the packing's waste, at most one chart per triangle):
+/// element_at, the build's overlap sums and the lightmaps laid out (56); per triangle the
+/// build's adjacency (about 200). Visibility is not included (an item buffer: about 112
+/// bytes per triangle and 12 per pixel of its buffers).
+inline double radiosity_memory_estimate(const scene_view& scene, const atlas_options& options) {
+    const double e = double(options.elements), n = double(scene.triangles.size()), p = double(options.padding);
+    const double texels = 1.25 * (1.3 * e + 4 * p * std::sqrt(e * n) + 4 * p * p * n);
+    const double shooters = e / double(options.block_texels * options.block_texels) + n;
+    return e * (2 * 64 + 36) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
+}
+
 /// The solver. `Real` is the type of the radiosity arrays and of the kernel's arithmetic
 /// (float, as a GPU would; double for reference solutions). `Visibility` models
 /// shot_visibility.
@@ -74,7 +94,8 @@ public:
 
     /// Copies `atlas` (subdivide() refines the copy) and keeps the visibility (moved in);
     /// `scene` is read only here (its lights). Throws parameter_error on bad options or an
-    /// atlas not built from `scene`.
+    /// atlas not built from `scene`, radiosity_error when the scene's lights reach no
+    /// surface's front side (check_lights_reach_surfaces, radiosity_solve.hpp).
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, Visibility visibility,
                           radiosity_options options = {})
         : atlas_(atlas), visibility_(std::move(visibility)), options_(options) {
@@ -99,6 +120,7 @@ public:
         for (const packed_light& l : lights_) shoot_light(l, false);
         timings_.lights_ms = ms_since(start);
         refresh_powers();
+        check_lights_reach_surfaces(scene, atlas_, emitted_);
     }
 
     /// One step: choose shooters_per_step shooters by unshot power and shoot each in turn.
@@ -131,15 +153,32 @@ public:
 
     /// Steps until the unshot fraction is at most `fraction` (in [0, 1)) or nothing is left
     /// to shoot, calling `progress` after each step (return false from it to stop early).
-    /// Returns the steps taken.
+    /// Returns the steps taken. The checks of solve(radiosity_solve_options) apply.
     std::size_t solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress = {}) {
         require(fraction >= 0 && fraction < 1, "fraction", "must lie in [0, 1)");
-        std::size_t taken = 0;
-        while (unshot_fraction() > fraction && step()) {
-            ++taken;
-            if (progress && !progress(radiosity_progress{steps_, shots_, unshot_fraction()})) break;
-        }
-        return taken;
+        radiosity_solve_options o;
+        o.converge = 1.0 - fraction;
+        o.progress = progress;
+        return solve(o).steps;
+    }
+
+    /// The solve of radiosity_solve.hpp: to `options.converge`, within `options.max_seconds`,
+    /// with its progress and checkpoint callbacks (the clock paused during checkpoints).
+    /// Throws radiosity_error when energy is created or every shot escapes without reaching
+    /// a surface's front side, parameter_error on bad options.
+    radiosity_solve_report solve(const radiosity_solve_options& options) {
+        return bounce::detail::run_radiosity_solve(*this, options, [](std::size_t) { return std::size_t(0); });
+    }
+
+    /// The same with adaptive subdivision: subdivide(scene, subdivision) after each of the
+    /// first `subdivide_steps` steps of this solve (inside its clock; the report counts the
+    /// leaves split). `scene` is the scene the atlas was built from.
+    radiosity_solve_report solve(const radiosity_solve_options& options, const scene_view& scene,
+                                 const subdivision_options& subdivision, std::size_t subdivide_steps) {
+        subdivision.validate();
+        return bounce::detail::run_radiosity_solve(*this, options, [&](std::size_t step) {
+            return step <= subdivide_steps ? subdivide(scene, subdivision) : std::size_t(0);
+        });
     }
 
     /// Unshot power / emitted power, channels summed; 0 for a scene that emits nothing.
@@ -153,6 +192,9 @@ public:
     glm::dvec3 emitted_power() const noexcept { return emitted_; }
     glm::dvec3 absorbed_power() const noexcept { return absorbed_; }
     glm::dvec3 escaped_power() const noexcept { return escaped_; }
+    /// Power that reached elements since construction (the lights' direct light and what
+    /// every shot delivered, before visibility's losses are counted as escaped), W per channel.
+    glm::dvec3 intercepted_power() const noexcept { return intercepted_; }
     glm::dvec3 unshot_power() const {
         glm::dvec3 s(0);
         for (std::size_t i = 0; i < unshot_.size(); ++i) s += glm::dvec3(unshot_[i]) * double(atlas_.area[i]);
@@ -190,7 +232,7 @@ public:
     }
 
     const radiosity_timings& timings() const noexcept { return timings_; }
-    radiosity_progress progress() const noexcept { return {steps_, shots_, unshot_fraction()}; }
+    radiosity_progress progress() const noexcept { return {steps_, shots_, unshot_fraction(), 0.0}; }
     std::size_t shooters() const noexcept { return power_.size(); }
     const lightmap_atlas& atlas() const noexcept { return atlas_; }
     Visibility& visibility() noexcept { return visibility_; }
@@ -388,6 +430,7 @@ private:
         timings_.distribution_ms += ms_since(start);
         absorbed_ += total.absorbed;
         escaped_ += power - total.intercepted;
+        intercepted_ += total.intercepted;
         ++shots_;
     }
 
@@ -410,6 +453,7 @@ private:
             absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * power;
         }
         emitted_ += added;
+        intercepted_ += added;
         absorbed_ += absorbed;
         timings_.lights_ms += ms_since(start);
     }
@@ -464,6 +508,7 @@ private:
             });
             if (measure_only) continue;
             emitted_ += total.intercepted;
+            intercepted_ += total.intercepted;
             absorbed_ += total.absorbed;
         }
     }
@@ -543,7 +588,7 @@ private:
         }
     }
     double unshot_total_ = 0, total_area_ = 0;
-    glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, albedo_area_{0};
+    glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, intercepted_{0}, albedo_area_{0};
     radiosity_timings timings_;
     std::size_t steps_ = 0, shots_ = 0;
 };

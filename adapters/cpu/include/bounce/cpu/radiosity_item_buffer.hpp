@@ -38,6 +38,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/lightmap_atlas.hpp>
 #include <bounce/radiosity.hpp>
+#include <bounce/radiosity_options.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/scene_view.hpp>
 #include <bounce/stereographic_tessellation.hpp>
@@ -48,6 +49,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -207,7 +209,8 @@ public:
     struct options {
         item_projection projection = item_projection::stereographic;
         int resolution = 256;          ///< item buffer side, pixels (hemicube: per face; typical: 128-512)
-        float tolerance_px = 0.25f;    ///< largest sagitta of a tessellated edge, pixels (stereographic)
+        float tolerance_px = 0.25f;    ///< largest sagitta of a tessellated edge, pixels (stereographic;
+                                       ///< at least stereographic_tolerance_floor, radiosity_options.hpp)
         int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges (4^depth pieces at most)
         int parallel_resolution = 1024; ///< side of the directional light's buffer, pixels
     };
@@ -225,6 +228,16 @@ public:
                 "must lie in [8, 16384]");
         require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
                 "was not built from this scene (triangle counts differ)");
+        if (opt.projection == item_projection::stereographic) {
+            const float finest = stereographic_tolerance_floor(scene, atlas.size(), opt.resolution);
+            if (opt.tolerance_px < finest)
+                throw parameter_error("options.tolerance_px", bounce::detail::radiosity_number(opt.tolerance_px) +
+                                                                  " px is below what the item buffer resolves here (" +
+                                                                  bounce::detail::radiosity_number(finest) +
+                                                                  " px: its 1/256-pixel vertex snap, or float32 "
+                                                                  "positions at this scene's scale), so it would only "
+                                                                  "tessellate deeper for nothing");
+        }
         for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
             if (atlas.chart_of_triangle[t] == lightmap_atlas::none) continue;
             const auto& tri = scene.triangles[t];

@@ -43,6 +43,7 @@
 #include <bounce/image.hpp>
 #include <bounce/lightmap_atlas.hpp>
 #include <bounce/radiosity_options.hpp>
+#include <bounce/radiosity_solve.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cstddef>
@@ -91,8 +92,10 @@ public:
     /// Uploads `atlas` (copied: base blocks only, as build_lightmap_atlas makes them; a
     /// subdivided atlas is refused) and the scene's triangles, compiles the passes, shoots the
     /// scene's lights and runs the first reduction. `scene` is read only here. Throws
-    /// parameter_error on bad options, an atlas not built from `scene`, a subdivided atlas,
-    /// or blocks wider than 16 texels; gl_error when GL cannot run it.
+    /// parameter_error on bad options (tolerance_px below stereographic_tolerance_floor
+    /// included), an atlas not built from `scene`, a subdivided atlas, or blocks wider than
+    /// 16 texels; radiosity_error when the scene's lights reach no surface's front side
+    /// (check_lights_reach_surfaces); gl_error when GL cannot run it.
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, radiosity_options options = {});
     ~progressive_radiosity();
     progressive_radiosity(progressive_radiosity&&) noexcept;
@@ -107,6 +110,11 @@ public:
     /// shoot, calling `progress` after each step (return false from it to stop early).
     /// Returns the steps taken.
     std::size_t solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress = {});
+    /// The solve of radiosity_solve.hpp (the CPU solver's): to `options.converge`, within
+    /// `options.max_seconds`, with its progress and checkpoint callbacks (the clock paused
+    /// during checkpoints). Throws radiosity_error when energy is created or every shot
+    /// escapes without reaching a surface's front side, parameter_error on bad options.
+    radiosity_solve_report solve(const radiosity_solve_options& options);
 
     /// Unshot power / emitted power, channels summed (from the last reduction); 0 for a
     /// scene that emits nothing.
@@ -127,6 +135,9 @@ public:
     glm::dvec3 emitted_power() const noexcept;
     glm::dvec3 absorbed_power() const noexcept;
     glm::dvec3 escaped_power() const noexcept;
+    /// Power that reached elements since construction (lights' direct light and every shot's
+    /// interception), W per channel.
+    glm::dvec3 intercepted_power() const noexcept;
     glm::dvec3 unshot_power() const;
 
     /// Radiosity B and unshot radiosity per element (read back), W/m^2 per channel.

@@ -1,0 +1,56 @@
+#pragma once
+// What one radiosity solve gives the report, and its JSON beside study::run_report's fields.
+#include <bounce/image.hpp>
+#include <bounce/radiosity_solve.hpp>
+
+#include <nlohmann/json.hpp>
+#include <sys/resource.h>
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace bounce::examples {
+
+/// A point of the convergence curve: where the solve stood, its time, and the view's error.
+struct checkpoint {
+    std::size_t step = 0, shots = 0, elements = 0;
+    double time_ms = 0, unshot_fraction = 1, rel_rms = 0;
+};
+
+/// What a solve gives the report.
+struct solve_result {
+    radiosity_solve_report report;  // the library's (steps, why it stopped, per-step figures)
+    std::vector<checkpoint> curve;
+    double setup_ms = 0;  // atlas and solver construction (lights shot), before the solve
+    std::size_t shots = 0, shooters = 0, elements = 0, charts = 0, base_elements = 0;
+    glm::dvec3 emitted{0}, absorbed{0}, escaped{0};
+    image<glm::vec3> lightmap, unshot, view;
+};
+
+/// The solve's figures for the report: why it stopped, energy, memory, and the curves (times
+/// from the atlas on, checkpoints excluded).
+inline void add_solve_json(nlohmann::ordered_json& j, const solve_result& r) {
+    j["unshot_fraction"] = r.report.unshot_fraction;
+    j["stopped"] = to_string(r.report.stop);
+    const auto sum = [](const glm::dvec3& v) { return v.x + v.y + v.z; };
+    j["energy"] = {{"emitted_w", sum(r.emitted)},
+                   {"absorbed_fraction", sum(r.absorbed) / sum(r.emitted)},
+                   {"escaped_fraction", sum(r.escaped) / sum(r.emitted)}};
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    j["peak_rss_mb"] = double(usage.ru_maxrss) / 1024.0;
+    j["ms_per_iteration"] = r.report.steps ? r.report.solve_ms / double(r.report.steps) : 0.0;
+    j["converged_fraction"] = r.report.converged;
+    std::vector<double> iteration_ms = r.report.step_ms;
+    for (double& t : iteration_ms) t += r.setup_ms;
+    j["iteration_ms"] = iteration_ms;
+    nlohmann::ordered_json curve = nlohmann::ordered_json::array();
+    for (const auto& c : r.curve)
+        curve.push_back({{"step", c.step}, {"shots", c.shots}, {"elements", c.elements}, {"time_ms", c.time_ms},
+                         {"unshot_fraction", c.unshot_fraction}, {"rel_rms", c.rel_rms}});
+    j["convergence"] = curve;
+}
+
+}  // namespace bounce::examples

@@ -1,0 +1,225 @@
+// The solve of radiosity_solve.hpp (what cpu::progressive_radiosity::solve and the GL
+// solver's run): where it stops, its checkpoints and paused clock, its time limit; and what
+// it refuses to do silently: create energy, or give a black answer for a scene whose
+// surfaces face away from its lights (reversed winding). Also the tolerance floor of the
+// stereographic item buffer.
+#include "radiosity_scenes.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/radiosity_solve.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+namespace {
+
+// `s` with every triangle's winding reversed (each surface's front becomes its back).
+owned_scene reversed(owned_scene s) {
+    for (glm::uvec3& t : s.triangles) std::swap(t.y, t.z);
+    return s;
+}
+
+// closed_box with its emitting quad replaced by a point light at the box's centre.
+owned_scene box_with_point_light() {
+    owned_scene s = closed_box(1.f, 0.7f, 0.f);
+    s.triangles.resize(s.triangles.size() - 2);  // the lamp quad
+    s.material_of.resize(s.material_of.size() - 2);
+    s.lights.push_back(point_light{{0.5f, 0.5f, 0.5f}, {1.f, 1.f, 1.f}});
+    return s;
+}
+
+// A solver whose unshot fraction follows a script, for the loop's own checks.
+struct scripted_solver {
+    std::vector<double> fractions;  // after each step
+    std::size_t steps = 0;
+    double emitted = 1, intercepted = 1;
+    bool step() {
+        if (steps >= fractions.size()) return false;
+        ++steps;
+        return true;
+    }
+    double unshot_fraction() const { return steps == 0 ? 1.0 : fractions[steps - 1]; }
+    radiosity_progress progress() const { return {steps, steps, unshot_fraction(), 0.0}; }
+    glm::dvec3 emitted_power() const { return glm::dvec3(emitted, 0, 0); }
+    glm::dvec3 unshot_power() const { return glm::dvec3(emitted * unshot_fraction(), 0, 0); }
+    glm::dvec3 intercepted_power() const { return glm::dvec3(intercepted, 0, 0); }
+};
+
+radiosity_solve_report run(scripted_solver& s, const radiosity_solve_options& o) {
+    return detail::run_radiosity_solve(s, o, [](std::size_t) { return std::size_t(0); });
+}
+
+}  // namespace
+
+TEST_CASE("a solve stops where asked and says why", "[radiosity][solve]") {
+    scripted_solver s{{0.8, 0.5, 0.3, 0.2, 0.05, 0.01}};
+    radiosity_solve_options o;
+    o.converge = 0.7;
+    auto r = run(s, o);
+    CHECK(r.stop == radiosity_stop::converged);
+    CHECK(r.steps == 3);
+    CHECK(r.converged == std::vector<double>{1 - 0.8, 1 - 0.5, 1 - 0.3});
+    CHECK(r.step_ms.size() == 3);
+    CHECK(r.unshot_fraction == 0.3);
+    // Nothing left to shoot before the target.
+    o.converge = 1;
+    r = run(s, o);
+    CHECK(r.stop == radiosity_stop::exhausted);
+    CHECK(r.steps == 3);
+    // A progress callback that says stop.
+    scripted_solver t{{0.8, 0.5, 0.3}};
+    o.progress = [](const radiosity_progress& p) { return p.steps < 2; };
+    r = run(t, o);
+    CHECK(r.stop == radiosity_stop::callback);
+    CHECK(r.steps == 2);
+    CHECK(to_string(r.stop) == std::string("callback"));
+}
+
+TEST_CASE("checkpoints fall at fractions of the target, and their time is not the solve's", "[radiosity][solve]") {
+    std::vector<double> f;
+    for (int k = 1; k <= 64; ++k) f.push_back(1.0 - k / 64.0);  // converged 1/64 .. 1, exactly
+    scripted_solver s{f};
+    radiosity_solve_options o;
+    o.converge = 0.75;
+    o.checkpoints = 4;
+    std::vector<radiosity_progress> seen;
+    o.checkpoint = [&](const radiosity_progress& p) {
+        seen.push_back(p);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    };
+    const auto r = run(s, o);
+    CHECK(r.stop == radiosity_stop::converged);
+    CHECK(r.steps == 48);
+    // After the first step, then at converged 12/64, 24/64, 36/64, 48/64 (k / 4 of 0.75; the
+    // last is also the end).
+    std::vector<std::size_t> steps;
+    for (const auto& p : seen) steps.push_back(p.steps);
+    CHECK(steps == std::vector<std::size_t>{1, 12, 24, 36, 48});
+    CHECK(r.checkpoint_ms >= 5 * 20 * 0.9);
+    CHECK(r.solve_ms < 50);  // the 100 ms of sleeping is not solving
+    for (std::size_t k = 1; k < seen.size(); ++k) CHECK(seen[k].elapsed_ms >= seen[k - 1].elapsed_ms);
+}
+
+TEST_CASE("a solve stops at its time limit, checkpoints not counted", "[radiosity][solve]") {
+    struct slow : scripted_solver {
+        bool step() {
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            return scripted_solver::step();
+        }
+    };
+    slow s;
+    s.fractions.assign(1000, 0.5);
+    radiosity_solve_options o;
+    o.max_seconds = 0.05;
+    o.checkpoints = 1000;
+    o.checkpoint = [](const radiosity_progress&) { std::this_thread::sleep_for(std::chrono::milliseconds(5)); };
+    const auto r = detail::run_radiosity_solve(s, o, [](std::size_t) { return std::size_t(0); });
+    CHECK(r.stop == radiosity_stop::time_limit);
+    CHECK(r.steps >= 5);
+    CHECK(r.steps <= 12);
+    CHECK(r.solve_ms >= 50);
+}
+
+TEST_CASE("a solve that creates energy is stopped with the step named", "[radiosity][solve][errors]") {
+    const scripted_solver gains{{0.8, 0.9, 1.5, 3.0}};
+    scripted_solver s = gains, t = gains;
+    CHECK_THROWS_AS(run(s, {}), radiosity_error);
+    CHECK_THROWS_WITH(run(t, {}), Catch::Contains("step 3"));
+    scripted_solver n{{0.8, std::nan("")}};
+    CHECK_THROWS_AS(run(n, {}), radiosity_error);
+    radiosity_solve_options bad;
+    bad.converge = std::nan("");
+    scripted_solver u{{0.5}};
+    CHECK_THROWS_AS(run(u, bad), parameter_error);
+    CHECK_THROWS_WITH(run(u, bad), Catch::Contains("radiosity_solve_options.converge"));
+}
+
+TEST_CASE("the CPU solver's solve gives what step() by step gives, with the report", "[radiosity][solve]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
+    cpu::progressive_radiosity a(scene.view(), atlas, cpu::all_visible{}), b(scene.view(), atlas, cpu::all_visible{});
+    radiosity_solve_options o;
+    o.converge = 0.8;
+    const auto r = a.solve(o);
+    while (b.unshot_fraction() > 0.2 && b.step()) {
+    }
+    CHECK(r.steps == b.progress().steps);
+    CHECK(r.unshot_fraction == b.unshot_fraction());
+    CHECK(std::equal(a.radiosity().begin(), a.radiosity().end(), b.radiosity().begin()));
+    // With adaptive subdivision after the first steps: splits counted, the atlas refined.
+    cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{});
+    const auto rc = c.solve(o, scene.view(), subdivision_options{.threshold = 0.1}, 10);
+    CHECK(rc.splits > 0);
+    CHECK(c.atlas().size() > atlas.size());
+}
+
+TEST_CASE("reversed winding is an error naming it, not a black answer", "[radiosity][solve][errors]") {
+    // An emitting quad in a box, every triangle wound the other way: the lamp faces the
+    // ceiling's back and every wall faces out, so nothing the lamp shoots is received.
+    const auto box = reversed(closed_box(1.f, 0.7f, 2.f));
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 400});
+    cpu::progressive_radiosity solver(box.view(), atlas, cpu::item_buffer_visibility(box.view(), atlas, {.resolution = 64}));
+    CHECK_THROWS_AS(solver.solve(0.1), radiosity_error);
+    CHECK_THROWS_WITH(solver.solve(0.1), Catch::Contains("reversed winding"));
+    // The same box wound the right way solves.
+    const auto good = closed_box(1.f, 0.7f, 2.f);
+    const auto good_atlas = build_lightmap_atlas(good.view(), {.elements = 400});
+    cpu::progressive_radiosity fine(good.view(), good_atlas, cpu::all_visible{});
+    CHECK_NOTHROW(fine.solve(0.5));
+
+    // A point light inside a reversed box reaches only the walls' backs: the constructor says so.
+    const auto lit = reversed(box_with_point_light());
+    const auto lit_atlas = build_lightmap_atlas(lit.view(), {.elements = 300});
+    CHECK_THROWS_AS(cpu::progressive_radiosity(lit.view(), lit_atlas, cpu::all_visible{}), radiosity_error);
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(lit.view(), lit_atlas, cpu::all_visible{}),
+                      Catch::Contains("reversed winding") && Catch::Contains("back of"));
+    const auto right = box_with_point_light();
+    const auto right_atlas = build_lightmap_atlas(right.view(), {.elements = 300});
+    cpu::progressive_radiosity ok(right.view(), right_atlas, cpu::all_visible{});
+    CHECK(ok.emitted_power().x > 0);
+    // A point light outside the box: it faces the outer side of the back wall (its back) and
+    // the inside of the front wall, which the back wall hides from it.
+    auto outside = box_with_point_light();
+    outside.lights[0] = point_light{{0.5f, 0.5f, -3.f}, {1.f, 1.f, 1.f}};
+    const auto out_atlas = build_lightmap_atlas(outside.view(), {.elements = 300});
+    const auto hidden = [&] {
+        return cpu::progressive_radiosity(outside.view(), out_atlas,
+                                          cpu::item_buffer_visibility(outside.view(), out_atlas, {.resolution = 64}));
+    };
+    CHECK_THROWS_WITH(hidden(), Catch::Contains("occluded"));
+    // A spot aimed away from everything reaches no surface.
+    auto away = box_with_point_light();
+    spot_light spot;
+    spot.position = {0.5f, 0.5f, -3.f};
+    spot.direction = {0, 0, -1};
+    spot.intensity = glm::vec3(1.f);
+    spot.cone_deg = 30.f;
+    away.lights[0] = spot;
+    const auto away_atlas = build_lightmap_atlas(away.view(), {.elements = 300});
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(away.view(), away_atlas, cpu::all_visible{}),
+                      Catch::Contains("reaches no surface"));
+}
+
+TEST_CASE("a stereographic tolerance below what the buffer resolves is refused with the floor", "[radiosity][solve][errors]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 500});
+    const float floor = stereographic_tolerance_floor(scene.view(), atlas.size(), 128);
+    CHECK(floor == Approx(1.0 / 256.0));  // a scene near the origin in metres: the snap decides
+    const auto buffer = [&](float tolerance) {
+        return cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 128, .tolerance_px = tolerance});
+    };
+    CHECK_THROWS_AS(buffer(1e-7f), parameter_error);
+    CHECK_THROWS_WITH(buffer(1e-7f), Catch::Contains("options.tolerance_px") && Catch::Contains("0.003906"));
+    CHECK_NOTHROW(buffer(0.01f));
+    // Far from the origin, float32 positions resolve less than the snap.
+    auto far = cornell_box();
+    for (glm::vec3& p : far.positions) p += glm::vec3(1e5f, 0.f, 0.f);
+    const float far_floor = stereographic_tolerance_floor(far.view(), atlas.size(), 128);
+    CHECK(far_floor > 0.1f);
+}
