@@ -1,6 +1,8 @@
 // Reflective shadow maps cast with Embree, and the one-bounce reference without
 // receiver-sender visibility, against closed forms: flux budgets of the three light types,
 // the maps' projection, and a lit floor under a lit occluder seen from above.
+#include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
@@ -269,5 +271,61 @@ TEST_CASE("the ray caster's maps are bounce::rsm_layout's, less the cube faces t
         CHECK(m.light_view_projection == layout[k].light_view_projection);
         CHECK(m.texel_size == layout[k].texel_size);
         CHECK(m.orthographic == layout[k].orthographic);
+    }
+}
+
+TEST_CASE("RSM and SII frames do not depend on the scene's unit: the defaults scale with the scene", "[rsm][embree]") {
+    // A floor and a back wall lit by a spot and a directional light, built at scale s with
+    // intensities s^2 (so every irradiance is the same), rendered with the library's
+    // scene-derived default clamp (scene_clamp_distance): the frames at 1e-4 and 1e4 must be
+    // the one at 1. A fixed constant anywhere (the directional map's old 1e-3 floor, an
+    // absolute clamp) would change the tenth-of-a-millimetre or the ten-kilometre frame.
+    const auto frame = [](float s, indirect_technique technique) {
+        hand_built::scene sc;
+        const auto grey = hand_built::add_material(sc, glm::vec3(0.6f));
+        const auto red = hand_built::add_material(sc, glm::vec3(0.8f, 0.2f, 0.2f));
+        hand_built::add_quad(sc, s * glm::vec3(-1, 0, -1), s * glm::vec3(-1, 0, 1), s * glm::vec3(1, 0, 1),
+                             s * glm::vec3(1, 0, -1), {0, 1, 0}, grey);
+        hand_built::add_quad(sc, s * glm::vec3(-1, 0, -1), s * glm::vec3(1, 0, -1), s * glm::vec3(1, 2, -1),
+                             s * glm::vec3(-1, 2, -1), {0, 0, 1}, red);
+        sc.lights.push_back(spot_light{s * glm::vec3(0.3f, 1.5f, 0.2f), {-0.2f, -1.f, -0.4f}, glm::vec3(s * s), 50.f});
+        sc.lights.push_back(directional_light{{0.4f, -1.f, -0.5f}, glm::vec3(1.f)});
+        camera cam;
+        cam.position = s * glm::vec3(0.f, 1.2f, 3.f);
+        cam.look_at = s * glm::vec3(0.f, 0.6f, 0.f);
+        cam.near_plane = 1e-3f * s;
+        cam.far_plane = 10.f * s;
+        const embree::accel bvh(sc.view());
+        gbuffer<float> g = embree::ray_cast_gbuffer(bvh, sc.view(), cam, 40, 30);
+        embree::rsm_ray_caster caster(bvh, sc.view(), {64, 60.f});
+        caster.render();
+        indirect_options o;
+        o.technique = technique;
+        o.count = 256;
+        o.pattern = {2, 2};
+        const float clamp = scene_clamp_distance(sc.view());
+        o.light.min_distance2 = clamp * clamp;
+        image<glm::vec3> e(40, 30);
+        cpu::indirect_renderer(o).render(g.view(), cam, caster.views(), e.view());
+        return e;
+    };
+    for (const auto technique : {indirect_technique::rsm_gather, indirect_technique::sii}) {
+        const image<glm::vec3> unit = frame(1.f, technique);
+        double ref2 = 0;
+        for (std::size_t y = 0; y < 30; ++y)
+            for (std::size_t x = 0; x < 40; ++x) ref2 += double(glm::dot(unit(x, y), unit(x, y)));
+        REQUIRE(ref2 > 0);
+        for (const float s : {1e-4f, 1e4f}) {
+            const image<glm::vec3> scaled = frame(s, technique);
+            double d2 = 0;
+            for (std::size_t y = 0; y < 30; ++y)
+                for (std::size_t x = 0; x < 40; ++x) {
+                    const glm::vec3 d = scaled(x, y) - unit(x, y);
+                    d2 += double(glm::dot(d, d));
+                }
+            INFO("technique " << int(technique) << ", scale " << s << ", relative RMS difference "
+                              << std::sqrt(d2 / ref2));
+            CHECK(std::sqrt(d2 / ref2) < 1e-3);
+        }
     }
 }
