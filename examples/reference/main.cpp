@@ -8,10 +8,12 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/io/image_io.hpp>
+#include <bounce/io/output_files.hpp>
 #include <bounce/study/run_report.hpp>
 #include <bounce/io/scene.hpp>
 
 #include <CLI/CLI.hpp>
+#include "../common/cli_number_checks.hpp"
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -69,15 +71,16 @@ int main(int argc, char** argv) {
     app.add_option("--secondary-area-samples", secondary_area_samples, "samples on emissive triangles per hemisphere hit")
         ->check(CLI::Range(1u, 1u << 10))
         ->capture_default_str();
-    app.add_option("--seed", seed, "base seed of every random stream")->capture_default_str();
+    app.add_option("--seed", seed, "base seed of every random stream")->check(examples::detail::number_in(0, 18446744073709551615.0, true, "a seed"))->capture_default_str();
     app.add_option("--environment", environment, "uniform radiance R G B of rays that escape (W/m^2/sr)")
         ->expected(3)
+        ->check(examples::finite_non_negative)
         ->capture_default_str();
     app.add_option("--out", out, "combined image (EXR); X.direct.exr and X.indirect.exr beside it")->capture_default_str();
     app.add_option("--png", png, "tone-mapped combined image (PNG); X.direct.png and X.indirect.png beside it");
     app.add_option("--json", json, "run report (design.md section 6)");
     app.add_option("--exposure", exposure, "PNG exposure; 0 maps the 99th luminance percentile to white")
-        ->check(CLI::Range(0.f, 1e9f))
+        ->check(examples::detail::number_in(0, 1e9, true, "an exposure"))
         ->capture_default_str();
     app.add_option("--repeat", repeat, "compute N times (bypassing the cache) and report median timings")
         ->check(CLI::Range(1, 100))
@@ -88,7 +91,17 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
 
     try {
+        // Every output before the work: the images, their siblings, the report and the cache.
+        io::check_image_output("--out", out);
+        for (const char* stage : {"direct", "indirect"}) io::check_image_output("--out", sibling(out, stage));
+        if (!png.empty()) {
+            io::check_image_output("--png", png);
+            for (const char* stage : {"direct", "indirect"}) io::check_image_output("--png", sibling(png, stage));
+        }
+        if (!json.empty()) io::check_output_file("--json", json);
+        if (!no_cache) study::check_cache_dir(cache_dir);
         const io::scene scene = io::load_scene_arg(scene_arg);
+        scene.view().validate();  // magnitudes and lights named before Embree sees them
         for (const auto& w : scene.warnings) fmt::print(stderr, "warning: {}\n", w);
 
         embree::reference_settings settings;
