@@ -109,21 +109,25 @@ TEST_CASE("checkpoints fall at fractions of the target, and their time is not th
 TEST_CASE("a solve stops at its time limit, checkpoints not counted", "[radiosity][solve]") {
     struct slow : scripted_solver {
         bool step() {
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
             return scripted_solver::step();
         }
     };
     slow s;
-    s.fractions.assign(1000, 0.5);
+    for (int k = 1; k <= 1000; ++k) s.fractions.push_back(1.0 - k / 2048.0);  // 1/2048 more per step
     radiosity_solve_options o;
     o.max_seconds = 0.05;
-    o.checkpoints = 1000;
-    o.checkpoint = [](const radiosity_progress&) { std::this_thread::sleep_for(std::chrono::milliseconds(5)); };
+    o.converge = 0.5;
+    o.checkpoints = 1024;  // one mark per 1/2048 converged: a checkpoint after every step
+    o.checkpoint = [](const radiosity_progress&) { std::this_thread::sleep_for(std::chrono::milliseconds(10)); };
     const auto r = detail::run_radiosity_solve(s, o, [](std::size_t) { return std::size_t(0); });
     CHECK(r.stop == radiosity_stop::time_limit);
-    CHECK(r.steps >= 5);
-    CHECK(r.steps <= 12);
+    CHECK(r.steps >= 2);
     CHECK(r.solve_ms >= 50);
+    // Every step had its 10 ms checkpoint, five times a step's own time, and the limit still
+    // counted only the steps.
+    CHECK(r.checkpoint_ms >= 10.0 * double(r.steps));
+    CHECK(r.checkpoint_ms > r.solve_ms);
 }
 
 TEST_CASE("a solve that creates energy is stopped with the step named", "[radiosity][solve][errors]") {
