@@ -101,7 +101,9 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
             {"gradient_limit", o.gradient_limit}, {"height", o.height}, {"radius", o.radius},
             {"hessian_a", o.radius == "hessian" ? o.a : 0.f},
-            {"hessian_rule", o.radius == "hessian" ? "total-error" : ""},  // radii of the first, edge-bound rule differ {"adaptive_rays", o.adaptive_rays},
+            // Radii of the first, edge-bound Hessian rule differ. Adaptive rays: the three
+            // fields below are 0 without them (no key of its own, so saved caches still load).
+            {"hessian_rule", o.radius == "hessian" ? "total-error" : ""},
             {"min_record_samples", o.adaptive_rays ? o.min_record_samples : 0u},
             {"record_error", o.adaptive_rays ? o.record_error * o.a : 0.f},
             {"record_error_floor", o.adaptive_rays ? o.record_error_floor : 0.f}};

@@ -16,6 +16,9 @@
 /// The GL backend (gl::irradiance_splatter) does steps 1 and 3 on the GPU and asks the cache
 /// for step 2 alone (`scan`) on the splat buffer it read back, so both backends share one
 /// scan and one record list.
+///
+/// Frames over a camera path, with either backend: cpu::render_frame and cpu::walkthrough
+/// (bounce/cpu/cache_walkthrough.hpp); gl::irradiance_splatter::frame follows generation().
 
 #include <bounce/camera.hpp>
 #include <bounce/cpu/batched_scan.hpp>
