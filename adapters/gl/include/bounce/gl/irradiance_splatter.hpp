@@ -112,7 +112,8 @@ public:
     ///   - the splatter takes the cache's splat parameters and hole filling (its a included;
     ///     the weighting stays this splatter's, which must be the cache's Weight), clamps the
     ///     cache's older records to its neighbours and restarts the GPU's copy of the records
-    ///     when the cache replaced or shrank them (its generation changed) or is another cache;
+    ///     when the cache replaced or shrank them (its generation changed) or is another cache
+    ///     (told apart by address: call reset() when a new cache takes a destroyed one's place);
     ///   - passes.gbuffer renders the G-buffer of passes.mesh, passes.light its direct light;
     ///   - render() with cache.scan(g, cam, sampler, splat) as the scan. `record_points(points)`
     ///     may first move the read-back G-buffer's points to where `sampler` should measure the
