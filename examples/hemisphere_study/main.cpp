@@ -1,16 +1,10 @@
 // hemisphere_study: single-plane hemisphere sampling (Gautron 2008, section 8.4, Table 8.1)
-// against a full-hemisphere Monte Carlo reference, on K random visible points of a scene.
-//
-//   build/bin/hemisphere_study --scene ../shared/scenes/sponza/scene.json --resolution 64
-//       --aperture 126 --points 10000 --json study.json        (one command line)
-//   build/bin/hemisphere_study --scene ... --sweep --sweep-points 1000 --json sweep.json
-//
-// Per point, irradiance from the plane's pixels with four weightings (plane only, coverage
-// ratio, border stretching, fall-off stretching), from two samplers: the GL raster sampler
-// (gl::hemisphere_raster: read-back and CPU sums, the GPU reduction, the running fall-off
-// of gl::raster_record_sampler) and the ray-cast sampler (embree::sample_planes), which
-// separates the estimator's error from rasterization's. The measurements are
-// bounce::study's (hemisphere_comparison.hpp); this program parses, calls and reports.
+// against a full-hemisphere Monte Carlo reference, on K random visible points of a scene:
+// irradiance with four weightings (plane, coverage, stretching, fall-off) from the GL raster
+// sampler and the ray-cast sampler (which separates the estimator's error from
+// rasterization's). The measurements are bounce::study's (hemisphere_comparison.hpp).
+//   build/bin/hemisphere_study --scene sponza --resolution 64 --aperture 126 --points 10000 --json study.json
+//   build/bin/hemisphere_study --scene sponza --sweep --sweep-points 1000 --json sweep.json
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/output_files.hpp>
@@ -33,6 +27,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,11 +47,13 @@ void print_row(const std::string& sampler, const json& e, double records_per_s) 
                e["falloff_kappa"].get<double>(), 100 * e["rms_falloff_running"].get<double>(), records_per_s);
 }
 
-#ifdef BOUNCE_STUDY_WITH_GL
 struct raster_run {
     study::plane_estimates cpu;  // read-back + CPU sums, the running sampler's kappas
     double gpu_ms = 0, running_ms = 0, cpu_gpu_difference = 0, running_cpu_gpu_difference = 0;
+    double per_s(double ms) const { return 1000.0 * double(cpu.size()) / ms; }
 };
+
+#ifdef BOUNCE_STUDY_WITH_GL
 
 // The raster sampler three ways over the same batches: read-back overlapping the next batch
 // with CPU sums; gl::raster_record_sampler's running fall-off (whose kappas the CPU sums
@@ -74,14 +71,13 @@ raster_run raster(const gl::hemisphere_raster_options& o, const io::scene& scene
     running.estimate(pts.positions, pts.normals, est, out.cpu.running_kappa);
     out.running_ms = study::ms_since(t1);
     out.cpu.kappa = running.falloff_kappa();  // after the last batch: pooled over the run
-    const auto irradiance = [&] { return study::irradiance_of(est); };
     out.running_cpu_gpu_difference =
-        study::max_relative_luminance_difference(irradiance(), out.cpu.falloff(out.cpu.running_kappa));
+        study::max_relative_luminance_difference(study::irradiance_of(est), out.cpu.falloff(out.cpu.running_kappa));
     gl::raster_record_sampler gpu(r, radius_limits{}, plane_weighting::stretch);
     const auto t2 = clock_type::now();
     gpu.estimate(pts.positions, pts.normals, est, {});
     out.gpu_ms = study::ms_since(t2);
-    out.cpu_gpu_difference = study::max_relative_luminance_difference(irradiance(), out.cpu.stretch);
+    out.cpu_gpu_difference = study::max_relative_luminance_difference(study::irradiance_of(est), out.cpu.stretch);
     return out;
 }
 #endif
@@ -178,9 +174,10 @@ int main(int argc, char** argv) {
         const auto main_pts = pts.first(points);
         const auto main_ref = reference.first(points);
 
-        json report_error = json::object(), records_per_s = json::object(), extra = json::object();
+        json report_error = json::object();
         std::vector<study::plane_sweep_sampler> samplers;
-        std::optional<study::plane_estimates> raster_main, ray_main;
+        std::optional<raster_run> raster_main;
+        std::optional<study::plane_estimates> ray_main;
 #ifdef BOUNCE_STUDY_WITH_GL
         std::optional<gl::context> context;
         std::optional<gl::scene_mesh> mesh;
@@ -202,21 +199,14 @@ int main(int argc, char** argv) {
             return raster({c, std::min(batch, p.size())}, scene, *mesh, *light, p);
         };
         if (!no_raster) {
-            const raster_run r = run_raster(main_pts, cam);
-            raster_main = r.cpu;
+            const raster_run& r = raster_main.emplace(run_raster(main_pts, cam));
             report_error["raster"] = study::plane_estimate_errors(r.cpu, main_ref);
-            const double n = double(main_pts.size());
-            records_per_s["raster"] = r.cpu.records_per_s();
-            records_per_s["raster_gpu_sum"] = 1000 * n / r.gpu_ms;
-            extra["raster_cpu_gpu_max_relative_difference"] = r.cpu_gpu_difference;
-            records_per_s["raster_falloff_running"] = 1000 * n / r.running_ms;
-            extra["raster_running_cpu_gpu_max_relative_difference"] = r.running_cpu_gpu_difference;
             print_row("raster (CPU sum)", report_error["raster"], r.cpu.records_per_s());
             fmt::print("  raster (GPU sum)  {:8.1f} records/s; CPU and GPU sums differ by at most {:.2e} (relative)\n",
-                       1000 * n / r.gpu_ms, r.cpu_gpu_difference);
+                       r.per_s(r.gpu_ms), r.cpu_gpu_difference);
             fmt::print("  raster (running)  {:8.1f} records/s (record sampler, running fall-off: read-back, profile, GPU "
                        "sum); its sums differ from the CPU's by at most {:.2e} (relative)\n",
-                       1000 * n / r.running_ms, r.running_cpu_gpu_difference);
+                       r.per_s(r.running_ms), r.running_cpu_gpu_difference);
             if (texel_points > 0) {
                 const auto tp = pts.first(texel_points);
                 study::plane_texel_difference diff(ref, cam, tp);
@@ -234,7 +224,6 @@ int main(int argc, char** argv) {
         if (!no_ray_cast) {
             ray_main = study::ray_cast_plane_estimates(ref, main_pts, cam, batch);
             report_error["ray_cast"] = study::plane_estimate_errors(*ray_main, main_ref);
-            records_per_s["ray_cast"] = ray_main->records_per_s();
             print_row("ray cast", report_error["ray_cast"], ray_main->records_per_s());
             samplers.insert(samplers.begin(), {"ray_cast", [&](const plane_camera& c) {
                                                    return study::ray_cast_plane_estimates(ref, pts.first(sweep_points), c, batch);
@@ -244,15 +233,15 @@ int main(int argc, char** argv) {
 
         json sweep_rows = json::array();
         if (sweep)
-            sweep_rows = study::plane_sweep(samplers, reference.first(sweep_points), turn, hashed_turn, [](const json& row) {
-                print_row(fmt::format("{} {}^2 {}", row["sampler"].get<std::string>(), row["resolution"].get<int>(),
-                                      row["aperture"].get<double>()),
-                          row, row["records_per_s"].get<double>());
+            sweep_rows = study::plane_sweep(samplers, reference.first(sweep_points), turn, hashed_turn, [](const json& r) {
+                const std::string label = fmt::format("{} {}^2 {}", r["sampler"].get<std::string>(), r["resolution"].get<int>(),
+                                                      r["aperture"].get<double>());
+                print_row(label, r, r["records_per_s"].get<double>());
             });
 
         if (!points_csv.empty()) {
             std::vector<std::pair<std::string, const study::plane_estimates*>> named;
-            if (raster_main) named.emplace_back("raster", &*raster_main);
+            if (raster_main) named.emplace_back("raster", &raster_main->cpu);
             if (ray_main) named.emplace_back("ray_cast", &*ray_main);
             study::write_plane_points_csv(points_csv, main_pts, main_ref, named);
         }
@@ -275,15 +264,21 @@ int main(int argc, char** argv) {
             report.set_count("records", points);
             json j = report.to_json();
             j["timings_ms"] = json::object();
-            if (raster_main) j["timings_ms"]["raster"] = raster_main->ms;
+            if (raster_main) j["timings_ms"]["raster"] = raster_main->cpu.ms;
             if (ray_main) j["timings_ms"]["ray_cast"] = ray_main->ms;
             j["timings_ms"]["reference"] = reference_ms;
             j["error"] = report_error;
-            j["records_per_s"] = records_per_s;
+            j["records_per_s"] = json::object();
+            const auto& r = raster_main;
+            if (r)
+                j["records_per_s"] = {{"raster", r->cpu.records_per_s()}, {"raster_gpu_sum", r->per_s(r->gpu_ms)},
+                                      {"raster_falloff_running", r->per_s(r->running_ms)}};
+            if (ray_main) j["records_per_s"]["ray_cast"] = ray_main->records_per_s();
             j["reference"] = {{"rays_per_point", 2 * reference.spp},
                               {"own_rel_rms", reference.own_rel_rms},
                               {"from_cache", reference.from_cache}};
-            for (const auto& [k, v] : extra.items()) j[k] = v;
+            if (r) j["raster_cpu_gpu_max_relative_difference"] = r->cpu_gpu_difference;
+            if (r) j["raster_running_cpu_gpu_max_relative_difference"] = r->running_cpu_gpu_difference;
             if (sweep) {
                 j["sweep_points"] = sweep_points;
                 j["sweep"] = sweep_rows;
@@ -293,6 +288,10 @@ int main(int argc, char** argv) {
         }
     } catch (const bounce::error& e) {
         fmt::print(stderr, "hemisphere_study: {}\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        fmt::print(stderr, "hemisphere_study: out of memory ({} points, planes of {}^2, batches of {})\n",
+                   std::max(points, sweep_points), resolution, batch);
         return 1;
     }
     return 0;

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -190,6 +191,12 @@ int main(int argc, char** argv) {
         fmt::print("wrote {}, {}, {}\n", out.string(), sibling(out, "direct").string(), sibling(out, "indirect").string());
     } catch (const bounce::error& e) {
         fmt::print(stderr, "reference: {}\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        // A G-buffer (40 bytes a pixel) and three float RGB images (36) at the least.
+        fmt::print(stderr, "reference: out of memory for {}x{} pixels (about {:.1f} GiB of images); try a smaller "
+                           "--width/--height\n",
+                   width, height, 76.0 * double(width) * double(height) / double(1ull << 30));
         return 1;
     }
     return 0;
