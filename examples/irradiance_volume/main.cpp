@@ -12,8 +12,9 @@
 // along the camera's view (study::default_sphere_path) unless --path / --radius give them.
 // Reports probes, bake_ms, lookup_ns per shaded point, error.rel_rms of the luminance over
 // every sphere point of every frame, popping (largest step-to-step change at the point
-// facing down over its mean) with the reference's own figure, and popping_excess (the part
-// of the change the true field does not have), for every lookup under "lookups".
+// facing down, against the camera's up, over its mean) with the reference's own figure,
+// and popping_excess (the part of the change the true field does not have), for every
+// lookup under "lookups".
 // --sh-study instead captures environments along the path and prints SH errors per order.
 #include "../common/cli_number_checks.hpp"
 
@@ -156,8 +157,11 @@ int run(const options& o) {
     const double bake_ms = study::ms_since(bake_start);
     std::fprintf(stderr, "\n");
 
-    // Every lookup on the same volume, against the reference on the sphere.
-    const study::volume_sphere_study sphere(light, path, o.sphere);
+    // Every lookup on the same volume, against the reference on the sphere; popping at the
+    // point facing down, against the scene's up.
+    study::volume_sphere_settings ss = o.sphere;
+    ss.popping_normal = -glm::normalize(scene.camera.up);
+    const study::volume_sphere_study sphere(light, path, ss);
     const std::vector<std::pair<std::string, cpu::volume_lookup>> variants = {
         {"trilinear", {cpu::volume_interpolation::trilinear, {o.b, false, o.support}}},
         {"weighted", {cpu::volume_interpolation::weighted, {o.b, false, o.support}}},

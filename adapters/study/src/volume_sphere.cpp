@@ -204,6 +204,8 @@ volume_sphere_study::volume_sphere_study(const embree::reference_integrator& lig
     require(s.popping_steps >= 2, "popping_steps", "at least two steps");
     require(s.reference_samples > 0, "reference_samples", "at least one sample");
     require(s.repeat > 0, "repeat", "at least one timed repeat");
+    require(finite3(s.popping_normal) && std::abs(glm::length(s.popping_normal) - 1.f) < 1e-4f, "popping_normal",
+            "must be a unit vector");
     require(finite3(path.a) && finite3(path.b) && std::isfinite(path.radius) && path.radius > 0, "path",
             "the path must be finite with a radius > 0");
     const auto dirs = fibonacci_sphere(s.sphere_points);
@@ -223,9 +225,9 @@ volume_sphere_study::volume_sphere_study(const embree::reference_integrator& lig
     reference_ms_ = ms_since(t0);
     const std::size_t steps = s.popping_steps;
     pop_points_.resize(steps);
-    pop_normals_.assign(steps, glm::vec3(0, -1, 0));
+    pop_normals_.assign(steps, s.popping_normal);
     pop_reference_.resize(steps);
-    for (std::size_t k = 0; k < steps; ++k) pop_points_[k] = path.centre(k, steps) + path.radius * glm::vec3(0, -1, 0);
+    for (std::size_t k = 0; k < steps; ++k) pop_points_[k] = path.centre(k, steps) + path.radius * s.popping_normal;
     const std::uint32_t pop_samples = std::min<std::uint32_t>(16 * s.reference_samples, 1u << 16);
     tbb::parallel_for(std::size_t(0), steps, [&](std::size_t k) {
         pop_reference_[k] = light.indirect_irradiance(pop_points_[k], pop_normals_[k], pop_samples, s.seed + 92);

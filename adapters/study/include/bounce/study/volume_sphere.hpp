@@ -13,8 +13,8 @@
 ///   frames), checked by sphere_path_is_clear.
 /// - `volume_sphere_study` holds the sphere's points in every frame and the reference
 ///   there (reference_integrator::indirect_irradiance: the one-bounce indirect light the
-///   probe baker's probes hold), and the popping series: the point facing down (-y) at
-///   many steps, its reference with one seed for every step (so that its noise is the same
+///   probe baker's probes hold), and the popping series: the point facing down (against the
+///   scene's up direction) at many steps, its reference with one seed for every step (so that its noise is the same
 ///   pattern at each step and its changes are real).
 /// - `render_sphere_strip` renders frames of the scene and the sphere, lit by the volume.
 
@@ -65,24 +65,27 @@ struct volume_sphere_settings {
     std::uint32_t reference_samples = 1024; ///< hemisphere samples per reference point
     int repeat = 5;                         ///< lookup timing repeats (the median is kept)
     std::uint64_t seed = 7;                 ///< the reference's seed
+    /// The normal of the popping point (unit): "down", against the scene's up direction
+    /// (programs pass -camera.up).
+    glm::vec3 popping_normal{0.f, -1.f, 0.f};
 };
 
 /// One lookup's figures on the sphere.
 struct volume_lookup_figures {
     std::string name;
     error_figures error;        ///< luminance over every sphere point of every frame
-    double popping = 0;         ///< largest step-to-step change at the bottom point / its mean
+    double popping = 0;         ///< largest step-to-step change at the popping point / its mean
     double popping_excess = 0;  ///< largest change of (lookup - reference) / the reference's mean
     double lookup_ns = 0;       ///< per point, median of the repeats
-    std::vector<double> popping_series;  ///< luminance at the bottom point, per step
+    std::vector<double> popping_series;  ///< luminance at the popping point, per step
 };
 
 /// The sphere's points and the reference on them (computed by the constructor, in parallel).
 class volume_sphere_study {
 public:
     /// Throws parameter_error naming the setting when frames, sphere_points,
-    /// reference_samples or repeat is 0, popping_steps < 2, or the path is not finite with
-    /// a radius > 0.
+    /// reference_samples or repeat is 0, popping_steps < 2, popping_normal is not unit, or
+    /// the path is not finite with a radius > 0.
     volume_sphere_study(const embree::reference_integrator& light, const sphere_path& path,
                         const volume_sphere_settings& settings = {});
 
