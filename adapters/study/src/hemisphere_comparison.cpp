@@ -246,10 +246,13 @@ void plane_estimate_sums::end_batch(std::size_t first, std::size_t last) {
     require(first <= last && last <= out_.size(), "batch", "records beyond the count");
     // Every plane so far: the threads' profiles pooled (each holds what its thread added).
     auto& profiles = impl_->profiles;
-    radial_profile all = *profiles.begin();
-    for (auto it = std::next(profiles.begin()); it != profiles.end(); ++it) all.merge(*it);
-    std::fill(out_.running_kappa.begin() + std::ptrdiff_t(first), out_.running_kappa.begin() + std::ptrdiff_t(last),
-              all.falloff_factor());
+    double kappa = 1.0;  // border stretching before any plane, as the raster's running mode
+    if (!profiles.empty()) {
+        radial_profile all = *profiles.begin();
+        for (auto it = std::next(profiles.begin()); it != profiles.end(); ++it) all.merge(*it);
+        kappa = all.falloff_factor();
+    }
+    std::fill(out_.running_kappa.begin() + std::ptrdiff_t(first), out_.running_kappa.begin() + std::ptrdiff_t(last), kappa);
 }
 
 plane_estimates plane_estimate_sums::result(double ms) const {
