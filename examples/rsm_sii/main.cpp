@@ -59,6 +59,9 @@ void check_arguments(const options& o) {
     if (o.backend == "gl") throw parameter_error("--backend", "'gl': this build has no GL adapter; use --backend cpu");
 #endif
     if (o.study) require(!o.json.empty(), "--study", "needs --json for the study's report");
+    if (o.study)
+        require(o.out.empty() && o.indirect_out.empty(), "--out/--indirect-out",
+                "write one run's images; --study makes many (run the configuration without --study)");
     if (!o.json.empty()) io::check_output_file("--json", o.json);
     if (!o.out.empty()) io::check_image_output("--out", o.out);
     if (!o.indirect_out.empty()) io::check_image_output("--indirect-out", o.indirect_out);

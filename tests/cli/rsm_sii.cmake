@@ -13,6 +13,8 @@ bounce_cli_refusal("an --out that is a folder" PROGRAM rsm_sii MATCH "--out"
                    ARGS ${rsm_big} --out ${CMAKE_CURRENT_BINARY_DIR})
 bounce_cli_refusal("an --indirect-out that is a folder" PROGRAM rsm_sii MATCH "--indirect-out"
                    ARGS ${rsm_big} --indirect-out ${CMAKE_CURRENT_BINARY_DIR})
+bounce_cli_refusal("--out with --study (which wrote no image)" PROGRAM rsm_sii MATCH "--out/--indirect-out"
+                   ARGS ${rsm_big} --study --json rsm_sii_study_x.json --out rsm_sii_x.png)
 # More sub-buffers than lights gave a black image; the library's indirect_options refuses
 # it naming both numbers, and the program names its flag.
 bounce_cli_refusal("fewer VPLs than sub-buffers" PROGRAM rsm_sii
