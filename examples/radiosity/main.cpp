@@ -72,6 +72,7 @@ struct comparison {
 template <class Solver>
 solve_result solve(Solver& solver, const options& o, const io::scene& scene, double atlas_ms, double setup_ms,
                    study::stage_timer& timer, const comparison& cmp, bool with_curve) {
+    const std::size_t base_elements = solver.atlas().size();  // before any subdivision
     solve_result r;
     r.setup_ms = setup_ms;
     constexpr bool cpu = requires(Solver& s) { s.subdivide(scene, subdivision_options{}); };
@@ -110,8 +111,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     r.shooters = solver.shooters();
     r.elements = a.size();
     r.charts = a.charts.size();
-    for (std::size_t k = 0; k < a.blocks(); ++k)
-        if (a.block_level.empty() || a.block_level[k] == 0) r.base_elements += a.block_first[k + 1] - a.block_first[k];
+    r.base_elements = base_elements;
     std::tie(r.emitted, r.absorbed, r.escaped) = std::tuple(solver.emitted_power(), solver.absorbed_power(), solver.escaped_power());
     r.lightmap = solver.lightmap(level);
     const auto u = solver.unshot();

@@ -24,7 +24,8 @@ struct solve_result {
     radiosity_solve_report report;  // the library's (steps, why it stopped, per-step figures)
     std::vector<checkpoint> curve;
     double setup_ms = 0;  // atlas and solver construction (lights shot), before the solve
-    std::size_t shots = 0, shooters = 0, elements = 0, charts = 0, base_elements = 0;
+    std::size_t shots = 0, shooters = 0, elements = 0, charts = 0;
+    std::size_t base_elements = 0;  // the atlas's, before adaptive subdivision
     glm::dvec3 emitted{0}, absorbed{0}, escaped{0};
     image<glm::vec3> lightmap, unshot, view;
 };
