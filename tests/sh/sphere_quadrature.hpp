@@ -15,6 +15,8 @@ namespace bounce::sh_test {
 
 // The library's quadrature (bounce/sh_quadrature.hpp) under the names the tests use.
 using quadrature_point = bounce::sphere_quadrature_point;
+using bounce::gauss_legendre;
+using bounce::sphere_quadrature;
 inline double legendre(int l, double x) { return bounce::legendre_polynomial(l, x); }
 
 // Uniformly distributed random unit directions (fixed seed), after the hard cases: the
