@@ -33,6 +33,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <new>
 #include <optional>
 #include <string>
@@ -186,7 +187,8 @@ int run(const options& o) {
     std::size_t strip_w = 0, strip_h = 0;
     if (!o.out.empty()) {
         const auto strip = study::render_sphere_strip(bvh, scene, scene.camera, light, volume, chosen_how, path, 4, 192, 144);
-        io::write_png(o.out, strip.view(), io::auto_exposure(strip.view()));
+        if (std::filesystem::path(o.out).extension() == ".exr") io::write_exr(o.out, strip.view());  // linear
+        else io::write_png(o.out, strip.view(), io::auto_exposure(strip.view()));
         strip_w = strip.width(), strip_h = strip.height();
     }
     if (o.json.empty()) return 0;
@@ -277,7 +279,7 @@ int main(int argc, char** argv) {
     app.add_option("--repeat", o.sphere.repeat, "lookup timing repeats (median)")->check(CLI::Range(1, 1000));
     app.add_option("--threads", o.threads, "TBB threads (0: all)")->check(CLI::Range(0, 1024));
     app.add_option("--json", o.json, "write the run report here");
-    app.add_option("--out", o.out, "write a PNG strip of four frames here");
+    app.add_option("--out", o.out, "write a strip of four frames here (.exr: linear; else 8-bit sRGB, auto exposure)");
     app.add_flag("--sh-study", o.sh_study, "SH projection and irradiance errors per order of environments along the path");
     CLI11_PARSE(app, argc, argv);
     o.sphere.seed = o.seed + 6;  // the reference on the sphere: 7 with the default seed, as before
