@@ -7,6 +7,7 @@
 #include <bounce/embree/lightmap_view.hpp>
 #include <bounce/lightmap_atlas.hpp>
 #include <bounce/radiosity_options.hpp>
+#include <bounce/radiosity_solve.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <fmt/core.h>
@@ -43,16 +44,20 @@ technique_run run_radiosity(const scene_setup& s) {
     ro.near_field = 4;
     s.clock.report(name, "lights");
     cpu::progressive_radiosity solver(s.scene, atlas, cpu::item_buffer_visibility(s.scene, atlas, vo), ro);
-    bool capped = false;
+    // The library's solve (radiosity_solve.hpp): to the target, within the run's time cap,
+    // refusing energy created or light reaching no surface's front with radiosity_error.
+    radiosity_solve_options so;
+    so.converge = converge;
+    so.max_seconds = s.settings.radiosity_max_seconds;
     auto last_report = std::chrono::steady_clock::now();
-    solver.solve(1.0 - converge, [&](const radiosity_progress& p) {
+    so.progress = [&](const radiosity_progress& p) {
         if (ms_since(last_report) > 2000) {
             last_report = std::chrono::steady_clock::now();
             s.clock.report(name, fmt::format("solve: {:.1f}% shot, {} shots", 100.0 * (1.0 - p.unshot_fraction), p.shots));
         }
-        capped = ms_since(t0) > s.settings.radiosity_max_seconds * 1e3;
-        return !capped;
-    });
+        return true;
+    };
+    const radiosity_solve_report report = solver.solve(so);
     const double solve_ms = ms_since(t0);
 
     s.clock.report(name, "view");
@@ -78,7 +83,8 @@ technique_run run_radiosity(const scene_setup& s) {
                 {"steps", solver.progress().steps},
                 {"shot_fraction", 1.0 - solver.unshot_fraction()},
                 {"emitted_w", emitted.x + emitted.y + emitted.z},
-                {"stopped_at_time_cap", capped}};
+                {"stop", to_string(report.stop)},
+                {"solve_ms", report.solve_ms}};
     r.parameters = {{"elements", elements},      {"block", block},       {"visibility", "stereo"},
                     {"resolution", resolution},  {"tolerance_px", tolerance_px}, {"adaptive", false},
                     {"converge", converge},      {"max_seconds", s.settings.radiosity_max_seconds}};

@@ -11,6 +11,7 @@
 #include <bounce/study/content_hash.hpp>
 #include <bounce/study/frame_comparison.hpp>
 #include <bounce/study/image_comparison.hpp>
+#include <bounce/study/multi_bounce_cache.hpp>
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/study/stage_timer.hpp>
 
@@ -150,17 +151,28 @@ halves_reference unoccluded_reference(const scene_setup& s) {
 }
 
 halves_reference all_bounces_reference(const scene_setup& s) {
-    const std::uint32_t spp = s.settings.all_bounces.reference;
+    // Each half is a multi-bounce view of its own seed, cached by the library as radiosity's
+    // whole reference is (multi_bounce_cache.hpp; the seed is part of the key).
+    halves_reference r;
+    r.spp = s.settings.all_bounces.reference;
     embree::multi_bounce_settings ms;
-    ms.paths = half_of(spp);
-    const std::string text = "max_bounces " + std::to_string(ms.max_bounces) + " roulette_after " +
-                             std::to_string(ms.roulette_after) + " area_samples " + std::to_string(ms.area_samples);
-    return cached_halves(s, halves_cache_key(s, "all-bounces", spp, text), spp, [&](int half) {
-        embree::multi_bounce_settings h = ms;
-        h.seed = half_seed(1, half);
-        h.progress = rows_progress(s, std::string("all_bounces, half ") + (half == 0 ? "A" : "B"));
-        return embree::multi_bounce_reference(s.bvh, s.scene, h).render(s.scene.camera, s.g.width(), s.g.height()).radiance;
-    });
+    ms.paths = half_of(r.spp);
+    r.cached = true;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int half = 0; half < 2; ++half) {
+        ms.seed = half_seed(1, half);
+        ms.progress = rows_progress(s, std::string("all_bounces, half ") + (half == 0 ? "A" : "B"));
+        bool hit = false;
+        image<glm::vec3> img = cached_multi_bounce(s.bvh, s.scene, s.scene.camera, s.g.width(), s.g.height(), ms,
+                                                   s.cache_dir, &hit)
+                                   .radiance;
+        r.cached = r.cached && hit;
+        (half == 0 ? r.a : r.b) = std::move(img);
+    }
+    r.ms = r.cached ? 0.0 : ms_since(t0);
+    r.mean = mean_of(r.a, r.b);
+    r.noise_rel_rms = noise_of(r, s.mask);
+    return r;
 }
 
 gbuffer<float> volume_points(const scene_setup& s) {
