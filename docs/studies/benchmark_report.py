@@ -122,10 +122,15 @@ def bound_prefix(entry):
     return {"lower": "≥ ", "upper": "≤ "}.get(bound, "")
 
 
+def times(sp):
+    """A speed-up: two significant figures, three near 1 (where the verdict turns on them)."""
+    return f"{sig(sp, 3 if 0.9 <= sp < 1.1 else 2)}x"
+
+
 def fmt_speedup(entry):
     if not isinstance(entry, dict) or num(entry.get("speedup")) is None:
         return DASH
-    return f"{bound_prefix(entry)}{sig(num(entry['speedup']), 2)}x"
+    return f"{bound_prefix(entry)}{times(num(entry['speedup']))}"
 
 
 def fmt_mc(entry):
@@ -157,22 +162,27 @@ def fmt_counts(counts):
         if isinstance(v, (dict, list)):
             continue
         n = num(v)
-        parts.append(f"{k} {v if isinstance(v, (str, bool)) or n is None else (int(n) if n == int(n) else sig(n))}")
+        if isinstance(v, bool):
+            v = json.dumps(v)
+        parts.append(f"{k} {v if isinstance(v, str) or n is None else (int(n) if n == int(n) else sig(n))}")
     return cell("; ".join(parts)) if parts else DASH
 
 
 def verdict(entry):
     """How a speed-up compares with 1: ('pays' | 'loses' | 'level' | 'open', text) or None
-    where there is no speed-up (missing, skipped, null)."""
+    where there is no speed-up (missing, skipped, null). 'level' when it shows as 1.00x;
+    'open' when Monte Carlo's sweep bounds it only on the far side of 1."""
     if not isinstance(entry, dict) or num(entry.get("speedup")) is None:
         return None
     sp, prefix = num(entry["speedup"]), bound_prefix(entry)
-    text = f"{prefix}{sig(sp, 2)}x"
+    text = f"{prefix}{times(sp)}"
     if prefix == "≥ ":
         return ("pays" if sp > 1 else "open"), text
     if prefix == "≤ ":
         return ("loses" if sp < 1 else "open"), text
-    return ("pays" if sp > 1 else "loses" if sp < 1 else "level"), text
+    if times(sp) == "1.00x":  # equal to the figures shown
+        return "level", text
+    return ("pays" if sp > 1 else "loses"), text
 
 
 def slug(name):
@@ -440,7 +450,7 @@ def technique_paragraph(tech, results):
             if any(isinstance(t.get("mc_equal_error_unoccluded"), dict) for _, t in unocc):
                 sentences += comparison("rel_rms", "mc_equal_error_unoccluded", "unoccluded rel_rms")
     if failed:
-        sentences.append("It failed on " + join_scenes(f"{n} ({t['failed']})" for n, t in failed) + ".")
+        sentences.append("It failed on " + join_scenes(n for n, _ in failed) + " (the messages are in the scenes' tables).")
     missing = [n for n, t in runs if t is None]
     if missing:
         sentences.append(f"Not run on {join_scenes(missing)}.")
@@ -472,7 +482,8 @@ def page(results, figures, md_dir, results_label):
     for tech in techs:
         lines += [technique_paragraph(tech, results), ""]
     lines += ["*These paragraphs are generated from the numbers in the results file by "
-              "`docs/studies/benchmark_report.py`: a speed-up above 1 reads \"beats\", below 1 \"does not pay\"; "
+              "`docs/studies/benchmark_report.py`: a speed-up above 1 reads \"beats\", below 1 \"does not pay\", one shown "
+              "as 1.00x \"level\"; "
               "where Monte Carlo's sweep only bounds the speed-up on the other side of 1, it says the sweep does not "
               "settle it. No sentence is written by hand.*", ""]
     return "\n".join(lines)

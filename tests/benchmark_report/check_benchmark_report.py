@@ -60,8 +60,9 @@ FIXTURE = {
         {"scene": "dining room/v2", "triangles": 270000, "lights": 2, "bounds_diagonal": None,
          "references": {"one_bounce": {"spp": 64, "ms": 4567.0, "cached": False, "noise_rel_rms": 0.02}},
          "techniques": [
-             technique("irradiance_cache", "one_bounce", 2500.0, 0.08, None, 0.8, 1.3),
+             technique("irradiance_cache", "one_bounce", 2500.0, 0.08, None, 0.8, 1.04),
              {"technique": "radiosity", "quantity": "all_bounces", "ms": 777.0,
+              "counts": {"elements": 9966, "stopped_at_time_cap": False},
               "error": {"rel_rms": 0.5, "rel_rms_debiased": None, "rel_rms_debiased_se": None, "ssim": 0.5},
               "mc_equal_error": {"rel_rms": {"skipped": "the debiased error is not above 0"},
                                  "ssim": {"spp": 64, "ms": 640.0, "reached": False, "speedup": 3.3,
@@ -130,7 +131,7 @@ def main(script, workdir):
     # Figures of the fixture on the page, nulls as a dash, nothing unformatted.
     for needle in ("6.5x", "2.4x", "0.61x", "123 ms", "2.50 s", "0.0450 ± 0.0020", "0.930", "≥ 3.3x", "≤ 0.50x",
                    "0.1110 ± 0.0030", "failed: out of memory \\| at 4096 VPLs", "0123abc", "`benchmark --quick`",
-                   "records 1234", "0.0123", "avx2"):
+                   "records 1234", "0.0123", "avx2", "1.04x", "stopped_at_time_cap false"):
         if needle not in text:
             fail(f"{needle!r} is not on the page")
     if re.search(r"\b(None|nan|NaN|inf|null)\b", text):
