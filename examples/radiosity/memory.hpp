@@ -64,6 +64,8 @@ inline void check_memory(const options& o, const io::scene& scene) {
     if (o.visibility != "rays") {
         const double faces = o.visibility == "hemicube" ? 3 : 1;  // five faces of res x res/2 or res
         need += 112.0 * double(scene.triangles.size()) + faces * 12.0 * double(o.resolution) * double(o.resolution);
+    } else {
+        need += 150.0 * double(scene.triangles.size());  // Embree's own copy of the scene and its BVH
     }
     need += 4 * 12.0 * double(o.width) * double(o.height);  // view, reference, mask, versus
     const double have = available_memory_bytes();

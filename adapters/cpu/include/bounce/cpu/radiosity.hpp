@@ -76,9 +76,12 @@ using bounce::radiosity_timings;
 /// plus each chart's padding ring and the packing's waste, at most one chart per triangle):
 /// element_at, the build's overlap sums and the lightmaps laid out (56); per triangle the
 /// build's adjacency (about 200). Visibility is not included (an item buffer: about 112
-/// bytes per triangle and 12 per pixel of its buffers).
+/// bytes per triangle and 12 per pixel of its buffers). Measured peaks are lower by 10-25%
+/// (docs/radiosity.md, section 7).
 inline double radiosity_memory_estimate(const scene_view& scene, const atlas_options& options) {
-    const double e = double(options.elements), n = double(scene.triangles.size()), p = double(options.padding);
+    // Each chart takes at least one element whatever the budget: at most one chart per triangle.
+    const double n = double(scene.triangles.size()), e = std::max(double(options.elements), n);
+    const double p = double(options.padding);
     const double texels = 1.25 * (1.3 * e + 4 * p * std::sqrt(e * n) + 4 * p * p * n);
     const double shooters = e / double(options.block_texels * options.block_texels) + n;
     return e * (2 * 64 + 36) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
