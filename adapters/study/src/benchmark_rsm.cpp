@@ -16,11 +16,10 @@ namespace {
 
 // rsm_sii's defaults (examples/rsm_sii/options.hpp): 1,024 lights (SII: VPLs by flux
 // warping; the gather: disc samples per pixel and map over a disc of radius 1.5 map units),
-// 256^2 texels per map, d^2 clamped at 1% of the scene's diagonal, the geometry-aware blur
-// after interleaving, energy-correct weights, seed 1.
+// 256^2 texels per map, d^2 clamped at scene_clamp_distance (1% of the scene's diagonal), the
+// geometry-aware blur after interleaving, energy-correct weights, seed 1.
 constexpr std::size_t lights_per_frame = 1024;
 constexpr std::size_t map_resolution = 256;
-constexpr float clamp_fraction = 0.01f;
 
 indirect_options options_for(bench_technique t, float clamp_distance) {
     indirect_options o;
@@ -39,7 +38,7 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
             "technique", "is not an RSM technique");
     require(!s.scene.lights.empty(), "scene", "has no point, spot or directional light: reflective shadow maps need one");
     const std::string name(technique_name(t));
-    const float clamp_distance = clamp_fraction * s.diagonal;
+    const float clamp_distance = scene_clamp_distance(s.scene);
     const indirect_options options = options_for(t, clamp_distance);
 
     // The maps are part of every frame's cost (the lights may move); cast once timed.
