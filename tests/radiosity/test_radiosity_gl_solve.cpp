@@ -1,0 +1,48 @@
+// The GL solver runs the same solve as the CPU solver (radiosity_solve.hpp): the same stop,
+// the same steps, the same checks (reversed winding, the tolerance floor). llvmpipe via EGL.
+#include "../gl/shared_context.hpp"
+#include "radiosity_scenes.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/gl/radiosity.hpp>
+#include <bounce/radiosity_solve.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <utility>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+TEST_CASE("the GL solver's solve(options) stops where the CPU solver's does", "[radiosity][solve][gl]") {
+    gl_test::shared_context();
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400, .block_texels = 4});
+    gl::progressive_radiosity g(scene.view(), atlas, {.visibility = gl::radiosity_visibility::none});
+    cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{});
+    radiosity_solve_options o;
+    o.converge = 0.8;
+    o.checkpoints = 2;
+    int checkpoints = 0;
+    o.checkpoint = [&](const radiosity_progress&) { ++checkpoints; };
+    const auto rg = g.solve(o);
+    const auto rc = c.solve(o);
+    CHECK(rg.stop == radiosity_stop::converged);
+    CHECK(rg.steps == rc.steps);
+    CHECK(rg.unshot_fraction == Approx(rc.unshot_fraction).epsilon(1e-4));
+    CHECK(checkpoints >= 2 * 2);  // each solve: after the first step, then at 0.4 and 0.8
+    CHECK(g.intercepted_power().x == Approx(c.intercepted_power().x).epsilon(1e-4));
+}
+
+TEST_CASE("the GL solver names reversed winding and refuses a tolerance below the floor", "[radiosity][solve][gl][errors]") {
+    gl_test::shared_context();
+    owned_scene box = closed_box(1.f, 0.7f, 2.f);
+    for (glm::uvec3& t : box.triangles) std::swap(t.y, t.z);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 300, .block_texels = 4});
+    gl::progressive_radiosity g(box.view(), atlas, {.resolution = 64});
+    CHECK_THROWS_AS(g.solve(0.1), radiosity_error);
+    const auto good = cornell_box();
+    const auto good_atlas = build_lightmap_atlas(good.view(), {.elements = 300, .block_texels = 4});
+    CHECK_THROWS_WITH(gl::progressive_radiosity(good.view(), good_atlas, {.resolution = 64, .tolerance_px = 1e-6f}),
+                      Catch::Contains("radiosity_options.tolerance_px") && Catch::Contains("0.003906"));
+}
