@@ -22,6 +22,7 @@
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
 #include <bounce/io/scene.hpp>
+#include <bounce/study/memory_budget.hpp>
 #include <bounce/study/provenance.hpp>
 #include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
@@ -59,17 +60,6 @@ struct options {
     int threads = 0;
     bool sh_study = false;
 };
-
-// A whole number in [0, 2^64), decimal digits only (CLI11 would wrap "-1" to 2^64 - 1).
-const CLI::Validator whole_number(
-    [](std::string& s) -> std::string {
-        const std::string max = "18446744073709551615";
-        if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > max.size() ||
-            (s.size() == max.size() && s > max))
-            return "'" + s + "' is not a whole number in [0, " + max + "]";
-        return {};
-    },
-    "UINT64");
 
 // Refuses a depth whose worst case (the uniform grid) would not fit in memory.
 void check_memory(const options& o) {
@@ -241,6 +231,7 @@ int main(int argc, char** argv) {
     using examples::finite_non_negative;
     using examples::finite_positive;
     using examples::detail::number_in;
+    using examples::seed_u64;
     app.add_option("--scene", o.scene, "cornell, a scene folder name under BOUNCE_SCENES, or a path");
     app.add_option("--mode", o.mode, "uniform or adaptive")->check(CLI::IsMember({"uniform", "adaptive"}));
     app.add_option("--max-depth", o.max_depth, "deepest octree level (uniform: the grid's depth), 0..10")
@@ -248,9 +239,9 @@ int main(int argc, char** argv) {
     app.add_option("--min-depth", o.min_depth, "shallowest leaf level of an adaptive octree (default 1)")
         ->check(CLI::Range(0, irradiance_volume::depth_limit));
     app.add_option("--interp", o.interp, "trilinear or weighted")->check(CLI::IsMember({"trilinear", "weighted"}));
-    app.add_option("--b", o.b, "distance exponent of the weighted average, (0, 4]")->check(number_in(1e-6, 4, true, "an exponent"));
+    app.add_option("--b", o.b, "distance exponent of the weighted average, (0, 4]")->check(number_in(0, 4, true, "an exponent", /*lo_included=*/false));
     app.add_option("--support", o.support, "a probe's weight reaches 0 at support * half the diagonal of its largest leaf, > 1")
-        ->check(number_in(1.000001, 16, true, "a support"));
+        ->check(number_in(1, 16, true, "a support", /*lo_included=*/false));
     app.add_option("--gradients", o.gradients, "on or off (weighted interpolation)")->check(CLI::IsMember({"on", "off"}));
     app.add_option("--rays", o.rays, "rays per probe")->check(CLI::Range(1u, 1u << 20));
     app.add_option("--ref-samples", o.sphere.reference_samples, "reference hemisphere samples per sphere point")
@@ -275,7 +266,7 @@ int main(int argc, char** argv) {
     app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge")
         ->check(finite_positive);
     app.add_option("--seed", o.seed, "seed of the probes' and the reference's light samples, 0 .. 2^64 - 1")
-        ->check(whole_number);
+        ->check(seed_u64);
     app.add_option("--repeat", o.sphere.repeat, "lookup timing repeats (median)")->check(CLI::Range(1, 1000));
     app.add_option("--threads", o.threads, "TBB threads (0: all)")->check(CLI::Range(0, 1024));
     app.add_option("--json", o.json, "write the run report here");

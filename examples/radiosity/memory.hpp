@@ -7,55 +7,12 @@
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/errors.hpp>
 #include <bounce/io/scene.hpp>
+#include <bounce/study/memory_budget.hpp>
 
 #include <fmt/core.h>
-#include <sys/resource.h>
-#include <unistd.h>
-
-#include <algorithm>
-#include <fstream>
-#include <limits>
-#include <sstream>
 #include <string>
 
 namespace bounce::examples {
-
-namespace detail {
-// The number after `key` in a "key: value kB" file (/proc/meminfo, /proc/self/status), in
-// bytes; -1 when absent.
-inline double proc_kb(const char* file, const std::string& key) {
-    std::ifstream in(file);
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind(key, 0) == 0) {
-            std::istringstream rest(line.substr(key.size()));
-            double kb = -1;
-            rest >> kb;
-            return kb * 1024;
-        }
-    return -1;
-}
-inline double file_number(const char* file) {
-    std::ifstream in(file);
-    double v = -1;
-    return (in >> v) ? v : -1;
-}
-}  // namespace detail
-
-/// Bytes this process can still allocate: the least of MemAvailable (/proc/meminfo; else
-/// sysconf's available pages), the cgroup's memory.max less memory.current, and the address
-/// space and data limits (ulimit -v, -d) less what the process has mapped already.
-inline double available_memory_bytes() {
-    double avail = detail::proc_kb("/proc/meminfo", "MemAvailable:");
-    if (avail < 0) avail = double(sysconf(_SC_AVPHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
-    const double cg_max = detail::file_number("/sys/fs/cgroup/memory.max"), cg_now = detail::file_number("/sys/fs/cgroup/memory.current");
-    if (cg_max > 0 && cg_now >= 0) avail = std::min(avail, cg_max - cg_now);
-    rlimit lim{};
-    const double mapped = std::max(0.0, detail::proc_kb("/proc/self/status", "VmSize:"));
-    for (const int which : {RLIMIT_AS, RLIMIT_DATA})
-        if (getrlimit(which, &lim) == 0 && lim.rlim_cur != RLIM_INFINITY) avail = std::min(avail, double(lim.rlim_cur) - mapped);
-    return std::max(avail, 0.0);
-}
 
 /// Throws parameter_error naming --elements when the run's estimated peak exceeds what the
 /// machine can give it, with both figures.
@@ -68,7 +25,7 @@ inline void check_memory(const options& o, const io::scene& scene) {
         need += 150.0 * double(scene.triangles.size());  // Embree's own copy of the scene and its BVH
     }
     need += 4 * 12.0 * double(o.width) * double(o.height);  // view, reference, mask, versus
-    const double have = available_memory_bytes();
+    const double have = double(study::available_memory_bytes());
     if (need > have)
         throw parameter_error("--elements", fmt::format("{} elements over {}'s {} triangles need about {:.1f} GiB (atlas, "
                                                         "solver, lightmaps), more than the {:.1f} GiB this machine can give "

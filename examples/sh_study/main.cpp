@@ -14,6 +14,7 @@
 
 #include <bounce/cpu/sh_projection_benchmark.hpp>
 #include <bounce/io/output_files.hpp>
+#include <bounce/study/memory_budget.hpp>
 #include <bounce/study/provenance.hpp>
 #include <bounce/study/sh_accuracy.hpp>
 

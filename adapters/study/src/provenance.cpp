@@ -134,25 +134,4 @@ provenance collect_provenance(const fs::path& source_dir, std::string gl_rendere
     return p;
 }
 
-std::uint64_t available_memory_bytes() {
-    std::ifstream in("/proc/meminfo");
-    std::string key;
-    std::uint64_t value = 0;
-    std::string unit;
-    while (in >> key >> value) {
-        std::getline(in, unit);
-        if (key == "MemAvailable:") return value * 1024;
-    }
-    const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : 0;
-}
-
-std::string format_bytes(double bytes) {
-    char buf[64];
-    if (bytes >= 1e12) std::snprintf(buf, sizeof buf, "%.3g TB", bytes / 1e12);
-    else if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
-    else std::snprintf(buf, sizeof buf, "%.3g MB", bytes / 1e6);
-    return buf;
-}
-
 }  // namespace bounce::study

@@ -33,11 +33,4 @@ struct provenance {
 /// (gl::context::renderer()) when the run used GL.
 provenance collect_provenance(const std::filesystem::path& source_dir = {}, std::string gl_renderer = {});
 
-/// Memory the system can still give this process without swapping (/proc/meminfo's
-/// MemAvailable, else free + reclaimable pages from sysconf), in bytes; 0 when unknown.
-std::uint64_t available_memory_bytes();
-
-/// "3.2 GB", "512 MB": a byte count for messages.
-std::string format_bytes(double bytes);
-
 }  // namespace bounce::study
