@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -64,5 +65,17 @@ inline const CLI::Validator finite_non_negative = detail::finite_number_at_least
 inline const CLI::Validator unit_interval = detail::number_in(0, 1, true, "a number");
 /// An angle in [0, 90) degrees: a turn of a square, which repeats every 90.
 inline const CLI::Validator quarter_turn_deg = detail::number_in(0, 90, false, "an angle");
+
+/// A whole number in [0, 2^64), spelled in decimal digits only: a seed. CLI11 would take
+/// "-1" and wrap it to 2^64 - 1, and a double range would let "1.5" or "1e3" through.
+inline const CLI::Validator seed_u64 = CLI::Validator(
+    [](std::string& s) -> std::string {
+        const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) {
+            return c >= '0' && c <= '9';
+        });
+        if (digits && (s.size() < 20 || s <= "18446744073709551615")) return {};
+        return "'" + s + "' is not a whole number in [0, 18446744073709551615]";
+    },
+    "UINT64");
 
 }  // namespace bounce::examples

@@ -12,6 +12,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -51,6 +53,17 @@ void make_context() {  // headless desktop GL 4.5 through Mesa's surfaceless EGL
 
 int main(int argc, char** argv) {
     const std::string out = argc == 3 && std::string(argv[1]) == "--out" ? argv[2] : "embedding.png";
+    // The output checked before the work: a format OpenImageIO writes, in a place it can go.
+    {
+        const bool existed = std::filesystem::exists(out);
+        std::ofstream probe(out, std::ios::app);
+        if (!OIIO::ImageOutput::create(out) || !probe || std::filesystem::is_directory(out)) {
+            std::fprintf(stderr, "embedding: --out %s: not a writable image file (.png, .exr ...)\n", out.c_str());
+            return 2;
+        }
+        probe.close();
+        if (!existed) std::filesystem::remove(out);
+    }
     const std::size_t w = 256, h = 256;
     // The renderer's mesh: a floor, a red and a green wall, flat-shaded, one material each.
     std::vector<glm::vec3> positions, normals, albedos;
@@ -149,8 +162,10 @@ int main(int argc, char** argv) {
         bytes[i] = (unsigned char)(255.f * std::pow(std::min(1.f, 2.f * pixels.data()[i / 3][int(i % 3)]), 1.f / 2.2f));
     auto file = OIIO::ImageOutput::create(out);
     if (!file || !file->open(out, OIIO::ImageSpec(int(w), int(h), 3, OIIO::TypeDesc::UINT8)) ||
-        !file->write_image(OIIO::TypeDesc::UINT8, bytes.data()) || !file->close())
-        throw std::runtime_error("embedding: cannot write " + out);
+        !file->write_image(OIIO::TypeDesc::UINT8, bytes.data()) || !file->close()) {
+        std::fprintf(stderr, "embedding: cannot write %s\n", out.c_str());
+        return 1;
+    }
     std::printf("%zu records (%.1f ms splatting, %.1f ms scan); wrote %s\n", cache.records().size(),
                 stats.splat_existing_ms + stats.interpolate_ms, stats.scan_ms, out.c_str());
 }

@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     app.add_flag("--hashed-turn", hashed_turn, "also turn each plane by its own angle in [0, 90) degrees, hashed from its point");
     app.add_option("--points", points, "random visible points (fixed seed)")->check(CLI::Range(1, 200000))->capture_default_str();
-    app.add_option("--seed", rs.seed, "seed of the points and of the reference")->check(examples::detail::number_in(0, 18446744073709551615.0, true, "a seed"))->capture_default_str();
+    app.add_option("--seed", rs.seed, "seed of the points and of the reference")->check(examples::seed_u64)->capture_default_str();
     app.add_option("--reference-spp", rs.spp, "reference rays per point and half (doubled until the error target)")
         ->check(CLI::Range(16u, 1u << 22))
         ->capture_default_str();

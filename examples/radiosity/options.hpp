@@ -51,17 +51,6 @@ struct options {
     std::filesystem::path json, out, lightmaps, versus, reference_out;
 };
 
-/// A whole number in [0, 2^64), in decimal digits only (CLI11 would wrap "-1" to 2^64 - 1).
-inline const CLI::Validator seed_64 = CLI::Validator(
-    [](std::string& s) -> std::string {
-        const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) {
-            return c >= '0' && c <= '9';
-        });
-        if (digits && (s.size() < 20 || s <= "18446744073709551615")) return {};
-        return "'" + s + "' is not a whole number in [0, 18446744073709551615]";
-    },
-    "UINT64");
-
 inline void add_options(CLI::App& app, options& o) {
     const auto on_off = [&app](const char* name, bool& flag, const char* what) {
         app.add_option_function<std::string>(name, [&flag](const std::string& v) { flag = v == "on"; }, what)
@@ -104,7 +93,7 @@ inline void add_options(CLI::App& app, options& o) {
     on_off("--reference", o.reference, "compare with the multi-bounce reference: on | off");
     app.add_option("--reference-paths", o.reference_paths, "reference paths per pixel")
         ->check(CLI::Range(1u, 1u << 20))->capture_default_str();
-    app.add_option("--seed", o.seed, "base seed of the reference's paths, 0 .. 2^64 - 1")->check(seed_64)
+    app.add_option("--seed", o.seed, "base seed of the reference's paths, 0 .. 2^64 - 1")->check(seed_u64)
         ->capture_default_str();
     app.add_option("--curve-points", o.curve_points, "error checkpoints along the solve (0: none)")
         ->check(CLI::Range(0, 1000))->capture_default_str();

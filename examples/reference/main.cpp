@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     app.add_option("--secondary-area-samples", secondary_area_samples, "samples on emissive triangles per hemisphere hit")
         ->check(CLI::Range(1u, 1u << 10))
         ->capture_default_str();
-    app.add_option("--seed", seed, "base seed of every random stream")->check(examples::detail::number_in(0, 18446744073709551615.0, true, "a seed"))->capture_default_str();
+    app.add_option("--seed", seed, "base seed of every random stream")->check(examples::seed_u64)->capture_default_str();
     app.add_option("--environment", environment, "uniform radiance R G B of rays that escape (W/m^2/sr)")
         ->expected(3)
         ->check(examples::finite_non_negative)

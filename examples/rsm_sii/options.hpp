@@ -95,18 +95,6 @@ inline indirect_options indirect_options_for(const options& o, const std::string
     return c;
 }
 
-/// A whole number in [0, 2^64), spelled in decimal digits only (CLI11 would take "-1" and
-/// wrap it to 2^64 - 1).
-inline const CLI::Validator unsigned_64 = CLI::Validator(
-    [](std::string& s) -> std::string {
-        const bool digits = !s.empty() && s.size() <= 20 && std::all_of(s.begin(), s.end(), [](char c) {
-            return c >= '0' && c <= '9';
-        });
-        if (digits && (s.size() < 20 || s <= "18446744073709551615")) return {};
-        return "'" + s + "' is not a whole number in [0, 18446744073709551615]";
-    },
-    "UINT64");
-
 /// An even number of rays per pixel in [4, 2^20] (the unoccluded reference is two halves of
 /// at least 2 rays each).
 inline const CLI::Validator even_ref_spp = CLI::Validator(
@@ -153,7 +141,7 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_flag("!--no-blur", o.blur, "skip the geometry-aware blur after interleaving");
     app.add_flag("--thesis-weights", o.thesis_weights,
                  "interleaved lights at weight 1 as in Hahn 2012 (loses 1 - 1/(N M) of the energy), not N M");
-    app.add_option("--seed", o.seed, "seed of the VPLs and of the disc pattern")->check(unsigned_64)->capture_default_str();
+    app.add_option("--seed", o.seed, "seed of the VPLs and of the disc pattern")->check(seed_u64)->capture_default_str();
     app.add_option("--ref-spp", o.ref_spp, "rays per pixel of the references (with and without indirect visibility)")
         ->check(even_ref_spp)
         ->capture_default_str();

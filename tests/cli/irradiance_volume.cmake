@@ -15,6 +15,10 @@ bounce_cli_refusal("a --seed of -1" PROGRAM irradiance_volume MATCH "--seed.*'-1
 foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull)
   bounce_cli_refusal("${option} nan" PROGRAM irradiance_volume MATCH "${option}.*'nan' is not" ARGS ${iv_big} ${option} nan)
 endforeach()
+# --support must exceed 1; the refusal prints the open bound as such, "(1, 16]", not 1.000001
+# (the brackets matched by '.': a bracket in a CMake list argument groups its semicolons).
+bounce_cli_refusal("a --support of 1" PROGRAM irradiance_volume MATCH "--support.*'1' is not a support in .1, 16. "
+                   ARGS ${iv_big} --support 1)
 bounce_cli_refusal("a --path of nan" PROGRAM irradiance_volume MATCH "--path.*'nan' is not"
                    ARGS ${iv_big} --path 0.1 0.1 0.1 nan 0.5 0.5)
 

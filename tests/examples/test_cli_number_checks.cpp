@@ -82,3 +82,12 @@ TEST_CASE("the refusal says what the option wants", "[examples][cli]") {
     CHECK(message.find("'nan'") != std::string::npos);
     CHECK(message.find("finite number > 0") != std::string::npos);
 }
+
+TEST_CASE("seed_u64 takes every 64-bit seed in decimal digits and nothing else", "[examples][cli]") {
+    // Doubles hold these exactly; larger seeds are checked through the message alone.
+    takes_exactly(bounce::examples::seed_u64, {"0", "1", "4294967296", "9007199254740992"},
+                  {"-1", "1.5", "1e3", "+3", " 7", "0x10", "nan", "", "18446744073709551616", "99999999999999999999"});
+    CHECK(bounce::examples::seed_u64(std::string("18446744073709551615")).empty());
+    CHECK(bounce::examples::seed_u64(std::string("-1")).find("whole number in [0, 18446744073709551615]") !=
+          std::string::npos);
+}
