@@ -1,11 +1,11 @@
 // Output paths are checked before a program's work, and a write that fails is an error: the
 // cases users hit (/proc, /dev/full, a folder, an unknown image extension) each refused.
+#include "../parameter_refusal.hpp"
+#include "../scoped_environment.hpp"
 #include "scratch_folder.hpp"
 
 #include <bounce/io/output_files.hpp>
 #include <bounce/io/scene.hpp>
-
-#include "../scoped_environment.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -15,6 +15,7 @@
 #include <string>
 
 using namespace bounce;
+using bounce::test::refusal_message;
 using bounce::test::scratch_folder;
 using Catch::Matchers::Contains;
 namespace fs = std::filesystem;
@@ -23,16 +24,6 @@ namespace {
 std::string read_all(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-// The message of the parameter_error `f` throws, or "" when it throws none.
-template <class F>
-std::string refusal(F&& f) {
-    try {
-        f();
-    } catch (const parameter_error& e) {
-        return e.what();
-    }
-    return {};
 }
 }  // namespace
 
@@ -49,23 +40,23 @@ TEST_CASE("a writable output path passes the check and is left as it was", "[io]
 
 TEST_CASE("outputs that cannot be written are refused naming the option", "[io][output][bad-input]") {
     scratch_folder dir;
-    CHECK_THAT(refusal([&] { io::check_output_file("--json", dir.path()); }), Contains("'--json'") && Contains("is a folder"));
-    CHECK_THAT(refusal([&] { io::check_output_file("--json", ""); }), Contains("empty"));
+    CHECK_THAT(refusal_message([&] { io::check_output_file("--json", dir.path()); }), Contains("'--json'") && Contains("is a folder"));
+    CHECK_THAT(refusal_message([&] { io::check_output_file("--json", ""); }), Contains("empty"));
     const fs::path blocker = dir.write("file", "x");
-    CHECK_THAT(refusal([&] { io::check_output_file("--out", blocker / "x.png"); }), Contains("'--out'"));
+    CHECK_THAT(refusal_message([&] { io::check_output_file("--out", blocker / "x.png"); }), Contains("'--out'"));
     if (fs::is_directory("/proc/self"))  // root may write almost anywhere, but not create files in /proc
-        CHECK_THAT(refusal([&] { io::check_output_file("--json", "/proc/x.json"); }), Contains("cannot create"));
+        CHECK_THAT(refusal_message([&] { io::check_output_file("--json", "/proc/x.json"); }), Contains("cannot create"));
     if (fs::exists("/dev/full"))
-        CHECK_THAT(refusal([&] { io::check_output_file("--json", "/dev/full"); }), Contains("not a regular file"));
+        CHECK_THAT(refusal_message([&] { io::check_output_file("--json", "/dev/full"); }), Contains("not a regular file"));
 }
 
 TEST_CASE("an image output needs an extension the image writer knows", "[io][output][bad-input]") {
     scratch_folder dir;
     CHECK_NOTHROW(io::check_image_output("--out", dir.path() / "a.png"));
     CHECK_NOTHROW(io::check_image_output("--exr", dir.path() / "a.exr"));
-    CHECK_THAT(refusal([&] { io::check_image_output("--out", dir.path() / "a.unknown"); }),
+    CHECK_THAT(refusal_message([&] { io::check_image_output("--out", dir.path() / "a.unknown"); }),
                Contains("'--out'") && Contains("'.unknown' is not an image format"));
-    CHECK_THAT(refusal([&] { io::check_image_output("--out", dir.path() / "noextension"); }), Contains("'--out'"));
+    CHECK_THAT(refusal_message([&] { io::check_image_output("--out", dir.path() / "noextension"); }), Contains("'--out'"));
 }
 
 TEST_CASE("a failed write raises output_error naming the file; a good one writes every byte", "[io][output][bad-input]") {
