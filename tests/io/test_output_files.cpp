@@ -59,7 +59,7 @@ TEST_CASE("an image output needs an extension the image writer knows", "[io][out
     CHECK_THAT(refusal_message([&] { io::check_image_output("--out", dir.path() / "noextension"); }), Contains("'--out'"));
 }
 
-TEST_CASE("a failed write raises output_error naming the file; a good one writes every byte", "[io][output][bad-input]") {
+TEST_CASE("a failed write raises output_error naming the file, and a good one writes every byte", "[io][output][bad-input]") {
     scratch_folder dir;
     const fs::path good = dir.path() / "sub" / "a.txt";
     io::write_text_file(good, "hello\n");
