@@ -172,7 +172,7 @@ TEST_CASE("the square plane's cosine-weighted solid angle is 4 sin(h) atan(sin h
           Approx(plane_cosine_solid_angle(126.0)).epsilon(1e-12));
 }
 
-TEST_CASE("weight tables are non-negative; stretching and coverage integrate the cosine over the whole hemisphere", "[hemisphere][weights]") {
+TEST_CASE("weight tables are non-negative, and stretching and coverage integrate the cosine over the whole hemisphere", "[hemisphere][weights]") {
     const auto N = GENERATE(1u, 2u, 3u, 5u, 16u, 64u, 128u);
     const auto aperture = GENERATE(1.0, 45.0, 90.0, 126.0, 150.0, 178.0);
     CAPTURE(N, aperture);

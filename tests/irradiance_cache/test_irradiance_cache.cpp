@@ -112,7 +112,7 @@ TEST_CASE("batched and sequential scans, in either order, agree with each other 
     }
 }
 
-TEST_CASE("a budget caps each frame's records; assign() restarts neighbour clamping from the given records",
+TEST_CASE("a budget caps each frame's records, and assign() restarts neighbour clamping from the given records",
           "[irradiance_cache]") {
     auto& f = fixture();
     const auto [lo, hi] = f.scene.bounds();

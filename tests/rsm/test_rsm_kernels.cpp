@@ -106,7 +106,7 @@ TEST_CASE("a texel reflects rho I dw of a point or spot light, nothing from behi
     CHECK(directional_light_texel_flux<float, glm::vec3>(albedo, -up, axis, intensity, 0.01f).x == 0.f);
 }
 
-TEST_CASE("the disc pattern's weights estimate the sum over the disc without bias; DS05's xi1^2 does not", "[rsm]") {
+TEST_CASE("the disc pattern's weights estimate the sum over the disc without bias, and DS05's xi1^2 does not", "[rsm]") {
     // Sum of w f over K samples for f = (distance from the centre)^k over a disc of radius
     // r: exact integrals r^2 pi T (k = 0) and 2 pi r^3 T / 3 (k = 1), T texels per unit area.
     // Only xi1 matters and the estimate is (2 pi r^(2+k) T) mean(xi1^(1+k)); van der Corput's

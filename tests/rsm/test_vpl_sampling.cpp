@@ -54,7 +54,7 @@ TEST_CASE("hierarchical warping reaches each texel with probability importance /
     }
 }
 
-TEST_CASE("warped VPLs each carry total / K of the importance; grid VPLs keep a uniform map's total", "[vpl]") {
+TEST_CASE("warped VPLs each carry total / K of the importance, and grid VPLs keep a uniform map's total", "[vpl]") {
     test_map m(37, 23);
     double total = 0;
     for (std::size_t y = 0; y < 23; ++y)

@@ -111,7 +111,7 @@ TEST_CASE("the run report is the object every example writes", "[study][report]"
     CHECK(j["vpls"] == 0);
 }
 
-TEST_CASE("a run that used GL names its renderer after the backend; one without GL does not", "[study][report]") {
+TEST_CASE("a run that used GL names its renderer after the backend, and one without GL does not", "[study][report]") {
     auto r = sample_report();
     CHECK_FALSE(r.to_json().contains("gl_renderer"));
     r.gl_renderer = "llvmpipe (LLVM 15.0.6, 256 bits)";
