@@ -1,0 +1,455 @@
+// gl::progressive_radiosity's steps: the reduction that picks the next shooter, the item
+// buffer or hemicube drawn from it, and the shot of an element or a light.
+#include "radiosity_state.hpp"
+
+namespace bounce::gl {
+
+void progressive_radiosity::state::bind_common() const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, texels.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, nodes_binding, nodes.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, planes_binding, planes.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, first_binding, first_buffer.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, element_binding, element_texel.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, partial_binding, partials.id());
+    glBindImageTexture(radiosity_unit, radiosity.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(unshot_unit, unshot.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(intercepted_unit, intercepted.id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(item_unit, item_color.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+}
+
+progressive_radiosity::state::reduction progressive_radiosity::state::reduce() {
+    const auto start = clock_type::now();
+    {
+        binding_state saved;
+        bind_common();
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        glUseProgram(reduce_program->id());
+        reduce_program->set(0, int(width));
+        reduce_program->set(1, unsigned(first.size() - 1));
+        glDispatchCompute(GLuint((first.size() - 1 + reduce_group - 1) / reduce_group), 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glUseProgram(finish_program->id());
+        finish_program->set(0, unsigned(first.size() - 1));
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        check_error("progressive_radiosity: the shooter reduction");
+    }
+    std::array<double, 9> r{};
+    partials.read(0, r.data(), sizeof(double) * 9);
+    next_power = std::max(0.0, r[0]);
+    next = std::uint32_t(std::clamp(r[1], 0.0, double(first.size() - 2)));
+    unshot_total = r[2];
+    timings.choice_ms += ms_since(start);
+    return {{r[3], r[4], r[5]}, {r[6], r[7], r[8]}};
+}
+
+void progressive_radiosity::state::set_shot(glm::vec3 position, glm::vec3 axis, float chart) {
+    shot_position = position;
+    shot_axis = axis;
+    shot_chart = chart;
+    const auto tb = orthonormal_basis<float, glm::vec3>(axis);
+    t = tb[0];
+    b = tb[1];
+}
+
+void progressive_radiosity::state::draw_item_buffer() {
+    // The triangles in the shooter's frame, clipped above its plane and tessellated until no
+    // projected edge bends more than tolerance_px from its chord (cpu::item_buffer_visibility).
+    pieces.clear();
+    const float res = float(options.resolution);
+    const float z_min = 1e-6f * diagonal;
+    const stereographic_tessellation how{res, options.tolerance_px, options.max_tessellation_depth};
+    std::vector<glm::vec3> poly, scratch;
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+        if (float(triangle_chart[k]) == shot_chart) continue;
+        std::array<glm::vec3, 3> l;
+        for (int m = 0; m < 3; ++m)
+            l[std::size_t(m)] = to_shooter_frame<float, glm::vec3>(corners[k][std::size_t(m)], shot_position, t, b, shot_axis);
+        if (l[0].z < z_min && l[1].z < z_min && l[2].z < z_min) continue;
+        const glm::vec3 nl(glm::dot(glm::vec3(world_plane[k]), t), glm::dot(glm::vec3(world_plane[k]), b),
+                           glm::dot(glm::vec3(world_plane[k]), shot_axis));
+        const float d = glm::dot(nl, l[0]);
+        local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
+        const float chart = float(triangle_chart[k]), id = float(k);
+        // The CPU's pieces in the CPU's order (stereographic_tessellation.hpp).
+        clip_and_tessellate_stereographic(l, z_min, how, poly, scratch,
+                                          [&](const std::array<glm::vec3, 3>& piece, const std::array<glm::vec2, 3>&) {
+                                              for (const glm::vec3& v : piece) pieces.push_back({v, chart, id});
+                                          });
+    }
+    drawn = pieces.size() / 3;
+    planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));
+    if (pieces.size() > vertex_capacity) {
+        vertex_capacity = std::max<std::size_t>(pieces.size() * 2, 1024);
+        vertices = std::make_unique<buffer>(vertex_capacity * sizeof(item_vertex));
+        glVertexArrayVertexBuffer(item_vao.id(), 0, vertices->id(), 0, GLsizei(sizeof(item_vertex)));
+        glEnableVertexArrayAttrib(item_vao.id(), 0);
+        glEnableVertexArrayAttrib(item_vao.id(), 1);
+        glVertexArrayAttribFormat(item_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribFormat(item_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
+        glVertexArrayAttribBinding(item_vao.id(), 0, 0);
+        glVertexArrayAttribBinding(item_vao.id(), 1, 0);
+    }
+    if (!pieces.empty()) vertices->write(0, pieces.data(), pieces.size() * sizeof(item_vertex));
+
+    // The farthest the scene can be from the shooter: the depth attachment's scale.
+    float far_distance = 0.f;
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        far_distance = std::max(far_distance, glm::length(corner - shot_position));
+    }
+    detail::raster_state raster;
+    binding_state saved;
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(item_fbo.id(), GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(item_fbo.id(), GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
+    glViewport(0, 0, options.resolution, options.resolution);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, planes_binding, planes.id());
+    glUseProgram(item_program->id());
+    item_program->set(0, res);
+    item_program->set(1, far_distance * 1.01f + 1e-6f * diagonal);
+    glBindVertexArray(item_vao.id());
+    if (!pieces.empty()) glDrawArrays(GL_TRIANGLES, 0, GLsizei(pieces.size()));
+    check_error("progressive_radiosity: drawing the item buffer");
+}
+
+void progressive_radiosity::state::draw_visibility() {
+    if (options.visibility == radiosity_visibility::stereographic) draw_item_buffer();
+    else if (options.visibility == radiosity_visibility::hemicube) draw_hemicube();
+}
+
+void progressive_radiosity::state::world_vertices() {
+    if (cube_vertices) return;
+    std::vector<item_vertex> v;
+    for (std::size_t k = 0; k < corners.size(); ++k)
+        for (int m = 0; m < 3; ++m) v.push_back({corners[k][std::size_t(m)], float(triangle_chart[k]), float(k)});
+    cube_vertex_count = v.size();
+    cube_vertices = std::make_unique<buffer>(std::max<std::size_t>(v.size(), 1) * sizeof(item_vertex), v.data());
+    glVertexArrayVertexBuffer(cube_vao.id(), 0, cube_vertices->id(), 0, GLsizei(sizeof(item_vertex)));
+    glEnableVertexArrayAttrib(cube_vao.id(), 0);
+    glEnableVertexArrayAttrib(cube_vao.id(), 1);
+    glVertexArrayAttribFormat(cube_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribFormat(cube_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
+    glVertexArrayAttribBinding(cube_vao.id(), 0, 0);
+    glVertexArrayAttribBinding(cube_vao.id(), 1, 0);
+}
+
+void progressive_radiosity::state::draw_parallel() {
+    const int res = options.parallel_resolution;
+    if (!parallel_fbo) {
+        parallel_color = std::make_unique<texture>(texel_format::rgba32f, std::size_t(res), std::size_t(res));
+        parallel_depth = std::make_unique<texture>(texel_format::depth32f, std::size_t(res), std::size_t(res));
+        parallel_fbo = std::make_unique<framebuffer>();
+        parallel_fbo->attach_color(0, *parallel_color);
+        parallel_fbo->attach_depth(*parallel_depth);
+        parallel_fbo->set_draw_buffers(1);
+        parallel_fbo->check_complete();
+    }
+    world_vertices();
+    // The planes the lookup reads are the world planes here.
+    std::vector<glm::vec4> wp(world_plane);
+    wp.resize(local_plane.size(), glm::vec4(0.f, 0.f, 1.f, 0.f));
+    planes.write(0, wp.data(), wp.size() * sizeof(glm::vec4));
+    // The scene's box projected across the light, widened by a pixel each side
+    // (cpu::item_buffer_visibility's parallel buffer); its extent along the light.
+    glm::vec2 mn(std::numeric_limits<float>::max()), mx(-std::numeric_limits<float>::max());
+    float d0 = std::numeric_limits<float>::max(), d1 = -std::numeric_limits<float>::max();
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        const glm::vec2 q(glm::dot(corner, t), glm::dot(corner, b));
+        mn = glm::min(mn, q);
+        mx = glm::max(mx, q);
+        d0 = std::min(d0, glm::dot(corner, shot_axis));
+        d1 = std::max(d1, glm::dot(corner, shot_axis));
+    }
+    const float side = std::max(std::max(mx.x - mn.x, mx.y - mn.y), 1e-30f) * (1.f + 2.f / float(res));
+    ortho_lo = 0.5f * (mn + mx) - glm::vec2(0.5f * side);
+    ortho_scale = float(res) / side;
+    const float margin = 0.01f * diagonal;
+    detail::raster_state raster;
+    binding_state saved;
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(parallel_fbo->id(), GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(parallel_fbo->id(), GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, parallel_fbo->id());
+    glViewport(0, 0, res, res);
+    const program& p = *parallel_program;
+    glUseProgram(p.id());
+    p.set(0, t);
+    p.set(1, b);
+    p.set(2, shot_axis);
+    p.set(3, ortho_lo);
+    p.set(4, ortho_scale);
+    p.set(5, float(res));
+    p.set(6, d0 - margin);
+    p.set(7, d1 + margin);
+    glBindVertexArray(cube_vao.id());
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
+    drawn = cube_vertex_count / 3;
+    check_error("progressive_radiosity: drawing the directional light's buffer");
+}
+
+void progressive_radiosity::state::draw_hemicube() {
+    // Each triangle's plane in the shooter's frame, facing away from it, for the lookup.
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+        const glm::vec3 nl(glm::dot(glm::vec3(world_plane[k]), t), glm::dot(glm::vec3(world_plane[k]), b),
+                           glm::dot(glm::vec3(world_plane[k]), shot_axis));
+        const float d = glm::dot(nl, to_shooter_frame<float, glm::vec3>(corners[k][0], shot_position, t, b, shot_axis));
+        local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
+    }
+    planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));
+    world_vertices();
+    float far_distance = 0.f;
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        far_distance = std::max(far_distance, glm::length(corner - shot_position));
+    }
+    const float far_z = far_distance * 1.01f + 1e-6f * diagonal, near_z = 1e-6f * diagonal;
+    detail::raster_state raster;
+    binding_state saved;
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(item_fbo.id(), GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(item_fbo.id(), GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
+    const program& p = *cube_program;
+    glUseProgram(p.id());
+    p.set(0, shot_position);
+    p.set(1, t);
+    p.set(2, b);
+    p.set(3, shot_axis);
+    p.set(8, near_z);
+    p.set(9, far_z);
+    p.set(10, shot_chart);
+    glBindVertexArray(cube_vao.id());
+    const int res = options.resolution;
+    for (int face = 0; face < 5; ++face) {
+        const auto axes = face_axes(face);
+        p.set(4, axes[0]);
+        p.set(5, axes[1]);
+        p.set(6, axes[2]);
+        p.set(7, face == 0 ? 0 : 1);
+        if (face == 0) glViewport(0, 0, res, res);
+        else glViewport(0, res + (face - 1) * (res / 2), res, res / 2);
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
+    }
+    drawn = 5 * cube_vertex_count / 3;
+    check_error("progressive_radiosity: drawing the hemicube");
+}
+
+std::vector<glm::vec3> progressive_radiosity::state::read_elements(const texture& tex) const {
+    const std::vector<float> all = tex.read_floats();
+    std::vector<glm::vec3> out(atlas.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        const std::size_t at = 4 * (std::size_t(atlas.texel[i].y) * width + atlas.texel[i].x);
+        out[i] = glm::vec3(all[at], all[at + 1], all[at + 2]);
+    }
+    return out;
+}
+
+void progressive_radiosity::state::shoot(std::uint32_t k) {
+    auto start = clock_type::now();
+    const std::uint32_t i0 = first[k], i1 = first[k + 1];
+    // The shooter's texels, read back: its power and its near-field tree (the CPU solver's
+    // build_near_tree: elements, then 2 x 2 groups of its grid cells, ..., the block last);
+    // then cleared.
+    const glm::uvec4 r = rect[k];
+    std::vector<glm::vec4> texels_back(std::size_t(r.z) * r.w);
+    {
+        detail::pack_state pack;
+        glGetTextureSubImage(unshot.id(), 0, GLint(r.x), GLint(r.y), 0, GLsizei(r.z), GLsizei(r.w), 1, GL_RGBA, GL_FLOAT,
+                             GLsizei(texels_back.size() * sizeof(glm::vec4)), texels_back.data());
+        const glm::vec4 zero(0.f);
+        glClearTexSubImage(unshot.id(), 0, GLint(r.x), GLint(r.y), 0, GLsizei(r.z), GLsizei(r.w), 1, GL_RGBA, GL_FLOAT,
+                           &zero);
+        check_error("progressive_radiosity: reading the shooter back");
+    }
+    glm::dvec3 power(0.0);
+    struct node_sum {
+        glm::uvec2 cell;
+        glm::dvec3 moment, power;
+        double area;
+        std::int32_t first_child, child_count;
+    };
+    std::vector<node_sum> level, up;
+    glm::vec4 block_rect(0.f, 0.f, 1.f, 1.f);
+    glm::uvec2 grid(1u);
+    if (options.shooting.shoot_blocks) {
+        block_rect = atlas.block_rect[k];
+        grid = atlas.block_grid[k];
+    }
+    const lightmap_chart& ch = atlas.charts[atlas.chart[i0]];
+    for (std::uint32_t i = i0; i < i1; ++i) {
+        const glm::uvec2 tx = atlas.texel[i] - glm::uvec2(r.x, r.y);
+        const glm::vec3 u(texels_back[std::size_t(tx.y) * r.z + tx.x]);
+        const double a = double(atlas.area[i]);
+        power += glm::dvec3(u) * a;
+        const glm::vec3 d = atlas.position[i] - ch.origin;
+        const glm::vec2 g((glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u) - block_rect.x) /
+                              (block_rect.z / float(grid.x)),
+                          (glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v) - block_rect.y) /
+                              (block_rect.w / float(grid.y)));
+        const glm::uvec2 cell(std::uint32_t(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1)),
+                              std::uint32_t(std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1)));
+        level.push_back({cell, glm::dvec3(atlas.position[i]) * a, glm::dvec3(u) * a, a, 0, 0});
+    }
+    near.clear();
+    const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
+    for (;;) {
+        std::stable_sort(level.begin(), level.end(),
+                         [&](const node_sum& x, const node_sum& y) { return key(x.cell / 2u) < key(y.cell / 2u); });
+        const std::int32_t base = std::int32_t(near.size());
+        for (const node_sum& p : level) {
+            near.push_back({glm::vec4(glm::vec3(p.moment / p.area), float(p.area)), glm::vec4(glm::vec3(p.power / p.area), 0.f),
+                            {p.first_child, p.child_count, 0, 0}});
+        }
+        if (level.size() == 1) break;
+        up.clear();
+        for (std::size_t j = 0; j < level.size(); ++j) {
+            const glm::uvec2 pc = level[j].cell / 2u;
+            if (up.empty() || key(up.back().cell) != key(pc))
+                up.push_back({pc, glm::dvec3(0.0), glm::dvec3(0.0), 0.0, base + std::int32_t(j), 0});
+            node_sum& q = up.back();
+            q.moment += level[j].moment;
+            q.power += level[j].power;
+            q.area += level[j].area;
+            ++q.child_count;
+        }
+        level.swap(up);
+    }
+    require(near.size() <= std::size_t(max_nodes), "atlas", "a shooter's near-field tree outgrew its bound");
+    nodes.write(0, near.data(), near.size() * sizeof(gpu_node));
+
+    const float chart = float(atlas.chart[i0]);
+    set_shot(centre[k], atlas.normal[i0], chart);
+    draw_visibility();
+    if (options.timed_stages) finish();
+    timings.visibility_ms += ms_since(start);
+
+    start = clock_type::now();
+    {
+        binding_state saved;
+        bind_common();
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        const program& p = *distribute_program;
+        glUseProgram(p.id());
+        p.set(0, int(width));
+        p.set(1, int(height));
+        p.set(2, shot_position);
+        p.set(3, t);
+        p.set(4, b);
+        p.set(5, shot_axis);
+        p.set(6, chart);
+        p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
+        p.set(8, float(options.resolution));
+        p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
+        p.set(21, unsigned(atlas.size()));
+        p.set(9, diagonal);
+        p.set(10, int(near.size()));
+        p.set(11, float(options.shooting.near_field * options.shooting.near_field));
+        glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
+        check_error("progressive_radiosity: the distribution pass");
+    }
+    if (options.timed_stages) finish();
+    timings.distribution_ms += ms_since(start);
+    const reduction got = reduce();
+    absorbed += got.absorbed;
+    escaped += power - got.intercepted;
+    intercepted_power += got.intercepted;
+    ++shots;
+}
+
+void progressive_radiosity::state::shoot_light(const packed_light& l) {
+    const light_kind kind = l.kind();
+    if (kind == light_kind::directional) {
+        set_shot(glm::vec3(0.f), l.direction(), -2.f);
+        if (options.visibility != radiosity_visibility::none) draw_parallel();
+        {
+            binding_state saved;
+            bind_common();
+            if (parallel_color)
+                glBindImageTexture(item_unit, parallel_color->id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+            glMemoryBarrier(GL_ALL_BARRIER_BITS);
+            const program& p = *light_program;
+            glUseProgram(p.id());
+            p.set(0, int(width));
+            p.set(1, int(height));
+            p.set(2, shot_position);
+            p.set(3, t);
+            p.set(4, b);
+            p.set(5, shot_axis);
+            p.set(6, -2.f);
+            p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
+            p.set(8, float(options.resolution));
+            p.set(9, diagonal);
+            p.set(10, 0);
+            p.set(11, l.direction());
+            p.set(12, l.intensity());
+            p.set(13, l.cos_cone());
+            p.set(14, l.cosine_falloff());
+            p.set(15, 0);
+            p.set(16, 1);
+            p.set(17, ortho_lo);
+            p.set(18, ortho_scale);
+            p.set(19, float(options.parallel_resolution));
+            p.set(20, 0);
+            p.set(21, unsigned(atlas.size()));
+            glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
+            check_error("progressive_radiosity: shooting a directional light");
+        }
+        const reduction got = reduce();
+        emitted += got.intercepted;
+        intercepted_power += got.intercepted;
+        absorbed += got.absorbed;
+        return;
+    }
+    const glm::vec3 axis = kind == light_kind::spot ? l.direction() : glm::vec3(0, 0, 1);
+    std::vector<glm::vec3> axes{axis};
+    // A point light, or a spot wider than a hemisphere, needs the other half too.
+    if (kind == light_kind::point || l.cos_cone() < 0.f) axes.push_back(-axis);
+    for (std::size_t h = 0; h < axes.size(); ++h) {
+        set_shot(l.position(), axes[h], -2.f);
+        draw_visibility();
+        {
+            binding_state saved;
+            bind_common();
+            glMemoryBarrier(GL_ALL_BARRIER_BITS);
+            const program& p = *light_program;
+            glUseProgram(p.id());
+            p.set(0, int(width));
+            p.set(1, int(height));
+            p.set(2, shot_position);
+            p.set(3, t);
+            p.set(4, b);
+            p.set(5, shot_axis);
+            p.set(6, -2.f);
+            p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
+            p.set(8, float(options.resolution));
+            p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
+            p.set(21, unsigned(atlas.size()));
+        p.set(21, unsigned(atlas.size()));
+            p.set(9, diagonal);
+            p.set(10, kind == light_kind::spot ? 1 : 0);
+            p.set(11, l.direction());
+            p.set(12, l.intensity());
+            p.set(13, l.cos_cone());
+            p.set(14, l.cosine_falloff());
+            p.set(15, h == 0 ? 0 : 1);
+            p.set(16, 0);
+            p.set(17, ortho_lo);
+            p.set(18, ortho_scale);
+            p.set(19, float(options.parallel_resolution));
+            glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
+            check_error("progressive_radiosity: shooting a light");
+        }
+        const reduction got = reduce();
+        emitted += got.intercepted;
+        intercepted_power += got.intercepted;
+        absorbed += got.absorbed;
+    }
+}
+
+}  // namespace bounce::gl

@@ -1,0 +1,214 @@
+#pragma once
+// What gl::progressive_radiosity keeps between steps (its state) and the GL plumbing its
+// passes share: private to adapters/gl/src, included by radiosity.cpp (the public type),
+// radiosity_passes.cpp (the programs) and radiosity_shooting.cpp (a shot's passes).
+#include <bounce/gl/radiosity.hpp>
+
+#include <bounce/glsl/emit.hpp>
+#include <bounce/light.hpp>
+#include <bounce/lights.hpp>
+#include <bounce/radiosity.hpp>
+#include <bounce/radiosity_solve.hpp>
+#include <bounce/sampling.hpp>
+#include <bounce/stereographic_tessellation.hpp>
+
+#include "saved_state.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <utility>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+namespace bounce::gl {
+
+namespace radiosity_detail {
+
+using clock_type = std::chrono::steady_clock;
+inline double ms_since(clock_type::time_point t) { return std::chrono::duration<double, std::milli>(clock_type::now() - t).count(); }
+
+// Storage-buffer bindings and image units the passes use.
+constexpr GLuint texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
+                 partial_binding = 5;
+constexpr GLuint radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
+constexpr unsigned reduce_group = 64;
+// The reduction's buffer: the result (best power, best index, total unshot, intercepted rgb,
+// absorbed rgb) in the first 9 doubles, then from double 16 on 8 per shooter (power, intercepted rgb, absorbed rgb).
+constexpr std::size_t partial_doubles = 8;
+
+// The bindings the passes change beyond raster_state: program, the storage buffers and image
+// units above; restored on destruction.
+class binding_state {
+public:
+    binding_state() {
+        glGetIntegerv(GL_CURRENT_PROGRAM, &program_);
+        glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &generic_);
+        for (GLuint i = 0; i < storage_.size(); ++i) {
+            glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &storage_[i].buffer);
+            glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, i, &storage_[i].start);
+            glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, i, &storage_[i].size);
+        }
+        for (GLuint i = 0; i < images_.size(); ++i) {
+            image& m = images_[i];
+            glGetIntegeri_v(GL_IMAGE_BINDING_NAME, i, &m.name);
+            glGetIntegeri_v(GL_IMAGE_BINDING_LEVEL, i, &m.level);
+            glGetIntegeri_v(GL_IMAGE_BINDING_LAYERED, i, &m.layered);
+            glGetIntegeri_v(GL_IMAGE_BINDING_LAYER, i, &m.layer);
+            glGetIntegeri_v(GL_IMAGE_BINDING_ACCESS, i, &m.access);
+            glGetIntegeri_v(GL_IMAGE_BINDING_FORMAT, i, &m.format);
+        }
+    }
+    ~binding_state() {
+        for (GLuint i = 0; i < images_.size(); ++i) {
+            const image& m = images_[i];
+            glBindImageTexture(i, GLuint(m.name), m.level, GLboolean(m.layered), m.layer, GLenum(m.access),
+                               GLenum(m.format));
+        }
+        for (GLuint i = 0; i < storage_.size(); ++i) {
+            const auto& b = storage_[i];
+            if (b.size > 0) glBindBufferRange(GL_SHADER_STORAGE_BUFFER, i, GLuint(b.buffer), b.start, b.size);
+            else glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(b.buffer));
+        }
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, GLuint(generic_));
+        glUseProgram(GLuint(program_));
+    }
+    binding_state(const binding_state&) = delete;
+    binding_state& operator=(const binding_state&) = delete;
+
+private:
+    struct storage {
+        GLint buffer = 0;
+        GLint64 start = 0, size = 0;
+    };
+    struct image {
+        GLint name = 0, level = 0, layered = 0, layer = 0, access = GL_READ_ONLY, format = GL_RGBA32F;
+    };
+    GLint program_ = 0, generic_ = 0;
+    std::array<storage, 6> storage_{};
+    std::array<image, 4> images_{};
+};
+
+// One vertex of the item buffer's vertex stream: shooter-frame position, chart, triangle.
+struct item_vertex {
+    glm::vec3 local;
+    float chart, triangle;
+};
+
+// std430 layouts shared with the shaders.
+struct texel_attributes {
+    glm::vec4 position_area{0.f};  // world position, area (0: not an element's texel)
+    glm::vec4 normal_chart{0.f};   // unit normal, chart
+    glm::vec4 albedo{0.f};         // rho, unused
+};
+struct gpu_node {
+    glm::vec4 position_area;
+    glm::vec4 unshot;
+    std::array<std::int32_t, 4> meta;  // first child, child count (0: a leaf)
+};
+
+inline std::string version_header() { return "#version 450 core\n"; }
+
+// Rows of the item buffer: one square, or the hemicube's top face (res rows) above its four
+// half side faces (res / 2 rows each).
+inline std::size_t item_rows(const radiosity_options& o) {
+    return std::size_t(o.resolution) * (o.visibility == radiosity_visibility::hemicube ? 3 : 1);
+}
+
+// The hemicube faces' (right, up, forward) in the shooter's frame: radiosity.hpp's table.
+inline std::array<glm::vec3, 3> face_axes(int face) {
+    switch (face) {
+        case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};
+        case 2: return {glm::vec3(0, -1, 0), glm::vec3(0, 0, 1), glm::vec3(-1, 0, 0)};
+        case 3: return {glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 1, 0)};
+        case 4: return {glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)};
+        default: return {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
+    }
+}
+
+
+}  // namespace radiosity_detail
+
+using namespace radiosity_detail;
+
+struct progressive_radiosity::state {
+    lightmap_atlas atlas;
+    radiosity_options options;
+    std::uint32_t width = 0, height = 0;
+    // Shooters.
+    std::vector<std::uint32_t> first;
+    std::vector<glm::vec3> centre;
+    std::vector<glm::uvec4> rect;  // texel bounding box of each shooter's elements: x, y, w, h
+    // Scene triangles with a chart: corners, chart, world plane (unit n, n . x).
+    std::vector<std::array<glm::vec3, 3>> corners;
+    std::vector<std::uint32_t> triangle_chart;
+    std::vector<glm::vec4> world_plane;
+    float diagonal = 1.f;
+    glm::vec3 lo{0.f}, hi{0.f};
+    int max_nodes = 1, stack_size = 4;
+    double total_area = 0;
+    glm::dvec3 albedo_area{0.0};
+
+    // GL objects.
+    texture radiosity, unshot, intercepted, item_color, item_depth;
+    framebuffer item_fbo;
+    vertex_array item_vao;
+    buffer texels, nodes, planes, first_buffer, element_texel, partials;
+    std::unique_ptr<buffer> vertices;
+    std::size_t vertex_capacity = 0;
+    vertex_array cube_vao;
+    std::unique_ptr<buffer> cube_vertices;
+    std::size_t cube_vertex_count = 0;
+    // A directional light's orthographic buffer, made when the scene has one.
+    std::unique_ptr<texture> parallel_color, parallel_depth;
+    std::unique_ptr<framebuffer> parallel_fbo;
+    glm::vec2 ortho_lo{0.f};
+    float ortho_scale = 1.f;
+    // The display lightmap: element_at as packed source texels (0xffffffff: no chart).
+    std::unique_ptr<texture> lightmap_texture;
+    std::unique_ptr<buffer> source_texel;
+    std::unique_ptr<program> lightmap_program;
+    std::unique_ptr<program> item_program, cube_program, parallel_program, distribute_program, light_program, reduce_program, finish_program;
+
+    // Per shot, CPU side.
+    glm::vec3 shot_position{0.f}, shot_axis{0.f, 0.f, 1.f}, t{1, 0, 0}, b{0, 1, 0};
+    float shot_chart = -2.f;
+    std::vector<glm::vec4> local_plane;
+    std::vector<item_vertex> pieces;
+    std::vector<gpu_node> near;
+    std::size_t drawn = 0;
+
+    // Bookkeeping (double, per channel), from the reductions.
+    glm::dvec3 emitted{0.0}, absorbed{0.0}, escaped{0.0}, intercepted_power{0.0};
+    double unshot_total = 0;
+    std::uint32_t next = 0;
+    double next_power = 0;
+    std::size_t steps = 0, shots = 0;
+    radiosity_timings timings;
+
+    state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o);
+    void compile();
+    struct reduction {
+        glm::dvec3 intercepted{0.0}, absorbed{0.0};
+    };
+    reduction reduce();
+    void draw_item_buffer();
+    void draw_hemicube();
+    void draw_parallel();
+    void world_vertices();
+    void draw_visibility();
+    void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
+    void shoot(std::uint32_t k);
+    void shoot_light(const packed_light& l);
+    std::vector<glm::vec3> read_elements(const texture& t) const;
+    void bind_common() const;
+};
+
+
+}  // namespace bounce::gl
