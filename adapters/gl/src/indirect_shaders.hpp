@@ -1,0 +1,21 @@
+#pragma once
+// The GLSL texts of gl::indirect_renderer's passes (private to adapters/gl/src): plumbing
+// around the kernels emitted from rsm.hpp and interleaved_sampling.hpp.
+#include <string>
+
+namespace bounce::gl::indirect_glsl {
+
+extern const char* const fullscreen_vertex;
+extern const char* const common_glsl;
+extern const char* const downsample_fragment;
+extern const char* const splat_vertex;
+std::string index_kernels();
+std::string split_fragment();
+std::string gather_fragment();
+std::string gather_rsm_fragment();
+std::string upsample_fragment();
+std::string splat_fragment();
+std::string discontinuity_fragment();
+std::string tent_fragment(int radius, bool vertical);
+
+}  // namespace bounce::gl::indirect_glsl
