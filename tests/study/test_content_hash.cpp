@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstdint>
+#include <cstdio>
 #include <string_view>
 
 TEST_CASE("fnv1a_hash gives FNV-1a's published 64-bit values, and text() keeps its pieces apart", "[study][hash]") {
@@ -34,4 +35,14 @@ TEST_CASE("fnv1a_hash gives FNV-1a's published 64-bit values, and text() keeps i
     a_bc.text("a");
     a_bc.text("bc");
     CHECK(ab_c.digest() != a_bc.digest());
+}
+
+TEST_CASE("hex_digest spells the digest as the cache keys always did: 16 lower-case hex digits", "[study][hash]") {
+    for (const char* text : {"", "a", "bounce-reference-1", "a longer text with spaces"}) {
+        bounce::study::fnv1a_hash h;
+        h.text(text);
+        char expected[17];
+        std::snprintf(expected, sizeof expected, "%016llx", static_cast<unsigned long long>(h.digest()));
+        CHECK(h.hex_digest() == expected);
+    }
 }

@@ -10,6 +10,7 @@
 #include <bounce/io/output_files.hpp>
 #include <bounce/study/content_hash.hpp>
 #include <bounce/study/frame_comparison.hpp>
+#include <bounce/study/image_entry.hpp>
 #include <bounce/study/image_comparison.hpp>
 #include <bounce/study/multi_bounce_cache.hpp>
 #include <bounce/study/reference_cache.hpp>
@@ -70,47 +71,25 @@ std::string halves_cache_key(const scene_setup& s, const std::string& kind, std:
     h.value(spp);
     h.text(settings_text);
     h.text(s.bvh.owner().config());
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
     return s.scene.name + "-" + std::to_string(s.g.width()) + "x" + std::to_string(s.g.height()) + "-" +
-           std::to_string(spp) + "spp-" + kind + "-" + hex;
+           std::to_string(spp) + "spp-" + kind + "-" + h.hex_digest();
 }
 
 halves_reference cached_halves(const scene_setup& s, const std::string& key, std::uint32_t spp,
                                const std::function<image<glm::vec3>(int half)>& render) {
-    const fs::path dir = s.cache_dir;
-    const fs::path file_a = dir / (key + ".a.exr"), file_b = dir / (key + ".b.exr"), meta = dir / (key + ".json");
     halves_reference r;
     r.spp = spp;
-    std::error_code ec;
-    if (fs::exists(file_a, ec) && fs::exists(file_b, ec) && fs::exists(meta, ec)) {
-        try {
-            image<glm::vec3> a = io::read_rgb(file_a), b = io::read_rgb(file_b);
-            if (a.width() == s.g.width() && a.height() == s.g.height() && b.width() == a.width() &&
-                b.height() == a.height()) {
-                r.a = std::move(a);
-                r.b = std::move(b);
-                r.cached = true;
-            }
-        } catch (const bounce::error&) {
-            // An unreadable entry is computed again.
-        }
-    }
-    if (!r.cached) {
+    if (auto images = load_image_entry(s.cache_dir, key, {".a.exr", ".b.exr"}, s.g.width(), s.g.height())) {
+        r.a = std::move((*images)[0]);
+        r.b = std::move((*images)[1]);
+        r.cached = true;
+    } else {
         const auto t0 = std::chrono::steady_clock::now();
         r.a = render(0);
         r.b = render(1);
         r.ms = ms_since(t0);
-        fs::create_directories(dir);
-        // Temporary names renamed, so that a reader never sees half an entry.
-        const fs::path tmp_a = dir / (key + ".a.tmp.exr"), tmp_b = dir / (key + ".b.tmp.exr");
-        io::write_exr(tmp_a, r.a.view());
-        io::write_exr(tmp_b, r.b.view());
-        io::write_text_file(dir / (key + ".json.tmp"),
-                            ojson{{"key", key}, {"spp", spp}, {"ms", r.ms}, {"halves", 2}}.dump(2) + "\n");
-        fs::rename(tmp_a, file_a);
-        fs::rename(tmp_b, file_b);
-        fs::rename(dir / (key + ".json.tmp"), meta);
+        store_image_entry(s.cache_dir, key, {{".a.exr", &r.a}, {".b.exr", &r.b}},
+                          ojson{{"key", key}, {"spp", spp}, {"ms", r.ms}, {"halves", 2}}.dump(2) + "\n");
     }
     r.mean = mean_of(r.a, r.b);
     r.noise_rel_rms = noise_of(r, s.mask);

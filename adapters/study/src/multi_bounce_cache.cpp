@@ -24,10 +24,8 @@ std::string multi_bounce_cache_key(const io::scene& scene, const bounce::camera&
     hash.value(settings.area_samples);
     hash.value(settings.seed);
     hash.text(device_config);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash.digest()));
     return scene.name + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" + std::to_string(settings.paths) +
-           "paths-multibounce-" + hex;
+           "paths-multibounce-" + hash.hex_digest();
 }
 
 std::optional<embree::multi_bounce_image> load_multi_bounce(const std::filesystem::path& dir, const std::string& key,

@@ -2,6 +2,7 @@
 #include <bounce/study/reference_cache.hpp>
 
 #include <bounce/study/content_hash.hpp>
+#include <bounce/study/image_entry.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
@@ -41,24 +42,6 @@ std::string safe_name(const std::string& name) {
 
 nlohmann::json json_of(const glm::vec3& v) { return {v.x, v.y, v.z}; }
 
-std::filesystem::path entry(const std::filesystem::path& dir, const std::string& key, const char* suffix) {
-    return dir / (key + suffix);
-}
-
-// Writes through a temporary name in the same directory, then renames (atomic on POSIX).
-template <class Write>
-void write_atomically(const std::filesystem::path& final_path, const char* extension, Write write) {
-    const auto tmp = final_path.parent_path() /
-                     (final_path.filename().string() + ".tmp" + std::to_string(::getpid()) + extension);
-    write(tmp);
-    std::error_code ec;
-    std::filesystem::rename(tmp, final_path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw bounce::error("bounce::study: cannot move " + tmp.string() + " to " + final_path.string());
-    }
-}
-
 // The key of a reference render: "<scene>-<W>x<H>-<S>spp-<kind><16 hex digits>", hashing
 // `tag` (when not empty), the integrator's version, the scene's view and the settings.
 std::string settings_key(std::string_view tag, std::string_view kind, const io::scene& scene, const bounce::camera& cam,
@@ -75,43 +58,8 @@ std::string settings_key(std::string_view tag, std::string_view kind, const io::
     h.value(settings.ray_epsilon);
     h.value(settings.seed);
     if (!device_config.empty()) h.text(device_config);  // Embree's default: the keys of earlier versions
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.digest()));
     return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
-           std::to_string(settings.hemisphere_samples) + "spp-" + std::string(kind) + hex;
-}
-
-// The entry's images `<key><suffix>` for each suffix, or nothing when one is missing,
-// unreadable or not `width` x `height` (the caller then recomputes and overwrites).
-std::optional<std::vector<image<glm::vec3>>> load_entry(const std::filesystem::path& dir, const std::string& key,
-                                                        std::initializer_list<const char*> suffixes,
-                                                        std::size_t width, std::size_t height) {
-    std::vector<image<glm::vec3>> images;
-    std::error_code ec;
-    for (const char* suffix : suffixes) {
-        const auto file = entry(dir, key, suffix);
-        if (!std::filesystem::exists(file, ec)) return std::nullopt;
-        try {
-            images.push_back(io::read_rgb(file));
-        } catch (const bounce::error&) {
-            return std::nullopt;  // unreadable or truncated
-        }
-        if (images.back().width() != width || images.back().height() != height) return std::nullopt;
-    }
-    return images;
-}
-
-// Writes the entry's images and its JSON description, each atomically.
-void store_entry(const std::filesystem::path& dir, const std::string& key,
-                 std::initializer_list<std::pair<const char*, const image<glm::vec3>*>> images,
-                 const nlohmann::json& description) {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw bounce::error("bounce::study: cannot create the cache directory " + dir.string() + ": " + ec.message());
-    for (const auto& [suffix, img] : images)
-        write_atomically(entry(dir, key, suffix), ".exr", [&](const std::filesystem::path& p) { io::write_exr(p, img->view()); });
-    write_atomically(entry(dir, key, ".json"), ".json",
-                     [&](const std::filesystem::path& p) { io::write_text_file(p, description.dump(2) + '\n'); });
+           std::to_string(settings.hemisphere_samples) + "spp-" + std::string(kind) + h.hex_digest();
 }
 
 // What every entry's JSON says of its source: the scene, the view and the settings.
@@ -232,7 +180,7 @@ std::string reference_cache_key(const io::scene& scene, const bounce::camera& ca
 std::optional<reference_images> load_cached_reference(const std::filesystem::path& dir, const std::string& key,
                                                       std::size_t width, std::size_t height,
                                                       const reference_settings& settings) {
-    auto images = load_entry(dir, key, {".direct.exr", ".indirect.exr"}, width, height);
+    auto images = load_image_entry(dir, key, {".direct.exr", ".indirect.exr"}, width, height);
     if (!images) return std::nullopt;
     reference_images r;
     r.direct = std::move((*images)[0]);
@@ -245,9 +193,10 @@ std::optional<reference_images> load_cached_reference(const std::filesystem::pat
 void store_cached_reference(const std::filesystem::path& dir, const std::string& key, const reference_images& images,
                             const io::scene& scene, const bounce::camera& cam, const reference_settings& settings,
                             std::string_view device_config) {
-    store_entry(dir, key, {{".direct.exr", &images.direct}, {".indirect.exr", &images.indirect}},
-                describe(key, scene, cam, images.direct.width(), images.direct.height(), images.grid, settings,
-                         device_config));
+    store_image_entry(dir, key, {{".direct.exr", &images.direct}, {".indirect.exr", &images.indirect}},
+                      describe(key, scene, cam, images.direct.width(), images.direct.height(), images.grid, settings,
+                               device_config)
+                              .dump(2) + '\n');
 }
 
 reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
@@ -307,7 +256,7 @@ std::string reference_halves_cache_key(const io::scene& scene, const bounce::cam
 std::optional<reference_halves> load_cached_reference_halves(const std::filesystem::path& dir, const std::string& key,
                                                              std::size_t width, std::size_t height,
                                                              const reference_settings& settings) {
-    auto images = load_entry(dir, key, {".direct.exr", ".indirect-a.exr", ".indirect-b.exr"}, width, height);
+    auto images = load_image_entry(dir, key, {".direct.exr", ".indirect-a.exr", ".indirect-b.exr"}, width, height);
     if (!images) return std::nullopt;
     reference_halves h;
     h.whole.direct = std::move((*images)[0]);
@@ -327,11 +276,11 @@ void store_cached_reference_halves(const std::filesystem::path& dir, const std::
     d["kind"] = "halves: indirect = (indirect-a + indirect-b) / 2, direct computed with half a's seed";
     d["half_samples"] = settings.hemisphere_samples / 2;
     d["half_seeds"] = {half_seed(settings.seed, 0), half_seed(settings.seed, 1)};
-    store_entry(dir, key,
-                {{".direct.exr", &halves.whole.direct},
-                 {".indirect-a.exr", &halves.indirect_a},
-                 {".indirect-b.exr", &halves.indirect_b}},
-                d);
+    store_image_entry(dir, key,
+                      {{".direct.exr", &halves.whole.direct},
+                       {".indirect-a.exr", &halves.indirect_a},
+                       {".indirect-b.exr", &halves.indirect_b}},
+                      d.dump(2) + '\n');
 }
 
 reference_halves render_reference_halves(const accel& bvh, const scene_view& scene, const gbuffer_view<float>& g,

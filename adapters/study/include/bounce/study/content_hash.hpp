@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <type_traits>
 
@@ -32,6 +33,13 @@ public:
         bytes(s.data(), s.size());
     }
     std::uint64_t digest() const noexcept { return h_; }
+    /// digest() as 16 lower-case hex digits, the tail of every cache key.
+    std::string hex_digest() const {
+        static constexpr char digits[] = "0123456789abcdef";
+        std::string out(16, '0');
+        for (int i = 0; i < 16; ++i) out[std::size_t(15 - i)] = digits[(h_ >> (4 * i)) & 0xf];
+        return out;
+    }
 
 private:
     std::uint64_t h_ = offset_basis;
