@@ -4,8 +4,8 @@
 // program's main.cpp runs and reports).
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/errors.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

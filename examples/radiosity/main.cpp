@@ -2,7 +2,7 @@
 // textures as Coombe and Harris 2005, GPU Gems 2 ch. 39) through the library's solvers
 // (cpu::progressive_radiosity with the stereographic or hemicube item buffer or Embree ray
 // casts, or gl::progressive_radiosity), compared with the multi-bounce path-traced reference.
-// The solve, its checkpoints and its time limit are the library's (radiosity_solve.hpp);
+// The solve, its checkpoints and its time limit are the library's (radiosity/solve.hpp);
 // this program parses, checks, calls and reports.
 //
 //   build/bin/radiosity --scene cornell --elements 10000 --visibility stereo --adaptive off

@@ -4,10 +4,10 @@
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/errors.hpp>
-#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/luminance.hpp>
-#include <bounce/radiosity_options.hpp>
-#include <bounce/radiosity_subdivision.hpp>
+#include <bounce/radiosity/options.hpp>
+#include <bounce/radiosity/subdivision.hpp>
 
 #ifdef BOUNCE_RADIOSITY_WITH_GL
 #include <bounce/gl/radiosity.hpp>
@@ -114,7 +114,7 @@ inline atlas_options atlas_options_for(const options& o) {
     return a;
 }
 
-// The shooting options, the same for both backends (include/bounce/radiosity_options.hpp).
+// The shooting options, the same for both backends (include/bounce/radiosity/options.hpp).
 inline radiosity_options solver_options_for(const options& o) {
     radiosity_options r;
     r.shoot_blocks = o.block > 1;

@@ -1,7 +1,7 @@
 #pragma once
 // What one radiosity solve gives the report, and its JSON beside study::run_report's fields.
 #include <bounce/image.hpp>
-#include <bounce/radiosity_solve.hpp>
+#include <bounce/radiosity/solve.hpp>
 
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>

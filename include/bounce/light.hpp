@@ -2,7 +2,7 @@
 /// \file light.hpp
 /// The light sources a scene may hold (point, spot, directional), their validation, and the
 /// one packed form both GPU buffers and CPU loops read. Area lights are emissive triangles of
-/// the mesh (scene_view.hpp). The irradiance each delivers is in lights.hpp.
+/// the mesh (scene_view.hpp). The irradiance each delivers is in direct_light.hpp.
 ///
 /// A renderer builds these from its own light list and hands bounce a span of them; nothing
 /// here allocates or loads files.

@@ -2,8 +2,8 @@
 // The half-lit ceiling of test_irradiance_gradients.cpp seen by a plane camera, and rigorous
 // bounds on the error of point-sampled plane estimates of it (shared by tests/core and
 // tests/hemisphere).
-#include <bounce/plane_camera.hpp>
-#include <bounce/plane_weights.hpp>
+#include <bounce/cache/plane_camera.hpp>
+#include <bounce/cache/plane_weights.hpp>
 #include <bounce/rectangle_solid_angle.hpp>
 
 #include <cmath>
@@ -67,7 +67,7 @@ inline error_bound mixed_cells(const plane_camera& cam, const half_lit_ceiling& 
                 const bool band_mixed = v != side(q1.x, q1.y) || v != at_infinity(q0.x, q0.y) ||
                                         v != at_infinity(q1.x, q1.y);
                 if (!(band_mixed || mixed)) continue;
-                // The band on the side plane: [s0/a, s1/a] x [0, 1/a] (plane_weights.hpp).
+                // The band on the side plane: [s0/a, s1/a] x [0, 1/a] (cache/plane_weights.hpp).
                 const bool vertical = q0.x == q1.x;
                 const double s0 = vertical ? q0.y : q0.x, s1 = vertical ? q1.y : q1.x;
                 // Its cosine weight is the moment along the side plane's v = z / x axis.

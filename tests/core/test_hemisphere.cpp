@@ -1,5 +1,5 @@
-// Single-plane hemisphere sampling (bounce/rectangle_solid_angle.hpp, plane_pixel.hpp,
-// plane_camera.hpp, plane_weights.hpp, radial_profile.hpp, cpu/plane_estimate.hpp): the
+// Single-plane hemisphere sampling (bounce/rectangle_solid_angle.hpp, cache/plane_pixel.hpp,
+// cache/plane_camera.hpp, cache/plane_weights.hpp, cache/radial_profile.hpp, cpu/plane_estimate.hpp): the
 // rectangle closed forms against quadrature, the three weight tables' totals against
 // closed forms, exact answers for uniform and half-space environments, and irradiance,
 // gradients and harmonic mean distance of a half-lit ceiling against the closed forms of
@@ -8,10 +8,10 @@
 
 #include <bounce/cpu/plane_estimate.hpp>
 #include <bounce/luminance.hpp>
-#include <bounce/plane_camera.hpp>
-#include <bounce/plane_pixel.hpp>
-#include <bounce/plane_weights.hpp>
-#include <bounce/radial_profile.hpp>
+#include <bounce/cache/plane_camera.hpp>
+#include <bounce/cache/plane_pixel.hpp>
+#include <bounce/cache/plane_weights.hpp>
+#include <bounce/cache/radial_profile.hpp>
 #include <bounce/rectangle_solid_angle.hpp>
 #include <bounce/sampling.hpp>
 

@@ -5,7 +5,7 @@
 //   grad_r          = int L (n x w) dw = (0, (pi L0 / 2) h / sqrt(x0^2 + h^2), 0)
 // (derivations in docs/irradiance-splatting.md). The hemisphere is rotated about z by a
 // random angle so the edge does not line up with the strata.
-#include <bounce/irradiance_gradients.hpp>
+#include <bounce/cache/gradients.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

@@ -4,7 +4,7 @@
 #include "../sh/sphere_quadrature.hpp"
 
 #include <bounce/sampling.hpp>
-#include <bounce/sh_basis.hpp>
+#include <bounce/sh/basis.hpp>
 
 #include <catch2/catch.hpp>
 #include <glm/glm.hpp>

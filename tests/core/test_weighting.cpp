@@ -1,8 +1,8 @@
 // Properties of the weighting policies and of record extrapolation, on random and
 // adversarial inputs: the singular point, n.nk above 1, grazing normals, the zone border.
-#include <bounce/irradiance_record.hpp>
+#include <bounce/cache/record.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <catch2/catch.hpp>
 #include <glm/glm.hpp>

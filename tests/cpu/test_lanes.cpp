@@ -25,7 +25,7 @@ glm::vec3 unit(pcg32& rng) {
     return rng.next_u32() & 1 ? h : -h;
 }
 
-// One lane's inputs: random, or one of the hard cases of weighting.hpp.
+// One lane's inputs: random, or one of the hard cases of cache/weighting.hpp.
 struct lane_input {
     glm::vec3 p, n, albedo, pk, nk, e, rot[3], tr[3];
     float inv_r;

@@ -6,7 +6,7 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/sampling.hpp>
 
 #include "hand_built_scenes.hpp"

@@ -1,6 +1,6 @@
-// Properties of the direct-light kernels of bounce/lights.hpp: each against its closed form
+// Properties of the direct-light kernels of bounce/direct_light.hpp: each against its closed form
 // in double, on random and adversarial inputs, in float and double instantiations.
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/sampling.hpp>
 
 #include "hand_built_scenes.hpp"

@@ -19,7 +19,7 @@
 
 #include <bounce/gl/kernel_map.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/sh_basis.hpp>
+#include <bounce/sh/basis.hpp>
 #include <bounce/surface.hpp>
 
 #include <catch2/catch.hpp>

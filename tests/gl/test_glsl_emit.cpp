@@ -3,7 +3,7 @@
 // signatures read off the kernel's types, and names checked.
 #include <bounce/glsl/emit.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/sh_basis.hpp>
+#include <bounce/sh/basis.hpp>
 #include <bounce/surface.hpp>
 
 #include <catch2/catch.hpp>

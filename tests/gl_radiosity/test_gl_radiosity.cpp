@@ -7,7 +7,7 @@
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/gl/radiosity.hpp>
-#include <bounce/radiosity_subdivision.hpp>
+#include <bounce/radiosity/subdivision.hpp>
 
 #include <catch2/catch.hpp>
 #include <epoxy/gl.h>  // GL entry points from whatever context is current (EGL, GLX, WGL)

@@ -1,4 +1,4 @@
-// The GL radiosity passes' own kernels (include/bounce/radiosity.hpp), printed as GLSL and run on
+// The GL radiosity passes' own kernels (include/bounce/radiosity/kernels.hpp), printed as GLSL and run on
 // llvmpipe, against their CPU float instantiation over random and hard inputs.
 //
 // Tolerance: item_plane_depth is d / (n . w), n . w off by a few ulps of 1: 1e-5 of its value
@@ -10,7 +10,7 @@
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/kernel_map.hpp>
-#include <bounce/radiosity.hpp>
+#include <bounce/radiosity/kernels.hpp>
 
 #include <catch2/catch.hpp>
 

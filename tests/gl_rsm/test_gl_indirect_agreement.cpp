@@ -223,7 +223,7 @@ TEST_CASE("the GL renderer splats the core's VPLs (select_vpls), dealt and weigh
         o.selection = selection;
         gl::indirect_renderer r(o);
         const indirect_timings t = r.render(gb.textures(), s.cam, maps, out);
-        // The host-side choices are the core's (rsm_sampling.hpp), on the read-back map.
+        // The host-side choices are the core's (indirect/rsm_sampling.hpp), on the read-back map.
         const auto all = select_vpls(views, o);
         const light_groups g = assign_lights(all.size(), 4, light_assignment::interleaved);
         REQUIRE(t.vpls == all.size());

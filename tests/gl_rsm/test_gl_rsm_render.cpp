@@ -8,9 +8,9 @@
 #include <bounce/camera.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/rsm_renderer.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/rectangle_solid_angle.hpp>
-#include <bounce/rsm.hpp>
+#include <bounce/indirect/rsm.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -5,7 +5,7 @@
 // radiance kd / pi * E_perp. Records sit at y = 0 looking up (n = +y).
 #include "../core/half_lit_ceiling.hpp"
 
-#include <bounce/plane_camera.hpp>
+#include <bounce/cache/plane_camera.hpp>
 #include "../owned_scene.hpp"
 
 #include <cmath>

@@ -8,8 +8,8 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/plane_weights.hpp>
-#include <bounce/radial_profile.hpp>
+#include <bounce/cache/plane_weights.hpp>
+#include <bounce/cache/radial_profile.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/study/hemisphere_comparison.hpp>
 

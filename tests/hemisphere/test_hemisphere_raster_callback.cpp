@@ -13,8 +13,8 @@
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/raster_record_sampler.hpp>
 #include <bounce/cpu/plane_estimate.hpp>
-#include <bounce/plane_camera.hpp>
-#include <bounce/plane_weights.hpp>
+#include <bounce/cache/plane_camera.hpp>
+#include <bounce/cache/plane_weights.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

@@ -8,8 +8,8 @@
 #include <bounce/embree/plane_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/cpu/plane_estimate.hpp>
-#include <bounce/plane_camera.hpp>
-#include <bounce/plane_weights.hpp>
+#include <bounce/cache/plane_camera.hpp>
+#include <bounce/cache/plane_weights.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

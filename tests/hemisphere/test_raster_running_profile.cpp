@@ -9,8 +9,8 @@
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/raster_record_sampler.hpp>
-#include <bounce/plane_weights.hpp>
-#include <bounce/radial_profile.hpp>
+#include <bounce/cache/plane_weights.hpp>
+#include <bounce/cache/radial_profile.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

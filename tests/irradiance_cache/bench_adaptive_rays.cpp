@@ -8,7 +8,7 @@
 // Each entry: fixed:RAYS, or adaptive:MIN:MAX:TARGET[:FLOOR]. a = 0.15, smoothed Ward
 // weight, gradients, neighbour clamping, radius in [1.5, 64] pixel footprints: the
 // defaults of ic_splatting. References are kept in the system's temporary folder.
-#include <bounce/adaptive_hemisphere.hpp>
+#include <bounce/cache/adaptive_hemisphere.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
@@ -16,7 +16,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/luminance.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include "../skip.hpp"
 

@@ -1,8 +1,8 @@
-// Adaptive rays per record (bounce/adaptive_hemisphere.hpp, embree::record_sampler with
+// Adaptive rays per record (bounce/cache/adaptive_hemisphere.hpp, embree::record_sampler with
 // adaptive_rays): the variance estimator against the spread of the estimate over seeds, the
 // stopping rule on easy and hard hemispheres, the adaptive estimate's mean against the exact
 // irradiance, and refusal of bad settings.
-#include <bounce/adaptive_hemisphere.hpp>
+#include <bounce/cache/adaptive_hemisphere.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>

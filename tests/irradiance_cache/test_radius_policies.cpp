@@ -8,7 +8,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <catch2/catch.hpp>
 

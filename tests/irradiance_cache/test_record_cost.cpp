@@ -8,13 +8,13 @@
 //    against the same records computed the plain way from the integrator's public calls,
 //    bit for bit, serially and on every core;
 //  - bad input still refused, naming the parameter.
-#include <bounce/adaptive_hemisphere.hpp>
+#include <bounce/cache/adaptive_hemisphere.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
-#include <bounce/irradiance_gradients.hpp>
-#include <bounce/irradiance_record.hpp>
+#include <bounce/cache/gradients.hpp>
+#include <bounce/cache/record.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

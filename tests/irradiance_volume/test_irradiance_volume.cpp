@@ -1,10 +1,10 @@
-// Irradiance volumes (irradiance_volume.hpp): the octree's invariants, the exact
+// Irradiance volumes (volume/probe_octree.hpp): the octree's invariants, the exact
 // triangle-box test against a brute-force clipper, trilinear and gradient-extrapolated
 // lookups on linear fields (exact up to float rounding), continuity of the weighted lookup
 // across a subdivision boundary, skipped inside probes and bad input.
 #include "../owned_scene.hpp"
 
-#include <bounce/irradiance_volume.hpp>
+#include <bounce/volume/probe_octree.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

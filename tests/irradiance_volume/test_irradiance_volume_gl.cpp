@@ -1,6 +1,6 @@
 // The GPU lookups of an irradiance volume (gl/irradiance_volume.hpp: the kernels of
-// irradiance_volume_kernels.hpp emitted to GLSL, run by a compute pass on llvmpipe in CI)
-// agree with the CPU's (irradiance_volume.hpp) on an adaptive octree with gradients and
+// volume/kernels.hpp emitted to GLSL, run by a compute pass on llvmpipe in CI)
+// agree with the CPU's (volume/probe_octree.hpp) on an adaptive octree with gradients and
 // inside probes.
 //
 // Tolerance 1e-5 relative to the largest irradiance of the volume: both sides add the same
@@ -14,7 +14,7 @@
 #include "../owned_scene.hpp"
 
 #include <bounce/gl/irradiance_volume.hpp>
-#include <bounce/irradiance_volume.hpp>
+#include <bounce/volume/probe_octree.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

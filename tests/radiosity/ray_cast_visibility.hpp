@@ -4,7 +4,7 @@
 #include "radiosity_scenes.hpp"
 
 #include <bounce/cpu/radiosity_item_buffer.hpp>
-#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
 
 #include <limits>
 #include <optional>

@@ -4,8 +4,8 @@
 #include "ray_cast_visibility.hpp"
 
 #include <bounce/cpu/radiosity_item_buffer.hpp>
-#include <bounce/lightmap_atlas.hpp>
-#include <bounce/radiosity.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/kernels.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

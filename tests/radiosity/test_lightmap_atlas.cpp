@@ -1,7 +1,7 @@
 // The lightmap atlas: charts, exact element areas, layout without bleeding, blocks.
 #include "radiosity_scenes.hpp"
 
-#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -175,7 +175,7 @@ TEST_CASE("absorbed + unshot + escaped power equals emitted power after every st
 TEST_CASE("a point light gives each element rho times the inverse-square cosine law", "[radiosity][solver][lights]") {
     // One floor quad under a point light, nothing else: after the light's shot (in the
     // constructor) each element's radiosity is rho I cos / d^2 at its centroid, as the kernel
-    // of lights.hpp gives it; the item buffer sees every element of an unoccluded floor.
+    // of direct_light.hpp gives it; the item buffer sees every element of an unoccluded floor.
     owned_scene s;
     s.use_emission = false;
     const auto m = s.add_material(glm::vec3(0.5f, 0.25f, 1.f));

@@ -8,7 +8,7 @@
 #include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
-#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

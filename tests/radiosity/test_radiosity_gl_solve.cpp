@@ -1,11 +1,11 @@
-// The GL solver runs the same solve as the CPU solver (radiosity_solve.hpp): the same stop,
+// The GL solver runs the same solve as the CPU solver (radiosity/solve.hpp): the same stop,
 // the same steps, the same checks (reversed winding, the tolerance floor). llvmpipe via EGL.
 #include "../gl/shared_context.hpp"
 #include "radiosity_scenes.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/gl/radiosity.hpp>
-#include <bounce/radiosity_solve.hpp>
+#include <bounce/radiosity/solve.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -15,8 +15,8 @@
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/kernel_map.hpp>
-#include <bounce/radiosity.hpp>
-#include <bounce/radiosity_subdivision.hpp>
+#include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/subdivision.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

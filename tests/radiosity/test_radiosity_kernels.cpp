@@ -1,5 +1,5 @@
-// Properties of the radiosity kernels (include/bounce/radiosity.hpp) against closed forms.
-#include <bounce/radiosity.hpp>
+// Properties of the radiosity kernels (include/bounce/radiosity/kernels.hpp) against closed forms.
+#include <bounce/radiosity/kernels.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

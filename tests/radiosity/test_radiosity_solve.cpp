@@ -1,4 +1,4 @@
-// The solve of radiosity_solve.hpp (what cpu::progressive_radiosity::solve and the GL
+// The solve of radiosity/solve.hpp (what cpu::progressive_radiosity::solve and the GL
 // solver's run): where it stops, its checkpoints and paused clock, its time limit; and what
 // it refuses to do silently: create energy, or give a black answer for a scene whose
 // surfaces face away from its lights (reversed winding). Also the tolerance floor of the
@@ -6,7 +6,7 @@
 #include "radiosity_scenes.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
-#include <bounce/radiosity_solve.hpp>
+#include <bounce/radiosity/solve.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -3,7 +3,7 @@
 #include "radiosity_scenes.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
-#include <bounce/radiosity_subdivision.hpp>
+#include <bounce/radiosity/subdivision.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -7,7 +7,7 @@
 // of the patterns.
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <cmath>
 #include <limits>

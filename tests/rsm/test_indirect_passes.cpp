@@ -1,13 +1,13 @@
 // The CPU passes and cpu::indirect_renderer: energy-correct interleaving (the expectation
 // over relabellings of the sub-buffers is the non-interleaved value, the thesis's Section
 // 5.2 loss avoided), thread-count independence, the splat cutoff's bound, the blur and
-// upsampling at discontinuities, the core's splat rectangles (rsm_sampling.hpp) against
+// upsampling at discontinuities, the core's splat rectangles (indirect/rsm_sampling.hpp) against
 // cpu::splat_rect, and bad input.
 #include "corner_scene.hpp"
 
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/cpu/splatting.hpp>
-#include <bounce/rsm_sampling.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -296,7 +296,7 @@ TEST_CASE("the SII splat bounds cut off at most the cutoff at any pixel", "[indi
 
 TEST_CASE("the core's sphere rectangle rounds as cpu::splat_rect, and split rectangles hold the sub-buffer's pixels",
           "[indirect]") {
-    // rsm_sampling.hpp's sphere_pixel_rect is what both RSM backends splat over; the
+    // indirect/rsm_sampling.hpp's sphere_pixel_rect is what both RSM backends splat over; the
     // irradiance splatting's cpu::splat_rect (cpu/splatting.hpp) rounds the same way.
     const corner_scene s(61, 47);
     const glm::mat4 view = s.cam.view_matrix();

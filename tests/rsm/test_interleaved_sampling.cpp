@@ -1,7 +1,7 @@
 // Properties of the interleave index maps, the light assignment and the geometry-aware
-// tent (include/bounce/interleaved_sampling.hpp, adapters/cpu/.../interleave.hpp).
+// tent (include/bounce/indirect/interleaved_sampling.hpp, adapters/cpu/.../interleave.hpp).
 #include <bounce/cpu/interleave.hpp>
-#include <bounce/interleaved_sampling.hpp>
+#include <bounce/indirect/interleaved_sampling.hpp>
 
 #include <catch2/catch.hpp>
 

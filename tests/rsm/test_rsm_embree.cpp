@@ -7,7 +7,7 @@
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
 #include <bounce/errors.hpp>
-#include <bounce/rsm.hpp>
+#include <bounce/indirect/rsm.hpp>
 
 #include "../embree/hand_built_scenes.hpp"
 

@@ -10,14 +10,14 @@
 // output's terms: Phi / (pi max(d^2, d_min^2)) for the pixel-light irradiance (the value with
 // both cosines 1), the largest input for the tent, 1 for weights and cosines. 1e-5 is
 // 2 k ulp (ulp = 1.2e-7) for k up to 40 operations, more than any kernel here has.
-// Index maps are integers and must agree exactly (interleaved_sampling.hpp: exact for
+// Index maps are integers and must agree exactly (indirect/interleaved_sampling.hpp: exact for
 // sizes below 2^14 and patterns up to 64 wide).
 #include "../gl/agreement_inputs.hpp"
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/kernel_map.hpp>
-#include <bounce/interleaved_sampling.hpp>
-#include <bounce/rsm.hpp>
+#include <bounce/indirect/interleaved_sampling.hpp>
+#include <bounce/indirect/rsm.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>

@@ -1,9 +1,9 @@
-// The RSM kernels (include/bounce/rsm.hpp): convergence of the pixel-light sum to the
+// The RSM kernels (include/bounce/indirect/rsm.hpp): convergence of the pixel-light sum to the
 // closed-form one-bounce irradiance, the texel fluxes, the disc pattern's weights, and the
 // numerical hard cases (coincident, grazing, behind, shared boundary, float accumulation);
-// the map layouts of rsm_layout.hpp.
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_layout.hpp>
+// the map layouts of indirect/rsm_layout.hpp.
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -283,7 +283,7 @@ TEST_CASE("the sum over a spot light's RSM converges to the closed-form irradian
     }
 }
 
-// ---- map layouts (include/bounce/rsm_layout.hpp) ----------------------------------------
+// ---- map layouts (include/bounce/indirect/rsm_layout.hpp) ----------------------------------------
 
 TEST_CASE("rsm_layout: six faces per point light, one map or the reachable faces per spot, one "
           "orthographic map per distant light",

@@ -1,6 +1,6 @@
-// VPL selection from an RSM (include/bounce/vpl_sampling.hpp): hierarchical warping reaches
+// VPL selection from an RSM (include/bounce/indirect/vpl_sampling.hpp): hierarchical warping reaches
 // each texel with probability importance / total, and the VPL fluxes keep the total.
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <catch2/catch.hpp>
 

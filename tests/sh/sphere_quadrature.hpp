@@ -1,9 +1,9 @@
 #pragma once
-// Test helpers of the SH tests: the library's sphere quadrature (bounce/sh_quadrature.hpp:
+// Test helpers of the SH tests: the library's sphere quadrature (bounce/sh/quadrature.hpp:
 // Gauss-Legendre in z times the trapezoid rule in phi, exact for products of SH of bands
 // < min(nz, nphi / 2)), random test directions and rotations.
 #include <bounce/sampling.hpp>
-#include <bounce/sh_quadrature.hpp>
+#include <bounce/sh/quadrature.hpp>
 
 #include <glm/glm.hpp>
 
@@ -13,7 +13,7 @@
 
 namespace bounce::sh_test {
 
-// The library's quadrature (bounce/sh_quadrature.hpp) under the names the tests use.
+// The library's quadrature (bounce/sh/quadrature.hpp) under the names the tests use.
 using quadrature_point = bounce::sphere_quadrature_point;
 using bounce::gauss_legendre;
 using bounce::sphere_quadrature;

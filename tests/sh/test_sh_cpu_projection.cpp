@@ -4,8 +4,8 @@
 #include "sphere_quadrature.hpp"
 
 #include <bounce/cpu/sh_projection.hpp>
-#include <bounce/sh_irradiance.hpp>
-#include <bounce/sh_projection.hpp>
+#include <bounce/sh/irradiance.hpp>
+#include <bounce/sh/projection.hpp>
 
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>

@@ -13,8 +13,8 @@
 
 #include <bounce/gl/kernel_map.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/sh_gradients.hpp>
-#include <bounce/sh_irradiance.hpp>
+#include <bounce/sh/gradients.hpp>
+#include <bounce/sh/irradiance.hpp>
 
 #include <catch2/catch.hpp>
 

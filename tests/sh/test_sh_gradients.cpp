@@ -2,8 +2,8 @@
 // extrapolation I'_i = I_i + grad I_i . d: exact for fields up to quadratic, the known
 // h^2 / 6 error on a cubic, the probe callback's calls, bad steps.
 #include <bounce/errors.hpp>
-#include <bounce/sh_gradients.hpp>
-#include <bounce/sh_lights.hpp>
+#include <bounce/sh/gradients.hpp>
+#include <bounce/sh/lights.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -4,8 +4,8 @@
 // directional light.
 #include "sphere_quadrature.hpp"
 
-#include <bounce/sh_irradiance.hpp>
-#include <bounce/sh_lights.hpp>
+#include <bounce/sh/irradiance.hpp>
+#include <bounce/sh/lights.hpp>
 
 #include <catch2/catch.hpp>
 

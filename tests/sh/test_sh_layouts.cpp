@@ -2,7 +2,7 @@
 // SphericalHarmonics3 uses, channel-major round trips.
 #include "sphere_quadrature.hpp"
 
-#include <bounce/sh_layouts.hpp>
+#include <bounce/sh/layouts.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -4,10 +4,10 @@
 // normal equations, and bad input.
 #include "sphere_quadrature.hpp"
 
-#include <bounce/sh_irradiance.hpp>
-#include <bounce/sh_lights.hpp>
-#include <bounce/sh_projection.hpp>
-#include <bounce/sh_windowing.hpp>
+#include <bounce/sh/irradiance.hpp>
+#include <bounce/sh/lights.hpp>
+#include <bounce/sh/projection.hpp>
+#include <bounce/sh/windowing.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -1,8 +1,8 @@
-// The library's quadrature (bounce/sh_quadrature.hpp): Gauss-Legendre exact to degree
+// The library's quadrature (bounce/sh/quadrature.hpp): Gauss-Legendre exact to degree
 // 2n - 1 and not beyond, the sphere rule's weights and its exactness on SH products up to
 // its bands, bad sizes refused.
-#include <bounce/sh_basis.hpp>
-#include <bounce/sh_quadrature.hpp>
+#include <bounce/sh/basis.hpp>
+#include <bounce/sh/quadrature.hpp>
 
 #include <catch2/catch.hpp>
 

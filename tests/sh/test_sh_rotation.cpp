@@ -4,8 +4,8 @@
 #include "sphere_quadrature.hpp"
 
 #include <bounce/errors.hpp>
-#include <bounce/sh_lights.hpp>
-#include <bounce/sh_rotation.hpp>
+#include <bounce/sh/lights.hpp>
+#include <bounce/sh/rotation.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -3,9 +3,9 @@
 // unwindowed and not after the widest non-negative window.
 #include "sphere_quadrature.hpp"
 
-#include <bounce/sh_irradiance.hpp>
-#include <bounce/sh_lights.hpp>
-#include <bounce/sh_windowing.hpp>
+#include <bounce/sh/irradiance.hpp>
+#include <bounce/sh/lights.hpp>
+#include <bounce/sh/windowing.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -1,7 +1,7 @@
 #include <bounce/embree/probe_baker.hpp>
 
-#include <bounce/sh_gradients.hpp>
-#include <bounce/sh_projection.hpp>
+#include <bounce/sh/gradients.hpp>
+#include <bounce/sh/projection.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -2,7 +2,7 @@
 // stratified cosine-weighted Monte Carlo (Ward and Heckbert 1992), per-pixel images.
 #include <bounce/embree/reference.hpp>
 
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/sampling.hpp>
 
 #include <algorithm>

@@ -3,8 +3,8 @@
 #include <bounce/embree/rsm_ray_cast.hpp>
 
 #include <bounce/camera.hpp>
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_layout.hpp>
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_layout.hpp>
 
 #include <array>
 #include <cmath>

@@ -4,7 +4,7 @@
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
 
 #include <bounce/embree/reference.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/sampling.hpp>
 

@@ -1,10 +1,10 @@
 // Shadow-mapped direct lighting: depth maps rendered from each light with a slope-scaled
 // bias, looked up with a normal offset and 16 hardware-compared PCF taps. The light models
-// (lights.hpp) and the lookup arithmetic (shadow_mapping.hpp) are emitted kernels; the
+// (direct_light.hpp) and the lookup arithmetic (shadow_mapping.hpp) are emitted kernels; the
 // GLSL written here only declares uniforms, transforms by matrices, fetches and loops.
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/glsl/emit.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/shadow_mapping.hpp>
 
 #include "saved_state.hpp"

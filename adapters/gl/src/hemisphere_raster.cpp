@@ -2,11 +2,11 @@
 // batch (or by the caller's callback, once per record), read back through pixel buffer
 // objects, or reduced by a compute shader. The
 // shaders are plumbing; the per-texel maths are emitted kernels (surface.hpp's
-// facing_normal, lights.hpp's lambertian_radiance, plane_pixel.hpp's plane_hit_distance and
+// facing_normal, direct_light.hpp's lambertian_radiance, cache/plane_pixel.hpp's plane_hit_distance and
 // plane_pixel_terms) and gl::direct_light's direct_irradiance.
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/glsl/emit.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/surface.hpp>
 

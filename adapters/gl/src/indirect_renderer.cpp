@@ -4,11 +4,11 @@
 // additive blending, the discontinuity buffer and the separable geometry-aware tent. The
 // shaders are plumbing (fetches, loops over storage buffers, row flips, writes); the index
 // maps, disc centre, pixel-light irradiance, discontinuity test and tent are the emitted
-// kernels of rsm.hpp and interleaved_sampling.hpp.
+// kernels of indirect/rsm.hpp and indirect/interleaved_sampling.hpp.
 #include <bounce/gl/indirect_renderer.hpp>
 #include <bounce/glsl/emit.hpp>
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_sampling.hpp>
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
 
 #include "indirect_shaders.hpp"
 #include "saved_state.hpp"
@@ -372,7 +372,7 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
             for (const auto& l : all) positions.push_back(l.position);
         const light_groups groups =
             assign_lights(all.size(), pattern.cells(), options_.assignment, positions, options_.shift);
-        // Each VPL's rectangle in the split buffer (as cpu::splat_vpls: rsm_sampling.hpp's
+        // Each VPL's rectangle in the split buffer (as cpu::splat_vpls: indirect/rsm_sampling.hpp's
         // vpl_splat_rect and split_buffer_rect), in group order.
         const glm::mat4 view = cam.view_matrix();
         splatted_.clear();

@@ -4,8 +4,8 @@
 #include "indirect_shaders.hpp"
 
 #include <bounce/glsl/emit.hpp>
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_sampling.hpp>
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
 
 namespace bounce::gl::indirect_glsl {
 

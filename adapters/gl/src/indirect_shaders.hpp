@@ -1,6 +1,6 @@
 #pragma once
 // The GLSL texts of gl::indirect_renderer's passes (private to adapters/gl/src): plumbing
-// around the kernels emitted from rsm.hpp and interleaved_sampling.hpp.
+// around the kernels emitted from indirect/rsm.hpp and indirect/interleaved_sampling.hpp.
 #include <string>
 
 namespace bounce::gl::indirect_glsl {

@@ -4,7 +4,7 @@
 
 #include <bounce/gl/errors.hpp>
 #include <bounce/glsl/emit.hpp>
-#include <bounce/irradiance_volume_kernels.hpp>
+#include <bounce/volume/kernels.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // gl::progressive_radiosity: the GL backend of progressive refinement radiosity (Cohen et al.
-// 1988; Coombe and Harris 2005). See radiosity.hpp for the steps and docs/radiosity-gl.md.
+// 1988; Coombe and Harris 2005). See radiosity/kernels.hpp for the steps and docs/radiosity-gl.md.
 #include "radiosity_state.hpp"
 
 namespace bounce::gl {

@@ -71,7 +71,7 @@ void progressive_radiosity::state::draw_item_buffer() {
         const float d = glm::dot(nl, l[0]);
         local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
         const float chart = float(triangle_chart[k]), id = float(k);
-        // The CPU's pieces in the CPU's order (stereographic_tessellation.hpp).
+        // The CPU's pieces in the CPU's order (radiosity/stereographic_tessellation.hpp).
         clip_and_tessellate_stereographic(l, z_min, how, poly, scratch,
                                           [&](const std::array<glm::vec3, 3>& piece, const std::array<glm::vec2, 3>&) {
                                               for (const glm::vec3& v : piece) pieces.push_back({v, chart, id});

@@ -6,11 +6,11 @@
 
 #include <bounce/glsl/emit.hpp>
 #include <bounce/light.hpp>
-#include <bounce/lights.hpp>
-#include <bounce/radiosity.hpp>
-#include <bounce/radiosity_solve.hpp>
+#include <bounce/direct_light.hpp>
+#include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/solve.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/stereographic_tessellation.hpp>
+#include <bounce/radiosity/stereographic_tessellation.hpp>
 
 #include "saved_state.hpp"
 
@@ -121,7 +121,7 @@ inline std::size_t item_rows(const radiosity_options& o) {
     return std::size_t(o.resolution) * (o.visibility == radiosity_visibility::hemicube ? 3 : 1);
 }
 
-// The hemicube faces' (right, up, forward) in the shooter's frame: radiosity.hpp's table.
+// The hemicube faces' (right, up, forward) in the shooter's frame: radiosity/kernels.hpp's table.
 inline std::array<glm::vec3, 3> face_axes(int face) {
     switch (face) {
         case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};

@@ -1,13 +1,13 @@
 // Reflective shadow maps by rasterization (Dachsbacher and Stamminger 2005, section 3.1):
 // one indexed draw of the scene per map into three RGBA32F targets. The shaders are
 // plumbing (transform, interpolate, fetch Kd and the texel's solid angle, write); the
-// facing normal and the reflected flux are the kernels of surface.hpp and rsm.hpp, emitted.
+// facing normal and the reflected flux are the kernels of surface.hpp and indirect/rsm.hpp, emitted.
 #include <bounce/gl/rsm_renderer.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/glsl/emit.hpp>
 #include <bounce/camera.hpp>
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_layout.hpp>
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/surface.hpp>
 
 #include "saved_state.hpp"

@@ -6,7 +6,7 @@
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/study/stage_timer.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/weighting.hpp>
 
 namespace bounce::study::bench {
 

@@ -5,9 +5,9 @@
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/embree/lightmap_view.hpp>
-#include <bounce/lightmap_atlas.hpp>
-#include <bounce/radiosity_options.hpp>
-#include <bounce/radiosity_solve.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/options.hpp>
+#include <bounce/radiosity/solve.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <fmt/core.h>
@@ -44,7 +44,7 @@ technique_run run_radiosity(const scene_setup& s) {
     ro.near_field = 4;
     s.clock.report(name, "lights");
     cpu::progressive_radiosity solver(s.scene, atlas, cpu::item_buffer_visibility(s.scene, atlas, vo), ro);
-    // The library's solve (radiosity_solve.hpp): to the target, within the run's time cap,
+    // The library's solve (radiosity/solve.hpp): to the target, within the run's time cap,
     // refusing energy created or light reaching no surface's front with radiosity_error.
     radiosity_solve_options so;
     so.converge = converge;

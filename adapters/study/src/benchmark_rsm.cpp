@@ -4,7 +4,7 @@
 
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <algorithm>

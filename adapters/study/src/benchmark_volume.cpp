@@ -5,8 +5,8 @@
 #include <bounce/cpu/irradiance_volume.hpp>
 #include <bounce/embree/probe_baker.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/irradiance_volume.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/volume/probe_octree.hpp>
+#include <bounce/direct_light.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <fmt/core.h>

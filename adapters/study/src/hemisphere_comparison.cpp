@@ -5,8 +5,8 @@
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/output_files.hpp>
 #include <bounce/luminance.hpp>
-#include <bounce/plane_weights.hpp>
-#include <bounce/radial_profile.hpp>
+#include <bounce/cache/plane_weights.hpp>
+#include <bounce/cache/radial_profile.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/study/content_hash.hpp>
 #include <bounce/study/image_comparison.hpp>

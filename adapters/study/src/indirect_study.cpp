@@ -3,7 +3,7 @@
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
-#include <bounce/lights.hpp>
+#include <bounce/direct_light.hpp>
 
 #include <fmt/core.h>
 

@@ -3,12 +3,12 @@
 
 #include <bounce/errors.hpp>
 #include <bounce/sampling.hpp>
-#include <bounce/sh_gradients.hpp>
-#include <bounce/sh_irradiance.hpp>
-#include <bounce/sh_lights.hpp>
-#include <bounce/sh_projection.hpp>
-#include <bounce/sh_quadrature.hpp>
-#include <bounce/sh_windowing.hpp>
+#include <bounce/sh/gradients.hpp>
+#include <bounce/sh/irradiance.hpp>
+#include <bounce/sh/lights.hpp>
+#include <bounce/sh/projection.hpp>
+#include <bounce/sh/quadrature.hpp>
+#include <bounce/sh/windowing.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -4,8 +4,8 @@
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/errors.hpp>
 #include <bounce/luminance.hpp>
-#include <bounce/sh_irradiance.hpp>
-#include <bounce/sh_projection.hpp>
+#include <bounce/sh/irradiance.hpp>
+#include <bounce/sh/projection.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <tbb/parallel_for.h>

@@ -1,6 +1,6 @@
 // The core alone: Ward's weight (Gautron 2008, Eq. 8.2) from the installed headers, on plain
 // glm vectors. Exits non-zero if the value is wrong.
-#include <bounce/weighting.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -12,12 +12,12 @@
 /// small one's surroundings with the wrong irradiance (docs/irradiance-splatting.md, "Many
 /// frames").
 
-#include <bounce/cache_frame.hpp>
+#include <bounce/cache/frame.hpp>
 #include <bounce/camera.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/record_sampler.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/record_sampler.hpp>
 
 #include <chrono>
 #include <concepts>

@@ -13,18 +13,18 @@
 /// outgoing radiance is rho_d / pi times it (lambertian_radiance).
 ///
 /// The options and timings (bounce::indirect_options, bounce::indirect_timings in
-/// indirect_options.hpp) and the host-side choices (disc pattern, VPL selection, splat
-/// rectangles in rsm_sampling.hpp) are the core's, shared with gl::indirect_renderer.
+/// indirect/options.hpp) and the host-side choices (disc pattern, VPL selection, splat
+/// rectangles in indirect/rsm_sampling.hpp) are the core's, shared with gl::indirect_renderer.
 
 #include <bounce/camera.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/cpu/sii_splat.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/indirect_options.hpp>
-#include <bounce/interleaved_sampling.hpp>
-#include <bounce/rsm_sampling.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/options.hpp>
+#include <bounce/indirect/interleaved_sampling.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <chrono>
 #include <cmath>

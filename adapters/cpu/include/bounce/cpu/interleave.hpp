@@ -3,15 +3,15 @@
 /// The interleaved-sampling passes on the CPU (Segovia et al. 2006 steps 2, 4, 5 and 6):
 /// split a buffer into the N x M sub-buffers of a pattern, gather it back, build the
 /// discontinuity buffer, and blur with the geometry-aware tent that covers the pattern.
-/// Every index comes from the kernels of interleaved_sampling.hpp, evaluated once per
+/// Every index comes from the kernels of indirect/interleaved_sampling.hpp, evaluated once per
 /// column and once per row (the maps are separable), so a pass is a copy through two small
 /// index tables. Results do not depend on the thread count: each output pixel is written
 /// by one task, from inputs no task writes.
 
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
-#include <bounce/indirect_options.hpp>
-#include <bounce/interleaved_sampling.hpp>
+#include <bounce/indirect/options.hpp>
+#include <bounce/indirect/interleaved_sampling.hpp>
 
 #include <array>
 #include <cstdint>

@@ -28,8 +28,8 @@
 #include <bounce/errors.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/record_sampler.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/record_sampler.hpp>
 
 #include <algorithm>
 #include <chrono>

@@ -2,10 +2,10 @@
 /// \file irradiance_volume.hpp
 /// Lighting many points from an irradiance volume at once: the per-frame call a renderer
 /// makes for the surface points of its moving objects (Oat 2006). Each point's lookup is
-/// independent (irradiance_volume.hpp), so the result does not depend on the thread count.
+/// independent (volume/probe_octree.hpp), so the result does not depend on the thread count.
 
 #include <bounce/errors.hpp>
-#include <bounce/irradiance_volume.hpp>
+#include <bounce/volume/probe_octree.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

@@ -15,7 +15,7 @@
 /// (docs/irradiance-splatting.md shows such a strip and the cost).
 
 #include <bounce/errors.hpp>
-#include <bounce/irradiance_record.hpp>
+#include <bounce/cache/record.hpp>
 
 #include <algorithm>
 #include <array>

@@ -16,8 +16,8 @@
 
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/weighting.hpp>
 #include <bounce/cpu/lanes.hpp>
 #include <bounce/cpu/splatting.hpp>
 

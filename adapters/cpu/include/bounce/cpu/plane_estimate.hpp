@@ -5,10 +5,10 @@
 /// the same kernel, emitted as GLSL, on the GPU.
 
 #include <bounce/errors.hpp>
-#include <bounce/irradiance_gradients.hpp>
-#include <bounce/plane_camera.hpp>
-#include <bounce/plane_pixel.hpp>
-#include <bounce/plane_weights.hpp>
+#include <bounce/cache/gradients.hpp>
+#include <bounce/cache/plane_camera.hpp>
+#include <bounce/cache/plane_pixel.hpp>
+#include <bounce/cache/plane_weights.hpp>
 
 #include <cmath>
 #include <cstddef>

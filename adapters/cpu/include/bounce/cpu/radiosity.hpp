@@ -3,19 +3,19 @@
 /// Progressive refinement radiosity on the CPU (Cohen et al. 1988, on textures as in Coombe
 /// and Harris 2005, GPU Gems 2 ch. 39): `cpu::progressive_radiosity`, the solver a program or
 /// a renderer drives with step() / solve() (a solve to a target with checkpoints, a time limit
-/// and its checks: radiosity_solve.hpp).
+/// and its checks: radiosity/solve.hpp).
 ///
 /// One step: choose the shooter with the largest unshot power (a parallel reduction over the
 /// shooters), prepare visibility from it (the caller's shot_visibility: an item buffer, ray
 /// casts, or all_visible), then add the shot's radiosity to every element in front of it
-/// (the kernel shot_radiosity of radiosity.hpp, the chapter's Listing 39-4) and zero the
+/// (the kernel shot_radiosity of radiosity/kernels.hpp, the chapter's Listing 39-4) and zero the
 /// shooter's unshot radiosity. A shooter is one element or, with substructuring (Cohen et al.
 /// 1986; the chapter's section 39.4), one block of the atlas (block_texels^2 texels of one
 /// chart) shooting its total unshot power from its area-weighted centroid as one disc.
 /// Per shot the work is O(elements) over struct-of-arrays, with nothing stored per pair.
 ///
 /// Lights: the scene's emissive triangles start with unshot radiosity E = pi L_e; point, spot
-/// and directional lights are shot once, first, as direct irradiance (lights.hpp) times
+/// and directional lights are shot once, first, as direct irradiance (direct_light.hpp) times
 /// visibility from the light (two hemispheres for a point light or a spot wider than 90
 /// degrees, parallel rays for a directional light). Their power is counted as what reaches
 /// the elements: emitted power = sum E_i A_i + sum of direct irradiance times area.
@@ -34,12 +34,12 @@
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
 #include <bounce/light.hpp>
-#include <bounce/lightmap_atlas.hpp>
-#include <bounce/lights.hpp>
-#include <bounce/radiosity.hpp>
-#include <bounce/radiosity_options.hpp>
-#include <bounce/radiosity_solve.hpp>
-#include <bounce/radiosity_subdivision.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/direct_light.hpp>
+#include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/options.hpp>
+#include <bounce/radiosity/solve.hpp>
+#include <bounce/radiosity/subdivision.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <algorithm>
@@ -60,7 +60,7 @@
 
 namespace bounce::cpu {
 
-// The options, timings and progress are the core's (radiosity_options.hpp), shared with the
+// The options, timings and progress are the core's (radiosity/options.hpp), shared with the
 // GL solver.
 using bounce::radiosity_options;
 using bounce::radiosity_progress;
@@ -98,7 +98,7 @@ public:
     /// Copies `atlas` (subdivide() refines the copy) and keeps the visibility (moved in);
     /// `scene` is read only here (its lights). Throws parameter_error on bad options or an
     /// atlas not built from `scene`, radiosity_error when the scene's lights reach no
-    /// surface's front side (check_lights_reach_surfaces, radiosity_solve.hpp).
+    /// surface's front side (check_lights_reach_surfaces, radiosity/solve.hpp).
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, Visibility visibility,
                           radiosity_options options = {})
         : atlas_(atlas), visibility_(std::move(visibility)), options_(options) {
@@ -165,7 +165,7 @@ public:
         return solve(o).steps;
     }
 
-    /// The solve of radiosity_solve.hpp: to `options.converge`, within `options.max_seconds`,
+    /// The solve of radiosity/solve.hpp: to `options.converge`, within `options.max_seconds`,
     /// with its progress and checkpoint callbacks (the clock paused during checkpoints).
     /// Throws radiosity_error when energy is created or every shot escapes without reaching
     /// a surface's front side, parameter_error on bad options.
@@ -240,7 +240,7 @@ public:
     const lightmap_atlas& atlas() const noexcept { return atlas_; }
     Visibility& visibility() noexcept { return visibility_; }
 
-    /// Adaptive subdivision (radiosity_subdivision.hpp): splits the leaves whose radiosity
+    /// Adaptive subdivision (radiosity/subdivision.hpp): splits the leaves whose radiosity
     /// fails the test, gives each child element its parent's radiosity and unshot radiosity
     /// (power is unchanged: children's areas add up to their parent's), and rebuilds the
     /// shooters. Point, spot and directional lights are then evaluated again at the children
@@ -462,7 +462,7 @@ private:
     }
 
     // Direct light from one point, spot or directional light: each element's irradiance
-    // E (lights.hpp) times visibility becomes incident power; rho E is its first radiosity.
+    // E (direct_light.hpp) times visibility becomes incident power; rho E is its first radiosity.
     // With `measure_only` the irradiance is only added to direct_ (regather_lights).
     void shoot_light(const packed_light& l, bool measure_only) {
         const lightmap_atlas& at = atlas_;

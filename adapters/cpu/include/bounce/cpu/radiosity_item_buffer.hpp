@@ -19,7 +19,7 @@
 /// projection bends most (a wall through the shooter's corner). Neighbouring triangles may
 /// split a shared edge differently; the T-junctions this leaves open cracks narrower than
 /// the tolerance (the tests measure the pixels that differ from an exact per-pixel ray cast).
-/// The clipping and this tessellation are the core's (stereographic_tessellation.hpp), which
+/// The clipping and this tessellation are the core's (radiosity/stereographic_tessellation.hpp), which
 /// gl::progressive_radiosity draws from too, so both backends rasterize the same pieces.
 /// The hemicube's faces are perspective projections, where straight edges stay straight and
 /// 1/depth is linear in screen space, so they need no tessellation and their depth is exact.
@@ -36,12 +36,12 @@
 /// item buffer.
 
 #include <bounce/errors.hpp>
-#include <bounce/lightmap_atlas.hpp>
-#include <bounce/radiosity.hpp>
-#include <bounce/radiosity_options.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/options.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/scene_view.hpp>
-#include <bounce/stereographic_tessellation.hpp>
+#include <bounce/radiosity/stereographic_tessellation.hpp>
 
 #include <algorithm>
 #include <array>
@@ -194,7 +194,7 @@ inline void scan_triangle(item_buffer& buffer, raster_vertex a, raster_vertex b,
 }
 
 namespace detail {
-// The clipping of stereographic_tessellation.hpp, shared with the GL solver.
+// The clipping of radiosity/stereographic_tessellation.hpp, shared with the GL solver.
 using bounce::canonical_lerp;
 using bounce::clip_polygon;
 }  // namespace detail
@@ -210,7 +210,7 @@ public:
         item_projection projection = item_projection::stereographic;
         int resolution = 256;          ///< item buffer side, pixels (hemicube: per face; typical: 128-512)
         float tolerance_px = 0.25f;    ///< largest sagitta of a tessellated edge, pixels (stereographic;
-                                       ///< at least stereographic_tolerance_floor, radiosity_options.hpp)
+                                       ///< at least stereographic_tolerance_floor, radiosity/options.hpp)
         int max_tessellation_depth = 10; ///< cap on the halvings of one triangle's edges (4^depth pieces at most)
         int parallel_resolution = 1024; ///< side of the directional light's buffer, pixels
     };
@@ -312,7 +312,7 @@ public:
     std::size_t drawn_triangles() const noexcept { return drawn_; }
     const options& settings() const noexcept { return opt_; }
 
-    /// The hemicube face frames (right, up, forward) of radiosity.hpp's table.
+    /// The hemicube face frames (right, up, forward) of radiosity/kernels.hpp's table.
     static std::array<glm::vec3, 3> face_axes(int face) {
         switch (face) {
             case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};
@@ -336,7 +336,7 @@ private:
     bool seen(const item_buffer& buf, int x, int y, std::uint32_t chart, glm::vec3 p, bool parallel) const {
         const std::size_t i = std::size_t(y) * std::size_t(buf.width) + std::size_t(x);
         if (buf.id[i] == chart || buf.id[i] == item_buffer::none) return true;
-        // The plane tests of radiosity.hpp (the GL passes emit the same kernels).
+        // The plane tests of radiosity/kernels.hpp (the GL passes emit the same kernels).
         const std::uint32_t k = buf.primitive[i];
         if (parallel) {
             // Distance along the light from p to the plane: upstream occludes.
@@ -378,7 +378,7 @@ private:
         to_local();
         pieces_.clear();
         // Clipped just above the shooter's plane and tessellated by the sagitta rule
-        // (stereographic_tessellation.hpp, which the GL solver draws from too).
+        // (radiosity/stereographic_tessellation.hpp, which the GL solver draws from too).
         const stereographic_tessellation how{float(opt_.resolution), opt_.tolerance_px, opt_.max_tessellation_depth};
         const float z_min = 1e-6f * diagonal_;
         std::vector<glm::vec3> poly, scratch;

@@ -2,25 +2,25 @@
 /// \file rsm_gather.hpp
 /// The RSM gather on the CPU (Dachsbacher and Stamminger 2005, section 3.2): every pixel
 /// sums the irradiance of the map texels a fixed disc pattern of samples picks around the
-/// pixel's own texel (rsm.hpp's rsm_disc_sample and pixel_light_irradiance); optionally at
+/// pixel's own texel (indirect/rsm.hpp's rsm_disc_sample and pixel_light_irradiance); optionally at
 /// a lower resolution with the geometry-aware upsampling and full-resolution fallback of
 /// DS05 section 3.3.
 ///
 /// Interleaved, the pixels of sub-buffer s use only the samples dealt to s, with their
-/// weights multiplied by N M (interleaved_sampling.hpp): a pixel of a split G-buffer reads
+/// weights multiplied by N M (indirect/interleaved_sampling.hpp): a pixel of a split G-buffer reads
 /// one contiguous run of the (reordered) pattern, so an 8 x 8 pattern does 1/64 of the
 /// work per pixel. The pattern (rsm_disc_pattern, grouped_pattern) and the parameter
-/// structs (pixel_light_params, upsample_params) are the core's (rsm_sampling.hpp,
-/// indirect_options.hpp), shared with the GL backend. Each pixel is computed by one task
+/// structs (pixel_light_params, upsample_params) are the core's (indirect/rsm_sampling.hpp,
+/// indirect/options.hpp), shared with the GL backend. Each pixel is computed by one task
 /// in a fixed order: results do not depend on the thread count.
 
 #include <bounce/camera.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/indirect_options.hpp>
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_sampling.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/options.hpp>
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <algorithm>
 #include <array>

@@ -2,7 +2,7 @@
 /// \file sh_projection.hpp
 /// SH projection of many RGB cube maps of one size at once (a probe bake's worth): the
 /// direction set of a size x size cube map is the same for every probe, so Y_i(texel) times
-/// the texel's exact solid angle is tabulated once (sh_projection.hpp of the core defines
+/// the texel's exact solid angle is tabulated once (sh/projection.hpp of the core defines
 /// the layout and the quadrature), and projecting a map is a matrix product:
 /// c_i = sum over texels of table_i(texel) f(texel).
 ///
@@ -36,8 +36,8 @@
 
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
-#include <bounce/sh_basis.hpp>
-#include <bounce/sh_projection.hpp>
+#include <bounce/sh/basis.hpp>
+#include <bounce/sh/projection.hpp>
 
 #include <algorithm>
 #include <array>

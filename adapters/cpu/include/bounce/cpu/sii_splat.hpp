@@ -1,12 +1,12 @@
 #pragma once
 /// \file sii_splat.hpp
 /// Splatting indirect illumination on the CPU (Dachsbacher and Stamminger 2006): every VPL
-/// adds its irradiance (rsm.hpp's pixel_light_irradiance) to the pixels of the screen
+/// adds its irradiance (indirect/rsm.hpp's pixel_light_irradiance) to the pixels of the screen
 /// rectangle that bounds the region where it can give more than a cutoff
 /// (pixel_light_bounding_sphere), contributions added up.
 ///
 /// Interleaved, VPL k reaches only the sub-buffer it is dealt to (light_groups), at flux
-/// times N M (interleaved_sampling.hpp), and only that sub-buffer's pixels inside its
+/// times N M (indirect/interleaved_sampling.hpp), and only that sub-buffer's pixels inside its
 /// rectangle: 1/(N M) of the pixels. The (VPL, rectangle) pairs are binned into tiles of the
 /// split buffer in a fixed order and each tile adds its pairs in that order, so every pixel
 /// sums the same terms in the same order whatever the thread count (bitwise reproducible).
@@ -15,10 +15,10 @@
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/gbuffer.hpp>
-#include <bounce/indirect_options.hpp>
-#include <bounce/rsm.hpp>
-#include <bounce/rsm_sampling.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/options.hpp>
+#include <bounce/indirect/rsm.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <algorithm>
 #include <cstdint>
@@ -52,7 +52,7 @@ struct sii_params {
 };
 
 /// Screen rectangle (full-resolution pixels) of VPL `l` for a frame of `vpl_count` VPLs
-/// (rsm_sampling.hpp's vpl_splat_rect, which the GL backend uses too).
+/// (indirect/rsm_sampling.hpp's vpl_splat_rect, which the GL backend uses too).
 inline bounce::pixel_rect sii_splat_rect(const camera& cam, const glm::mat4& view, const vpl& l,
                                          std::size_t vpl_count, const sii_params& params, std::size_t width,
                                          std::size_t height) {

@@ -14,9 +14,9 @@
 #include <bounce/cpu/lanes.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
-#include <bounce/irradiance_record.hpp>
+#include <bounce/cache/record.hpp>
 #include <bounce/splat_bounds.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -32,7 +32,7 @@
 
 namespace bounce::cpu {
 
-/// Parameters shared by every splat of a frame (irradiance_record.hpp).
+/// Parameters shared by every splat of a frame (cache/record.hpp).
 using bounce::splat_params;
 
 /// Inclusive pixel rectangle; empty when x0 > x1 or y0 > y1.

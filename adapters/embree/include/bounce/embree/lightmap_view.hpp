@@ -1,6 +1,6 @@
 #pragma once
 /// \file lightmap_view.hpp
-/// A camera's view of a radiosity solution stored as a lightmap (lightmap_atlas.hpp): one
+/// A camera's view of a radiosity solution stored as a lightmap (radiosity/lightmap_atlas.hpp): one
 /// primary ray per pixel centre, the hit's chart and its atlas coordinates, a bilinear
 /// lookup of the radiosity B there (the chapter's reconstruction: Coombe and Harris 2005,
 /// section 39.3.3, draws the atlas with bilinear filtering; the atlas's padding keeps the
@@ -11,7 +11,7 @@
 #include <bounce/camera.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/image.hpp>
-#include <bounce/lightmap_atlas.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <glm/vec3.hpp>

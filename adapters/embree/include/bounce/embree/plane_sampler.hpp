@@ -1,11 +1,11 @@
 #pragma once
 /// \file plane_sampler.hpp
 /// The ray-cast counterpart of gl::hemisphere_raster: one hemisphere plane (bounce/
-/// plane_camera.hpp) filled by casting its pixel rays through Embree, each hit shaded by the
+/// cache/plane_camera.hpp) filled by casting its pixel rays through Embree, each hit shaded by the
 /// reference integrator, so a plane estimator's error can be told from rasterization's.
 
 #include <bounce/embree/reference.hpp>
-#include <bounce/plane_camera.hpp>
+#include <bounce/cache/plane_camera.hpp>
 
 #include <algorithm>
 #include <cstddef>

@@ -21,11 +21,11 @@
 /// - Gradients (sh_translational_gradient): central differences of six re-projected
 ///   probes at p +- h e_k with h = min(gradient_step, nearest_fraction * the nearest hit
 ///   distance), so that a displaced probe does not cross the surface nearest to it
-///   (sh_gradients.hpp explains the step's two errors).
+///   (sh/gradients.hpp explains the step's two errors).
 
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/irradiance_volume.hpp>
+#include <bounce/volume/probe_octree.hpp>
 
 #include <cstdint>
 #include <functional>

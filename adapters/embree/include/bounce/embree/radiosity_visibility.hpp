@@ -7,7 +7,7 @@
 /// visible(point, chart), const and safe from many threads) without including the CPU
 /// adapter: begin_shot takes any frame with the fields of cpu::shot_frame.
 ///
-/// Which surfaces may end a ray is told by charts (lightmap_atlas.hpp): a ray is blocked by
+/// Which surfaces may end a ray is told by charts (radiosity/lightmap_atlas.hpp): a ray is blocked by
 /// a triangle of any chart but the receiver's own and the shooter's own. Both are planar,
 /// so they can only be met at the ray's ends, where a float hit test would decide by
 /// rounding; an Embree occlusion filter rejects their hits (the per-ray chart travels in

@@ -1,14 +1,14 @@
 #pragma once
-/// \file record_sampler.hpp
+/// \file cache/record_sampler.hpp
 /// Irradiance records by ray tracing: a stratified hemisphere of rays through Embree, hits
 /// shaded with direct light and shadow rays (the reference integrator's radiance), then
-/// irradiance, gradients and radius from bounce/irradiance_gradients.hpp.
+/// irradiance, gradients and radius from bounce/cache/gradients.hpp.
 ///
-/// It models bounce::record_sampler (record_sampler.hpp), as the GL single-plane rasterizer
+/// It models bounce::record_sampler (cache/record_sampler.hpp), as the GL single-plane rasterizer
 /// does, so a cache takes either; one record alone is
 ///   std::optional<irradiance_record> operator()(glm::vec3 p, glm::vec3 n, double pixel_footprint).
 ///
-/// With adaptive rays (bounce/adaptive_hemisphere.hpp) a record starts from a grid of about
+/// With adaptive rays (bounce/cache/adaptive_hemisphere.hpp) a record starts from a grid of about
 /// min_rays strata and adds rays to the strata next to uncertain ones until the estimated
 /// relative standard error of its irradiance is below the target or max_rays are cast.
 /// rays_cast() counts the rays and records of every call, adaptive or not.
@@ -18,12 +18,12 @@
 /// one record to the next on each thread (so measuring a record allocates nothing once they
 /// have grown), and the adaptive rounds' rays go through the integrator's batched queries.
 
-#include <bounce/adaptive_hemisphere.hpp>
+#include <bounce/cache/adaptive_hemisphere.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/irradiance_gradients.hpp>
-#include <bounce/irradiance_record.hpp>
+#include <bounce/cache/gradients.hpp>
+#include <bounce/cache/record.hpp>
 #include <bounce/luminance.hpp>
-#include <bounce/record_sampler.hpp>
+#include <bounce/cache/record_sampler.hpp>
 #include <bounce/sampling.hpp>
 
 #include <algorithm>

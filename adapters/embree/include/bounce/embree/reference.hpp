@@ -3,7 +3,7 @@
 /// The reference integrator: ground truth for every error figure in bounce.
 ///
 /// - Direct irradiance E_d(p, n): point, spot and directional lights (the kernels of
-///   bounce/lights.hpp) times a shadow ray each, plus, when scene.use_emission, the
+///   bounce/direct_light.hpp) times a shadow ray each, plus, when scene.use_emission, the
 ///   emissive triangles as Lambertian area lights by stratified area sampling.
 /// - One-bounce indirect irradiance E_i(p, n) = int L(w) cos dw by stratified
 ///   cosine-weighted Monte Carlo on the Ward-Heckbert M x N grid: each ray that hits a

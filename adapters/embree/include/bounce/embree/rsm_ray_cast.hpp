@@ -2,11 +2,11 @@
 /// \file rsm_ray_cast.hpp
 /// Reflective shadow maps (Dachsbacher and Stamminger 2005) by ray casting from the light:
 /// one ray through each texel centre finds the surface the light sees there (so the map
-/// carries the light's own shadows), and rsm.hpp's texel-flux kernels give the flux it
+/// carries the light's own shadows), and indirect/rsm.hpp's texel-flux kernels give the flux it
 /// reflects. A renderer without a rasterizer, or a test that needs exact maps, calls this
 /// where a GL renderer would rasterize the maps; both fill the same `rsm_view`s.
 ///
-/// Map layouts: those of bounce::rsm_layout (bounce/rsm_layout.hpp), shared with
+/// Map layouts: those of bounce::rsm_layout (bounce/indirect/rsm_layout.hpp), shared with
 /// gl::rsm_renderer (every map square, `resolution` texels per side, row 0 at the top):
 /// - point light: the six faces of a cube (90-degree perspective maps along +-x, +-y, +-z),
 ///   less those that see no lit surface;
@@ -23,9 +23,9 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/image.hpp>
 #include <bounce/light.hpp>
-#include <bounce/rsm_layout.hpp>
+#include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/scene_view.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <cstddef>
 #include <span>

@@ -9,12 +9,12 @@
 ///   L(q -> x) = rho(q) / pi * E_d(q, n_q),
 ///
 /// where E_d is the direct irradiance of the point, spot and directional lights with a shadow
-/// ray (lights.hpp's kernels), n_q is q's normal turned towards x, and the sum runs over all
+/// ray (direct_light.hpp's kernels), n_q is q's normal turned towards x, and the sum runs over all
 /// intersections of the ray, not only the first: that is the one difference from
 /// reference_integrator's indirect irradiance (reference.hpp), which keeps the first hit and
 /// so includes the receiver-sender visibility. Changing the variables from solid angle to
 /// area turns it into sum over senders of int L cos theta cos theta_q / d^2 dA, the limit of
-/// the RSM's texel sum (rsm.hpp) as its texels shrink. Emissive triangles are not senders'
+/// the RSM's texel sum (indirect/rsm.hpp) as its texels shrink. Emissive triangles are not senders'
 /// sources here (RSMs are made for point-like lights).
 ///
 /// Estimator: stratified cosine-weighted directions on the M x N grid of hemisphere_grid_for,

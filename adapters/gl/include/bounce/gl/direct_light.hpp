@@ -10,7 +10,7 @@
 ///   projects to across the light;
 /// - point light, and spot light with a wider cone: a cube map (six 90-degree faces) of
 ///   radial distance to the light, which compares and filters alike across face seams.
-/// The unshadowed irradiance is the emitted kernel of lights.hpp (the same the reference
+/// The unshadowed irradiance is the emitted kernel of direct_light.hpp (the same the reference
 /// integrator uses); the lookup coordinates, the normal offset and the PCF average are the
 /// emitted kernels of shadow_mapping.hpp; hardware depth comparison (sampler2DShadow,
 /// samplerCubeShadow, bilinear) does each tap's test.

@@ -14,7 +14,7 @@
 /// shadow-mapped `direct_irradiance` through the emitted lambertian_radiance and stores
 /// (radiance rgb, hit distance) in RGBA32F; texels that see nothing keep (environment, +inf).
 ///
-/// A record's plane is its local frame of plane_camera.hpp: x, y = the camera's
+/// A record's plane is its local frame of cache/plane_camera.hpp: x, y = the camera's
 /// plane_camera::frame(p, n), z = n; pixel (i, j) of tile k is texel (i, j) of the tile in
 /// memory order (the projection flips y so that row 0, the first in memory, is +y). The
 /// record's eye is p + offset n, as a ray caster offsets its origins.
@@ -28,8 +28,8 @@
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/objects.hpp>
-#include <bounce/plane_camera.hpp>
-#include <bounce/plane_weights.hpp>
+#include <bounce/cache/plane_camera.hpp>
+#include <bounce/cache/plane_weights.hpp>
 #include <bounce/image.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -67,7 +67,7 @@ struct hemisphere_raster_options {
     void validate() const;
 };
 
-/// The planes of one batch on the CPU, row 0 at the top (+y) as plane_camera.hpp says.
+/// The planes of one batch on the CPU, row 0 at the top (+y) as cache/plane_camera.hpp says.
 struct plane_batch {
     plane_camera camera;
     std::vector<image<glm::vec3>> radiance;  ///< per record, N x N

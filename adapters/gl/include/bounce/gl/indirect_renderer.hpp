@@ -7,7 +7,7 @@
 /// energy-correct (docs/rsm-sii-interleaved.md, section 5), on the caller's G-buffer and
 /// RSM textures in the caller's context, into the caller's output texture:
 ///
-///   split G-buffer (fragment pass, index maps of interleaved_sampling.hpp)
+///   split G-buffer (fragment pass, index maps of indirect/interleaved_sampling.hpp)
 ///   -> shade each sub-buffer with its light subset
 ///        RSM gather: a fragment pass reading the disc pattern from a storage buffer
 ///        SII: one instanced quad per VPL on its split-buffer rectangle, additive blending
@@ -17,10 +17,10 @@
 ///   gather of DS05 section 3.3, as the CPU renderer does)
 ///
 /// It is the GL twin of cpu::indirect_renderer: the same options and timings (the core's
-/// bounce::indirect_options and bounce::indirect_timings, indirect_options.hpp), the same
+/// bounce::indirect_options and bounce::indirect_timings, indirect/options.hpp), the same
 /// disc pattern, light groups, VPLs (selected on the host from the read-back RSM) and pixel
-/// rectangles (the core's rsm_sampling.hpp, which the CPU renderer calls too), and every
-/// formula an emitted kernel of rsm.hpp and interleaved_sampling.hpp, so its image agrees
+/// rectangles (the core's indirect/rsm_sampling.hpp, which the CPU renderer calls too), and every
+/// formula an emitted kernel of indirect/rsm.hpp and indirect/interleaved_sampling.hpp, so its image agrees
 /// with the CPU's to float rounding (tests/gl_rsm). Each pixel sums its terms in the CPU's order (blending
 /// adds in primitive order).
 ///
@@ -36,10 +36,10 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/rsm_textures.hpp>
 #include <bounce/gl/splat_pass.hpp>
-#include <bounce/indirect_options.hpp>
-#include <bounce/interleaved_sampling.hpp>
-#include <bounce/rsm_sampling.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/options.hpp>
+#include <bounce/indirect/interleaved_sampling.hpp>
+#include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <chrono>
 #include <cmath>

@@ -19,7 +19,7 @@
 /// any record sampler, and the indirect and composed images read back, as a
 /// bounce::cache_frame (what cpu::walkthrough and the cache studies take).
 
-#include <bounce/cache_frame.hpp>
+#include <bounce/cache/frame.hpp>
 #include <bounce/camera.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/gl/direct_light.hpp>
@@ -27,9 +27,9 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/image.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/record_sampler.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/record_sampler.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <chrono>
 #include <cstddef>

@@ -2,12 +2,12 @@
 /// \file irradiance_volume.hpp
 /// Irradiance-volume lookups on the GPU (Oat 2006): the flattened octree and probes
 /// (irradiance_volume::flatten, std430) in storage buffers, and a compute pass that lights
-/// points with the same kernels as the CPU (irradiance_volume_kernels.hpp, printed as GLSL
+/// points with the same kernels as the CPU (volume/kernels.hpp, printed as GLSL
 /// by glsl::emit). The pass's own GLSL is plumbing only: buffer reads, the descent loop,
 /// the traversal stack and the loops over corners.
 
 #include <bounce/gl/objects.hpp>
-#include <bounce/irradiance_volume.hpp>
+#include <bounce/volume/probe_octree.hpp>
 
 #include <cstdint>
 #include <span>

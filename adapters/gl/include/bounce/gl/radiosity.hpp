@@ -5,7 +5,7 @@
 /// solver cpu::progressive_radiosity (adapters/cpu), with the same steps, options and answers
 /// (docs/radiosity-gl.md).
 ///
-/// Elements are the texels of the lightmap atlas (include/bounce/lightmap_atlas.hpp): the
+/// Elements are the texels of the lightmap atlas (include/bounce/radiosity/lightmap_atlas.hpp): the
 /// radiosity and the unshot ("residual") radiosity are RGBA32F textures of the atlas's size,
 /// element e at texel atlas.texel[e]. One step:
 ///  1. the shooter chosen by the last reduction (the largest unshot power sum dB A, channels
@@ -13,10 +13,10 @@
 ///     (at most block_texels^2 texels) is read back to build its near-field quadtree and then
 ///     cleared;
 ///  2. visibility: the scene's triangles, in the shooter's frame, clipped above its plane and
-///     tessellated on the CPU with the sagitta rule (stereographic_tessellation.hpp, the same
+///     tessellated on the CPU with the sagitta rule (radiosity/stereographic_tessellation.hpp, the same
 ///     code as cpu::item_buffer_visibility's), are drawn
 ///     by GL in the stereographic projection (stereographic_item_coords, emitted from
-///     radiosity.hpp) into an item buffer holding chart id, triangle id and the exact depth at
+///     radiosity/kernels.hpp) into an item buffer holding chart id, triangle id and the exact depth at
 ///     each pixel centre (item_plane_depth), depth tested on a separate depth attachment;
 ///  3. a compute pass, one invocation per element at its texel, evaluates the shot from
 ///     the shooter's near-field nodes (disc_form_factor and shot_radiosity, emitted), looks
@@ -26,7 +26,7 @@
 ///     shooter, the total unshot power and the shot's intercepted and absorbed power, in
 ///     double: the convergence fraction is known after every step.
 /// Point, spot and directional lights are shot first, in the constructor, as the CPU solver
-/// does (their direct irradiance from lights.hpp times visibility from the light: a
+/// does (their direct irradiance from direct_light.hpp times visibility from the light: a
 /// hemisphere at a time, or an orthographic buffer along a directional light).
 ///
 /// Visibility can also come from a hemicube (five perspective faces drawn by GL, no
@@ -41,9 +41,9 @@
 #include <bounce/gl/errors.hpp>
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
-#include <bounce/lightmap_atlas.hpp>
-#include <bounce/radiosity_options.hpp>
-#include <bounce/radiosity_solve.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/options.hpp>
+#include <bounce/radiosity/solve.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cstddef>
@@ -64,7 +64,7 @@ enum class radiosity_visibility {
 };
 
 /// Options of gl::progressive_radiosity: the shooting options shared with the CPU solver
-/// (radiosity_options.hpp; shooters_per_step must be 1 here) and the item-buffer options of
+/// (radiosity/options.hpp; shooters_per_step must be 1 here) and the item-buffer options of
 /// cpu::item_buffer_visibility::options, with the same meanings and defaults.
 struct radiosity_options {
     bounce::radiosity_options shooting{};  ///< as cpu::progressive_radiosity takes them
@@ -81,7 +81,7 @@ struct radiosity_options {
     void validate() const;
 };
 
-/// The core's timings and progress (radiosity_options.hpp); subdivision_ms stays 0 here.
+/// The core's timings and progress (radiosity/options.hpp); subdivision_ms stays 0 here.
 using bounce::radiosity_progress;
 using bounce::radiosity_timings;
 
@@ -110,7 +110,7 @@ public:
     /// shoot, calling `progress` after each step (return false from it to stop early).
     /// Returns the steps taken.
     std::size_t solve(double fraction, const std::function<bool(const radiosity_progress&)>& progress = {});
-    /// The solve of radiosity_solve.hpp (the CPU solver's): to `options.converge`, within
+    /// The solve of radiosity/solve.hpp (the CPU solver's): to `options.converge`, within
     /// `options.max_seconds`, with its progress and checkpoint callbacks (the clock paused
     /// during checkpoints). Throws radiosity_error when energy is created or every shot
     /// escapes without reaching a surface's front side, parameter_error on bad options.

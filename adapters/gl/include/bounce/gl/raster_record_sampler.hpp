@@ -13,7 +13,7 @@
 /// sequential scan's result bit for bit.
 ///
 /// In falloff_mode::running the band factor kappa of fall-off stretching comes from the
-/// running radial profile (radial_profile.hpp, docs/hemisphere-sampling.md): each batch
+/// running radial profile (cache/radial_profile.hpp, docs/hemisphere-sampling.md): each batch
 /// takes the kappa of every plane the sampler has rendered, its own batch included. A record
 /// then depends on the batches before it and on the other planes of its own batch, so it is
 /// no longer a pure function of its point: the batched scan's records (its guesses, the
@@ -21,10 +21,10 @@
 /// the same points in other batches give other records.
 
 #include <bounce/gl/hemisphere_raster.hpp>
-#include <bounce/plane_weights.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/radial_profile.hpp>
-#include <bounce/record_sampler.hpp>
+#include <bounce/cache/plane_weights.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/radial_profile.hpp>
+#include <bounce/cache/record_sampler.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -3,9 +3,9 @@
 /// `gl::rsm_renderer`: reflective shadow maps (Dachsbacher and Stamminger 2005, section 3.1)
 /// rasterized from a scene_view's lights into RGBA32F textures (world position, unit
 /// normal, reflected flux), the flux computed per fragment by the emitted texel-flux kernels
-/// of rsm.hpp, so a GL renderer gets the maps embree::rsm_ray_caster casts on the CPU.
+/// of indirect/rsm.hpp, so a GL renderer gets the maps embree::rsm_ray_caster casts on the CPU.
 ///
-/// Map layouts: those of bounce::rsm_layout (bounce/rsm_layout.hpp), which
+/// Map layouts: those of bounce::rsm_layout (bounce/indirect/rsm_layout.hpp), which
 /// embree::rsm_ray_caster also follows, with the same light_view_projection matrices (every
 /// map square, `resolution` texels per side):
 /// - point light: the six faces of a cube (90-degree perspective maps along +x, -x, +y, -y,
@@ -33,7 +33,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/rsm_textures.hpp>
 #include <bounce/light.hpp>
-#include <bounce/rsm_layout.hpp>
+#include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cstddef>

@@ -5,7 +5,7 @@
 
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
-#include <bounce/vpl_sampling.hpp>
+#include <bounce/indirect/vpl_sampling.hpp>
 
 #include <cstddef>
 

@@ -9,7 +9,7 @@
 /// the quad on the exact screen box of the record's sphere of influence (the emitted
 /// `sphere_ndc_bounds` of splat_bounds.hpp around the emitted `influence_radius` of the
 /// weighting policy), the fragment stage fetches the G-buffer at its pixel and adds the
-/// emitted `splat_contribution` (irradiance_record.hpp) into an RGBA32F splat texture with
+/// emitted `splat_contribution` (cache/record.hpp) into an RGBA32F splat texture with
 /// additive blending. Blending happens in primitive order, i.e. record order, and adds
 /// the same float terms as cpu::splat_records in the same order, so the two splat
 /// buffers agree to the rounding of the kernels themselves.
@@ -22,8 +22,8 @@
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
-#include <bounce/irradiance_record.hpp>
-#include <bounce/weighting.hpp>
+#include <bounce/cache/record.hpp>
+#include <bounce/cache/weighting.hpp>
 
 #include <cstddef>
 #include <limits>
@@ -89,7 +89,7 @@ void read_texture(const texture_ref& t, image_view<glm::vec4> out);
 /// Copies the rgb of the RGBA32F texture `t` into `out` (row 0 at the top).
 void read_texture(const texture_ref& t, image_view<glm::vec3> out);
 
-/// Parameters shared by every splat of a frame (irradiance_record.hpp).
+/// Parameters shared by every splat of a frame (cache/record.hpp).
 using bounce::splat_params;
 
 /// The GL irradiance splatting pass: a record buffer on the GPU that grows by appending,

@@ -12,7 +12,7 @@
 ///   - monte_carlo_report, ray_rates, write_beside_reference: what a run adds after its frame.
 /// Progress goes to the settings' `log` (stdout by default; nullptr: silent).
 
-#include <bounce/cache_frame.hpp>
+#include <bounce/cache/frame.hpp>
 #include <bounce/camera.hpp>
 #include <bounce/cpu/cache_walkthrough.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>

@@ -18,8 +18,8 @@
 #include <bounce/camera.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
-#include <bounce/irradiance_gradients.hpp>
-#include <bounce/plane_camera.hpp>
+#include <bounce/cache/gradients.hpp>
+#include <bounce/cache/plane_camera.hpp>
 #include <bounce/scene_view.hpp>
 #include <bounce/study/reference_cache.hpp>
 

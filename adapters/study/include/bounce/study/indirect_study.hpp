@@ -13,7 +13,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
-#include <bounce/indirect_options.hpp>
+#include <bounce/indirect/options.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/study/image_comparison.hpp>
 #include <bounce/study/reference_cache.hpp>

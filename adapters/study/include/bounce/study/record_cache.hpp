@@ -8,7 +8,7 @@
 /// naming the first differing key.
 
 #include <bounce/errors.hpp>
-#include <bounce/irradiance_record.hpp>
+#include <bounce/cache/record.hpp>
 
 #include <filesystem>
 #include <vector>

@@ -4,13 +4,13 @@
 ///
 /// - per order 1 .. 8, for an environment symmetric about an axis (a directional light, a
 ///   uniform sky, a cone light): the irradiance error over the sphere (max and mean,
-///   relative to the peak) from the closed-form coefficients (sh_lights.hpp) and through a
+///   relative to the peak) from the closed-form coefficients (sh/lights.hpp) and through a
 ///   rasterized cube map (sh_project_cube_map), the radiance truncation error (Parseval),
 ///   and for the directional light from order 2 the widest non-negative Hann window's cost;
 /// - Oat's gradient extrapolation I + grad I . d against the probe re-projected at p + d.
 ///
 /// The exact irradiance of a cone is integrated in closed form in the azimuth and by
-/// Gauss-Legendre (sh_quadrature.hpp) in the polar cosine, on each side of the kink where
+/// Gauss-Legendre (sh/quadrature.hpp) in the polar cosine, on each side of the kink where
 /// the horizon starts to cut the cap's rings.
 
 #include <bounce/image.hpp>

@@ -23,7 +23,7 @@
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/image.hpp>
-#include <bounce/irradiance_volume.hpp>
+#include <bounce/volume/probe_octree.hpp>
 #include <bounce/study/image_comparison.hpp>
 
 #include <cstdint>

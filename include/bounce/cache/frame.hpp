@@ -1,0 +1,44 @@
+#pragma once
+/// \file cache/frame.hpp
+/// `bounce::cache_frame`: what one frame of an irradiance cache gives its caller, whichever
+/// backend made it (the CPU frame of cpu::render_frame, the GL frame of
+/// gl::irradiance_splatter::frame): the G-buffer the cache-miss scan saw, the indirect image,
+/// the scan's counts and the frame's stage times. Walkthroughs (cpu::walkthrough) and studies
+/// (bounce::study's cache studies) take frames of either backend through it.
+
+#include <bounce/gbuffer.hpp>
+#include <bounce/image.hpp>
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace bounce::inline cache {
+
+struct cache_frame {
+    gbuffer<float> g;           ///< the G-buffer the frame's scan saw (row 0 at the top)
+    image<glm::vec3> indirect;  ///< rho/pi * E per pixel (0 where no record reaches or g sees nothing)
+    /// direct + indirect, where the backend composes them itself (the GL frame); empty otherwise.
+    std::optional<image<glm::vec3>> combined;
+    std::size_t new_records = 0;  ///< records the scan added
+    std::size_t measured = 0;     ///< records the batched scan measured (new + wasted + refused)
+    std::size_t wasted = 0;       ///< guesses dropped because covered by the time the scan got there
+    /// The frame's stages in the order they ran, in milliseconds of wall time: "gbuffer",
+    /// ("direct",) "splat_existing", ("readback",) "scan", "compute_records", "interpolate",
+    /// "normalize" (the names in parentheses: the GL frame only).
+    std::vector<std::pair<std::string, double>> stages_ms;
+
+    /// The milliseconds of `stage`, 0 when the frame has no such stage.
+    double ms(std::string_view stage) const noexcept {
+        for (const auto& [name, ms] : stages_ms)
+            if (name == stage) return ms;
+        return 0.0;
+    }
+};
+
+}  // namespace bounce::cache

@@ -1,0 +1,102 @@
+#pragma once
+/// \file radiosity/options.hpp
+/// What the progressive radiosity solvers share whatever their backend: how they shoot
+/// (radiosity_options), the time they spent per stage (radiosity_timings) and where a solve
+/// stands (radiosity_progress), and the finest stereographic tolerance worth asking for
+/// (stereographic_tolerance_floor). cpu::progressive_radiosity takes these as they are;
+/// gl::radiosity_options extends radiosity_options with its item-buffer options. A solve to
+/// a target with checkpoints: radiosity/solve.hpp.
+
+#include <bounce/errors.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+namespace bounce::inline radiosity {
+
+/// How a solver shoots.
+struct radiosity_options {
+    bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
+    int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16;
+                                   ///< the GL solver shoots one)
+    bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
+    double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
+                                   ///< times its side (sqrt of its area), else as its quadrants,
+                                   ///< recursively; 0: always one disc (typical: 2-4)
+
+    /// Throws parameter_error naming the option ("radiosity_options.near_field" ...).
+    void validate() const {
+        require(shooters_per_step >= 1 && shooters_per_step <= 4096, "radiosity_options.shooters_per_step",
+                "must lie in [1, 4096]");
+        require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
+                "must be finite and non-negative");
+    }
+};
+
+/// Time spent per stage since construction, milliseconds. The GL solver ends visibility and
+/// distribution with glFinish when gl::radiosity_options::timed_stages is set (so the figures
+/// are the GPU's time, not the driver's queueing); otherwise the GPU's work is counted where
+/// the step waits for it, in choice_ms.
+struct radiosity_timings {
+    double lights_ms = 0;        ///< shooting point, spot and directional lights, their visibility included (construction)
+    double visibility_ms = 0;    ///< visibility of the surface shots: item buffers (GL: reading the
+                                 ///< shooter back, tessellating, drawing), ray casts
+    double choice_ms = 0;        ///< choosing shooters (reduction; GL: it also sums the powers)
+    double distribution_ms = 0;  ///< form factors and updates over the elements
+    double subdivision_ms = 0;   ///< adaptive subdivision: the test and the refined atlas (CPU only)
+};
+
+/// Where a solve stands after a step.
+struct radiosity_progress {
+    std::size_t steps = 0, shots = 0;
+    double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
+    double elapsed_ms = 0;       ///< time of the running solve(radiosity_solve_options) so far,
+                                 ///< its checkpoints excluded (radiosity/solve.hpp); 0 outside one
+};
+
+}  // namespace bounce::radiosity
+
+namespace bounce::detail {
+/// `v` with 4 significant digits (%.4g), for messages: std::to_string(1e-7f) reads 0.000000.
+inline std::string radiosity_number(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", v);
+    return text;
+}
+}  // namespace bounce::detail
+
+namespace bounce::inline radiosity {
+
+/// The smallest `tolerance_px` (the sagitta rule of radiosity/stereographic_tessellation.hpp) that can
+/// still change a stereographic item buffer of `resolution` pixels over `scene` cut into
+/// about `elements` elements: the larger of
+///  - 1/256 pixel, the scan converter's vertex snap (cpu::scan_triangle_with keeps 8
+///    sub-pixel bits; GL rasterizers keep at least 4), below which a tessellated vertex lands
+///    on the same snapped position as the chord's, and
+///  - what float32 positions resolve at the scene's scale: a coordinate of magnitude M (the
+///    scene's largest) carries 2^-24 M of rounding, which, seen from a shooter one element
+///    side s away (sqrt of the scene's area / elements), moves its projection by about
+///    resolution * 2^-24 M / s pixels.
+/// Below it the tessellation only splits deeper (4^depth pieces, up to its depth cap)
+/// without changing what is drawn: `--tolerance-px 1e-7` took a minute for 63 elements.
+inline float stereographic_tolerance_floor(const scene_view& scene, std::size_t elements, int resolution) {
+    double magnitude = 0, area = 0;
+    for (const glm::vec3& p : scene.positions)
+        magnitude = std::max({magnitude, double(std::abs(p.x)), double(std::abs(p.y)), double(std::abs(p.z))});
+    for (const glm::uvec3& t : scene.triangles) {
+        if (t.x >= scene.positions.size() || t.y >= scene.positions.size() || t.z >= scene.positions.size()) continue;
+        const glm::dvec3 a(scene.positions[t.x]), b(scene.positions[t.y]), c(scene.positions[t.z]);
+        area += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+    const double side = std::sqrt(area / double(std::max<std::size_t>(elements, 1)));
+    const double position_px = side > 0 ? double(resolution) * std::ldexp(magnitude, -24) / side : 0.0;
+    return float(std::max(1.0 / 256.0, position_px));
+}
+
+}  // namespace bounce::radiosity
