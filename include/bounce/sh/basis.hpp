@@ -18,6 +18,9 @@
 ///   with the Condon-Shortley phase (-1)^m included in P_l^m, so Y_1-1 = -0.4886 y,
 ///   Y_10 = 0.4886 z, Y_11 = -0.4886 x. The basis is orthonormal on the unit sphere, so a
 ///   function's coefficients are c_lm = int f Y_lm dw and int f^2 dw = sum c_lm^2 (Parseval).
+/// - Every function that takes coefficients also deduces L from them (`sh_evaluate(c, d)`,
+///   `sh_apply_window(c, hann_window<3>(w))`, `sh_irradiance(radiance, n)`); L is spelled
+///   only where nothing carries it (a projection's result, a window's length).
 /// - z is the polar axis, phi is measured from +x towards +y. sh/layouts.hpp converts to
 ///   the layouts other engines use (no phase, channel-major).
 
@@ -27,6 +30,8 @@
 #include <array>
 #include <cstddef>
 #include <numbers>
+#include <type_traits>
+#include <utility>
 
 namespace bounce::detail {
 
@@ -80,6 +85,11 @@ constexpr sh_recurrence<L> make_sh_recurrence() noexcept {
 template <int L>
 inline constexpr sh_recurrence<L> sh_recurrence_v = make_sh_recurrence<L>();
 
+/// The scalar of a vector type (double for glm::dvec3, glsl::f32 for glsl::vec3): what the
+/// SH functions that deduce their arguments pass as `T`.
+template <class V>
+using vector_scalar_t = std::remove_cvref_t<decltype(std::declval<const V&>().x)>;
+
 }  // namespace bounce::detail
 
 namespace bounce::inline sh {
@@ -89,6 +99,14 @@ constexpr std::size_t sh_index(int l, int m) noexcept { return std::size_t(l * (
 
 /// Number of coefficients of bands 0 .. bands - 1: bands^2.
 constexpr std::size_t sh_count(int bands) noexcept { return std::size_t(bands) * std::size_t(bands); }
+
+/// The band count L of `count` coefficients (count = L^2), or 0 when `count` is not the
+/// size of whole bands. What lets an SH function deduce L from a coefficient array.
+constexpr int sh_bands_of(std::size_t count) noexcept {
+    int l = 0;
+    while (sh_count(l + 1) <= count) ++l;
+    return sh_count(l) == count ? l : 0;
+}
 
 /// The band l of coefficient index i (the l with l^2 <= i < (l + 1)^2).
 constexpr int sh_band(std::size_t i) noexcept {
@@ -147,6 +165,15 @@ C sh_evaluate(const std::array<C, sh_count(L)>& c, const V& d) {
     C sum = c[0] * y[0];
     for (std::size_t i = 1; i < sh_count(L); ++i) sum = sum + c[i] * y[i];
     return sum;
+}
+
+/// `sh_evaluate` with L, T and C deduced from the arguments: `sh_evaluate(c, d)`. Every SH
+/// function that takes coefficients has such a form (the coefficient type first, so that a
+/// call spelling `<L, ...>` never reaches it); the spelled form is the kernel GLSL prints.
+template <class C, std::size_t N, class V>
+    requires(sh_bands_of(N) > 0)
+C sh_evaluate(const std::array<C, N>& c, const V& d) {
+    return sh_evaluate<sh_bands_of(N), detail::vector_scalar_t<V>, V, C>(c, d);
 }
 
 }  // namespace bounce::sh

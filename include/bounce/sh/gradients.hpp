@@ -20,6 +20,21 @@
 
 #include <glm/vec3.hpp>
 
+namespace bounce::detail {
+/// The band count and coefficient type of an SH coefficient array (bands = 0 for anything else).
+template <class A>
+struct sh_array_shape {
+    static constexpr int bands = 0;
+};
+template <class C, std::size_t N>
+struct sh_array_shape<std::array<C, N>> {
+    using coefficient = C;
+    static constexpr int bands = sh_bands_of(N);
+};
+template <class F>
+using probe_result_t = std::remove_cvref_t<std::invoke_result_t<F&, const glm::dvec3&>>;
+}  // namespace bounce::detail
+
 namespace bounce::inline sh {
 
 /// d c_i / dx, d c_i / dy, d c_i / dz of every coefficient (units: the coefficients' per
@@ -59,6 +74,15 @@ sh_gradient<L, C> sh_translational_gradient(ProbeAt&& probe_at, const glm::dvec3
     return g;
 }
 
+/// `sh_translational_gradient` with L and C deduced from what `probe_at` returns (an
+/// std::array of whole bands): `sh_translational_gradient(probe_at, position, step)`.
+template <class ProbeAt>
+    requires std::invocable<ProbeAt&, const glm::dvec3&> && (detail::sh_array_shape<detail::probe_result_t<ProbeAt>>::bands > 0)
+auto sh_translational_gradient(ProbeAt&& probe_at, const glm::dvec3& position, double step) {
+    using shape = detail::sh_array_shape<detail::probe_result_t<ProbeAt>>;
+    return sh_translational_gradient<shape::bands, typename shape::coefficient>(probe_at, position, step);
+}
+
 /// Oat's extrapolation I'_i = I_i + grad I_i . d of the probe `c` with gradient
 /// (`gx`, `gy`, `gz`) to the point at offset `d` from it (scene units, not unit length).
 /// A kernel: `C` is the coefficient type (T or V); on the GPU each probe is 4 L^2 values.
@@ -71,8 +95,17 @@ std::array<C, sh_count(L)> sh_extrapolate(const std::array<C, sh_count(L)>& c, c
     return out;
 }
 
+/// The kernel `sh_extrapolate` with L, T and C deduced: `sh_extrapolate(c, gx, gy, gz, d)`.
+template <class C, std::size_t N, class V>
+    requires(sh_bands_of(N) > 0)
+std::array<C, N> sh_extrapolate(const std::array<C, N>& c, const std::array<C, N>& gx, const std::array<C, N>& gy,
+                                const std::array<C, N>& gz, const V& d) {
+    return sh_extrapolate<sh_bands_of(N), detail::vector_scalar_t<V>, V, C>(c, gx, gy, gz, d);
+}
+
 /// `sh_extrapolate` with a gradient from `sh_translational_gradient`, in double precision
-/// (`C` is double or glm::dvec3: GLM does not multiply a float vector by a double).
+/// (`C` is double or glm::dvec3: GLM does not multiply a float vector by a double). L and C
+/// are deduced from the gradient: `sh_extrapolate(c, g, d)`.
 template <int L, class C>
 sh_coefficients<L, C> sh_extrapolate(const sh_coefficients<L, C>& c, const sh_gradient<L, C>& g, const glm::dvec3& d) {
     return sh_extrapolate<L, double, glm::dvec3, C>(c, g.x, g.y, g.z, d);

@@ -53,6 +53,13 @@ sh_coefficients<L, C> sh_convolve_clamped_cosine(const sh_coefficients<L, C>& ra
     return e;
 }
 
+/// `sh_convolve_clamped_cosine` with L and C deduced: `sh_convolve_clamped_cosine(radiance)`.
+template <class C, std::size_t N>
+    requires(sh_bands_of(N) > 0)
+std::array<C, N> sh_convolve_clamped_cosine(const std::array<C, N>& radiance) {
+    return sh_convolve_clamped_cosine<sh_bands_of(N), C>(radiance);
+}
+
 /// Irradiance (W/m^2 per channel) at a surface with unit normal `n` under the radiance
 /// whose SH coefficients are `radiance` (W/(m^2 sr)): sum_lm A_l L_lm Y_lm(n)
 /// (Ramamoorthi and Hanrahan 2001). Bands with A_l = 0 (odd l > 1) cost nothing: the test
@@ -73,6 +80,13 @@ V sh_irradiance(const std::array<V, sh_count(L)>& radiance, const V& n) {
     return sum;
 }
 
+/// `sh_irradiance` with L and T deduced from the arguments: `sh_irradiance(radiance, n)`.
+template <class V, std::size_t N>
+    requires(sh_bands_of(N) > 0)
+V sh_irradiance(const std::array<V, N>& radiance, const V& n) {
+    return sh_irradiance<sh_bands_of(N), detail::vector_scalar_t<V>, V>(radiance, n);
+}
+
 /// Irradiance / pi (W/(m^2 sr)): the radiance a white Lambertian surface with unit normal
 /// `n` reflects under `radiance`; multiply by the albedo for the diffuse colour. The 1/pi
 /// is folded into the band factors, so this is exactly as cheap as `sh_irradiance`.
@@ -90,6 +104,13 @@ V sh_irradiance_over_pi(const std::array<V, sh_count(L)>& radiance, const V& n) 
         }
     }
     return sum;
+}
+
+/// `sh_irradiance_over_pi` with L and T deduced: `sh_irradiance_over_pi(radiance, n)`.
+template <class V, std::size_t N>
+    requires(sh_bands_of(N) > 0)
+V sh_irradiance_over_pi(const std::array<V, N>& radiance, const V& n) {
+    return sh_irradiance_over_pi<sh_bands_of(N), detail::vector_scalar_t<V>, V>(radiance, n);
 }
 
 }  // namespace bounce::sh

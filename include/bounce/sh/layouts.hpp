@@ -36,6 +36,20 @@ sh_coefficients<L, C> sh_with_condon_shortley_phase(const sh_coefficients<L, C>&
     return sh_without_condon_shortley_phase<L, C>(no_phase);
 }
 
+/// `sh_without_condon_shortley_phase` with L and C deduced from `c`.
+template <class C, std::size_t N>
+    requires(sh_bands_of(N) > 0)
+std::array<C, N> sh_without_condon_shortley_phase(const std::array<C, N>& c) {
+    return sh_without_condon_shortley_phase<sh_bands_of(N), C>(c);
+}
+
+/// `sh_with_condon_shortley_phase` with L and C deduced from `no_phase`.
+template <class C, std::size_t N>
+    requires(sh_bands_of(N) > 0)
+std::array<C, N> sh_with_condon_shortley_phase(const std::array<C, N>& no_phase) {
+    return sh_with_condon_shortley_phase<sh_bands_of(N), C>(no_phase);
+}
+
 /// Channel-major copy of RGB coefficients: element [channel * L^2 + i].
 template <int L, class T, glm::qualifier Q>
 std::array<T, 3 * sh_count(L)> sh_to_channel_major(const sh_coefficients<L, glm::vec<3, T, Q>>& c) {
@@ -45,6 +59,13 @@ std::array<T, 3 * sh_count(L)> sh_to_channel_major(const sh_coefficients<L, glm:
     return out;
 }
 
+/// `sh_to_channel_major` with L deduced from `c`.
+template <class T, glm::qualifier Q, std::size_t N>
+    requires(sh_bands_of(N) > 0)
+std::array<T, 3 * N> sh_to_channel_major(const std::array<glm::vec<3, T, Q>, N>& c) {
+    return sh_to_channel_major<sh_bands_of(N), T, Q>(c);
+}
+
 /// RGB coefficients from a channel-major array (`sh_to_channel_major`'s inverse).
 template <int L, class T>
 sh_coefficients<L, glm::vec<3, T>> sh_from_channel_major(const std::array<T, 3 * sh_count(L)>& planar) {
@@ -52,6 +73,13 @@ sh_coefficients<L, glm::vec<3, T>> sh_from_channel_major(const std::array<T, 3 *
     for (std::size_t i = 0; i < sh_count(L); ++i)
         for (int k = 0; k < 3; ++k) out[i][k] = planar[std::size_t(k) * sh_count(L) + i];
     return out;
+}
+
+/// `sh_from_channel_major` with L deduced from `planar` (3 L^2 values).
+template <class T, std::size_t N>
+    requires(N % 3 == 0 && sh_bands_of(N / 3) > 0)
+std::array<glm::vec<3, T>, N / 3> sh_from_channel_major(const std::array<T, N>& planar) {
+    return sh_from_channel_major<sh_bands_of(N / 3), T>(planar);
 }
 
 }  // namespace bounce::sh

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <concepts>
 #include <cstddef>
 #include <numbers>
 #include <vector>
@@ -67,6 +68,14 @@ sh_coefficients<L, C> sh_apply_window(const sh_coefficients<L, C>& c, const std:
     sh_coefficients<L, C> w = c;
     for (std::size_t i = 0; i < sh_count(L); ++i) w[i] = c[i] * window[std::size_t(sh_band(i))];
     return w;
+}
+
+/// `sh_apply_window` with the band count deduced from the window (and checked against the
+/// coefficients at compile time): `sh_apply_window(radiance, hann_window<3>(w))`.
+template <class C, std::size_t N, std::size_t B>
+    requires(N == sh_count(int(B)))
+std::array<C, N> sh_apply_window(const std::array<C, N>& c, const std::array<double, B>& window) {
+    return sh_apply_window<int(B), C>(c, window);
 }
 
 /// What a window costs one function (one channel).
@@ -116,6 +125,13 @@ window_cost sh_window_cost(const sh_coefficients<L, double>& c, const std::array
     return {kept / energy, peak_w / peak, lo, lo_w};
 }
 
+/// `sh_window_cost` with the band count deduced from the window: `sh_window_cost(c, h)`.
+template <class C, std::size_t N, std::size_t B>
+    requires std::same_as<C, double> && (N == sh_count(int(B)))
+window_cost sh_window_cost(const std::array<C, N>& c, const std::array<double, B>& window, std::size_t probes = 16384) {
+    return sh_window_cost<int(B)>(c, window, probes);
+}
+
 /// The widest width w <= `max_width` (typical: L), on a grid of step `resolution`
 /// (typical: 1/64), for which the window of `family` leaves no negative value of the
 /// function `c` on `probes` spherical Fibonacci directions (typical: 4096). The scan runs
@@ -144,6 +160,14 @@ double sh_nonnegative_window_width(const sh_coefficients<L, double>& c, sh_windo
         if (nonnegative) return w;
     }
     return resolution;
+}
+
+/// `sh_nonnegative_window_width` with the band count deduced from `c`.
+template <class C, std::size_t N>
+    requires std::same_as<C, double> && (sh_bands_of(N) > 0)
+double sh_nonnegative_window_width(const std::array<C, N>& c, sh_window_family family, double max_width,
+                                   std::size_t probes = 4096, double resolution = 1.0 / 64) {
+    return sh_nonnegative_window_width<sh_bands_of(N)>(c, family, max_width, probes, resolution);
 }
 
 }  // namespace bounce::sh
