@@ -178,8 +178,10 @@ accel::accel(const device& dev, const scene_view& scene) : device_(dev), state_(
     state_->handle = rtcNewScene(d);
     device_.check("rtcNewScene");
     // Robust traversal: no cracks between triangles that share an edge, which the closed
-    // sphere of the furnace test and every watertight scene rely on.
-    rtcSetSceneFlags(state_->handle, RTC_SCENE_FLAG_ROBUST);
+    // sphere of the furnace test and every watertight scene rely on. Context filters: a
+    // query may pass a filter in its intersect context (radiosity_visibility does), so the
+    // BVH serves queries that skip some triangles; queries without one pay nothing for it.
+    rtcSetSceneFlags(state_->handle, RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
     rtcSetSceneBuildQuality(state_->handle, RTC_BUILD_QUALITY_HIGH);
     device_.check("rtcSetSceneFlags");
 

@@ -2,6 +2,8 @@
 // stratified cosine-weighted Monte Carlo (Ward and Heckbert 1992), per-pixel images.
 #include <bounce/embree/reference.hpp>
 
+#include "light_rays.hpp"
+
 #include <bounce/direct_light.hpp>
 #include <bounce/sampling.hpp>
 
@@ -205,30 +207,8 @@ template <class Term>
 void reference_integrator::direct_terms(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal, std::uint32_t area_grid,
                                         std::uint64_t seed, bool choose_light, Term&& term) const {
     const glm::vec3 origin = p + epsilon_ * offset_normal;
-    // Unshadowed irradiance from light l, and the shadow ray that tests it.
-    auto unshadowed = [&](const packed_light& l) {
-        const light_kind kind = l.kind();
-        if (kind == light_kind::point)
-            return point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
-        if (kind == light_kind::spot)
-            return spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
-                                                            l.cos_cone(), l.cosine_falloff());
-        return directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
-    };
-    auto shadow_ray = [&](const packed_light& l) {
-        ray shadow;
-        shadow.origin = origin;
-        if (l.kind() == light_kind::directional) {
-            shadow.direction = -l.direction();
-        } else {
-            // Towards the light; stop short of it by epsilon so geometry at the light's
-            // own position does not shadow it.
-            shadow.direction = l.position() - origin;
-            const float d = glm::length(shadow.direction);
-            shadow.tfar = std::max(0.f, 1.f - epsilon_ / std::max(d, epsilon_));
-        }
-        return shadow;
-    };
+    auto unshadowed = [&](const packed_light& l) { return detail::unshadowed_irradiance(l, p, n); };
+    auto shadow_ray = [&](const packed_light& l) { return detail::shadow_ray_towards(l, origin, epsilon_); };
     auto weight = [](glm::vec3 c) { return c.x + c.y + c.z; };
 
     if (choose_light && lights_.size() > 1) {
@@ -282,12 +262,7 @@ void reference_integrator::direct_terms(glm::vec3 p, glm::vec3 n, glm::vec3 offs
                 const glm::vec3 c =
                     area_light_irradiance_sample<float, glm::vec3>(p, n, q, em.normal, em.radiance, inv_pdf);
                 if (!(c.x > 0.f || c.y > 0.f || c.z > 0.f)) continue;
-                ray shadow;
-                shadow.origin = origin;
-                shadow.direction = q - origin;
-                const float d = glm::length(shadow.direction);
-                shadow.tfar = std::max(0.f, 1.f - epsilon_ / std::max(d, epsilon_));
-                term(c, shadow, true);
+                term(c, detail::shadow_ray_to(origin, q, epsilon_), true);
             }
     }
 }

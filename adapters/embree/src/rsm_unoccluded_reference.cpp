@@ -4,6 +4,8 @@
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
 
 #include <bounce/embree/reference.hpp>
+
+#include "light_rays.hpp"
 #include <bounce/direct_light.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/sampling.hpp>
@@ -46,27 +48,9 @@ glm::vec3 unoccluded_reference::direct_irradiance(glm::vec3 p, glm::vec3 n, glm:
     const glm::vec3 origin = p + epsilon_ * offset_normal;
     glm::dvec3 e(0.0);
     for (const packed_light& l : lights_) {
-        glm::vec3 c;
-        ray shadow;
-        shadow.origin = origin;
-        if (l.kind() == light_kind::point) {
-            c = point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
-        } else if (l.kind() == light_kind::spot) {
-            c = spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(), l.cos_cone(),
-                                                        l.cosine_falloff());
-        } else {
-            c = directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
-        }
+        const glm::vec3 c = detail::unshadowed_irradiance(l, p, n);
         if (!(c.x > 0.f || c.y > 0.f || c.z > 0.f)) continue;
-        if (l.kind() == light_kind::directional) {
-            shadow.direction = -l.direction();
-        } else {
-            // Stop short of the light by epsilon, as reference_integrator does.
-            shadow.direction = l.position() - origin;
-            const float d = glm::length(shadow.direction);
-            shadow.tfar = std::max(0.f, 1.f - epsilon_ / std::max(d, epsilon_));
-        }
-        if (!bvh_.occluded(shadow)) e += glm::dvec3(c);
+        if (!bvh_.occluded(detail::shadow_ray_towards(l, origin, epsilon_))) e += glm::dvec3(c);
     }
     return glm::vec3(e);
 }

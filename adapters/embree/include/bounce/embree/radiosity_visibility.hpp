@@ -13,9 +13,12 @@
 /// rounding; an Embree occlusion filter rejects their hits (the per-ray chart travels in
 /// the ray's id). This is the definition the tests' brute-force ray caster uses.
 ///
-/// The scene is copied into its own Embree scene (robust traversal, the filter attached);
-/// degenerate triangles (no chart) are left out. Copies share it; it is immutable after
-/// construction apart from the shot, which begin_shot sets and visible only reads.
+/// The rays go through an `accel`'s BVH, the caller's when it has one: the charts are
+/// passed in each query's intersect context to a context filter (accel's scenes allow one),
+/// which also lets rays pass triangles without a chart. So a renderer that has an accel
+/// builds no second BVH and makes no second Embree device. Copies share the accel and the
+/// charts; the object is immutable after construction apart from the shot, which begin_shot
+/// sets and visible only reads.
 
 #include <bounce/embree/accel.hpp>
 #include <bounce/scene_view.hpp>
@@ -23,6 +26,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -37,10 +41,6 @@ struct radiosity_shot {
     std::uint32_t chart = none;     ///< the shooter's chart, which never blocks its own rays
 };
 
-namespace detail {
-struct radiosity_scene;
-}
-
 /// Exact visibility by occlusion rays (see the file comment).
 class radiosity_visibility {
 public:
@@ -50,14 +50,22 @@ public:
         float end_tolerance = 1e-5f;
     };
 
-    /// Builds on `dev` from `scene` and the chart of each of its triangles
-    /// (lightmap_atlas::chart_of_triangle, radiosity_shot::none for triangles to leave out).
-    /// Throws parameter_error when the sizes differ or the options are out of range, and
-    /// embree_error when Embree fails.
+    /// Visibility through `bvh` (its device, triangles and BVH), with the chart of each of
+    /// its triangles (lightmap_atlas::chart_of_triangle of the scene `bvh` was built from;
+    /// radiosity_shot::none for triangles that never block). Throws parameter_error when
+    /// the sizes differ or the options are out of range.
+    radiosity_visibility(const accel& bvh, std::span<const std::uint32_t> chart_of_triangle, options opt);
+    radiosity_visibility(const accel& bvh, std::span<const std::uint32_t> chart_of_triangle)
+        : radiosity_visibility(bvh, chart_of_triangle, options{}) {}
+    /// Builds an accel of `scene` on `dev` for itself, then as above. Throws parameter_error
+    /// as above and as accel does, and embree_error when Embree fails.
     radiosity_visibility(const device& dev, const scene_view& scene, std::span<const std::uint32_t> chart_of_triangle,
                          options opt);
     radiosity_visibility(const device& dev, const scene_view& scene, std::span<const std::uint32_t> chart_of_triangle)
         : radiosity_visibility(dev, scene, chart_of_triangle, options{}) {}
+
+    /// The accel the rays go through (the caller's, or the one built for the scene).
+    const accel& bvh() const noexcept { return bvh_; }
 
     /// Prepares for a shot. `Frame` has position, axis, parallel and chart (cpu::shot_frame).
     template <class Frame>
@@ -77,7 +85,8 @@ public:
     void visible(std::span<const glm::vec3> points, std::span<const std::uint32_t> charts, std::span<float> out) const;
 
 private:
-    std::shared_ptr<const detail::radiosity_scene> scene_;
+    accel bvh_;
+    std::shared_ptr<const std::vector<std::uint32_t>> chart_;  // per triangle of bvh_
     radiosity_shot shot_{};
     options options_{};
 };

@@ -1,5 +1,5 @@
 #pragma once
-/// \file cache/record_sampler.hpp
+/// \file embree/record_sampler.hpp
 /// Irradiance records by ray tracing: a stratified hemisphere of rays through Embree, hits
 /// shaded with direct light and shadow rays (the reference integrator's radiance), then
 /// irradiance, gradients and radius from bounce/cache/gradients.hpp.
@@ -42,6 +42,23 @@ namespace bounce::embree {
 
 class record_sampler {
 public:
+    /// The grid of a record when the caller names none: settings().hemisphere_samples of the
+    /// integrator (default 1024) on the M x N grid of hemisphere_grid_for, M = round(sqrt(S /
+    /// pi)) rings of equal projected solid angle by N = round(S / M) wedges (18 x 57 for
+    /// 1024). That is the stratification cache/gradients.hpp differentiates, in the proportion
+    /// N ~ pi M of Ward and Heckbert (1992) that Gautron and Krivanek's irradiance caching
+    /// keeps (strata of about square solid angle); the rays per record are the one number a
+    /// caller tunes, in the integrator's settings (records take 64 to 1024, references 1024).
+    static hemisphere_grid default_grid(const reference_integrator& integrator) {
+        return hemisphere_grid_for(integrator.settings().hemisphere_samples);
+    }
+
+    /// Records on default_grid(integrator); `limits`, `kind` and `seed` as below.
+    explicit record_sampler(const reference_integrator& integrator, radius_limits limits = {},
+                            translation_gradient_kind kind = translation_gradient_kind::krivanek_2005,
+                            std::uint64_t seed = 7)
+        : record_sampler(integrator, default_grid(integrator), limits, kind, seed) {}
+
     /// `grid`: the M x N strata per record (typical 16 x 50); `limits`: radius clamps;
     /// `kind`: translation-gradient formula; `seed`: base of the per-record streams (each keyed by its point).
     record_sampler(const reference_integrator& integrator, hemisphere_grid grid, radius_limits limits,
