@@ -287,32 +287,40 @@ bool accel::occluded(const ray& r) const {
     return found_occluder(rh.ray);
 }
 
+namespace {
+
+// Calls query(base, n) for the consecutive chunks [base, base + n) of `count` rays, n <= size:
+// streams go through Embree in chunks that fit the stack (memory stays bounded), packets in
+// chunks of their width.
+template <class Query>
+void in_chunks(std::size_t count, std::size_t size, Query&& query) {
+    for (std::size_t base = 0; base < count; base += size) query(base, std::min(size, count - base));
+}
+
+constexpr std::size_t stream_chunk = 256;
+
+}  // namespace
+
 void accel::intersect(std::span<const ray> rays, std::span<hit> hits, bool coherent) const {
     require_sizes(rays.size(), hits.size());
-    // Streams go through Embree in chunks that fit the stack, keeping memory bounded.
-    constexpr std::size_t chunk = 256;
-    RTCRayHit buffer[chunk];
+    RTCRayHit buffer[stream_chunk];
     RTCIntersectContext c = context(coherent);
-    for (std::size_t base = 0; base < rays.size(); base += chunk) {
-        const std::size_t n = std::min(chunk, rays.size() - base);
+    in_chunks(rays.size(), stream_chunk, [&](std::size_t base, std::size_t n) {
         for (std::size_t i = 0; i < n; ++i) buffer[i] = to_rayhit(rays[base + i]);
         rtcIntersect1M(state_->handle, &c, buffer, unsigned(n), sizeof(RTCRayHit));
         for (std::size_t i = 0; i < n; ++i) hits[base + i] = from_rayhit(buffer[i]);
-    }
+    });
 }
 
 void accel::occluded(std::span<const ray> rays, std::span<std::uint8_t> blocked, bool coherent) const {
     require_sizes(rays.size(), blocked.size());
-    constexpr std::size_t chunk = 256;
-    RTCRay buffer[chunk];
+    RTCRay buffer[stream_chunk];
     RTCIntersectContext c = context(coherent);
-    for (std::size_t base = 0; base < rays.size(); base += chunk) {
-        const std::size_t n = std::min(chunk, rays.size() - base);
+    in_chunks(rays.size(), stream_chunk, [&](std::size_t base, std::size_t n) {
         for (std::size_t i = 0; i < n; ++i) buffer[i] = to_rayhit(rays[base + i]).ray;
         rtcOccluded1M(state_->handle, &c, buffer, unsigned(n), sizeof(RTCRay));
-        for (std::size_t i = 0; i < n; ++i)
-            blocked[base + i] = found_occluder(buffer[i]) ? 1 : 0;
-    }
+        for (std::size_t i = 0; i < n; ++i) blocked[base + i] = found_occluder(buffer[i]) ? 1 : 0;
+    });
 }
 
 namespace {
@@ -351,8 +359,7 @@ void fill_packet(std::span<const ray> rays, std::size_t base, std::size_t n, int
 void accel::intersect_packets(std::span<const ray> rays, std::span<hit> hits) const {
     require_sizes(rays.size(), hits.size());
     RTCIntersectContext c = context(true);
-    for (std::size_t base = 0; base < rays.size(); base += packet_width) {
-        const std::size_t n = std::min(packet_width, rays.size() - base);
+    in_chunks(rays.size(), packet_width, [&](std::size_t base, std::size_t n) {
         alignas(32) int valid[packet_width];
         RTCRayHit8 rh;
         fill_packet(rays, base, n, valid, rh.ray);
@@ -372,21 +379,20 @@ void accel::intersect_packets(std::span<const ray> rays, std::span<hit> hits) co
             }
             hits[base + i] = h;
         }
-    }
+    });
 }
 
 void accel::occluded_packets(std::span<const ray> rays, std::span<std::uint8_t> blocked) const {
     require_sizes(rays.size(), blocked.size());
     RTCIntersectContext c = context(true);
-    for (std::size_t base = 0; base < rays.size(); base += packet_width) {
-        const std::size_t n = std::min(packet_width, rays.size() - base);
+    in_chunks(rays.size(), packet_width, [&](std::size_t base, std::size_t n) {
         alignas(32) int valid[packet_width];
         RTCRay8 r8;
         fill_packet(rays, base, n, valid, r8);
         rtcOccluded8(valid, state_->handle, &c, &r8);
         // rtcOccluded8 sets a lane's tfar to -inf when it finds an occluder.
         for (std::size_t i = 0; i < n; ++i) blocked[base + i] = r8.tfar[i] < 0.f && std::isinf(r8.tfar[i]) ? 1 : 0;
-    }
+    });
 }
 
 std::size_t accel::triangle_count() const noexcept { return state_->triangles; }

@@ -45,40 +45,52 @@ void allocate(reflective_shadow_map& m, std::size_t r) {
     m.flux = image<glm::vec3>(r, r);
 }
 
-// Fills `m` with the perspective map `layout` of `l`, each texel's flux from `flux_of`.
-void cast_perspective(const accel& bvh, const scene_view& scene, const packed_light& l, const rsm_map_layout& layout,
-                      std::size_t r, texel_flux flux_of, reflective_shadow_map& m) {
-    const camera cam = layout.perspective_camera();
-    const glm::vec3 forward = layout.forward;
-    allocate(m, r);
-    m.light_view_projection = layout.light_view_projection;
-    m.orthographic = false;
-    m.texel_size = layout.texel_size;
-    const double t = std::tan(glm::radians(double(layout.fov_deg)) * 0.5);
+// Fills the r x r texels of `m`, rows on every core: texel (x, y) is what ray_of(x, y)
+// hits, its flux flux_at(surface, x, y); a texel whose ray hits nothing is empty (no
+// position, flux or light: normal `empty_normal`).
+template <class RayOf, class FluxAt>
+void cast_texels(const accel& bvh, const scene_view& scene, std::size_t r, glm::vec3 empty_normal, RayOf ray_of,
+                 FluxAt flux_at, reflective_shadow_map& m) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r), [&](const tbb::blocked_range<std::size_t>& rows) {
         std::vector<ray> rays(r);
         std::vector<hit> hits(r);
         for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
-            for (std::size_t x = 0; x < r; ++x) {
-                rays[x].origin = cam.position;
-                rays[x].direction = cam.direction(float(x) + 0.5f, float(y) + 0.5f, r, r);
-                rays[x].tnear = 0.f;
-            }
+            for (std::size_t x = 0; x < r; ++x) rays[x] = ray_of(x, y);
             bvh.intersect(rays, hits, /*coherent=*/true);
             for (std::size_t x = 0; x < r; ++x) {
                 if (!hits[x].found()) {
                     m.position(x, y) = glm::vec3(0.f);
-                    m.normal(x, y) = -forward;
+                    m.normal(x, y) = empty_normal;
                     m.flux(x, y) = glm::vec3(0.f);
                     continue;
                 }
                 const surface s = surface_at(scene, rays[x], hits[x]);
                 m.position(x, y) = s.position;
                 m.normal(x, y) = s.normal;
-                m.flux(x, y) = flux_of(l, s, rsm_texel_solid_angle(t, r, x, y));
+                m.flux(x, y) = flux_at(s, x, y);
             }
         }
     });
+}
+
+// Fills `m` with the perspective map `layout` of `l`, each texel's flux from `flux_of`.
+void cast_perspective(const accel& bvh, const scene_view& scene, const packed_light& l, const rsm_map_layout& layout,
+                      std::size_t r, texel_flux flux_of, reflective_shadow_map& m) {
+    const camera cam = layout.perspective_camera();
+    allocate(m, r);
+    m.light_view_projection = layout.light_view_projection;
+    m.orthographic = false;
+    m.texel_size = layout.texel_size;
+    const double t = std::tan(glm::radians(double(layout.fov_deg)) * 0.5);
+    cast_texels(
+        bvh, scene, r, -layout.forward,
+        [&](std::size_t x, std::size_t y) {
+            return ray{.origin = cam.position, .direction = cam.direction(float(x) + 0.5f, float(y) + 0.5f, r, r)};
+        },
+        [&](const surface& s, std::size_t x, std::size_t y) {
+            return flux_of(l, s, rsm_texel_solid_angle(t, r, x, y));
+        },
+        m);
 }
 
 // Fills `m` with the orthographic map `layout` across the beam of the directional light `l`.
@@ -96,32 +108,17 @@ void cast_orthographic(const accel& bvh, const scene_view& scene, const packed_l
     const double side = 2.0 * double(radius) / double(r);
     m.texel_size = layout.texel_size;
     const float area = float(side * side);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r), [&](const tbb::blocked_range<std::size_t>& rows) {
-        std::vector<ray> rays(r);
-        std::vector<hit> hits(r);
-        for (std::size_t y = rows.begin(); y != rows.end(); ++y) {
+    cast_texels(
+        bvh, scene, r, -d,
+        [&](std::size_t x, std::size_t y) {
+            const float u = float(-double(radius) + (double(x) + 0.5) * side);
             const float v = float(double(radius) - (double(y) + 0.5) * side);
-            for (std::size_t x = 0; x < r; ++x) {
-                const float u = float(-double(radius) + (double(x) + 0.5) * side);
-                rays[x].origin = eye + u * right + v * true_up;
-                rays[x].direction = d;
-                rays[x].tnear = 0.f;
-            }
-            bvh.intersect(rays, hits, /*coherent=*/true);
-            for (std::size_t x = 0; x < r; ++x) {
-                if (!hits[x].found()) {
-                    m.position(x, y) = glm::vec3(0.f);
-                    m.normal(x, y) = -d;
-                    m.flux(x, y) = glm::vec3(0.f);
-                    continue;
-                }
-                const surface s = surface_at(scene, rays[x], hits[x]);
-                m.position(x, y) = s.position;
-                m.normal(x, y) = s.normal;
-                m.flux(x, y) = directional_light_texel_flux<float, glm::vec3>(s.albedo, s.normal, d, l.intensity(), area);
-            }
-        }
-    });
+            return ray{.origin = eye + u * right + v * true_up, .direction = d};
+        },
+        [&](const surface& s, std::size_t, std::size_t) {
+            return directional_light_texel_flux<float, glm::vec3>(s.albedo, s.normal, d, l.intensity(), area);
+        },
+        m);
 }
 
 bool any_flux(const reflective_shadow_map& m) {
