@@ -7,6 +7,7 @@
 #include <bounce/glsl/emit.hpp>
 #include <bounce/splat_bounds.hpp>
 
+#include "fullscreen_triangle.hpp"
 #include "saved_state.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
@@ -95,14 +96,6 @@ void upload_rows(const texture& t, const std::vector<glm::vec4>& gl_rows) {
     glTextureSubImage2D(t.id(), 0, 0, 0, GLsizei(t.width()), GLsizei(t.height()), GL_RGBA, GL_FLOAT, gl_rows.data());
     check_error("glTextureSubImage2D");
 }
-
-// The full-screen triangle: plumbing shared by the compose pass.
-constexpr const char* fullscreen_vertex = R"(#version 450 core
-void main() {
-    vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
-    gl_Position = vec4(corner - 1.0, 0.0, 1.0);
-}
-)";
 
 }  // namespace
 
@@ -462,10 +455,10 @@ std::string compose_fragment(bool with_direct, bool with_wide) {
 }  // namespace
 
 compose_pass::compose_pass()
-    : with_direct_(fullscreen_vertex, compose_fragment(true, false)),
-      without_direct_(fullscreen_vertex, compose_fragment(false, false)),
-      with_direct_wide_(fullscreen_vertex, compose_fragment(true, true)),
-      without_direct_wide_(fullscreen_vertex, compose_fragment(false, true)) {}
+    : with_direct_(detail::fullscreen_vertex, compose_fragment(true, false)),
+      without_direct_(detail::fullscreen_vertex, compose_fragment(false, false)),
+      with_direct_wide_(detail::fullscreen_vertex, compose_fragment(true, true)),
+      without_direct_wide_(detail::fullscreen_vertex, compose_fragment(false, true)) {}
 
 void compose_pass::compose(const texture& splat, const texture* direct) { compose(splat, direct, nullptr, 0.f); }
 
