@@ -91,7 +91,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
         return true;
     };
     s.checkpoint = [&](const radiosity_progress& p) {
-        const auto v = cmp.view(solver.atlas(), solver.lightmap(level), level, o);
+        const auto v = cmp.view(solver.atlas(), solver.radiosity_lightmap(level), level, o);
         r.curve.push_back({p.steps, p.shots, solver.atlas().size(), setup_ms + p.elapsed_ms, p.unshot_fraction, cmp.rel_rms(v)});
     };
     if constexpr (cpu) r.report = o.adaptive ? solver.solve(s, scene, subdivision_options_for(o), std::size_t(o.subdivide_steps))
@@ -113,7 +113,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     r.charts = a.charts.size();
     r.base_elements = base_elements;
     std::tie(r.emitted, r.absorbed, r.escaped) = std::tuple(solver.emitted_power(), solver.absorbed_power(), solver.escaped_power());
-    r.lightmap = solver.lightmap(level);
+    r.lightmap = solver.radiosity_lightmap(level);
     const auto u = solver.unshot();
     const std::vector<glm::vec3> unshot(u.begin(), u.end());
     r.unshot = a.to_fine_texels(std::span<const glm::vec3>(unshot), level);

@@ -282,7 +282,7 @@ TEST_CASE("a directional light shot first gives the CPU's direct radiosity, shad
     CHECK(gl_solver.emitted_power().x > 0);
 }
 
-TEST_CASE("the GL lightmap texture is the solver's lightmap, padding filled, with and without the ambient term",
+TEST_CASE("the GL lightmap texture is the solver's radiosity lightmap, padding filled, with and without the ambient term",
           "[gl][radiosity]") {
     // Both lay out display_radiosity by element_at: the same float values (each texel holds one
     // element's value, no division) through the same kernel radiosity_with_ambient; with the
@@ -293,7 +293,7 @@ TEST_CASE("the GL lightmap texture is the solver's lightmap, padding filled, wit
     for (const bool ambient : {false, true}) {
         gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient}, .resolution = 64});
         for (int s = 0; s < 10; ++s) REQUIRE(solver.step());
-        const auto expected = solver.lightmap();
+        const auto expected = solver.radiosity_lightmap();
         const gl::texture_ref t = solver.update_lightmap_texture();
         REQUIRE(t.width == atlas.width);
         REQUIRE(t.height == atlas.height);

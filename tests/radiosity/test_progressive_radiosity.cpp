@@ -311,7 +311,7 @@ TEST_CASE("the ambient term brightens the display before convergence and vanishe
     solver.solve(1e-14);
     CHECK(glm::length(solver.ambient()) < 1e-12);
     // The lightmap holds the display radiosity at each element's texel.
-    const auto lm = solver.lightmap();
+    const auto lm = solver.radiosity_lightmap();
     const auto shown = solver.display_radiosity();
     for (std::size_t i = 0; i < atlas.size(); ++i) CHECK(lm(atlas.texel[i].x, atlas.texel[i].y) == shown[i]);
 }

@@ -164,7 +164,7 @@ TEST_CASE("subdividing during a solve keeps the power balance and refines where 
     CHECK(deepest <= o.max_level);
     // The lightmap still covers the atlas: every element's base texel holds the area-weighted
     // mean of the elements in it.
-    const auto lm = solver.lightmap();
+    const auto lm = solver.radiosity_lightmap();
     CHECK(lm.width() == atlas.width);
     solver.solve(0.1);
     CHECK(solver.unshot_fraction() <= 0.1);

@@ -2,6 +2,8 @@
 // 1988; Coombe and Harris 2005). See radiosity/kernels.hpp for the steps and docs/radiosity-gl.md.
 #include "radiosity_state.hpp"
 
+#include <numbers>
+
 namespace bounce::gl {
 
 void radiosity_options::validate() const {
@@ -49,6 +51,7 @@ progressive_radiosity::progressive_radiosity(const scene_view& scene, const ligh
     for (const light& l : scene.lights) s_->shoot_light(pack(l));
     finish();
     s_->timings.lights_ms = ms_since(start);
+    direct_ = radiosity();
     s_->reduce();
     check_lights_reach_surfaces(scene, s_->atlas, s_->emitted);
 }
@@ -110,7 +113,29 @@ std::vector<glm::vec3> progressive_radiosity::display_radiosity() const {
         out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb);
     return out;
 }
-image<glm::vec3> progressive_radiosity::lightmap(int level) const {
+std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, light_paths paths) const {
+    const lightmap_atlas& at = s_->atlas;
+    std::vector<glm::vec3> out = radiosity();
+    const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
+    const glm::vec3 amb = s_->options.shooting.ambient && indirect ? glm::vec3(ambient()) : glm::vec3(0.f);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        // Reflected radiosity of the parts asked for: rho E.
+        const glm::vec3 reflected = (direct ? direct_[i] - at.emission[i] : glm::vec3(0.f)) +
+                                    (indirect ? out[i] - direct_[i] + at.albedo[i] * amb : glm::vec3(0.f));
+        if (quantity == output_quantity::radiance) {
+            out[i] = (reflected + (direct ? at.emission[i] : glm::vec3(0.f))) * float(1.0 / std::numbers::pi);
+            continue;
+        }
+        for (int c = 0; c < 3; ++c)
+            out[i][c] = at.albedo[i][c] > 0.f ? std::max(reflected[c], 0.f) / at.albedo[i][c] : 0.f;
+    }
+    return out;
+}
+image<glm::vec3> progressive_radiosity::lightmap(output_quantity quantity, light_paths paths, int level) const {
+    const auto values = output(quantity, paths);
+    return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
+}
+image<glm::vec3> progressive_radiosity::radiosity_lightmap(int level) const {
     const auto values = display_radiosity();
     return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
 }

@@ -65,7 +65,7 @@ technique_run run_radiosity(const scene_setup& s) {
     r.technique = bench_technique::radiosity;
     r.quantity = bench_quantity::all_bounces;
     const auto tv = std::chrono::steady_clock::now();
-    const image<glm::vec3> lightmap = solver.lightmap(0);
+    const image<glm::vec3> lightmap = solver.radiosity_lightmap(0);
     r.radiance = embree::lightmap_view(s.bvh, s.scene, solver.atlas(), lightmap.view(), 0, s.scene.camera,
                                        s.g.width(), s.g.height());
     const double view_ms = ms_since(tv);

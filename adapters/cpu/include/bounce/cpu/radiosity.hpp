@@ -20,6 +20,12 @@
 /// degrees, parallel rays for a directional light). Their power is counted as what reaches
 /// the elements: emitted power = sum E_i A_i + sum of direct irradiance times area.
 ///
+/// Outputs (output.hpp): radiosity() is the solver's unknown B (emission included);
+/// output() and lightmap() give irradiance or radiance, direct or indirect or both. The direct
+/// part is what the lights above deliver (direct_ per element); the indirect part is what
+/// the shots delivered, kept as irradiance per element (gathered_), so that irradiance is
+/// exact even where an albedo channel is 0.
+///
 /// Energy: with the disc form factor a shot hands out dB_s sum_r F_{r->s} V A_r, which need not
 /// equal the shot power dB_s A_s (energy leaves open scenes; and the approximation is not
 /// exactly conservative). The solver keeps, in double per channel, absorbed power (the
@@ -34,6 +40,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
 #include <bounce/light.hpp>
+#include <bounce/output.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
@@ -47,6 +54,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <numbers>
 #include <numeric>
 #include <span>
 #include <utility>
@@ -72,7 +80,7 @@ using bounce::radiosity_timings;
 /// and the triangle count made before anything is allocated, so a caller can refuse a budget
 /// that cannot fit (`--elements 50000000`) instead of dying in std::bad_alloc or the OOM
 /// killer. Per element: the atlas's arrays (64 bytes), twice while the solver copies it, and
-/// the solver's radiosity, unshot and direct arrays (36); per texel of the atlas (elements
+/// the solver's radiosity, unshot, direct and gathered arrays (48); per texel of the atlas (elements
 /// plus each chart's padding ring and the packing's waste, at most one chart per triangle):
 /// element_at, the build's overlap sums and the lightmaps laid out (56); per triangle the
 /// build's adjacency (about 200). Visibility is not included (an item buffer: about 112
@@ -84,7 +92,7 @@ inline double radiosity_memory_estimate(const scene_view& scene, const atlas_opt
     const double p = double(options.padding);
     const double texels = 1.25 * (1.3 * e + 4 * p * std::sqrt(e * n) + 4 * p * p * n);
     const double shooters = e / double(options.block_texels * options.block_texels) + n;
-    return e * (2 * 64 + 36) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
+    return e * (2 * 64 + 48) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
 }
 
 /// The solver. `Real` is the type of the radiosity arrays and of the kernel's arithmetic
@@ -119,6 +127,7 @@ public:
         build_shooters();
         const auto start = clock::now();
         direct_.assign(n, vec(0));
+        gathered_.assign(n, vec(0));
         for (const light& l : scene.lights) lights_.push_back(pack(l));
         for (const packed_light& l : lights_) shoot_light(l, false);
         timings_.lights_ms = ms_since(start);
@@ -216,6 +225,36 @@ public:
         return unshot_power() / total_area_ / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
     }
 
+    /// Per element, the light of `paths` as `quantity` (output.hpp): irradiance (W/m^2) or
+    /// the radiance of the atlas's albedo (W/(m^2 sr)). Direct: the point, spot and
+    /// directional lights' irradiance times visibility (as radiance, plus the emission
+    /// L_e); indirect: what the shots delivered (emissive surfaces' light included), plus the
+    /// ambient term when the options ask. Radiance of `all` is display_radiosity() / pi.
+    std::vector<glm::vec3> output(output_quantity quantity = output_quantity::irradiance,
+                                  light_paths paths = light_paths::indirect) const {
+        std::vector<glm::vec3> out(radiosity_.size());
+        const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
+        const glm::vec3 amb = options_.ambient && indirect ? glm::vec3(ambient()) : glm::vec3(0.f);
+        for (std::size_t i = 0; i < out.size(); ++i) {
+            const glm::vec3 e = (direct ? glm::vec3(direct_[i]) : glm::vec3(0.f)) +
+                                (indirect ? glm::vec3(gathered_[i]) + amb : glm::vec3(0.f));
+            out[i] = quantity == output_quantity::irradiance ? e : lambertian_radiance<float, glm::vec3>(atlas_.albedo[i], e);
+            if (quantity == output_quantity::radiance && direct)
+                out[i] += atlas_.emission[i] * float(1.0 / std::numbers::pi);
+        }
+        return out;
+    }
+
+    /// output(quantity, paths) laid out as the atlas at 2^level times its resolution
+    /// (lightmap_atlas::to_fine_texels: unsplit regions interpolated from the base texels;
+    /// level > 0 shows what adaptive subdivision added): the lightmap a renderer samples with
+    /// the atlas's corner_uvs.
+    image<glm::vec3> lightmap(output_quantity quantity = output_quantity::irradiance,
+                              light_paths paths = light_paths::indirect, int level = 0) const {
+        const auto values = output(quantity, paths);
+        return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level, glm::vec3(0.f), true);
+    }
+
     /// Radiosity to display now: B, plus rho times the ambient term when the options ask.
     std::vector<glm::vec3> display_radiosity() const {
         std::vector<glm::vec3> out(radiosity_.size());
@@ -225,11 +264,9 @@ public:
         return out;
     }
 
-    /// display_radiosity laid out as the atlas at 2^level times its resolution
-    /// (lightmap_atlas::to_fine_texels, unsplit regions interpolated from the base texels;
-    /// level > 0 shows what adaptive subdivision added), for
-    /// writing a lightmap or texturing a view.
-    image<glm::vec3> lightmap(int level = 0) const {
+    /// display_radiosity (B, W/m^2) laid out as lightmap() lays outputs out: what
+    /// embree::lightmap_view takes.
+    image<glm::vec3> radiosity_lightmap(int level = 0) const {
         const auto values = display_radiosity();
         return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level, glm::vec3(0.f), true);
     }
@@ -258,16 +295,19 @@ public:
         const auto split = blocks_to_subdivide(atlas_, std::span<const glm::vec3>(b), options);
         if (!split.empty()) {
             atlas_refinement r = refine_lightmap_atlas(scene, atlas_, split);
-            std::vector<vec> radiosity(r.parent.size()), unshot(r.parent.size()), direct(r.parent.size());
+            std::vector<vec> radiosity(r.parent.size()), unshot(r.parent.size()), direct(r.parent.size()),
+                gathered(r.parent.size());
             for (std::size_t i = 0; i < r.parent.size(); ++i) {
                 radiosity[i] = radiosity_[r.parent[i]];
                 unshot[i] = unshot_[r.parent[i]];
                 direct[i] = direct_[r.parent[i]];
+                gathered[i] = gathered_[r.parent[i]];
             }
             atlas_ = std::move(r.atlas);
             radiosity_ = std::move(radiosity);
             unshot_ = std::move(unshot);
             direct_ = direct;
+            gathered_ = std::move(gathered);
             build_shooters();  // the distribution below walks the new shooters' elements
             if (!lights_.empty()) {
                 regather_lights(direct);
@@ -426,6 +466,7 @@ private:
             gain *= v;
             radiosity_[i] += gain;
             unshot_[i] += gain;
+            gathered_[i] += vec(incident * double(v));
             const glm::dvec3 intercepted = incident * (double(v) * double(at.area[i]));
             s.intercepted += intercepted;
             s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
@@ -521,6 +562,7 @@ private:
     radiosity_options options_;
     std::vector<vec> radiosity_, unshot_;
     std::vector<vec> direct_;             // direct irradiance from lights_ per element (W/m^2)
+    std::vector<vec> gathered_;           // irradiance the shots delivered per element (W/m^2)
     std::vector<packed_light> lights_;    // the scene's point, spot and directional lights
     std::vector<std::uint32_t> first_;
     std::vector<glm::vec3> centre_;

@@ -41,6 +41,7 @@
 #include <bounce/gl/errors.hpp>
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
+#include <bounce/output.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/radiosity/options.hpp>
 #include <bounce/radiosity/solve.hpp>
@@ -146,13 +147,22 @@ public:
     /// The ambient radiosity (Cohen et al. 1988) and B plus rho times it when the options ask.
     glm::dvec3 ambient() const;
     std::vector<glm::vec3> display_radiosity() const;
-    /// display_radiosity laid out as the atlas at 2^level times its resolution
-    /// (lightmap_atlas::to_fine_texels; level 0: to_texels, padding filled), as
-    /// cpu::progressive_radiosity::lightmap gives it.
-    image<glm::vec3> lightmap(int level = 0) const;
+    /// Per element, the light of `paths` as `quantity` (output.hpp), as
+    /// cpu::progressive_radiosity::output gives it. The parts come from B and the B read back
+    /// after the lights were shot (direct radiosity B_e + rho E_d): irradiance is a part's
+    /// reflected radiosity divided by rho per channel, so a channel whose albedo is 0 reports
+    /// 0 here (the CPU solver, which keeps irradiance itself, reports the light that arrived).
+    std::vector<glm::vec3> output(output_quantity quantity = output_quantity::irradiance,
+                                  light_paths paths = light_paths::indirect) const;
+    /// output(quantity, paths) laid out as the atlas (lightmap_atlas::to_fine_texels; level 0:
+    /// to_texels, padding filled), as cpu::progressive_radiosity::lightmap gives it.
+    image<glm::vec3> lightmap(output_quantity quantity = output_quantity::irradiance,
+                              light_paths paths = light_paths::indirect, int level = 0) const;
+    /// display_radiosity (B, W/m^2) laid out the same way: what embree::lightmap_view takes.
+    image<glm::vec3> radiosity_lightmap(int level = 0) const;
     /// Writes display_radiosity laid out as the atlas into the solver's lightmap texture
     /// (RGBA32F, atlas size, alpha 1 on charts, 0 elsewhere) on the GPU, padding texels
-    /// filled from their element as lightmap() fills them, so a renderer can sample it
+    /// filled from their element as radiosity_lightmap() fills them, so a renderer can sample it
     /// bilinearly with the atlas's corner_uvs; returns it (valid while the solver lives).
     texture_ref update_lightmap_texture();
     /// The solver's radiosity and unshot textures (RGBA32F, atlas size, element texels only;
@@ -170,6 +180,7 @@ public:
 private:
     struct state;
     std::unique_ptr<state> s_;
+    std::vector<glm::vec3> direct_;  // B once the lights were shot (emission + rho E_d), per element
 };
 
 }  // namespace bounce::gl
