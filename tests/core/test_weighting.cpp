@@ -259,3 +259,40 @@ TEST_CASE("neighbour clamping makes radii 1-Lipschitz", "[record]") {
         for (std::size_t j = 0; j < i; ++j)
             CHECK(recs[i].radius <= recs[j].radius + glm::length(recs[i].position - recs[j].position) + 1e-6f);
 }
+
+namespace {
+// A class template over a policy, standing in for cpu::irradiance_cache<Weight>.
+template <class Weight>
+struct policy_holder {
+    float weight_at(const query& q) const { return w_of<Weight>(q); }
+};
+}  // namespace
+
+TEST_CASE("policy types and weighting kinds map both ways, by name too", "[weighting][vocabulary]") {
+    static_assert(weighting_kind_of<ward_smooth_weight> == weighting_kind::ward_smooth);
+    static_assert(weighting_kind_of<const tabellion_weight&> == weighting_kind::tabellion);
+    static_assert(named_weighting<ward_scaled_normal_weight> && !named_weighting<ward_early_reject_weight<1, 3>>,
+                  "only the policies the GL pass compiles have a kind");
+    static_assert(!named_weighting<weighting_kind>);
+    for (const weighting_kind k : weighting_kinds) {
+        CHECK(with_weighting(k, [](auto w) { return weighting_kind_of<decltype(w)>; }) == k);
+        CHECK(parse_weighting(weighting_name(k)) == k);
+    }
+    CHECK(weighting_name(weighting_kind::ward_early_reject) == "ward-gpu");
+    CHECK(weighting_name(weighting_kind::ward_scaled_normal) == "ward-gpu-shader");
+    CHECK_FALSE(parse_weighting("Ward").has_value());
+    CHECK_FALSE(parse_weighting("").has_value());
+
+    // A policy-templated type chosen at run time: the variant holds the kind's instantiation
+    // and weighs exactly as that policy does.
+    const std::vector<query> qs = queries();
+    for (const weighting_kind k : weighting_kinds) {
+        const weighting_variant<policy_holder> held =
+            with_weighting(k, [](auto w) { return weighting_variant<policy_holder>(policy_holder<decltype(w)>{}); });
+        CHECK(held.index() == std::size_t(k));
+        for (const query& q : qs) {
+            const float by_variant = std::visit([&](const auto& h) { return h.weight_at(q); }, held);
+            CHECK(by_variant == with_weighting(k, [&](auto w) { return w_of<decltype(w)>(q); }));
+        }
+    }
+}

@@ -327,6 +327,31 @@ TEST_CASE("appending records and splatting only them on top of an uploaded buffe
     CHECK(std::memcmp(at_once.data(), one_by_one.read_splat().data(), W * H * sizeof(glm::vec4)) == 0);
 }
 
+TEST_CASE("the splat pass takes the weighting as a policy object as well as a kind", "[gl][splat][weighting]") {
+    gl_test::shared_context();
+    plane_view v;
+    const auto recs = test_records(v);
+    const gl::gbuffer_upload gbuf(v.gb.view());
+    gl::splat_params sp;
+    sp.a = 0.3f;
+    gl::splat_pass pass;
+    pass.upload(recs);
+    auto splat_with = [&](auto weighting) {
+        pass.clear(W, H);
+        pass.splat(gbuf.textures(), v.cam, sp, weighting);
+        return pass.read_splat();
+    };
+    for (const weighting_kind kind : weighting_kinds) {
+        INFO("weighting " << kind_name(kind));
+        const auto by_kind = splat_with(kind);
+        const auto by_policy = with_weighting(kind, [&](auto w) { return splat_with(w); });
+        CHECK(std::memcmp(by_kind.data(), by_policy.data(), W * H * sizeof(glm::vec4)) == 0);
+    }
+    // The policy chose the program: two policies give two different buffers.
+    const auto ward = splat_with(ward_weight{}), tabellion = splat_with(tabellion_weight{});
+    CHECK(std::memcmp(ward.data(), tabellion.data(), W * H * sizeof(glm::vec4)) != 0);
+}
+
 TEST_CASE("normalization and composition on the GPU equal cpu::normalize_splats and cpu::compose",
           "[gl][splat][compose]") {
     gl_test::shared_context();

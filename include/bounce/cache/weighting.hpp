@@ -23,6 +23,10 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <string_view>
+#include <type_traits>
+#include <variant>
 
 namespace bounce::inline cache {
 
@@ -88,10 +92,13 @@ struct ward_smooth_weight {
 /// That shader uses c = 0.2 where Eq. 8.2 implies c = 1; `NormalScale` selects c: 1 (the
 /// default) reproduces Eq. 8.2 exactly, 1/5 the shader as printed (ward_scaled_normal_weight).
 /// Nothing here needs a GPU: the CPU runs it as well. `name` keeps the command-line and
-/// results spelling `ward-gpu`.
+/// results spellings: `ward-gpu` for c = 1, `ward-gpu-shader` for c = 1/5 (any other
+/// scale is `ward-gpu-scaled`, which no weighting_kind has).
 template <int NormalScaleNumerator = 1, int NormalScaleDenominator = 1>
 struct ward_early_reject_weight {
-    static constexpr const char* name = "ward-gpu";
+    static constexpr const char* name = NormalScaleNumerator == NormalScaleDenominator ? "ward-gpu"
+                                        : NormalScaleDenominator == 5 * NormalScaleNumerator ? "ward-gpu-shader"
+                                                                                             : "ward-gpu-scaled";
     static constexpr double normal_scale = double(NormalScaleNumerator) / NormalScaleDenominator;
 
     template <real T, vec3_of<T> V>
@@ -128,15 +135,31 @@ struct tabellion_weight {
     static T influence_radius(T r, T a) { return a * r; }
 };
 
-/// The weighting functions a program can choose at run time.
-/// Command-line spellings: ward, ward-smooth, ward-gpu (ward_early_reject), ward-gpu-shader
-/// (ward_scaled_normal), tabellion.
+/// The weighting functions a program can choose at run time, one per named policy above.
+/// Command-line spellings (each policy's `name`): ward, ward-smooth, ward-gpu
+/// (ward_early_reject), ward-gpu-shader (ward_scaled_normal), tabellion.
+///
+/// One vocabulary, two forms: the CPU cache and splatting take the policy as a template
+/// argument (`cpu::irradiance_cache<ward_smooth_weight>`), the GL splat pass compiles a
+/// program per kind at run time (`gl::splat_pass::splat(..., weighting_kind)`). Either
+/// reaches the other: `weighting_kind_of<Policy>` is the kind of a named policy,
+/// `with_weighting(kind, f)` calls f with the policy of a kind, and the GL pass accepts the
+/// policy object as well. A policy of one's own (or `ward_early_reject_weight` with another
+/// scale) has no kind: the CPU runs it, the GL pass does not (it compiles the named ones).
 enum class weighting_kind { ward, ward_smooth, ward_early_reject, ward_scaled_normal, tabellion };
 
+/// Every kind, in declaration order.
+inline constexpr weighting_kind weighting_kinds[] = {weighting_kind::ward, weighting_kind::ward_smooth,
+                                                     weighting_kind::ward_early_reject, weighting_kind::ward_scaled_normal,
+                                                     weighting_kind::tabellion};
+
 /// Calls `f(Policy{})` with the policy type for `k`, so run-time choices reach compile-time
-/// kernels: `with_weighting(k, [&](auto w) { splat<decltype(w)>(...); })`.
+/// kernels: `with_weighting(k, [&](auto w) { splat<decltype(w)>(...); })`. For a CPU cache
+/// chosen at run time, the choice wraps its use:
+/// `with_weighting(k, [&](auto w) { cpu::irradiance_cache<decltype(w)> cache(lo, hi); ... })`,
+/// or keep one in a `weighting_variant<cpu::irradiance_cache>`.
 template <class F>
-decltype(auto) with_weighting(weighting_kind k, F&& f) {
+constexpr decltype(auto) with_weighting(weighting_kind k, F&& f) {
     switch (k) {
         case weighting_kind::ward_smooth: return f(ward_smooth_weight{});
         case weighting_kind::ward_early_reject: return f(ward_early_reject_weight<>{});
@@ -145,6 +168,64 @@ decltype(auto) with_weighting(weighting_kind k, F&& f) {
         case weighting_kind::ward: break;
     }
     return f(ward_weight{});
+}
+
+/// `T<Policy>` for every named policy, in the order of weighting_kind: a class template
+/// over the policy (a CPU cache, a splatter of one's own) chosen at run time, e.g.
+/// `weighting_variant<cpu::irradiance_cache>`, filled by `with_weighting` and used with
+/// std::visit.
+template <template <class> class T>
+using weighting_variant = std::variant<T<ward_weight>, T<ward_smooth_weight>, T<ward_early_reject_weight<>>,
+                                       T<ward_scaled_normal_weight>, T<tabellion_weight>>;
+
+}  // namespace bounce::cache
+
+namespace bounce::detail {
+/// The kind of each named policy; undefined for the others.
+template <class Policy>
+struct weighting_kind_for;
+template <>
+struct weighting_kind_for<ward_weight> : std::integral_constant<weighting_kind, weighting_kind::ward> {};
+template <>
+struct weighting_kind_for<ward_smooth_weight> : std::integral_constant<weighting_kind, weighting_kind::ward_smooth> {};
+template <>
+struct weighting_kind_for<ward_early_reject_weight<>>
+    : std::integral_constant<weighting_kind, weighting_kind::ward_early_reject> {};
+template <>
+struct weighting_kind_for<ward_scaled_normal_weight>
+    : std::integral_constant<weighting_kind, weighting_kind::ward_scaled_normal> {};
+template <>
+struct weighting_kind_for<tabellion_weight> : std::integral_constant<weighting_kind, weighting_kind::tabellion> {};
+}  // namespace bounce::detail
+
+namespace bounce::inline cache {
+
+/// A policy that has a weighting_kind (the five above), which the GL splat pass can compile.
+template <class Policy>
+concept named_weighting = requires { detail::weighting_kind_for<std::remove_cvref_t<Policy>>::value; };
+
+/// The kind of a named policy: `weighting_kind_of<ward_smooth_weight>` is
+/// weighting_kind::ward_smooth.
+template <named_weighting Policy>
+inline constexpr weighting_kind weighting_kind_of = detail::weighting_kind_for<std::remove_cvref_t<Policy>>::value;
+
+// The two directions are one table: every kind maps to a policy that maps back to it.
+static_assert([] {
+    for (const weighting_kind k : weighting_kinds)
+        if (!with_weighting(k, [k](auto w) { return weighting_kind_of<decltype(w)> == k; })) return false;
+    return true;
+}());
+
+/// The command-line spelling of `k` (its policy's `name`).
+constexpr std::string_view weighting_name(weighting_kind k) {
+    return with_weighting(k, [](auto w) { return std::string_view(decltype(w)::name); });
+}
+
+/// The kind spelled `name` (weighting_name's inverse); nullopt for a name no kind has.
+constexpr std::optional<weighting_kind> parse_weighting(std::string_view name) {
+    for (const weighting_kind k : weighting_kinds)
+        if (weighting_name(k) == name) return k;
+    return std::nullopt;
 }
 
 }  // namespace bounce::cache

@@ -133,6 +133,15 @@ public:
     /// splat texture yet (call clear or upload_splat), or first > record_count().
     void splat(const gbuffer_textures& g, const camera& cam, const splat_params& params, weighting_kind weighting,
                std::size_t first = 0, std::size_t count = all);
+    /// The same with the weighting given as a policy object, as the CPU cache and
+    /// cpu::splat_records take it (cache/weighting.hpp): `pass.splat(g, cam, params,
+    /// ward_smooth_weight{})`, or `with_weighting(kind, [&](auto w) { pass.splat(g, cam,
+    /// params, w); })`. Only the named policies (those with a weighting_kind) compile here.
+    template <named_weighting Weight>
+    void splat(const gbuffer_textures& g, const camera& cam, const splat_params& params, Weight,
+               std::size_t first = 0, std::size_t count = all) {
+        splat(g, cam, params, weighting_kind_of<Weight>, first, count);
+    }
     /// Copies the splat texture into `out` (row 0 at the top; sizes must match).
     void read_splat(image_view<glm::vec4> out) const;
     /// The splat texture as an owning image.
