@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <variant>
 
 namespace bounce::gl {
@@ -207,8 +208,29 @@ direct_light::direct_light(const scene_view& scene, const scene_mesh& mesh, int 
           return o;
       }()) {}
 
+namespace {
+
+// The built-in drawer: the mesh's vertex array, one indexed draw.
+shadow_drawer mesh_drawer(const scene_mesh& mesh) {
+    return [&mesh](const shadow_draw&) {
+        if (mesh.triangle_count() == 0) return;
+        glBindVertexArray(mesh.vertices().id());
+        glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh.triangle_count()), GL_UNSIGNED_INT, nullptr);
+    };
+}
+
+shadow_drawer checked_drawer(shadow_drawer draw) {
+    require(bool(draw), "draw", "an empty shadow_drawer draws nothing: pass a callable");
+    return draw;
+}
+
+}  // namespace
+
 direct_light::direct_light(const scene_view& scene, const scene_mesh& mesh, const direct_light_options& options)
-    : mesh_(&mesh), options_(options), lights_(prepare(scene, options)),
+    : direct_light(scene, mesh_drawer(mesh), options) {}
+
+direct_light::direct_light(const scene_view& scene, shadow_drawer draw, const direct_light_options& options)
+    : draw_(checked_drawer(std::move(draw))), options_(options), lights_(prepare(scene, options)),
       window_depth_program_(shadow_vertex, window_depth_fragment), radial_depth_program_(shadow_vertex, radial_depth_fragment()),
       radiance_program_(fullscreen_vertex, radiance_fragment_source()) {
     glNamedFramebufferDrawBuffer(shadow_fbo_.id(), GL_NONE);
@@ -226,20 +248,24 @@ void direct_light::render_shadow_maps() {
     // glPolygonOffset, cube maps by the radial-depth shader itself).
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(options_.slope_bias, options_.constant_bias);
-    glBindVertexArray(mesh_->vertices().id());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, shadow_fbo_.id());
     glViewport(0, 0, res, res);
     const float far_depth = 1.f;
-    const auto draw = [&](const program& prog, const glm::mat4& view_projection) {
+    // The depth attachment is detached again however the callback leaves (an exception included).
+    struct detach {
+        GLuint fbo;
+        ~detach() { glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, 0, 0); }
+    } const detached{shadow_fbo_.id()};
+    const auto draw = [&](const program& prog, const shadow_draw& d) {
         const GLenum status = glCheckNamedFramebufferStatus(shadow_fbo_.id(), GL_DRAW_FRAMEBUFFER);
         if (status != GL_FRAMEBUFFER_COMPLETE) throw gl_error("bounce::gl: shadow-map framebuffer is not complete");
         glClearNamedFramebufferfv(shadow_fbo_.id(), GL_DEPTH, 0, &far_depth);
         glUseProgram(prog.id());
-        prog.set(0, view_projection);
-        if (mesh_->triangle_count() > 0)
-            glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh_->triangle_count()), GL_UNSIGNED_INT, nullptr);
+        prog.set(0, d.view_projection);
+        draw_(d);
     };
-    for (auto& l : lights_) {
+    for (std::size_t i = 0; i < lights_.size(); ++i) {
+        const light_entry& l = lights_[i];
         if (l.map == map_kind::cube) {
             radial_depth_program_.set(1, l.light.position());
             radial_depth_program_.set(2, 1.f / l.far_depth);
@@ -247,14 +273,13 @@ void direct_light::render_shadow_maps() {
             radial_depth_program_.set(4, options_.constant_bias);
             for (GLint face = 0; face < 6; ++face) {
                 glNamedFramebufferTextureLayer(shadow_fbo_.id(), GL_DEPTH_ATTACHMENT, l.depth.id(), 0, face);
-                draw(radial_depth_program_, l.face_view_projection[std::size_t(face)]);
+                draw(radial_depth_program_, {i, face, l.face_view_projection[std::size_t(face)]});
             }
         } else {
             glNamedFramebufferTexture(shadow_fbo_.id(), GL_DEPTH_ATTACHMENT, l.depth.id(), 0);
-            draw(window_depth_program_, l.view_projection);
+            draw(window_depth_program_, {i, -1, l.view_projection});
         }
     }
-    glNamedFramebufferTexture(shadow_fbo_.id(), GL_DEPTH_ATTACHMENT, 0, 0);
     check_error("direct_light::render_shadow_maps");
 }
 

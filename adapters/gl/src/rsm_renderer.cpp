@@ -1,5 +1,6 @@
 // Reflective shadow maps by rasterization (Dachsbacher and Stamminger 2005, section 3.1):
-// one indexed draw of the scene per map into three RGBA32F targets. The shaders are
+// the scene drawn once per map into three RGBA32F targets, by the caller's rsm_drawer or
+// by the built-in one (one indexed draw of a scene_mesh). The shaders are
 // plumbing (transform, interpolate, fetch Kd and the texel's solid angle, write); the
 // facing normal and the reflected flux are the kernels of surface.hpp and indirect/rsm.hpp, emitted.
 #include <bounce/gl/rsm_renderer.hpp>
@@ -17,36 +18,13 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace bounce::gl {
-
-// ---- rsm_textures -----------------------------------------------------------------------
-
-void rsm_textures::validate(const char* name) const {
-    require(position.id != 0 && normal.id != 0 && flux.id != 0, name, "a map texture is missing");
-    require(position.format == texel_format::rgba32f && normal.format == texel_format::rgba32f &&
-                flux.format == texel_format::rgba32f,
-            name, "position, normal and flux must be RGBA32F textures");
-    require(flux.width > 0 && flux.height > 0, name, "the map has no size");
-    require(position.width == flux.width && position.height == flux.height && normal.width == flux.width &&
-                normal.height == flux.height,
-            name, "position, normal and flux maps differ in size");
-}
-
-rsm_images::rsm_images(const rsm_textures& t)
-    : position(t.width(), t.height()),
-      normal(t.width(), t.height()),
-      flux(t.width(), t.height()),
-      light_view_projection(t.light_view_projection) {
-    t.validate();
-    read_texture(t.position, position.view());
-    read_texture(t.normal, normal.view());
-    read_texture(t.flux, flux.view());
-}
 
 // ---- rsm_renderer -----------------------------------------------------------------------
 
@@ -84,6 +62,7 @@ layout(location = 4) uniform float cos_cone;
 layout(location = 5) uniform float cosine_falloff;
 layout(location = 6) uniform int kind;
 layout(location = 7) uniform float texel_area;
+layout(location = 8) uniform uint first_triangle;
 in vec3 world_position;
 in vec3 world_normal;
 layout(location = 0) out vec4 out_position;
@@ -92,7 +71,7 @@ layout(location = 2) out vec4 out_flux;
 
 )" + k.source() + R"(
 void main() {
-    vec3 albedo = kd[gl_PrimitiveID].rgb;
+    vec3 albedo = kd[first_triangle + uint(gl_PrimitiveID)].rgb;
     // The normal faces the light: its position, or for a distant light a point up the beam.
     vec3 eye = kind == 2 ? world_position - light_direction : light_position;
     vec3 n = facing_normal(world_normal, world_position, eye);
@@ -122,6 +101,7 @@ enum location : int {
     loc_cosine_falloff = 5,
     loc_kind = 6,
     loc_texel_area = 7,
+    loc_first_triangle = 8,
 };
 
 // Corner `c` (0..7) of the box [lo, hi].
@@ -129,10 +109,33 @@ glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
     return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
 }
 
+
+// The built-in drawer: the mesh's vertex array and per-triangle albedo, one indexed draw.
+rsm_drawer mesh_drawer(const scene_mesh& mesh) {
+    return [&mesh](const rsm_draw&) {
+        if (mesh.triangle_count() == 0) return;
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh.albedo_per_triangle().id());
+        glBindVertexArray(mesh.vertices().id());
+        glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh.triangle_count()), GL_UNSIGNED_INT, nullptr);
+    };
+}
+
+rsm_drawer checked_drawer(rsm_drawer draw) {
+    require(bool(draw), "draw", "an empty rsm_drawer draws nothing: pass a callable");
+    return draw;
+}
+
 }  // namespace
 
+void rsm_draw::set_first_triangle(std::uint32_t first) const {
+    glProgramUniform1ui(program, loc_first_triangle, first);
+}
+
 rsm_renderer::rsm_renderer(const scene_view& scene, const scene_mesh& mesh, const rsm_render_options& options)
-    : scene_(scene), mesh_(mesh), options_(options), program_(vertex_source, fragment_source()) {
+    : rsm_renderer(scene, mesh_drawer(mesh), options) {}
+
+rsm_renderer::rsm_renderer(const scene_view& scene, rsm_drawer draw, const rsm_render_options& options)
+    : scene_(scene), draw_(checked_drawer(std::move(draw))), options_(options), program_(vertex_source, fragment_source()) {
     options_.validate();
 }
 
@@ -229,24 +232,28 @@ void rsm_renderer::render_map(const rsm_map_layout& m, const packed_light& l, co
     glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 1, away);
     glClearNamedFramebufferfv(fbo_.id(), GL_COLOR, 2, zero);
     glClearNamedFramebufferfv(fbo_.id(), GL_DEPTH, 0, &far_depth);
-    if (mesh_.triangle_count() > 0) {
-        program_.set(loc_view_projection, raster);
-        program_.set(loc_light_position, l.position());
-        program_.set(loc_light_direction, l.direction());
-        program_.set(loc_light_intensity, l.intensity());
-        program_.set(loc_cos_cone, l.cos_cone());
-        program_.set(loc_cosine_falloff, l.cosine_falloff());
-        program_.set(loc_kind, int(l.kind()));
-        program_.set(loc_texel_area, texel_area);
-        glUseProgram(program_.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh_.albedo_per_triangle().id());
-        glBindTextureUnit(0, m.orthographic ? 0 : solid_angles(m.fov_deg).id());
-        glBindSampler(0, 0);
-        glBindVertexArray(mesh_.vertices().id());
-        glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh_.triangle_count()), GL_UNSIGNED_INT, nullptr);
-    }
-    for (GLenum a : {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2})
-        glNamedFramebufferTexture(fbo_.id(), a, 0, 0);
+    program_.set(loc_view_projection, raster);
+    program_.set(loc_light_position, l.position());
+    program_.set(loc_light_direction, l.direction());
+    program_.set(loc_light_intensity, l.intensity());
+    program_.set(loc_cos_cone, l.cos_cone());
+    program_.set(loc_cosine_falloff, l.cosine_falloff());
+    program_.set(loc_kind, int(l.kind()));
+    program_.set(loc_texel_area, texel_area);
+    const rsm_draw d{m, raster, program_.id()};
+    d.set_first_triangle(0);
+    glUseProgram(program_.id());
+    glBindTextureUnit(0, m.orthographic ? 0 : solid_angles(m.fov_deg).id());
+    glBindSampler(0, 0);
+    // The targets are detached again however the callback leaves (an exception included).
+    struct detach {
+        GLuint fbo;
+        ~detach() {
+            for (GLenum a : {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2})
+                glNamedFramebufferTexture(fbo, a, 0, 0);
+        }
+    } const detached{fbo_.id()};
+    draw_(d);
     check_error("rsm_renderer::render");
 }
 

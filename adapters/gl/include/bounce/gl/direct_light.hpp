@@ -27,6 +27,11 @@
 ///
 /// Geometry closer to a spot or point light than 1/1000 of its farthest distance to the
 /// scene bounds is clipped from its map (casts no shadow).
+///
+/// The shadow maps are drawn by a callback (shadow_drawer), as hemisphere_raster's planes
+/// are: a renderer with its own vertex buffers passes one that draws them; the scene_mesh
+/// constructors pass one that draws the mesh. The radiance pass reads G-buffer textures,
+/// which may be the renderer's own (gbuffer_textures).
 
 #include <bounce/gl/gbuffer_pass.hpp>
 #include <bounce/gl/objects.hpp>
@@ -36,6 +41,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,6 +63,26 @@ struct direct_light_options {
     void validate() const;
 };
 
+/// What a shadow_drawer is given for one shadow map (each face of a cube map is one).
+struct shadow_draw {
+    std::size_t light = 0;           ///< the light's index in the scene's lights
+    int face = -1;                   ///< the cube face (0-5: +x, -x, +y, -y, +z, -z), -1 for a 2D map
+    glm::mat4 view_projection{1.f};  ///< world to the map's clip space, as the bound program applies it
+};
+
+/// The caller's geometry drawer: draws every shadow caster into the bound shadow map with
+/// the pass's program.
+///
+/// Contract. Before each call the pass sets, and the callback may rely on: the map's
+/// depth-only framebuffer bound as GL_DRAW_FRAMEBUFFER and cleared, its viewport, depth test
+/// GL_LESS with writes on, the slope-scaled polygon offset, no culling (both sides cast
+/// shadows), and the program bound with its uniforms set. The callback binds its own vertex
+/// array, whose attribute 0 is the world position (vec3, float), and draws triangles (any
+/// number of draws). It must not change the program, its uniforms, the framebuffer, the
+/// viewport, the depth or polygon-offset state. The pass restores the vertex array it saved,
+/// as the rest of its state.
+using shadow_drawer = std::function<void(const shadow_draw&)>;
+
 /// Shadowed direct lighting of a scene's lights, as a GLSL function other passes paste into
 /// their shaders and as a full-screen pass over a G-buffer.
 class direct_light {
@@ -66,9 +92,15 @@ public:
     /// this object). A context must be current.
     direct_light(const scene_view& scene, const scene_mesh& mesh, int shadow_resolution = 1024);
     direct_light(const scene_view& scene, const scene_mesh& mesh, const direct_light_options& options);
+    /// The caller's geometry: `draw` draws the shadow casters into each map (the contract is
+    /// shadow_drawer's; kept, and called again by render_shadow_maps). `scene` gives the
+    /// lights and the bounds the maps span (a view of positions and lights alone will do)
+    /// and need not outlive the constructor. Throws parameter_error naming "draw" when it is
+    /// empty, and as the constructors above.
+    direct_light(const scene_view& scene, shadow_drawer draw, const direct_light_options& options = {});
 
-    /// Renders every shadow map again (after the mesh's contents changed). Restores the GL
-    /// state it changes.
+    /// Renders every shadow map again (after the geometry changed). Restores the GL state it
+    /// changes.
     void render_shadow_maps();
 
     /// GLSL (no #version) declaring the uniforms and samplers of the lights and
@@ -118,7 +150,7 @@ private:
     static std::vector<light_entry> prepare(const scene_view& scene, const direct_light_options& options);
     std::string radiance_fragment_source() const;
 
-    const scene_mesh* mesh_;
+    shadow_drawer draw_;
     direct_light_options options_;
     std::vector<light_entry> lights_;
     program window_depth_program_, radial_depth_program_, radiance_program_;

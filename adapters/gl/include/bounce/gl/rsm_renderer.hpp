@@ -19,6 +19,12 @@
 ///   sphere.
 /// Normals face the light (two-sided surfaces, surface.hpp's facing_normal), as the ray
 /// caster's; a texel that sees nothing holds position 0, normal -(view direction), flux 0.
+///
+/// A renderer with its own vertex buffers builds the renderer with a draw callback
+/// (rsm_renderer(scene, rsm_drawer, options)), as hemisphere_raster takes a plane_drawer:
+/// per map the pass binds its program and target and calls the callback, which binds the
+/// renderer's vertex array and albedo buffer and draws. The scene_mesh constructor is the
+/// same pass with a callback that draws the mesh.
 /// A texel's solid angle is exact: rectangle_solid_angle evaluated in double on the CPU
 /// once per map shape and read from a table, as the ray caster evaluates it.
 ///
@@ -37,6 +43,8 @@
 #include <bounce/scene_view.hpp>
 
 #include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <span>
@@ -54,12 +62,48 @@ using rsm_render_options = bounce::rsm_layout_settings;
 /// One map a light needs: which light, how the map sees it (bounce::rsm_map_layout).
 using rsm_map_layout = bounce::rsm_map_layout;
 
+/// What an rsm_drawer is given for one map.
+struct rsm_draw {
+    rsm_map_layout map;              ///< the map drawn (map.light indexes the lights rendered)
+    glm::mat4 view_projection{1.f};  ///< world to the raster's clip space, as the bound program applies it
+    object_id program = 0;           ///< the pass's program, bound
+
+    /// Where the next draw's triangles start in the albedo buffer: the fragment stage reads
+    /// kd[first + gl_PrimitiveID] (gl_PrimitiveID restarts at 0 with every draw call). It is
+    /// 0 when the callback is called.
+    void set_first_triangle(std::uint32_t first) const;
+};
+
+/// The caller's geometry drawer: draws the scene's triangles, seen from one map's light,
+/// with the pass's program.
+///
+/// Contract. Before each call the pass sets, and the callback may rely on: the map's
+/// framebuffer bound as GL_DRAW_FRAMEBUFFER (outputs 0-2 position, normal, flux), cleared,
+/// its viewport, depth test GL_LESS with writes on, no blending, culling, scissor or clip
+/// distances (two-sided, as the ray caster sees surfaces), the program bound with every
+/// uniform set and texture unit 0 holding its solid-angle table. The callback binds its own
+/// vertex array, whose attribute 0 is the world position (vec3, float) and attribute 1 the
+/// surface normal (vec3, float; any length and either side: the pass normalizes it and
+/// turns it towards the light), and at shader-storage binding 0 a std430 buffer of one vec4
+/// per triangle whose rgb is the diffuse albedo (scene_mesh::albedo_per_triangle's layout),
+/// then draws triangles (any number of draws; `set_first_triangle` before a draw whose
+/// triangles do not start the buffer). It must not change the program, its uniforms,
+/// texture unit 0, the framebuffer, the viewport or the depth state. The pass restores the
+/// vertex array and storage binding 0 it saved, as the rest of its state (rsm_renderer).
+using rsm_drawer = std::function<void(const rsm_draw&)>;
+
 class rsm_renderer {
 public:
     /// Keeps references to `scene` (for its bounds and lights) and `mesh` (its geometry,
     /// uploaded by the caller); both must outlive the renderer. A context must be current.
-    /// Throws parameter_error for bad options.
+    /// Throws parameter_error for bad options. The mesh is drawn by an rsm_drawer of the
+    /// pass's own, as a caller's would be.
     rsm_renderer(const scene_view& scene, const scene_mesh& mesh, const rsm_render_options& options = {});
+    /// The caller's geometry: `draw` draws it for each map (the contract is rsm_drawer's).
+    /// `scene` gives the bounds and lights (a view of positions and lights alone will do) and
+    /// must outlive the renderer. Throws parameter_error naming "draw" when it is empty, and
+    /// for bad options.
+    rsm_renderer(const scene_view& scene, rsm_drawer draw, const rsm_render_options& options = {});
 
     const rsm_render_options& options() const noexcept { return options_; }
 
@@ -83,7 +127,7 @@ private:
     const texture& solid_angles(float fov_deg);
 
     scene_view scene_;
-    const scene_mesh& mesh_;
+    rsm_drawer draw_;
     rsm_render_options options_;
     program program_;
     framebuffer fbo_;

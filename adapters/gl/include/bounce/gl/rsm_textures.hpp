@@ -1,13 +1,18 @@
 #pragma once
 /// \file rsm_textures.hpp
 /// A reflective shadow map (Dachsbacher and Stamminger 2005) as GL textures: what
-/// gl::rsm_renderer writes and gl::indirect_renderer reads, and its copy on the CPU.
+/// gl::rsm_renderer writes and gl::indirect_renderer reads, its copy on the CPU
+/// (rsm_images), and the way back: maps made on the CPU (embree::rsm_ray_caster's, or a
+/// renderer's own rsm_view) uploaded as such textures (rsm_upload), so the GL gather and
+/// splatting passes run on them.
 
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
 #include <bounce/indirect/vpl_sampling.hpp>
 
 #include <cstddef>
+#include <span>
+#include <vector>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
@@ -39,6 +44,32 @@ struct rsm_images {
     /// Throws parameter_error on bad textures.
     explicit rsm_images(const rsm_textures& t);
     rsm_view view() const { return {position.view(), normal.view(), flux.view(), light_view_projection}; }
+};
+
+/// Reflective shadow maps made on the CPU (bounce::rsm_view: embree::rsm_ray_caster's
+/// views(), rsm_images, or a renderer's own buffers) uploaded as RGBA32F textures of
+/// rsm_renderer's layout (rgb the view's value, a = 0; rows flipped into GL order), so
+/// gl::indirect_renderer gathers and splats from them as from rendered maps. Maps of any
+/// size, each its own (a texture is reallocated only when its map's size changes). A
+/// context must be current; the textures live as long as this object.
+class rsm_upload {
+public:
+    rsm_upload() = default;
+    /// Uploads `maps`.
+    explicit rsm_upload(std::span<const rsm_view> maps) { upload(maps); }
+    /// Replaces the contents with `maps`. Throws parameter_error naming "maps[i]" (and
+    /// nothing is uploaded) when a map is empty or its views differ in size, a position,
+    /// normal or flux is not finite, a flux is negative, or the matrix is not finite.
+    void upload(std::span<const rsm_view> maps);
+    /// The uploaded maps, in the order given (light_view_projection copied from each view).
+    std::span<const rsm_textures> textures() const noexcept { return refs_; }
+
+private:
+    struct owned {
+        texture position, normal, flux;
+    };
+    std::vector<owned> owned_;
+    std::vector<rsm_textures> refs_;
 };
 
 }  // namespace bounce::gl
