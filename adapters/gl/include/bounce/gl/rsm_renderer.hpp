@@ -79,8 +79,8 @@ struct rsm_draw {
 ///
 /// Contract. Before each call the pass sets, and the callback may rely on: the map's
 /// framebuffer bound as GL_DRAW_FRAMEBUFFER (outputs 0-2 position, normal, flux), cleared,
-/// its viewport, depth test GL_LESS with writes on, no blending, culling, scissor or clip
-/// distances (two-sided, as the ray caster sees surfaces), the program bound with every
+/// its viewport, depth test GL_LESS with writes on, no blending, culling or scissor test
+/// (two-sided, as the ray caster sees surfaces), the program bound with every
 /// uniform set and texture unit 0 holding its solid-angle table. The callback binds its own
 /// vertex array, whose attribute 0 is the world position (vec3, float) and attribute 1 the
 /// surface normal (vec3, float; any length and either side: the pass normalizes it and
