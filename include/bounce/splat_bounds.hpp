@@ -10,10 +10,20 @@
 /// whose ends are either tangent points of lines through the eye or the ends of the chord
 /// cut by the near plane (the set is convex and the slope's level sets are lines through
 /// the eye, so no other point can be extreme). Cf. Mara and McGuire 2013.
+///
+/// On the host, sphere_pixel_rect rounds that box to the pixels a splat visits: the records
+/// of irradiance splatting (cpu/splatting.hpp) and the VPLs of splatting indirect
+/// illumination (indirect/rsm_sampling.hpp) both take their rectangles from it.
 
+#include <bounce/camera.hpp>
 #include <bounce/vocabulary.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstddef>
+
+#include <glm/glm.hpp>
 
 namespace bounce {
 
@@ -60,6 +70,36 @@ std::array<T, 4> sphere_ndc_bounds(const V& c, T r, T near_depth, T tan_half_fov
     const T sx = T(1) / (tan_half_fov_y * aspect), sy = T(1) / tan_half_fov_y;
     return {select(visible, x[0] * sx, T(2)), select(visible, y[0] * sy, T(2)),
             select(visible, x[1] * sx, T(2)), select(visible, y[1] * sy, T(2))};
+}
+
+/// Inclusive pixel rectangle, rows counted from the top; empty when x0 > x1 or y0 > y1.
+struct pixel_rect {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    bool empty() const noexcept { return x0 > x1 || y0 > y1; }
+};
+
+/// Pixels of a width x height image (seen by `cam`, `view` its view matrix) whose centres
+/// the sphere (`centre`, `radius`) can cover: sphere_ndc_bounds clipped to the image. The
+/// box is widened by 1/8 pixel so that no pixel is lost to rounding: a point inside the
+/// sphere lies on its pixel's centre ray up to float rounding of its position, some 1e-6 of
+/// its distance, and the box's corners are exact to a few ulps; 1/8 pixel is far above both.
+/// (A wider margin costs: a sphere a few pixels across would visit twice the pixels.)
+inline pixel_rect sphere_pixel_rect(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float radius,
+                                    std::size_t width, std::size_t height) {
+    const glm::vec3 c = glm::vec3(view * glm::vec4(centre, 1.f));
+    const auto b =
+        sphere_ndc_bounds<float, glm::vec3>(c, radius, cam.near_plane, cam.tan_half_fov(), float(width) / float(height));
+    if (!(b[0] <= b[2]) || b[0] >= 2.f) return {};
+    // Pixel x covers ndc [2x/W - 1, 2(x+1)/W - 1]; row 0 is the top (ndc y = +1).
+    auto px = [&](float ndc) { return double(ndc + 1.f) * 0.5 * double(width); };
+    auto py = [&](float ndc) { return double(1.f - ndc) * 0.5 * double(height); };
+    constexpr double m = 0.125;  // margin, pixels
+    pixel_rect r;
+    r.x0 = int(std::max(0.0, std::ceil(px(b[0]) - 0.5 - m)));
+    r.x1 = int(std::min(double(width) - 1, std::floor(px(b[2]) - 0.5 + m)));
+    r.y0 = int(std::max(0.0, std::ceil(py(b[3]) - 0.5 - m)));
+    r.y1 = int(std::min(double(height) - 1, std::floor(py(b[1]) - 0.5 + m)));
+    return r;
 }
 
 }  // namespace bounce

@@ -1,10 +1,9 @@
-// Masks of comparable pixels and the progressive runs' camera path.
+// Masks of the pixels where a frame and its reference can be compared.
 #include <bounce/study/frame_comparison.hpp>
 
-#include <algorithm>
-#include <cmath>
+#include <bounce/errors.hpp>
 
-#include <glm/gtc/quaternion.hpp>
+#include <cmath>
 
 namespace bounce::study {
 
@@ -23,21 +22,6 @@ image<float> comparable_mask(const gbuffer_view<float>& g, const gbuffer_view<fl
         for (std::size_t x = 0; x < g.width(); ++x)
             if (m(x, y) > 0.f && !same_surface(g, reference_g, x, y, scene_size)) m(x, y) = 0.f;
     return m;
-}
-
-camera_path::camera_path(const embree::accel& bvh, const camera& start, std::size_t frames)
-    : base_(start), forward_(start.forward()), frames_(frames) {
-    const embree::hit first = bvh.intersect({base_.position, forward_});  // t = inf on a miss
-    walk_ = std::min(0.1f * glm::length(base_.look_at - base_.position), 0.5f * first.t);
-}
-
-camera camera_path::at(std::size_t f) const {
-    const float t = float(f) / float(std::max<std::size_t>(1, frames_ - 1));
-    camera cam = base_;
-    cam.position = base_.position + t * walk_ * forward_;
-    const glm::quat pan = glm::angleAxis(glm::radians(20.f) * (t - 0.5f), glm::normalize(base_.up));
-    cam.look_at = cam.position + pan * (base_.look_at - cam.position);
-    return cam;
 }
 
 }  // namespace bounce::study

@@ -3,9 +3,10 @@
 /// The choices an indirect renderer of the RSM / SII family makes on the host, whatever
 /// its backend: the disc pattern of the RSM gather, the VPLs of a frame (shared between the
 /// maps by flux, on a grid or by flux warping) and the pixel rectangles the VPLs are
-/// splatted over, in the image and in an interleaved split buffer. cpu::indirect_renderer and
-/// gl::indirect_renderer both call these, so their frames use the same samples, lights and
-/// pixels (docs/rsm-sii-interleaved.md, docs/rsm-sii-gl.md).
+/// splatted over, in the image (sphere_pixel_rect of splat_bounds.hpp) and in an
+/// interleaved split buffer. cpu::indirect_renderer and gl::indirect_renderer both call
+/// these, so their frames use the same samples, lights and pixels
+/// (docs/rsm-sii-interleaved.md, docs/rsm-sii-gl.md).
 
 #include <bounce/camera.hpp>
 #include <bounce/errors.hpp>
@@ -103,32 +104,7 @@ inline std::vector<vpl> select_vpls(std::span<const rsm_view> maps, const indire
 
 // ---- pixel rectangles -------------------------------------------------------------------
 
-/// Inclusive pixel rectangle, rows counted from the top; empty when x0 > x1 or y0 > y1.
-struct pixel_rect {
-    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-    bool empty() const noexcept { return x0 > x1 || y0 > y1; }
-};
-
-/// Pixels of a width x height image (seen by `cam`, `view` its view matrix) whose centres
-/// the sphere (`centre`, `radius`) can cover, clipped to the image, widened by 1/8 pixel so
-/// that no pixel is lost to rounding (sphere_ndc_bounds; the rounding of cpu::splat_rect).
-inline pixel_rect sphere_pixel_rect(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float radius,
-                                    std::size_t width, std::size_t height) {
-    const glm::vec3 c = glm::vec3(view * glm::vec4(centre, 1.f));
-    const auto b =
-        sphere_ndc_bounds<float, glm::vec3>(c, radius, cam.near_plane, cam.tan_half_fov(), float(width) / float(height));
-    if (!(b[0] <= b[2]) || b[0] >= 2.f) return {};
-    // Pixel x covers ndc [2x/W - 1, 2(x+1)/W - 1]; row 0 is the top (ndc y = +1).
-    auto px = [&](float ndc) { return double(ndc + 1.f) * 0.5 * double(width); };
-    auto py = [&](float ndc) { return double(1.f - ndc) * 0.5 * double(height); };
-    constexpr double m = 0.125;  // margin, pixels
-    pixel_rect r;
-    r.x0 = int(std::max(0.0, std::ceil(px(b[0]) - 0.5 - m)));
-    r.x1 = int(std::min(double(width) - 1, std::floor(px(b[2]) - 0.5 + m)));
-    r.y0 = int(std::max(0.0, std::ceil(py(b[3]) - 0.5 - m)));
-    r.y1 = int(std::min(double(height) - 1, std::floor(py(b[1]) - 0.5 + m)));
-    return r;
-}
+// pixel_rect and sphere_pixel_rect, the rectangle of a sphere, are splat_bounds.hpp's.
 
 /// The image rectangle SII splats VPL `l` over in a frame of `vpl_count` VPLs: the pixels of
 /// the sphere outside which the VPL gives less than cutoff / vpl_count

@@ -35,34 +35,15 @@ namespace bounce::cpu {
 /// Parameters shared by every splat of a frame (cache/record.hpp).
 using bounce::splat_params;
 
-/// Inclusive pixel rectangle; empty when x0 > x1 or y0 > y1.
-struct pixel_rect {
-    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-    bool empty() const noexcept { return x0 > x1 || y0 > y1; }
-};
+/// Pixel rectangles and the one a sphere covers (splat_bounds.hpp).
+using bounce::pixel_rect;
+using bounce::sphere_pixel_rect;
 
-/// Pixels whose centres the record's sphere of influence (radius `zone`) can cover, clipped
-/// to a width x height image. The box is widened by 1/8 pixel so that no pixel is lost to
-/// rounding: a point inside the sphere lies on its pixel's centre ray up to float rounding
-/// of its position, some 1e-6 of its distance, and the box's corners are exact to a few
-/// ulps; 1/8 pixel is far above both. (A wider margin costs: a zone a few pixels across
-/// would visit twice the pixels.)
+/// The pixels a record's sphere of influence (radius `zone`) can cover: sphere_pixel_rect,
+/// under the name this adapter's callers know.
 inline pixel_rect splat_rect(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float zone,
                              std::size_t width, std::size_t height) {
-    const glm::vec3 c = glm::vec3(view * glm::vec4(centre, 1.f));
-    const auto b = sphere_ndc_bounds<float, glm::vec3>(c, zone, cam.near_plane, cam.tan_half_fov(),
-                                                       float(width) / float(height));
-    if (!(b[0] <= b[2]) || b[0] >= 2.f) return {};
-    // Pixel x covers ndc [2x/W - 1, 2(x+1)/W - 1]; row 0 is the top (ndc y = +1).
-    auto px = [&](float ndc) { return double(ndc + 1.f) * 0.5 * double(width); };
-    auto py = [&](float ndc) { return double(1.f - ndc) * 0.5 * double(height); };
-    pixel_rect r;
-    constexpr double m = 0.125;  // margin, pixels
-    r.x0 = int(std::max(0.0, std::ceil(px(b[0]) - 0.5 - m)));
-    r.x1 = int(std::min(double(width) - 1, std::floor(px(b[2]) - 0.5 + m)));
-    r.y0 = int(std::max(0.0, std::ceil(py(b[3]) - 0.5 - m)));
-    r.y1 = int(std::min(double(height) - 1, std::floor(py(b[1]) - 0.5 + m)));
-    return r;
+    return sphere_pixel_rect(cam, view, centre, zone, width, height);
 }
 
 namespace detail {
