@@ -147,9 +147,11 @@ int main(int argc, char** argv) {
     cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi);
     gl::irradiance_splatter splatter;
     const gl::gbuffer_textures g{gl::texture_ref::of(tex[0]), gl::texture_ref::of(tex[1]), gl::texture_ref::of(tex[2])};
-    const auto stats = splatter.render(g, cam, cache.records(), [&](gbuffer_view<float> gv, image_view<glm::vec4> splat) {
-        cache.scan(gv, cam, sampler, splat);
-    });
+    // Radiance rho/pi * E with the G-buffer's albedo, since compose adds it to the direct radiance.
+    const auto stats = splatter.render(
+        g, cam, cache.records(),
+        [&](gbuffer_view<float> gv, image_view<glm::vec4> splat) { cache.scan(gv, cam, sampler, splat); },
+        output_quantity::radiance);
     const gl::scene_mesh mesh(scene);
     gl::direct_light direct(scene, mesh);
     direct.render(g);

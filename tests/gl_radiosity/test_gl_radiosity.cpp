@@ -76,6 +76,37 @@ TEST_CASE("without occlusion, GL and CPU shoot the same shooters and agree to fl
     CHECK(gl_solver.progress().shots == std::size_t(shots));
 }
 
+TEST_CASE("the GL solver's outputs are the CPU solver's: irradiance or radiance, direct or indirect or all",
+          "[gl][radiosity][outputs]") {
+    // GL keeps B and the B read back after the lights' shots; irradiance is a part's
+    // reflected radiosity over rho (every albedo of this box is positive). Compared against
+    // the largest value of each output: the indirect part is a difference of B's.
+    gl_test::shared_context();
+    auto scene = closed_box(2.f, 0.7f, 10.f);
+    scene.lights.push_back(point_light{{0.6f, 1.2f, 0.8f}, glm::vec3(2.f, 1.5f, 1.f)});
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
+    for (const bool ambient : {false, true}) {
+        cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.ambient = ambient});
+        gl::progressive_radiosity gl_solver(scene.view(), atlas,
+                                            {.shooting = {.ambient = ambient}, .visibility = gl::radiosity_visibility::none});
+        for (int s = 0; s < 20; ++s) {
+            REQUIRE(gl_solver.step());
+            REQUIRE(cpu_solver.step());
+        }
+        for (const auto q : {output_quantity::irradiance, output_quantity::radiance})
+            for (const auto paths : {light_paths::indirect, light_paths::direct, light_paths::all}) {
+                const auto c = cpu_solver.output(q, paths), g = gl_solver.output(q, paths);
+                REQUIRE(c.size() == g.size());
+                float largest = 0;
+                for (const glm::vec3& v : c) largest = std::max({largest, v.x, v.y, v.z});
+                REQUIRE(largest > 0.f);
+                INFO(to_string(q) << " " << to_string(paths) << " ambient " << ambient);
+                for (std::size_t i = 0; i < c.size(); ++i)
+                    for (int k = 0; k < 3; ++k) CHECK(g[i][k] == Approx(c[i][k]).margin(1e-4 * largest));
+            }
+    }
+}
+
 TEST_CASE("absorbed + unshot + escaped power equals emitted power on GL after every step", "[gl][radiosity][energy]") {
     // The GL solver books, per shot, the intercepted power each element reports (float,
     // incident power times visibility times area) and the absorbed share (1 - rho) of it, summed

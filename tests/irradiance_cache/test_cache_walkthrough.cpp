@@ -84,7 +84,8 @@ by_hand frames_by_hand(box_fixture& f) {
         const camera cam = f.path.at(k);
         gbuffer<float> g = f.ray_cast(cam);
         image<glm::vec3> indirect(width, height);
-        h.new_records.push_back(cache.render(g.view(), cam, f.sampler, indirect.view()).new_records);
+        const auto stats = cache.render(g.view(), cam, f.sampler, indirect.view(), output_quantity::radiance);
+        h.new_records.push_back(stats.new_records);
         h.images.push_back(std::move(indirect));
         h.records.push_back(cache.records());
     }
@@ -124,7 +125,7 @@ TEST_CASE("render_frame is the cache's render on the G-buffer made for the camer
     auto b = f.cache();
     gbuffer<float> g = f.ray_cast(cam);
     image<glm::vec3> indirect(width, height);
-    const auto stats = b.render(g.view(), cam, f.sampler, indirect.view());
+    const auto stats = b.render(g.view(), cam, f.sampler, indirect.view(), output_quantity::radiance);
 
     CHECK(same_image(frame.indirect, indirect));
     CHECK(same_records(a.records(), b.records()));
@@ -175,7 +176,7 @@ TEST_CASE("a walkthrough's frames are the cache's frames camera by camera, with 
             auto empty = f.cache();
             gbuffer<float> g = f.ray_cast(s.cam);
             image<glm::vec3> indirect(width, height);
-            empty.render(g.view(), s.cam, f.sampler, indirect.view());
+            empty.render(g.view(), s.cam, f.sampler, indirect.view(), output_quantity::radiance);
             CHECK(same_image(s.fresh->indirect, indirect));
             CHECK(s.fresh_records == empty.records().size());
         }
@@ -262,7 +263,7 @@ TEST_CASE("an a sweep renders each a from the records before it, repeat after re
         hand.set_options(o);
         gbuffer<float> g = f.ray_cast(cam);
         image<glm::vec3> indirect(width, height);
-        hand.render(g.view(), cam, f.sampler, indirect.view());
+        hand.render(g.view(), cam, f.sampler, indirect.view(), output_quantity::radiance);
         if (a == as.back()) CHECK(same_image(r.last.frame.indirect, indirect));
     }
     CHECK(same_records(cache.records(), hand.records()));
@@ -328,7 +329,7 @@ TEST_CASE("the GL frame makes the CPU frame's records and follows a cache whose 
     auto cpu_cache = f.cache();
     gbuffer<float> raster = first.g;
     image<glm::vec3> cpu_indirect(width, height);
-    cpu_cache.render(raster.view(), cam, f.sampler, cpu_indirect.view());
+    cpu_cache.render(raster.view(), cam, f.sampler, cpu_indirect.view(), output_quantity::radiance);
     CHECK(same_records(gl_cache.records(), cpu_cache.records()));
 
     // Replaced records (a restart from empty): the splatter follows without reset(), and the

@@ -69,7 +69,7 @@ TEST_CASE("the cache's frame is Algorithm 5 composed by hand from the CPU passes
 
     cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, options_with(cpu::scan_kind::sequential));
     image<glm::vec3> indirect(width, height);
-    const auto stats = cache.render(gv, cam, f.sampler, indirect.view());
+    const auto stats = cache.render(gv, cam, f.sampler, indirect.view(), output_quantity::radiance);
 
     // By hand: splat nothing, scan with the sampler one pixel at a time, splat all, normalize.
     std::vector<irradiance_record> records;
@@ -91,8 +91,29 @@ TEST_CASE("the cache's frame is Algorithm 5 composed by hand from the CPU passes
 
     // A second frame from the same camera finds no miss and leaves the image as it was.
     image<glm::vec3> again(width, height);
-    CHECK(cache.render(gv, cam, f.sampler, again.view()).new_records == 0);
+    CHECK(cache.render(gv, cam, f.sampler, again.view(), output_quantity::radiance).new_records == 0);
     CHECK(same_image(again, indirect));
+}
+
+TEST_CASE("the cache's irradiance is its radiance divided by rho over pi, with the same records",
+          "[irradiance_cache][outputs]") {
+    auto& f = fixture();
+    const auto [lo, hi] = f.scene.bounds();
+    const auto gv = f.g.view();
+    cpu::irradiance_cache<ward_smooth_weight> by_e(lo, hi, options_with(cpu::scan_kind::batched));
+    cpu::irradiance_cache<ward_smooth_weight> by_l(lo, hi, options_with(cpu::scan_kind::batched));
+    image<glm::vec3> e(width, height), l(width, height);
+    by_e.render(gv, f.scene.camera, f.sampler, e.view());  // the default: irradiance
+    by_l.render(gv, f.scene.camera, f.sampler, l.view(), output_quantity::radiance);
+    CHECK(same_records(by_e.records(), by_l.records()));
+    std::size_t lit = 0;
+    for (std::size_t y = 0; y < height; ++y)
+        for (std::size_t x = 0; x < width; ++x) {
+            const glm::vec3 expected = lambertian_radiance<float, glm::vec3>(gv.albedo(x, y), e(x, y));
+            for (int c = 0; c < 3; ++c) CHECK(l(x, y)[c] == Approx(expected[c]).epsilon(1e-5).margin(1e-7));
+            lit += e(x, y).x > 0.f ? 1 : 0;
+        }
+    CHECK(lit > width * height / 2);
 }
 
 TEST_CASE("batched and sequential scans, in either order, agree with each other record for record",
@@ -234,5 +255,17 @@ TEST_CASE("the GL splatter around the cache's scan makes the CPU frame's records
     CHECK_THROWS_AS(splatter.render(gl::textures_of(pass), cam, gl_cache.records(), [](auto, auto) {}), parameter_error);
     splatter.reset();
     CHECK_NOTHROW(splatter.render(gl::textures_of(pass), cam, gl_cache.records(), [](auto, auto) {}));
+
+    // Both made irradiance (the default); compose adds direct radiance, so it wants radiance.
+    CHECK(splatter.output() == output_quantity::irradiance);
+    gl::texture direct(gl::texel_format::rgba32f, width, height);
+    try {
+        splatter.compose(direct);
+        FAIL("compose added radiance to irradiance");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "output");
+    }
+    splatter.render(gl::textures_of(pass), cam, gl_cache.records(), [](auto, auto) {}, output_quantity::radiance);
+    CHECK_NOTHROW(splatter.compose(direct));
 }
 #endif

@@ -92,4 +92,13 @@ TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_vo
                 REQUIRE(gpu[i][k] == Approx(cpu[i][k]).margin(1e-5 * largest));
             }
     }
+    // Radiance with the caller's albedo (output.hpp): rho/pi times the irradiance, per point.
+    const std::vector<glm::vec3> albedo(points.size(), glm::vec3(0.2f, 0.5f, 0.9f));
+    const auto e = lookup.light_points(buffers, points, normals, gl::volume_interpolation::weighted);
+    const auto l = lookup.light_points(buffers, points, normals, gl::volume_interpolation::weighted, {},
+                                       output_quantity::radiance, albedo);
+    for (std::size_t i = 0; i < points.size(); ++i) REQUIRE(l[i] == lambertian_radiance<float, glm::vec3>(albedo[i], e[i]));
+    CHECK_THROWS_AS(lookup.light_points(buffers, points, normals, gl::volume_interpolation::weighted, {},
+                                        output_quantity::radiance),
+                    parameter_error);
 }

@@ -430,7 +430,25 @@ TEST_CASE("bad options and sizes raise parameter_error naming the parameter", "[
     image<glm::vec3> wrong(15, 12);
     const rsm_view maps[] = {s.map()};
     auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
-    CHECK(name_of([&] { r.render(gbv, s.cam, maps, wrong.view()); }) == "irradiance");
+    CHECK(name_of([&] { r.render(gbv, s.cam, maps, wrong.view()); }) == "out");
+}
+
+TEST_CASE("asked for radiance, the renderer gives rho over pi times its irradiance with the G-buffer's albedo",
+          "[indirect][outputs]") {
+    const corner_scene s(16, 12);
+    const image<glm::vec3> e = render(s, {});  // the default: irradiance
+    cpu::indirect_renderer r;
+    image<glm::vec3> l(s.gb.width(), s.gb.height());
+    const rsm_view maps[] = {s.map()};
+    auto gbv = const_cast<gbuffer<float>&>(s.gb).view();
+    r.render(gbv, s.cam, maps, l.view(), output_quantity::radiance);
+    std::size_t lit = 0;
+    for (std::size_t y = 0; y < s.gb.height(); ++y)
+        for (std::size_t x = 0; x < s.gb.width(); ++x) {
+            CHECK(l(x, y) == lambertian_radiance<float, glm::vec3>(s.gb.albedo(x, y), e(x, y)));
+            lit += e(x, y).x > 0.f ? 1 : 0;
+        }
+    CHECK(lit > 0);
 }
 
 TEST_CASE("more sub-buffers than lights is refused by the options, naming both numbers", "[indirect]") {

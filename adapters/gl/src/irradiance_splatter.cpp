@@ -2,7 +2,10 @@
 #include <bounce/gl/irradiance_splatter.hpp>
 #include <bounce/gl/objects.hpp>
 
+#include <epoxy/gl.h>
+
 #include <cmath>
+#include <numbers>
 #include <span>
 
 namespace bounce::gl {
@@ -31,7 +34,7 @@ void irradiance_splatter::splat_existing(const gbuffer_textures& g, const camera
     else if (on_gpu_ < records.size()) splats_.append(std::span(records).subspan(on_gpu_));
     on_gpu_ = records.size();
     splats_.clear(w, h);
-    splats_.splat(g, cam, options_.splat, options_.weighting);
+    splats_.splat(splatted(g), cam, options_.splat, options_.weighting);
     if (options_.time_stages) finish();
     stats.splat_existing_ms = ms_since(t0);
 
@@ -51,7 +54,8 @@ void irradiance_splatter::splat_new(const gbuffer_textures& g, const camera& cam
     auto t0 = clock::now();
     splats_.append(std::span(records).subspan(before));
     on_gpu_ = records.size();
-    splats_.splat(g, cam, options_.splat, options_.weighting, before);
+    const gbuffer_textures sg = splatted(g);
+    splats_.splat(sg, cam, options_.splat, options_.weighting, before);
     const bool fill = options_.fill_holes > 0.f;
     if (fill) {
         // Every record again with zones fill_holes x wider, for the pixels none reaches.
@@ -62,7 +66,7 @@ void irradiance_splatter::splat_new(const gbuffer_textures& g, const camera& cam
         wide_splats_.clear(g.width(), g.height());
         splat_params wide = options_.splat;
         wide.a *= options_.fill_holes;
-        wide_splats_.splat(g, cam, wide, options_.weighting);
+        wide_splats_.splat(sg, cam, wide, options_.weighting);
     }
     if (options_.time_stages) finish();
     stats.interpolate_ms = ms_since(t0);
@@ -73,7 +77,22 @@ void irradiance_splatter::splat_new(const gbuffer_textures& g, const camera& cam
     stats.normalize_ms = ms_since(t0);
 }
 
+gbuffer_textures irradiance_splatter::splatted(const gbuffer_textures& g) {
+    if (output_ == output_quantity::radiance) return g;
+    if (!pi_albedo_ || pi_albedo_->width() != g.width() || pi_albedo_->height() != g.height()) {
+        pi_albedo_.emplace(texel_format::rgba32f, g.width(), g.height());
+        const float pi[4] = {std::numbers::pi_v<float>, std::numbers::pi_v<float>, std::numbers::pi_v<float>, 1.f};
+        glClearTexImage(pi_albedo_->id(), 0, GL_RGBA, GL_FLOAT, pi);
+        check_error("irradiance_splatter: the albedo of pi");
+    }
+    gbuffer_textures out = g;
+    out.albedo = *pi_albedo_;
+    return out;
+}
+
 const texture& irradiance_splatter::compose(const texture& direct) {
+    require(output_ == output_quantity::radiance, "output",
+            "compose adds direct radiance to the indirect light: render with output_quantity::radiance");
     const bool fill = options_.fill_holes > 0.f;
     compose_.compose(splats_.splat_texture(), &direct, fill ? &wide_splats_.splat_texture() : nullptr, 1e-3f);
     return compose_.result();

@@ -128,8 +128,11 @@ std::vector<glm::vec3> irradiance_volume_lookup::light_points(const irradiance_v
                                                                std::span<const glm::vec3> points,
                                                                std::span<const glm::vec3> normals,
                                                                volume_interpolation interpolation,
-                                                               const weighted_lookup& how) const {
+                                                               const weighted_lookup& how, output_quantity quantity,
+                                                               std::span<const glm::vec3> albedo) const {
     require(normals.size() == points.size(), "normals", "one normal per point");
+    require(quantity == output_quantity::irradiance || albedo.size() == points.size(), "albedo",
+            "one albedo per point is needed for radiance");
     require(how.b > 0 && how.b <= 4, "b", "the distance exponent must lie in (0, 4]");
     require(how.support > 1 && std::isfinite(how.support), "support", "must be finite and > 1");
     require(points.size() < 0x7fffffffu / 2, "points", "too many points for one dispatch (32-bit indices)");
@@ -163,6 +166,7 @@ std::vector<glm::vec3> irradiance_volume_lookup::light_points(const irradiance_v
     std::vector<float> raw(points.size() * 4);
     result.read(0, raw.data(), raw.size() * sizeof(float));
     for (std::size_t i = 0; i < points.size(); ++i) out[i] = glm::vec3(raw[4 * i], raw[4 * i + 1], raw[4 * i + 2]);
+    apply_output(quantity, albedo, std::span<glm::vec3>(out));
     return out;
 }
 

@@ -39,7 +39,8 @@ technique_run run_irradiance_cache(const scene_setup& s) {
     r.technique = bench_technique::irradiance_cache;
     r.quantity = bench_quantity::one_bounce;
     r.radiance = image<glm::vec3>(s.g.width(), s.g.height());
-    const cpu::cache_frame_stats st = cache.render(s.g.view(), s.scene.camera, sampler, r.radiance.view());
+    const cpu::cache_frame_stats st = cache.render(s.g.view(), s.scene.camera, sampler, r.radiance.view(),
+                                                   output_quantity::radiance);
     r.ms = ms_since(t0);
     r.timings_ms = {{"splat_existing", st.splat_existing_ms}, {"scan", st.scan_ms},
                     {"compute_records", st.records_ms},       {"interpolate", st.interpolate_ms},

@@ -37,9 +37,9 @@ concept camera_sequence = requires(const P& p, std::size_t f) {
 
 /// One CPU frame of `cache` seen by `cam`: the G-buffer `gbuffer_for(cam)` returns (a
 /// gbuffer<float>, e.g. embree::ray_cast_gbuffer; timed as the stage "gbuffer"), then
-/// cache.render with `sampler` (the stages of cache_frame_stats: splat_existing, scan,
-/// compute_records, interpolate, normalize). The frame's accuracy and policies are the
-/// cache's options.
+/// cache.render with `sampler` as radiance, cache_frame::indirect's quantity (the stages of
+/// cache_frame_stats: splat_existing, scan, compute_records, interpolate, normalize). The
+/// frame's accuracy and policies are the cache's options.
 template <class Weight, record_sampler Sampler, class GBufferFor>
     requires std::invocable<GBufferFor&, const camera&>
 cache_frame render_frame(irradiance_cache<Weight>& cache, const camera& cam, GBufferFor&& gbuffer_for, Sampler& sampler) {
@@ -49,7 +49,8 @@ cache_frame render_frame(irradiance_cache<Weight>& cache, const camera& cam, GBu
     f.stages_ms.emplace_back(
         "gbuffer", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     f.indirect = image<glm::vec3>(f.g.width(), f.g.height());
-    const cache_frame_stats s = cache.render(f.g.view(), cam, sampler, f.indirect.view());
+    // cache_frame holds radiance: the image a renderer shows (and the GL frame composes).
+    const cache_frame_stats s = cache.render(f.g.view(), cam, sampler, f.indirect.view(), output_quantity::radiance);
     f.new_records = s.new_records;
     f.measured = s.measured;
     f.wasted = s.wasted;

@@ -9,8 +9,9 @@
 ///
 /// A renderer keeps one `indirect_renderer` and calls `render` per frame with views of its
 /// own G-buffer and reflective shadow maps; scratch buffers are kept between frames and
-/// reallocated only when the size changes. The result is irradiance (W/m^2 per channel);
-/// outgoing radiance is rho_d / pi times it (lambertian_radiance).
+/// reallocated only when the size changes. The result is irradiance (W/m^2 per channel) or,
+/// asked for output_quantity::radiance, rho_d / pi times it with the G-buffer's albedo
+/// (output.hpp).
 ///
 /// The options and timings (bounce::indirect_options, bounce::indirect_timings in
 /// indirect/options.hpp) and the host-side choices (disc pattern, VPL selection, splat
@@ -25,6 +26,7 @@
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
 #include <bounce/indirect/vpl_sampling.hpp>
+#include <bounce/output.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -50,21 +52,31 @@ public:
         pattern_texels_ = 0;
     }
 
-    /// set_options(options), then render(gb, cam, maps, irradiance): the call
+    /// set_options(options), then render(gb, cam, maps, out, quantity): the call
     /// gl::offscreen_indirect_renderer offers too, so a caller switches backends by type.
     indirect_timings render(const indirect_options& options, const gbuffer_view<float>& gb, const camera& cam,
-                            std::span<const rsm_view> maps, image_view<glm::vec3> irradiance) {
+                            std::span<const rsm_view> maps, image_view<glm::vec3> out,
+                            output_quantity quantity = output_quantity::irradiance) {
         set_options(options);
-        return render(gb, cam, maps, irradiance);
+        return render(gb, cam, maps, out, quantity);
     }
 
-    /// Fills `irradiance` (the G-buffer's size) with the one-bounce indirect irradiance that
-    /// `maps` (one per spot or directional light, six per point light) reflect onto the
-    /// G-buffer's pixels, unoccluded; 0 where the G-buffer sees nothing.
+    /// Fills `out` (the G-buffer's size) with the one-bounce indirect light that `maps` (one
+    /// per spot or directional light, six per point light) reflect onto the G-buffer's
+    /// pixels, unoccluded, as `quantity` (output.hpp): irradiance (W/m^2, the default) or
+    /// radiance with the G-buffer's albedo; 0 where the G-buffer sees nothing.
     indirect_timings render(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
-                            image_view<glm::vec3> irradiance) {
+                            image_view<glm::vec3> out, output_quantity quantity = output_quantity::irradiance) {
+        const indirect_timings t = render_irradiance(gb, cam, maps, out);
+        apply_output(quantity, image_view<const glm::vec3>(gb.albedo), out);
+        return t;
+    }
+
+private:
+    indirect_timings render_irradiance(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
+                                       image_view<glm::vec3> irradiance) {
         cam.validate();
-        require(irradiance.width() == gb.width() && irradiance.height() == gb.height(), "irradiance",
+        require(irradiance.width() == gb.width() && irradiance.height() == gb.height(), "out",
                 "size differs from the G-buffer");
         require(!gb.depth.empty(), "gb", "is empty");
         for (const auto& m : maps) m.validate();
@@ -91,7 +103,6 @@ public:
         return t;
     }
 
-private:
     using clock = std::chrono::steady_clock;
     static double ms_since(clock::time_point s) {
         return std::chrono::duration<double, std::milli>(clock::now() - s).count();

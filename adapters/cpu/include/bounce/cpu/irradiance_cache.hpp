@@ -28,6 +28,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
+#include <bounce/output.hpp>
 #include <bounce/cache/record.hpp>
 #include <bounce/cache/record_sampler.hpp>
 
@@ -36,6 +37,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <vector>
@@ -184,16 +186,25 @@ public:
         return shrunk;
     }
 
-    /// One frame: the indirect radiance rho/pi * E of every pixel of `g` seen by `cam` into
-    /// `indirect` (0 where no record reaches, or where g sees nothing), measuring the records
-    /// it misses with `sampler`. `record_points`, when given (same size as g), is where the
-    /// records of missed pixels are measured instead of g's own points (a sampler's more
-    /// exact hit of the same pixel). Throws parameter_error on mismatched sizes.
+    /// One frame: the indirect light of every pixel of `gb` seen by `cam` into `indirect` as
+    /// `quantity` (output.hpp): irradiance E (W/m^2, the default) or radiance rho/pi * E with
+    /// the G-buffer's albedo (W/(m^2 sr)); 0 where no record reaches, or where gb sees
+    /// nothing. Misses are measured with `sampler`. `record_points`, when given (same size as
+    /// gb), is where the records of missed pixels are measured instead of gb's own points (a
+    /// sampler's more exact hit of the same pixel). Throws parameter_error on mismatched sizes.
     template <record_sampler Sampler>
-    cache_frame_stats render(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler,
-                             image_view<glm::vec3> indirect, const gbuffer_view<float>* record_points = nullptr) {
-        require(indirect.width() == g.width() && indirect.height() == g.height(), "indirect",
+    cache_frame_stats render(const gbuffer_view<float>& gb, const camera& cam, Sampler& sampler,
+                             image_view<glm::vec3> indirect, output_quantity quantity = output_quantity::irradiance,
+                             const gbuffer_view<float>* record_points = nullptr) {
+        require(indirect.width() == gb.width() && indirect.height() == gb.height(), "indirect",
                 "size differs from the G-buffer");
+        // The splat kernel weighs rho/pi * E (splat_contribution); an albedo of pi leaves E.
+        image<glm::vec3> pi_albedo;
+        gbuffer_view<float> g = gb;
+        if (quantity == output_quantity::irradiance) {
+            pi_albedo = image<glm::vec3>(gb.width(), gb.height(), glm::vec3(std::numbers::pi_v<float>));
+            g.albedo = pi_albedo.view();
+        }
         cache_frame_stats stats;
         timed(stats.splat_existing_ms, [&] { stats.reclamped = clamp_to_neighbours(); });
         image<glm::vec4> splat(g.width(), g.height(), glm::vec4(0.f));

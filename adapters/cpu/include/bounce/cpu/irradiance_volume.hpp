@@ -5,6 +5,7 @@
 /// independent (volume/probe_octree.hpp), so the result does not depend on the thread count.
 
 #include <bounce/errors.hpp>
+#include <bounce/output.hpp>
 #include <bounce/volume/probe_octree.hpp>
 
 #include <tbb/blocked_range.h>
@@ -28,19 +29,25 @@ struct volume_lookup {
     weighted_lookup weighted{};
 };
 
-/// Irradiance (W/m^2, RGB) at each point with its unit normal, rows of 256 points in
-/// parallel. Throws parameter_error naming "normals" or "out" when sizes differ, and "b"
-/// for an exponent outside (0, 16].
+/// The light at each point with its unit normal as `quantity` (output.hpp): irradiance
+/// (W/m^2, RGB; the default) or radiance rho/pi * E with `albedo` (one per point), rows of
+/// 256 points in parallel. Throws parameter_error naming "normals", "out" or "albedo" when
+/// sizes differ, and "b" for an exponent outside (0, 16].
 inline void light_points(const irradiance_volume& volume, std::span<const glm::vec3> points,
-                         std::span<const glm::vec3> normals, std::span<glm::vec3> out, const volume_lookup& how) {
+                         std::span<const glm::vec3> normals, std::span<glm::vec3> out, const volume_lookup& how,
+                         output_quantity quantity = output_quantity::irradiance,
+                         std::span<const glm::vec3> albedo = {}) {
     require(normals.size() == points.size(), "normals", "one normal per point");
     require(out.size() == points.size(), "out", "one result per point");
+    require(quantity == output_quantity::irradiance || albedo.size() == points.size(), "albedo",
+            "one albedo per point is needed for radiance");
     require(how.weighted.b > 0 && how.weighted.b <= 16, "b", "the distance exponent must lie in (0, 16]");
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i)
             out[i] = how.interpolation == volume_interpolation::trilinear ? volume.trilinear(points[i], normals[i])
                                                                           : volume.weighted(points[i], normals[i], how.weighted);
     });
+    apply_output(quantity, albedo, out);
 }
 
 }  // namespace bounce::cpu

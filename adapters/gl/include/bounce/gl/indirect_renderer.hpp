@@ -40,6 +40,7 @@
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
 #include <bounce/indirect/vpl_sampling.hpp>
+#include <bounce/output.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -78,7 +79,8 @@ public:
     /// unoccluded; 0 where the G-buffer sees nothing. Throws parameter_error naming the
     /// texture or map at fault (sizes, formats, zero-sized textures). The SII shade stage
     /// includes reading the maps back and selecting the VPLs on the host; fallback_pixels
-    /// is counted by an occlusion query.
+    /// is counted by an occlusion query. Irradiance only (output.hpp's default): for radiance
+    /// multiply by the albedo over pi in your shading pass.
     indirect_timings render(const gbuffer_textures& g, const camera& cam, std::span<const rsm_textures> maps,
                             const texture_ref& irradiance);
 
@@ -120,6 +122,14 @@ public:
     /// Throws parameter_error for bad options (before any GL work) or inputs.
     indirect_timings render(const indirect_options& options, const gbuffer_view<float>& gb, const camera& cam,
                             std::span<const rsm_view> maps, image_view<glm::vec3> irradiance);
+    /// The same as `quantity` (output.hpp): radiance is rho/pi times the irradiance with the
+    /// G-buffer's albedo, as cpu::indirect_renderer::render gives it.
+    indirect_timings render(const indirect_options& options, const gbuffer_view<float>& gb, const camera& cam,
+                            std::span<const rsm_view> maps, image_view<glm::vec3> out, output_quantity quantity) {
+        const indirect_timings t = render(options, gb, cam, maps, out);
+        apply_output(quantity, image_view<const glm::vec3>(gb.albedo), out);
+        return t;
+    }
 
     /// GL_RENDERER of the context ("llvmpipe (LLVM 15.0.6, 256 bits)" ...).
     std::string gl_renderer() const { return context_.renderer(); }

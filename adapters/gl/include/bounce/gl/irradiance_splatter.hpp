@@ -9,8 +9,9 @@
 ///   3. the cache-miss scan, on the CPU, by the caller's `scan` (cpu::irradiance_cache::scan:
 ///      it appends records and splats them into the read-back buffer);
 ///   4. upload the new records and splat them on top of step 1's buffer;
-///   5. normalize (and, with a budget, fill holes from a wider splat) into `indirect()`;
-///      `compose` adds the caller's direct radiance.
+///   5. normalize (and, with a budget, fill holes from a wider splat) into `indirect()`:
+///      irradiance E by default, or radiance rho/pi * E with the G-buffer's albedo
+///      (output.hpp); `compose` adds the caller's direct radiance to the latter.
 /// The splatter keeps the GPU copy of the cache in step with the caller's record list. It
 /// restores the GL state it changes (as splat_pass and compose_pass do).
 ///
@@ -27,6 +28,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/image.hpp>
+#include <bounce/output.hpp>
 #include <bounce/cache/record.hpp>
 #include <bounce/cache/record_sampler.hpp>
 #include <bounce/cache/weighting.hpp>
@@ -34,6 +36,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -90,11 +93,15 @@ public:
     /// image_view<glm::vec4> splat)` must append the records of the misses it finds to that
     /// same list (and splat them into `splat`), e.g.
     ///   [&](auto g, auto splat) { cache.scan(g, cam, sampler, splat); }.
+    /// `quantity` is what indirect() holds (output.hpp): irradiance (W/m^2, the default) or
+    /// radiance rho/pi * E with g's albedo (W/(m^2 sr)).
     /// Throws parameter_error on bad textures; whatever `scan` throws passes through.
     template <class Scan>
     splatter_frame_stats render(const gbuffer_textures& g, const camera& cam,
-                                const std::vector<irradiance_record>& records, Scan&& scan) {
+                                const std::vector<irradiance_record>& records, Scan&& scan,
+                                output_quantity quantity = output_quantity::irradiance) {
         splatter_frame_stats stats;
+        output_ = quantity;
         splat_existing(g, cam, records, stats);
         const std::size_t before = records.size();
         const auto t0 = clock::now();
@@ -115,7 +122,8 @@ public:
     ///     when the cache replaced or shrank them (its generation changed) or is another cache
     ///     (told apart by address: call reset() when a new cache takes a destroyed one's place);
     ///   - passes.gbuffer renders the G-buffer of passes.mesh, passes.light its direct light;
-    ///   - render() with cache.scan(g, cam, sampler, splat) as the scan. `record_points(points)`
+    ///   - render() with cache.scan(g, cam, sampler, splat) as the scan, as radiance (the
+    ///     quantity of cache_frame::indirect). `record_points(points)`
     ///     may first move the read-back G-buffer's points to where `sampler` should measure the
     ///     records (a ray tracer's own hits of the pixels: embree::snap_to_ray_hits); its time
     ///     counts as record computation;
@@ -157,7 +165,7 @@ public:
                     const gbuffer_view<float> where = points.view();
                     took(cache.scan(g, cam, sampler, splat, &where));
                 }
-            });
+            }, output_quantity::radiance);
         f.new_records = st.new_records;
         f.stages_ms.emplace_back("splat_existing", st.splat_existing_ms);
         f.stages_ms.emplace_back("readback", st.readback_ms);
@@ -176,9 +184,12 @@ public:
 
     /// The G-buffer and the splat buffer the last frame's scan saw (row 0 at the top).
     const gbuffer<float>& scanned_gbuffer() const noexcept { return gbuffer_; }
-    /// The last frame's indirect radiance (RGBA32F, rgb; alpha 1).
+    /// The last frame's indirect light as render() was asked for it (RGBA32F, rgb; alpha 1).
     const texture& indirect() const { return compose_.result(); }
+    /// What indirect() holds: the quantity of the last render().
+    output_quantity output() const noexcept { return output_; }
     /// indirect() plus `direct` (RGBA32F rgb, e.g. direct_light::radiance()) into result().
+    /// Throws parameter_error naming "output" unless the last render() made radiance.
     const texture& compose(const texture& direct);
     /// Copies the indirect image of the last frame into `out` (row 0 at the top). Call
     /// before compose, which replaces the result.
@@ -211,6 +222,9 @@ private:
                         splatter_frame_stats& stats);
     void splat_new(const gbuffer_textures& g, const camera& cam, const std::vector<irradiance_record>& records,
                    std::size_t before, splatter_frame_stats& stats);
+    // g as the splat passes read it: for irradiance, its albedo replaced by pi everywhere
+    // (the splat kernel weighs rho/pi * E).
+    gbuffer_textures splatted(const gbuffer_textures& g);
 
     irradiance_splatter_options options_;
     splat_pass splats_, wide_splats_;
@@ -220,6 +234,8 @@ private:
     std::uint64_t generation_ = 0;
     gbuffer<float> gbuffer_;
     image<glm::vec4> splat_;
+    output_quantity output_ = output_quantity::irradiance;
+    std::optional<texture> pi_albedo_;  // RGBA32F filled with pi, the G-buffer's size
 };
 
 }  // namespace bounce::gl

@@ -7,6 +7,7 @@
 /// the traversal stack and the loops over corners.
 
 #include <bounce/gl/objects.hpp>
+#include <bounce/output.hpp>
 #include <bounce/volume/probe_octree.hpp>
 
 #include <cstdint>
@@ -48,12 +49,16 @@ public:
     static std::string shader_source();
 
     /// Irradiance (W/m^2, RGB) at each point with its unit normal, as
-    /// irradiance_volume::trilinear or ::weighted compute it. Restores the program and the
-    /// storage-buffer bindings 0..4 it uses. Throws parameter_error on mismatched sizes or
-    /// a `how` the CPU lookup refuses, gl_error on a GL failure.
+    /// irradiance_volume::trilinear or ::weighted compute it, or as `quantity` radiance
+    /// rho/pi * E with `albedo` (one per point; output.hpp), as cpu::light_points gives it.
+    /// Restores the program and the storage-buffer bindings 0..4 it uses. Throws
+    /// parameter_error on mismatched sizes (naming "albedo" for radiance without one per
+    /// point) or a `how` the CPU lookup refuses, gl_error on a GL failure.
     std::vector<glm::vec3> light_points(const irradiance_volume_buffers& volume, std::span<const glm::vec3> points,
                                         std::span<const glm::vec3> normals, volume_interpolation interpolation,
-                                        const weighted_lookup& how = {}) const;
+                                        const weighted_lookup& how = {},
+                                        output_quantity quantity = output_quantity::irradiance,
+                                        std::span<const glm::vec3> albedo = {}) const;
 
 private:
     program program_;
