@@ -303,210 +303,242 @@ void for_each_cell_overlap(const std::array<glm::dvec2, 3>& q, std::uint32_t wid
 
 inline glm::dvec3 to_d(const glm::vec3& v) { return glm::dvec3(v); }
 
-}  // namespace bounce::detail
-
-namespace bounce::inline radiosity {
-
-/// Cuts `scene` into charts and elements as the file comment says. Throws parameter_error
-/// (via scene.validate() and options.validate()) on a bad scene or options.
-inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_options& options = {}) {
-    scene.validate();
-    options.validate();
+/// Unit normals and areas of a scene's triangles, in double; degenerate triangles have area
+/// 0 and normal 0.
+struct triangle_faces {
+    std::vector<glm::dvec3> normal;
+    std::vector<double> area;
+};
+inline triangle_faces face_normals_and_areas(const scene_view& scene) {
     const std::size_t nt = scene.triangles.size();
-    lightmap_atlas atlas;
-    atlas.block_texels = options.block_texels;
-    atlas.chart_of_triangle.assign(nt, lightmap_atlas::none);
-
-    // Face normals and areas; degenerate triangles get no chart.
-    std::vector<glm::dvec3> face_normal(nt);
-    std::vector<double> face_area(nt, 0.0);
-    const auto [lo, hi] = scene.bounds();
-    const double diagonal = glm::length(detail::to_d(hi) - detail::to_d(lo));
+    triangle_faces faces{std::vector<glm::dvec3>(nt), std::vector<double>(nt, 0.0)};
     for (std::size_t t = 0; t < nt; ++t) {
         const auto& tri = scene.triangles[t];
-        const glm::dvec3 a = detail::to_d(scene.positions[tri.x]), b = detail::to_d(scene.positions[tri.y]),
-                         c = detail::to_d(scene.positions[tri.z]);
+        const glm::dvec3 a = to_d(scene.positions[tri.x]), b = to_d(scene.positions[tri.y]), c = to_d(scene.positions[tri.z]);
         const glm::dvec3 cr = glm::cross(b - a, c - a);
         const double len = glm::length(cr);
-        face_area[t] = 0.5 * len;
-        face_normal[t] = len > 0 ? cr / len : glm::dvec3(0);
+        faces.area[t] = 0.5 * len;
+        faces.normal[t] = len > 0 ? cr / len : glm::dvec3(0);
     }
+    return faces;
+}
 
-    // Edge adjacency over welded positions (meshes often split vertices for normals or UVs).
+/// Each position's index of the first position equal to it: meshes often split vertices
+/// for normals or UVs, and charts must see through that.
+inline std::vector<std::uint32_t> welded_positions(std::span<const glm::vec3> positions) {
     std::unordered_map<std::uint64_t, std::uint32_t> weld;
-    std::vector<std::uint32_t> welded(scene.positions.size());
+    std::vector<std::uint32_t> welded(positions.size());
     const auto bits = [](float f) {
         f = f == 0.f ? 0.f : f;  // -0 and +0 are one position
         std::uint32_t u;
         std::memcpy(&u, &f, 4);
         return std::uint64_t(u);
     };
-    for (std::size_t i = 0; i < scene.positions.size(); ++i) {
-        const glm::vec3 p = scene.positions[i];
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const glm::vec3 p = positions[i];
         std::uint64_t key = bits(p.x) * 0x9e3779b97f4a7c15ULL ^ (bits(p.y) * 0xc2b2ae3d27d4eb4fULL) ^
                             (bits(p.z) * 0x165667b19e3779f9ULL);
         // Resolve the rare hash collision between different positions by probing.
         for (;;) {
             auto [it, inserted] = weld.try_emplace(key, std::uint32_t(i));
-            if (inserted || scene.positions[it->second] == p) {
+            if (inserted || positions[it->second] == p) {
                 welded[i] = it->second;
                 break;
             }
             ++key;
         }
     }
-    std::unordered_multimap<std::uint64_t, std::uint32_t> edge_triangles;
-    edge_triangles.reserve(3 * nt);
-    const auto edge_key = [&](std::uint32_t i, std::uint32_t j) {
-        const std::uint64_t a = welded[i], b = welded[j];
-        return std::min(a, b) << 32 | std::max(a, b);
-    };
-    for (std::size_t t = 0; t < nt; ++t) {
-        if (face_area[t] <= 0) continue;
-        const auto& tri = scene.triangles[t];
-        for (int k = 0; k < 3; ++k) edge_triangles.emplace(edge_key(tri[k], tri[(k + 1) % 3]), std::uint32_t(t));
-    }
+    return welded;
+}
 
-    // Flood fill charts from seeds in triangle order: a neighbour joins when it has the seed's
-    // material, its normal is within coplanar_degrees of the seed's and its vertices lie
-    // within coplanar_distance of the seed's plane (measuring against the seed, not the
-    // neighbour, keeps a gently curved surface from drifting into one chart).
+/// The triangles of positive area on each edge, edges keyed by their welded end points.
+class edge_adjacency {
+public:
+    edge_adjacency(const scene_view& scene, const triangle_faces& faces) : welded_(welded_positions(scene.positions)) {
+        triangles_.reserve(3 * scene.triangles.size());
+        for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+            if (faces.area[t] <= 0) continue;
+            const auto& tri = scene.triangles[t];
+            for (int k = 0; k < 3; ++k) triangles_.emplace(key(tri[k], tri[(k + 1) % 3]), std::uint32_t(t));
+        }
+    }
+    /// The triangles on the edge between positions i and j, as a range of (key, triangle).
+    auto triangles_on(std::uint32_t i, std::uint32_t j) const { return triangles_.equal_range(key(i, j)); }
+
+private:
+    std::uint64_t key(std::uint32_t i, std::uint32_t j) const {
+        const std::uint64_t a = welded_[i], b = welded_[j];
+        return std::min(a, b) << 32 | std::max(a, b);
+    }
+    std::vector<std::uint32_t> welded_;
+    std::unordered_multimap<std::uint64_t, std::uint32_t> triangles_;
+};
+
+/// Chart `c` grown from triangle `seed` by flood fill over shared edges: a neighbour joins
+/// when it has the seed's material, its normal is within cos_tol of the seed's and its
+/// vertices lie within dist_tol of the seed's plane (measuring against the seed, not the
+/// neighbour, keeps a gently curved surface from drifting into one chart). Appends the
+/// chart's triangles, in index order, to atlas.chart_triangles.
+inline lightmap_chart grow_chart(const scene_view& scene, const triangle_faces& faces, const edge_adjacency& edges,
+                                 std::uint32_t seed, double cos_tol, double dist_tol, lightmap_atlas& atlas) {
+    const std::uint32_t c = std::uint32_t(atlas.charts.size());
+    lightmap_chart chart;
+    chart.material = scene.material_of[seed];
+    chart.first_triangle = std::uint32_t(atlas.chart_triangles.size());
+    const glm::dvec3 n0 = faces.normal[seed];
+    const glm::dvec3 p0 = to_d(scene.positions[scene.triangles[seed].x]);
+    const auto joins = [&](std::uint32_t u) {
+        if (scene.material_of[u] != chart.material || glm::dot(faces.normal[u], n0) < cos_tol) return false;
+        bool in_plane = true;
+        for (int m = 0; m < 3; ++m)
+            in_plane = in_plane && std::abs(glm::dot(to_d(scene.positions[scene.triangles[u][m]]) - p0, n0)) <= dist_tol;
+        return in_plane;
+    };
+    atlas.chart_of_triangle[seed] = c;
+    std::vector<std::uint32_t> stack(1, seed);
+    while (!stack.empty()) {
+        const std::uint32_t t = stack.back();
+        stack.pop_back();
+        atlas.chart_triangles.push_back(t);
+        const auto& tri = scene.triangles[t];
+        for (int k = 0; k < 3; ++k) {
+            const auto range = edges.triangles_on(tri[k], tri[(k + 1) % 3]);
+            for (auto it = range.first; it != range.second; ++it) {
+                const std::uint32_t u = it->second;
+                if (atlas.chart_of_triangle[u] != lightmap_atlas::none || !joins(u)) continue;
+                atlas.chart_of_triangle[u] = c;
+                stack.push_back(u);
+            }
+        }
+    }
+    chart.triangle_count = std::uint32_t(atlas.chart_triangles.size()) - chart.first_triangle;
+    // Keep the triangles in index order within a chart (deterministic layout).
+    std::sort(atlas.chart_triangles.begin() + chart.first_triangle, atlas.chart_triangles.end());
+    glm::dvec3 n_sum(0);
+    for (std::uint32_t k = 0; k < chart.triangle_count; ++k) {
+        const std::uint32_t t = atlas.chart_triangles[chart.first_triangle + k];
+        n_sum += faces.area[t] * faces.normal[t];
+    }
+    chart.normal = glm::vec3(glm::normalize(n_sum));
+    return chart;
+}
+
+/// Every triangle of positive area in a chart, charts grown from seeds in triangle order.
+inline void group_into_charts(const scene_view& scene, const triangle_faces& faces, const atlas_options& options,
+                              double diagonal, lightmap_atlas& atlas) {
+    const edge_adjacency edges(scene, faces);
     const double cos_tol = std::cos(options.coplanar_degrees * std::numbers::pi / 180.0);
     const double dist_tol = options.coplanar_distance * std::max(diagonal, 1e-30);
-    std::vector<std::uint32_t> stack;
-    for (std::size_t seed = 0; seed < nt; ++seed) {
-        if (face_area[seed] <= 0 || atlas.chart_of_triangle[seed] != lightmap_atlas::none) continue;
-        const std::uint32_t c = std::uint32_t(atlas.charts.size());
-        lightmap_chart chart;
-        chart.material = scene.material_of[seed];
-        chart.first_triangle = std::uint32_t(atlas.chart_triangles.size());
-        const glm::dvec3 n0 = face_normal[seed];
-        const glm::dvec3 p0 = detail::to_d(scene.positions[scene.triangles[seed].x]);
-        atlas.chart_of_triangle[seed] = c;
-        stack.assign(1, std::uint32_t(seed));
-        while (!stack.empty()) {
-            const std::uint32_t t = stack.back();
-            stack.pop_back();
-            atlas.chart_triangles.push_back(t);
-            const auto& tri = scene.triangles[t];
-            for (int k = 0; k < 3; ++k) {
-                const auto range = edge_triangles.equal_range(edge_key(tri[k], tri[(k + 1) % 3]));
-                for (auto it = range.first; it != range.second; ++it) {
-                    const std::uint32_t u = it->second;
-                    if (atlas.chart_of_triangle[u] != lightmap_atlas::none) continue;
-                    if (scene.material_of[u] != chart.material || glm::dot(face_normal[u], n0) < cos_tol) continue;
-                    bool in_plane = true;
-                    for (int m = 0; m < 3; ++m)
-                        in_plane = in_plane && std::abs(glm::dot(detail::to_d(scene.positions[scene.triangles[u][m]]) -
-                                                                     p0,
-                                                                 n0)) <= dist_tol;
-                    if (!in_plane) continue;
-                    atlas.chart_of_triangle[u] = c;
-                    stack.push_back(u);
-                }
-            }
-        }
-        chart.triangle_count = std::uint32_t(atlas.chart_triangles.size()) - chart.first_triangle;
-        // Keep the triangles in index order within a chart (deterministic layout).
-        std::sort(atlas.chart_triangles.begin() + chart.first_triangle, atlas.chart_triangles.end());
-        glm::dvec3 n_sum(0);
-        for (std::uint32_t k = 0; k < chart.triangle_count; ++k) {
-            const std::uint32_t t = atlas.chart_triangles[chart.first_triangle + k];
-            n_sum += face_area[t] * face_normal[t];
-        }
-        chart.normal = glm::vec3(glm::normalize(n_sum));
-        atlas.charts.push_back(chart);
+    for (std::size_t seed = 0; seed < scene.triangles.size(); ++seed) {
+        if (faces.area[seed] <= 0 || atlas.chart_of_triangle[seed] != lightmap_atlas::none) continue;
+        atlas.charts.push_back(grow_chart(scene, faces, edges, std::uint32_t(seed), cos_tol, dist_tol, atlas));
     }
+}
 
-    // Each chart's frame: the in-plane direction, among its triangles' edges, with the smallest
-    // bounding rectangle (a rectangle's own sides for walls and quads). At most 64 edges are
-    // tried, which covers every chart of a few dozen triangles.
-    struct extent {
-        glm::dvec3 origin, u, v;
-        double eu = 0, ev = 0;
-    };
-    std::vector<extent> extents(atlas.charts.size());
-    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
-        const lightmap_chart& ch = atlas.charts[c];
-        const glm::dvec3 n = glm::dvec3(ch.normal);
-        const auto tris = std::span(atlas.chart_triangles).subspan(ch.first_triangle, ch.triangle_count);
-        double best = std::numeric_limits<double>::infinity();
-        int tried = 0;
-        for (const std::uint32_t t : tris) {
-            for (int k = 0; k < 3 && tried < 64; ++k, ++tried) {
-                const glm::dvec3 e = detail::to_d(scene.positions[scene.triangles[t][(k + 1) % 3]]) -
-                                     detail::to_d(scene.positions[scene.triangles[t][k]]);
-                glm::dvec3 u = e - n * glm::dot(e, n);
-                if (glm::length(u) <= 0) continue;
-                u = glm::normalize(u);
-                const glm::dvec3 v = glm::cross(n, u);
-                glm::dvec2 mn(std::numeric_limits<double>::infinity()), mx(-std::numeric_limits<double>::infinity());
-                for (const std::uint32_t s : tris)
-                    for (int m = 0; m < 3; ++m) {
-                        const glm::dvec3 p = detail::to_d(scene.positions[scene.triangles[s][m]]);
-                        const glm::dvec2 q(glm::dot(p, u), glm::dot(p, v));
-                        mn = glm::min(mn, q);
-                        mx = glm::max(mx, q);
-                    }
-                const glm::dvec2 size = mx - mn;
-                if (size.x * size.y < best) {
-                    best = size.x * size.y;
-                    // Origin on the chart's plane: the rectangle's corner, moved onto the plane.
-                    const glm::dvec3 on_plane =
-                        n * glm::dot(detail::to_d(scene.positions[scene.triangles[tris[0]].x]), n);
-                    extents[c] = {on_plane + u * mn.x + v * mn.y, u, v, size.x, size.y};
-                }
-            }
-        }
-    }
+/// A chart's frame on its plane (origin, unit in-plane axes u and v) and its extent along
+/// them (m).
+struct chart_extent {
+    glm::dvec3 origin, u, v;
+    double eu = 0, ev = 0;
+};
 
-    // Texels and elements for a texel size h (m): per chart, a grid of ceil(extent / h) texels
-    // stretched to fit the extent exactly. Returns the element count.
-    struct texel_sum {
-        double area = 0;
-        glm::dvec2 moment{0};
-    };
-    std::vector<std::vector<texel_sum>> sums(atlas.charts.size());
-    const auto cut = [&](double h) {
-        std::size_t count = 0;
-        for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
-            lightmap_chart& ch = atlas.charts[c];
-            const extent& ex = extents[c];
-            ch.width = std::uint32_t(std::clamp(std::ceil(ex.eu / h), 1.0, 65536.0));
-            ch.height = std::uint32_t(std::clamp(std::ceil(ex.ev / h), 1.0, 65536.0));
-            const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
-            ch.origin = glm::vec3(ex.origin);
-            ch.axis_u = glm::vec3(ex.u * su);
-            ch.axis_v = glm::vec3(ex.v * sv);
-            auto& s = sums[c];
-            s.assign(std::size_t(ch.width) * ch.height, texel_sum{});
-            for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
-                const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
-                std::array<glm::dvec2, 3> q;
+/// The frame of chart `ch` whose axis u runs along one of its triangles' edges and whose
+/// bounding rectangle is the smallest (a rectangle's own sides for walls and quads). At most
+/// 64 edges are tried, which covers every chart of a few dozen triangles.
+inline chart_extent smallest_bounding_frame(const scene_view& scene, const lightmap_atlas& atlas,
+                                            const lightmap_chart& ch) {
+    chart_extent out{};
+    const glm::dvec3 n = glm::dvec3(ch.normal);
+    const auto tris = std::span(atlas.chart_triangles).subspan(ch.first_triangle, ch.triangle_count);
+    const auto corner = [&](std::uint32_t t, int k) { return to_d(scene.positions[scene.triangles[t][k]]); };
+    double best = std::numeric_limits<double>::infinity();
+    int tried = 0;
+    for (const std::uint32_t t : tris) {
+        for (int k = 0; k < 3 && tried < 64; ++k, ++tried) {
+            const glm::dvec3 e = corner(t, (k + 1) % 3) - corner(t, k);
+            glm::dvec3 u = e - n * glm::dot(e, n);
+            if (glm::length(u) <= 0) continue;
+            u = glm::normalize(u);
+            const glm::dvec3 v = glm::cross(n, u);
+            glm::dvec2 mn(std::numeric_limits<double>::infinity()), mx(-std::numeric_limits<double>::infinity());
+            for (const std::uint32_t s : tris)
                 for (int m = 0; m < 3; ++m) {
-                    const glm::dvec3 d = detail::to_d(scene.positions[scene.triangles[t][m]]) - ex.origin;
-                    q[std::size_t(m)] = {glm::dot(d, ex.u) / su, glm::dot(d, ex.v) / sv};
+                    const glm::dvec3 p = corner(s, m);
+                    const glm::dvec2 q(glm::dot(p, u), glm::dot(p, v));
+                    mn = glm::min(mn, q);
+                    mx = glm::max(mx, q);
                 }
-                detail::for_each_cell_overlap(q, ch.width, ch.height, [&](std::size_t cell, double a, glm::dvec2 moment) {
-                    s[cell].area += a;
-                    s[cell].moment += moment;
-                });
+            const glm::dvec2 size = mx - mn;
+            if (size.x * size.y < best) {
+                best = size.x * size.y;
+                // Origin on the chart's plane: the rectangle's corner, moved onto the plane.
+                const glm::dvec3 on_plane = n * glm::dot(to_d(scene.positions[scene.triangles[tris[0]].x]), n);
+                out = {on_plane + u * mn.x + v * mn.y, u, v, size.x, size.y};
             }
-            // Slivers below 1e-6 of a texel are dropped: they carry no measurable power and
-            // their centroids are ill-conditioned.
-            for (const auto& ts : s) count += ts.area > 1e-6 ? 1 : 0;
         }
-        return count;
-    };
-    double total_area = 0;
-    for (std::size_t t = 0; t < nt; ++t) total_area += face_area[t];
-    require(total_area > 0, "scene.triangles", "the scene has no triangle of positive area");
-    // The count grows like 1/h^2 plus the charts' boundaries and jumps where a chart's
-    // ceil(extent / h) steps: secant steps on h, keeping the closest count seen.
+    }
+    return out;
+}
+
+/// The exact overlap of one texel with its chart's triangles: area and first moment, in
+/// texels of the chart's grid.
+struct texel_sum {
+    double area = 0;
+    glm::dvec2 moment{0};
+};
+
+/// A texel is an element when its overlap exceeds 1e-6 of a texel: slivers below carry no
+/// measurable power and their centroids are ill-conditioned.
+inline bool holds_element(const texel_sum& ts) { return ts.area > 1e-6; }
+
+/// Chart `ch` cut into texels of about h (m): a grid of ceil(extent / h) texels stretched
+/// to fit the extent exactly. Sets the chart's size and axes, fills `sums` with each
+/// texel's overlap and returns the number of elements.
+inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atlas, const chart_extent& ex, double h,
+                             lightmap_chart& ch, std::vector<texel_sum>& sums) {
+    ch.width = std::uint32_t(std::clamp(std::ceil(ex.eu / h), 1.0, 65536.0));
+    ch.height = std::uint32_t(std::clamp(std::ceil(ex.ev / h), 1.0, 65536.0));
+    const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
+    ch.origin = glm::vec3(ex.origin);
+    ch.axis_u = glm::vec3(ex.u * su);
+    ch.axis_v = glm::vec3(ex.v * sv);
+    sums.assign(std::size_t(ch.width) * ch.height, texel_sum{});
+    for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
+        const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
+        std::array<glm::dvec2, 3> q;
+        for (int m = 0; m < 3; ++m) {
+            const glm::dvec3 d = to_d(scene.positions[scene.triangles[t][m]]) - ex.origin;
+            q[std::size_t(m)] = {glm::dot(d, ex.u) / su, glm::dot(d, ex.v) / sv};
+        }
+        for_each_cell_overlap(q, ch.width, ch.height, [&](std::size_t cell, double a, glm::dvec2 moment) {
+            sums[cell].area += a;
+            sums[cell].moment += moment;
+        });
+    }
+    std::size_t count = 0;
+    for (const auto& ts : sums) count += holds_element(ts) ? 1 : 0;
+    return count;
+}
+
+/// Every chart cut into texels of about h (m); returns the element count.
+inline std::size_t cut_charts(const scene_view& scene, const std::vector<chart_extent>& extents, double h,
+                              lightmap_atlas& atlas, std::vector<std::vector<texel_sum>>& sums) {
+    std::size_t count = 0;
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c)
+        count += cut_chart(scene, atlas, extents[c], h, atlas.charts[c], sums[c]);
+    return count;
+}
+
+/// Cuts the charts with the texel size whose element count comes closest to
+/// options.elements. The count grows like 1/h^2 plus the charts' boundaries and jumps where
+/// a chart's ceil(extent / h) steps: secant steps on h, keeping the closest count seen.
+inline void cut_to_element_count(const scene_view& scene, const std::vector<chart_extent>& extents,
+                                 double total_area, const atlas_options& options, lightmap_atlas& atlas,
+                                 std::vector<std::vector<texel_sum>>& sums) {
     double h = std::sqrt(total_area / double(options.elements)), best_h = h;
     double best_miss = std::numeric_limits<double>::infinity();
     for (int iteration = 0; iteration < 8; ++iteration) {
-        const std::size_t count = cut(h);
+        const std::size_t count = cut_charts(scene, extents, h, atlas, sums);
         const double miss = std::abs(double(count) - double(options.elements));
         if (miss < best_miss) {
             best_miss = miss;
@@ -515,10 +547,12 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
         if (miss <= 0.01 * double(options.elements)) break;
         h *= std::sqrt(double(count) / double(options.elements));
     }
-    cut(best_h);
+    cut_charts(scene, extents, best_h, atlas, sums);
+}
 
-    // Shelf packing: charts by decreasing padded height, rows as wide as a square atlas.
-    const std::uint32_t pad = std::uint32_t(options.padding);
+/// Shelf packing: charts by decreasing height, each with `pad` texels around it, on rows as
+/// wide as a square atlas. Sets each chart's atlas position and the atlas size.
+inline void pack_charts_on_shelves(std::uint32_t pad, lightmap_atlas& atlas) {
     std::vector<std::uint32_t> order(atlas.charts.size());
     double padded_area = 0;
     std::uint32_t widest = 1;
@@ -546,71 +580,111 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
         shelf = std::max(shelf, hh);
     }
     atlas.height = std::max<std::uint32_t>(y + shelf, 1);
-    atlas.element_at = image<std::int32_t>(atlas.width, atlas.height, -1);
+}
 
-    // Elements, chart by chart, block by block, row by row within a block.
-    const std::uint32_t b = std::uint32_t(options.block_texels);
-    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
-        lightmap_chart& ch = atlas.charts[c];
-        const material& mat = scene.materials[ch.material];
-        const bool emits = scene.use_emission && (mat.emission.r > 0.f || mat.emission.g > 0.f || mat.emission.b > 0.f);
-        const glm::vec3 emitted = emits ? float(std::numbers::pi) * mat.emission : glm::vec3(0.f);
-        ch.first_element = std::uint32_t(atlas.size());
-        const extent& ex = extents[c];
-        const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
-        for (std::uint32_t by = 0; by < ch.height; by += b)
-            for (std::uint32_t bx = 0; bx < ch.width; bx += b) {
-                const std::uint32_t first = std::uint32_t(atlas.size());
-                for (std::uint32_t j = by; j < std::min(by + b, ch.height); ++j)
-                    for (std::uint32_t i = bx; i < std::min(bx + b, ch.width); ++i) {
-                        const texel_sum& ts = sums[c][std::size_t(j) * ch.width + i];
-                        if (!(ts.area > 1e-6)) continue;
-                        const glm::dvec2 centroid = ts.moment / ts.area;
-                        atlas.position.push_back(glm::vec3(ex.origin + ex.u * (centroid.x * su) + ex.v * (centroid.y * sv)));
-                        atlas.normal.push_back(ch.normal);
-                        atlas.area.push_back(float(ts.area * su * sv));
-                        atlas.albedo.push_back(mat.albedo);
-                        atlas.emission.push_back(emitted);
-                        atlas.chart.push_back(std::uint32_t(c));
-                        atlas.texel.emplace_back(ch.atlas_x + i, ch.atlas_y + j);
-                        atlas.element_at(ch.atlas_x + i, ch.atlas_y + j) = std::int32_t(atlas.size() - 1);
-                    }
-                if (atlas.size() > first) {
-                    atlas.block_first.push_back(first);
-                    const std::uint32_t bw = std::min(b, ch.width - bx), bh = std::min(b, ch.height - by);
-                    atlas.block_rect.emplace_back(float(bx), float(by), float(bw), float(bh));
-                    atlas.block_grid.emplace_back(bw, bh);
-                    atlas.block_level.push_back(0);
+/// The elements of chart c, block by block and row by row within a block: one per texel
+/// that holds_element, at the centroid of its overlap; a block with elements becomes a
+/// shooting block.
+inline void add_chart_elements(const scene_view& scene, std::uint32_t c, const chart_extent& ex,
+                               const std::vector<texel_sum>& sums, std::uint32_t b, lightmap_atlas& atlas) {
+    lightmap_chart& ch = atlas.charts[c];
+    const material& mat = scene.materials[ch.material];
+    const bool emits = scene.use_emission && (mat.emission.r > 0.f || mat.emission.g > 0.f || mat.emission.b > 0.f);
+    const glm::vec3 emitted = emits ? float(std::numbers::pi) * mat.emission : glm::vec3(0.f);
+    ch.first_element = std::uint32_t(atlas.size());
+    const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
+    for (std::uint32_t by = 0; by < ch.height; by += b)
+        for (std::uint32_t bx = 0; bx < ch.width; bx += b) {
+            const std::uint32_t first = std::uint32_t(atlas.size());
+            for (std::uint32_t j = by; j < std::min(by + b, ch.height); ++j)
+                for (std::uint32_t i = bx; i < std::min(bx + b, ch.width); ++i) {
+                    const texel_sum& ts = sums[std::size_t(j) * ch.width + i];
+                    if (!holds_element(ts)) continue;
+                    const glm::dvec2 centroid = ts.moment / ts.area;
+                    atlas.position.push_back(glm::vec3(ex.origin + ex.u * (centroid.x * su) + ex.v * (centroid.y * sv)));
+                    atlas.normal.push_back(ch.normal);
+                    atlas.area.push_back(float(ts.area * su * sv));
+                    atlas.albedo.push_back(mat.albedo);
+                    atlas.emission.push_back(emitted);
+                    atlas.chart.push_back(c);
+                    atlas.texel.emplace_back(ch.atlas_x + i, ch.atlas_y + j);
+                    atlas.element_at(ch.atlas_x + i, ch.atlas_y + j) = std::int32_t(atlas.size() - 1);
+                }
+            if (atlas.size() > first) {
+                atlas.block_first.push_back(first);
+                const std::uint32_t bw = std::min(b, ch.width - bx), bh = std::min(b, ch.height - by);
+                atlas.block_rect.emplace_back(float(bx), float(by), float(bw), float(bh));
+                atlas.block_grid.emplace_back(bw, bh);
+                atlas.block_level.push_back(0);
+            }
+        }
+    ch.element_count = std::uint32_t(atlas.size()) - ch.first_element;
+}
+
+/// Points the empty texels of chart `ch`'s padded rectangle (`pad` texels around it) at the
+/// nearest element of the chart: 4-neighbour dilation of element_at, repeated until the
+/// rectangle is full.
+inline void fill_chart_padding(const lightmap_chart& ch, std::uint32_t pad, lightmap_atlas& atlas) {
+    if (ch.element_count == 0) return;
+    const std::uint32_t x0 = ch.atlas_x - pad, y0 = ch.atlas_y - pad;
+    const std::uint32_t x1 = ch.atlas_x + ch.width + pad, y1 = ch.atlas_y + ch.height + pad;
+    const std::uint32_t w = x1 - x0;
+    std::vector<std::int32_t> before(std::size_t(w) * (y1 - y0));
+    const auto at = [&](std::uint32_t xx, std::uint32_t yy) { return before[std::size_t(yy - y0) * w + (xx - x0)]; };
+    for (bool changed = true; changed;) {
+        changed = false;
+        for (std::uint32_t yy = y0; yy < y1; ++yy)
+            for (std::uint32_t xx = x0; xx < x1; ++xx) before[std::size_t(yy - y0) * w + (xx - x0)] = atlas.element_at(xx, yy);
+        for (std::uint32_t yy = y0; yy < y1; ++yy)
+            for (std::uint32_t xx = x0; xx < x1; ++xx) {
+                if (at(xx, yy) >= 0) continue;
+                std::int32_t found = -1;
+                if (xx > x0 && at(xx - 1, yy) >= 0) found = at(xx - 1, yy);
+                else if (xx + 1 < x1 && at(xx + 1, yy) >= 0) found = at(xx + 1, yy);
+                else if (yy > y0 && at(xx, yy - 1) >= 0) found = at(xx, yy - 1);
+                else if (yy + 1 < y1 && at(xx, yy + 1) >= 0) found = at(xx, yy + 1);
+                if (found >= 0) {
+                    atlas.element_at(xx, yy) = found;
+                    changed = true;
                 }
             }
-        ch.element_count = std::uint32_t(atlas.size()) - ch.first_element;
+    }
+}
 
-        // Fill the chart's empty texels and its padding from the nearest element of the chart
-        // (4-neighbour dilation, repeated until the padded rectangle is full).
-        if (ch.element_count == 0) continue;
-        const std::uint32_t x0 = ch.atlas_x - pad, y0 = ch.atlas_y - pad;
-        const std::uint32_t x1 = ch.atlas_x + ch.width + pad, y1 = ch.atlas_y + ch.height + pad;
-        const std::uint32_t w = x1 - x0;
-        std::vector<std::int32_t> before(std::size_t(w) * (y1 - y0));
-        const auto at = [&](std::uint32_t xx, std::uint32_t yy) { return before[std::size_t(yy - y0) * w + (xx - x0)]; };
-        for (bool changed = true; changed;) {
-            changed = false;
-            for (std::uint32_t yy = y0; yy < y1; ++yy)
-                for (std::uint32_t xx = x0; xx < x1; ++xx) before[std::size_t(yy - y0) * w + (xx - x0)] = atlas.element_at(xx, yy);
-            for (std::uint32_t yy = y0; yy < y1; ++yy)
-                for (std::uint32_t xx = x0; xx < x1; ++xx) {
-                    if (at(xx, yy) >= 0) continue;
-                    std::int32_t found = -1;
-                    if (xx > x0 && at(xx - 1, yy) >= 0) found = at(xx - 1, yy);
-                    else if (xx + 1 < x1 && at(xx + 1, yy) >= 0) found = at(xx + 1, yy);
-                    else if (yy > y0 && at(xx, yy - 1) >= 0) found = at(xx, yy - 1);
-                    else if (yy + 1 < y1 && at(xx, yy + 1) >= 0) found = at(xx, yy + 1);
-                    if (found >= 0) {
-                        atlas.element_at(xx, yy) = found;
-                        changed = true;
-                    }
-                }
-        }
+}  // namespace bounce::detail
+
+namespace bounce::inline radiosity {
+
+/// Cuts `scene` into charts and elements as the file comment says. Throws parameter_error
+/// (via scene.validate() and options.validate()) on a bad scene or options.
+inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_options& options = {}) {
+    scene.validate();
+    options.validate();
+    const std::size_t nt = scene.triangles.size();
+    lightmap_atlas atlas;
+    atlas.block_texels = options.block_texels;
+    atlas.chart_of_triangle.assign(nt, lightmap_atlas::none);
+
+    const detail::triangle_faces faces = detail::face_normals_and_areas(scene);
+    const auto [lo, hi] = scene.bounds();
+    const double diagonal = glm::length(detail::to_d(hi) - detail::to_d(lo));
+    detail::group_into_charts(scene, faces, options, diagonal, atlas);
+    std::vector<detail::chart_extent> extents(atlas.charts.size());
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c)
+        extents[c] = detail::smallest_bounding_frame(scene, atlas, atlas.charts[c]);
+
+    double total_area = 0;
+    for (std::size_t t = 0; t < nt; ++t) total_area += faces.area[t];
+    require(total_area > 0, "scene.triangles", "the scene has no triangle of positive area");
+    std::vector<std::vector<detail::texel_sum>> sums(atlas.charts.size());
+    detail::cut_to_element_count(scene, extents, total_area, options, atlas, sums);
+
+    const std::uint32_t pad = std::uint32_t(options.padding);
+    detail::pack_charts_on_shelves(pad, atlas);
+    atlas.element_at = image<std::int32_t>(atlas.width, atlas.height, -1);
+    for (std::uint32_t c = 0; c < atlas.charts.size(); ++c) {
+        detail::add_chart_elements(scene, c, extents[c], sums[c], std::uint32_t(options.block_texels), atlas);
+        detail::fill_chart_padding(atlas.charts[c], pad, atlas);
     }
     atlas.block_first.push_back(std::uint32_t(atlas.size()));
     require(atlas.size() > 0, "scene.triangles", "the scene gives no element");

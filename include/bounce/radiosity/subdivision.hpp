@@ -110,6 +110,155 @@ struct atlas_refinement {
     std::vector<std::uint32_t> parent;
 };
 
+}  // namespace bounce::radiosity
+
+namespace bounce::detail {
+
+/// Appends element e of `atlas` to r as it is, its own parent.
+inline void keep_element(const lightmap_atlas& atlas, std::uint32_t e, atlas_refinement& r) {
+    lightmap_atlas& out = r.atlas;
+    out.position.push_back(atlas.position[e]);
+    out.normal.push_back(atlas.normal[e]);
+    out.area.push_back(atlas.area[e]);
+    out.albedo.push_back(atlas.albedo[e]);
+    out.emission.push_back(atlas.emission[e]);
+    out.chart.push_back(atlas.chart[e]);
+    out.texel.push_back(atlas.texel[e]);
+    r.parent.push_back(e);
+}
+
+/// Appends a block of level `level` to out's block lists, starting at out's next element.
+inline void open_block(lightmap_atlas& out, glm::vec4 rect, glm::uvec2 grid, std::uint8_t level) {
+    out.block_first.push_back(std::uint32_t(out.size()));
+    out.block_rect.push_back(rect);
+    out.block_grid.push_back(grid);
+    out.block_level.push_back(level);
+}
+
+/// For each cell of block k's grid, the element whose centroid lies in it (-1: none).
+inline std::vector<std::int64_t> cell_owners(const lightmap_atlas& atlas, std::size_t k) {
+    const std::uint32_t e0 = atlas.block_first[k], e1 = atlas.block_first[k + 1];
+    const glm::vec4 rect = atlas.block_rect[k];
+    const glm::uvec2 grid = atlas.block_grid[k];
+    const lightmap_chart& ch = atlas.charts[atlas.chart[e0]];
+    const glm::dvec3 origin(ch.origin), au(ch.axis_u), av(ch.axis_v);
+    const glm::dvec2 cell(double(rect.z) / grid.x, double(rect.w) / grid.y);
+    std::vector<std::int64_t> owner(std::size_t(grid.x) * grid.y, -1);
+    for (std::uint32_t e = e0; e < e1; ++e) {
+        const glm::dvec3 d = glm::dvec3(atlas.position[e]) - origin;
+        const glm::dvec2 chart_coords(glm::dot(d, au) / glm::dot(au, au), glm::dot(d, av) / glm::dot(av, av));
+        const glm::dvec2 g = (chart_coords - glm::dvec2(rect.x, rect.y)) / cell;
+        const glm::uvec2 c(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1),
+                           std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1));
+        owner[std::size_t(c.y) * grid.x + c.x] = e;
+    }
+    return owner;
+}
+
+/// Appends to r the elements of quadrant (qx, qy) of block k as a block of the next level:
+/// the exact overlaps of its grid's texels with the chart, each with the parent element
+/// whose cell it lies in (`owner`, from cell_owners).
+inline void add_quadrant(const scene_view& scene, const lightmap_atlas& atlas, std::size_t k, int qx, int qy,
+                         const std::vector<std::int64_t>& owner, atlas_refinement& r) {
+    lightmap_atlas& out = r.atlas;
+    const std::uint32_t e0 = atlas.block_first[k];
+    const glm::vec4 rect = atlas.block_rect[k];
+    const glm::uvec2 grid = atlas.block_grid[k];
+    const std::uint32_t c = atlas.chart[e0];
+    const lightmap_chart& ch = atlas.charts[c];
+    const glm::dvec3 origin(ch.origin), au(ch.axis_u), av(ch.axis_v);
+    const double texel_area = glm::length(glm::cross(au, av));  // m^2 per base texel
+    const glm::dvec4 child(rect.x + qx * rect.z / 2.0, rect.y + qy * rect.w / 2.0, rect.z / 2.0, rect.w / 2.0);
+    const auto overlaps = grid_overlaps(scene, atlas, c, child, grid);
+    const std::uint32_t first = std::uint32_t(out.size());
+    const double cell_area = child.z / grid.x * child.w / grid.y;
+    for (std::size_t idx = 0; idx < overlaps.size(); ++idx) {
+        const auto& o = overlaps[idx];
+        if (!(o.area > 1e-6 * cell_area)) continue;
+        const glm::dvec2 centroid = o.moment / o.area;
+        // The parent cell, exactly: child cell (i, j) of quadrant (qx, qy) spans half a
+        // parent cell starting at ((qx gx + i) / 2, (qy gy + j) / 2) parent cells.
+        const std::size_t i = idx % grid.x, j = idx / grid.x;
+        const std::size_t pi = (std::size_t(qx) * grid.x + i) / 2, pj = (std::size_t(qy) * grid.y + j) / 2;
+        const std::int64_t p = owner[pj * grid.x + pi];
+        // A child whose parent cell held only a dropped sliver takes the block's
+        // first element as parent (its radiosity is the nearest estimate there is).
+        const std::uint32_t parent = p >= 0 ? std::uint32_t(p) : e0;
+        out.position.push_back(glm::vec3(origin + au * centroid.x + av * centroid.y));
+        out.normal.push_back(atlas.normal[e0]);
+        out.area.push_back(float(o.area * texel_area));
+        out.albedo.push_back(atlas.albedo[e0]);
+        out.emission.push_back(atlas.emission[e0]);
+        out.chart.push_back(c);
+        out.texel.push_back(atlas.texel[parent]);  // a child lies in its parent's base texel
+        r.parent.push_back(parent);
+    }
+    if (out.size() > first) {
+        out.block_first.push_back(first);
+        out.block_rect.emplace_back(child);
+        out.block_grid.push_back(grid);
+        out.block_level.push_back(std::uint8_t(atlas.block_level[k] + 1));
+    }
+}
+
+/// Rescales the areas of the children of block k (r's elements from first_new on) so that
+/// the children of one parent add up to its area exactly. A parent none of whose children
+/// was kept (possible only for a sliver at a cell's edge, by rounding) stays as it is, in
+/// the last child block, so no power is lost.
+inline void conserve_parent_areas(const lightmap_atlas& atlas, std::size_t k, std::size_t first_new,
+                                  atlas_refinement& r) {
+    lightmap_atlas& out = r.atlas;
+    const std::uint32_t e0 = atlas.block_first[k], e1 = atlas.block_first[k + 1];
+    std::vector<double> child_area(e1 - e0, 0.0);
+    for (std::size_t i = first_new; i < out.size(); ++i) child_area[r.parent[i] - e0] += out.area[i];
+    for (std::uint32_t e = e0; e < e1; ++e)
+        if (child_area[e - e0] == 0) {
+            if (out.size() == first_new)
+                open_block(out, atlas.block_rect[k], atlas.block_grid[k], std::uint8_t(atlas.block_level[k] + 1));
+            keep_element(atlas, e, r);
+            child_area[e - e0] = atlas.area[e];
+        }
+    for (std::size_t i = first_new; i < out.size(); ++i) {
+        const double sum = child_area[r.parent[i] - e0];
+        if (sum > 0) out.area[i] = float(double(out.area[i]) * double(atlas.area[r.parent[i]]) / sum);
+    }
+}
+
+/// Block k of `atlas` split into its four quadrants, appended to r.
+inline void split_block(const scene_view& scene, const lightmap_atlas& atlas, std::size_t k, atlas_refinement& r) {
+    const std::vector<std::int64_t> owner = cell_owners(atlas, k);
+    const std::size_t first_new = r.atlas.size();
+    for (int qy = 0; qy < 2; ++qy)
+        for (int qx = 0; qx < 2; ++qx) add_quadrant(scene, atlas, k, qx, qy, owner, r);
+    conserve_parent_areas(atlas, k, first_new, r);
+}
+
+/// r's chart ranges and texel map: each atlas texel points to the first child of its old
+/// element (or, if it has none, to its chart's first element).
+inline void map_texels_to_children(const lightmap_atlas& atlas, atlas_refinement& r) {
+    lightmap_atlas& out = r.atlas;
+    std::vector<std::int64_t> first_child(atlas.size(), -1);
+    for (std::size_t i = out.size(); i-- > 0;) first_child[r.parent[i]] = std::int64_t(i);
+    for (std::size_t c = 0; c < out.charts.size(); ++c) out.charts[c].element_count = 0;
+    for (std::size_t i = out.size(); i-- > 0;) {
+        lightmap_chart& ch = out.charts[out.chart[i]];
+        ch.first_element = std::uint32_t(i);
+        ++ch.element_count;
+    }
+    out.element_at = atlas.element_at;
+    for (std::uint32_t y = 0; y < out.height; ++y)
+        for (std::uint32_t x = 0; x < out.width; ++x) {
+            const std::int32_t e = atlas.element_at(x, y);
+            if (e < 0) continue;
+            const std::int64_t child = first_child[std::size_t(e)];
+            out.element_at(x, y) = std::int32_t(child >= 0 ? child : std::int64_t(out.charts[atlas.chart[std::size_t(e)]].first_element));
+        }
+}
+
+}  // namespace bounce::detail
+
+namespace bounce::inline radiosity {
+
 /// Splits the blocks `split` (indices into atlas's blocks, any order, each at most once) of
 /// `atlas` (built from `scene`) into four children each, keeps the others, and returns the
 /// new atlas with each element's parent. Charts, triangles and the atlas layout are unchanged;
@@ -132,123 +281,16 @@ inline atlas_refinement refine_lightmap_atlas(const scene_view& scene, const lig
     out.chart_triangles = atlas.chart_triangles;
     out.chart_of_triangle = atlas.chart_of_triangle;
     out.block_texels = atlas.block_texels;
-    const auto copy_element = [&](std::uint32_t e) {
-        out.position.push_back(atlas.position[e]);
-        out.normal.push_back(atlas.normal[e]);
-        out.area.push_back(atlas.area[e]);
-        out.albedo.push_back(atlas.albedo[e]);
-        out.emission.push_back(atlas.emission[e]);
-        out.chart.push_back(atlas.chart[e]);
-        out.texel.push_back(atlas.texel[e]);
-        r.parent.push_back(e);
-    };
     for (std::size_t k = 0; k < atlas.blocks(); ++k) {
-        const std::uint32_t e0 = atlas.block_first[k], e1 = atlas.block_first[k + 1];
-        const glm::vec4 rect = atlas.block_rect[k];
-        const glm::uvec2 grid = atlas.block_grid[k];
-        if (!splits[k]) {
-            out.block_first.push_back(std::uint32_t(out.size()));
-            for (std::uint32_t e = e0; e < e1; ++e) copy_element(e);
-            out.block_rect.push_back(rect);
-            out.block_grid.push_back(grid);
-            out.block_level.push_back(atlas.block_level[k]);
+        if (splits[k]) {
+            detail::split_block(scene, atlas, k, r);
             continue;
         }
-        const std::uint32_t c = atlas.chart[e0];
-        const lightmap_chart& ch = atlas.charts[c];
-        const glm::dvec3 origin(ch.origin), au(ch.axis_u), av(ch.axis_v);
-        const double texel_area = glm::length(glm::cross(au, av));  // m^2 per base texel
-        // The old block's cells: which element holds each (its centroid lies in its cell).
-        const glm::dvec2 cell(double(rect.z) / grid.x, double(rect.w) / grid.y);
-        const auto cell_of = [&](glm::dvec2 p) {
-            const glm::dvec2 g = (p - glm::dvec2(rect.x, rect.y)) / cell;
-            return glm::uvec2(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1),
-                              std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1));
-        };
-        const auto chart_coords = [&](glm::vec3 p) {
-            const glm::dvec3 d = glm::dvec3(p) - origin;
-            return glm::dvec2(glm::dot(d, au) / glm::dot(au, au), glm::dot(d, av) / glm::dot(av, av));
-        };
-        std::vector<std::int64_t> owner(std::size_t(grid.x) * grid.y, -1);
-        for (std::uint32_t e = e0; e < e1; ++e) {
-            const glm::uvec2 g = cell_of(chart_coords(atlas.position[e]));
-            owner[std::size_t(g.y) * grid.x + g.x] = e;
-        }
-        // Children, and each child element's parent; then areas rescaled per parent so that
-        // the children of one parent add up to its area exactly.
-        const std::size_t first_new = out.size();
-        for (int qy = 0; qy < 2; ++qy)
-            for (int qx = 0; qx < 2; ++qx) {
-                const glm::dvec4 child(rect.x + qx * rect.z / 2.0, rect.y + qy * rect.w / 2.0, rect.z / 2.0, rect.w / 2.0);
-                const auto overlaps = detail::grid_overlaps(scene, atlas, c, child, grid);
-                const std::uint32_t first = std::uint32_t(out.size());
-                const double cell_area = child.z / grid.x * child.w / grid.y;
-                for (std::size_t idx = 0; idx < overlaps.size(); ++idx) {
-                    const auto& o = overlaps[idx];
-                    if (!(o.area > 1e-6 * cell_area)) continue;
-                    const glm::dvec2 centroid = o.moment / o.area;
-                    // The parent cell, exactly: child cell (i, j) of quadrant (qx, qy) spans half a
-                    // parent cell starting at ((qx gx + i) / 2, (qy gy + j) / 2) parent cells.
-                    const std::size_t i = idx % grid.x, j = idx / grid.x;
-                    const std::size_t pi = (std::size_t(qx) * grid.x + i) / 2, pj = (std::size_t(qy) * grid.y + j) / 2;
-                    const std::int64_t p = owner[pj * grid.x + pi];
-                    // A child whose parent cell held only a dropped sliver takes the block's
-                    // first element as parent (its radiosity is the nearest estimate there is).
-                    const std::uint32_t parent = p >= 0 ? std::uint32_t(p) : e0;
-                    out.position.push_back(glm::vec3(origin + au * centroid.x + av * centroid.y));
-                    out.normal.push_back(atlas.normal[e0]);
-                    out.area.push_back(float(o.area * texel_area));
-                    out.albedo.push_back(atlas.albedo[e0]);
-                    out.emission.push_back(atlas.emission[e0]);
-                    out.chart.push_back(c);
-                    out.texel.push_back(atlas.texel[parent]);  // a child lies in its parent's base texel
-                    r.parent.push_back(parent);
-                }
-                if (out.size() > first) {
-                    out.block_first.push_back(first);
-                    out.block_rect.emplace_back(child);
-                    out.block_grid.push_back(grid);
-                    out.block_level.push_back(std::uint8_t(atlas.block_level[k] + 1));
-                }
-            }
-        std::vector<double> child_area(e1 - e0, 0.0);
-        for (std::size_t i = first_new; i < out.size(); ++i) child_area[r.parent[i] - e0] += out.area[i];
-        // A parent none of whose children was kept (possible only for a sliver at a cell's
-        // edge, by rounding) stays as it is, in the last child block, so no power is lost.
-        for (std::uint32_t e = e0; e < e1; ++e)
-            if (child_area[e - e0] == 0) {
-                if (out.size() == first_new) {
-                    out.block_first.push_back(std::uint32_t(out.size()));
-                    out.block_rect.push_back(rect);
-                    out.block_grid.push_back(grid);
-                    out.block_level.push_back(std::uint8_t(atlas.block_level[k] + 1));
-                }
-                copy_element(e);
-                child_area[e - e0] = atlas.area[e];
-            }
-        for (std::size_t i = first_new; i < out.size(); ++i) {
-            const double sum = child_area[r.parent[i] - e0];
-            if (sum > 0) out.area[i] = float(double(out.area[i]) * double(atlas.area[r.parent[i]]) / sum);
-        }
+        detail::open_block(out, atlas.block_rect[k], atlas.block_grid[k], atlas.block_level[k]);
+        for (std::uint32_t e = atlas.block_first[k]; e < atlas.block_first[k + 1]; ++e) detail::keep_element(atlas, e, r);
     }
     out.block_first.push_back(std::uint32_t(out.size()));
-    // Chart ranges and the texel map: each atlas texel points to a child of its old element.
-    std::vector<std::int64_t> first_child(atlas.size(), -1);
-    for (std::size_t i = out.size(); i-- > 0;) first_child[r.parent[i]] = std::int64_t(i);
-    for (std::size_t c = 0; c < out.charts.size(); ++c) out.charts[c].element_count = 0;
-    for (std::size_t i = out.size(); i-- > 0;) {
-        lightmap_chart& ch = out.charts[out.chart[i]];
-        ch.first_element = std::uint32_t(i);
-        ++ch.element_count;
-    }
-    out.element_at = atlas.element_at;
-    for (std::uint32_t y = 0; y < out.height; ++y)
-        for (std::uint32_t x = 0; x < out.width; ++x) {
-            const std::int32_t e = atlas.element_at(x, y);
-            if (e < 0) continue;
-            const std::int64_t child = first_child[std::size_t(e)];
-            out.element_at(x, y) = std::int32_t(child >= 0 ? child : std::int64_t(out.charts[atlas.chart[std::size_t(e)]].first_element));
-        }
+    detail::map_texels_to_children(atlas, r);
     return r;
 }
 
