@@ -8,7 +8,8 @@
 /// - A uniform grid is the octree subdivided everywhere to one depth; an adaptive octree
 ///   subdivides a cell when one of Oat's heuristics fires, each with its threshold
 ///   (`irradiance_volume_settings`), between a minimum and a maximum depth, and culls
-///   children whose probes do not differ from their parent's interpolation.
+///   children whose probes do not differ from their parent's interpolation. The probes,
+///   the settings and the heuristics are in volume/octree_subdivision.hpp.
 /// - Probes sit at cell corners and are shared: a corner is an integer point of the
 ///   lattice of the finest level, and each lattice point holds at most one probe. A probe
 ///   inside geometry (flagged by its source) is kept but skipped by every lookup.
@@ -23,10 +24,9 @@
 /// (embree/probe_baker.hpp), a GL cube-map renderer, or an analytic field in tests.
 
 #include <bounce/errors.hpp>
-#include <bounce/volume/kernels.hpp>
-#include <bounce/luminance.hpp>
 #include <bounce/scene_view.hpp>
-#include <bounce/volume/triangle_box_overlap.hpp>
+#include <bounce/volume/kernels.hpp>
+#include <bounce/volume/octree_subdivision.hpp>
 
 #include <algorithm>
 #include <array>
@@ -46,80 +46,6 @@
 #include <glm/vec3.hpp>
 
 namespace bounce::inline volume {
-
-/// One probe: SH coefficients of the incoming radiance at `position` (W/(m^2 sr), RGB,
-/// bands 0..2), their gradients per unit length, the harmonic mean distance to the
-/// surfaces around it, and whether it lies inside geometry.
-struct irradiance_probe {
-    using coefficients = sh_coefficients<irradiance_volume_bands, glm::vec3>;
-    glm::vec3 position{0.f};
-    coefficients radiance{};
-    /// d radiance / dx, dy, dz (per world unit); zero when the source computes none.
-    std::array<coefficients, 3> gradient{};
-    /// N / sum_j 1 / d_j over the source's rays (world units; +infinity when all miss).
-    float harmonic_mean_distance = std::numeric_limits<float>::infinity();
-    /// Inside geometry: flagged by the source, skipped by lookups and heuristics.
-    bool inside = false;
-    /// Set by the build: half the diagonal of the largest leaf this probe is a corner of
-    /// (world units). The weighted lookup lets the probe reach support * reach.
-    float reach = 0.f;
-};
-
-/// Something that fills probes at positions: `source(positions, out)` with spans of equal
-/// size (a batch per octree level, so a source can bake them in parallel).
-template <class S>
-concept probe_source = requires(S& s, std::span<const glm::vec3> positions, std::span<irradiance_probe> out) {
-    s(positions, out);
-};
-
-/// The octree's shape and Oat's subdivision heuristics. A heuristic is off when its
-/// threshold is 0. A cell at or above min_depth and below max_depth is split when any
-/// fires, unless all its corners are inside geometry (nothing there to light).
-struct irradiance_volume_settings {
-    /// Depth every cell reaches (0: the root may stay a leaf). Uniform grid: min = max.
-    int min_depth = 1;
-    /// Depth no cell exceeds, 0 .. irradiance_volume::depth_limit (10). A uniform grid of
-    /// depth D has (2^D + 1)^3 probes. Typical: 4-6.
-    int max_depth = 4;
-    /// Harmonic mean distance against cell size: split when a corner probe's harmonic mean
-    /// distance is below distance_ratio times the cell's diagonal (lighting changes over
-    /// about the distance to the surfaces a probe sees). Typical: 0.5-2; 0 off.
-    float distance_ratio = 1.f;
-    /// Change between neighbours: split when two corners' irradiance luminance (the band-0
-    /// term, pi * c_00 Y_00) differ by more than this fraction of their mean (plus
-    /// `absolute_floor`). Typical: 0.1-0.5; 0 off.
-    float neighbour_change = 0.25f;
-    /// Geometry inside the cell: split when at least this many triangles overlap the cell
-    /// (exact triangle-box test). Typical: 1; 0 off.
-    std::uint32_t geometry_triangles = 1;
-    /// Gradient magnitude: split when |grad E| times the cell's longest edge exceeds this
-    /// fraction of E at a corner (E: the band-0 irradiance luminance). Typical: 0.2-0.5;
-    /// 0 off (and off for probes without gradients).
-    float gradient_ratio = 0.3f;
-    /// Culling: children are removed again when every new probe's irradiance at the six
-    /// axis normals lies within this fraction (plus `absolute_floor`) of what the parent's
-    /// trilinear interpolation predicts there. Typical: 0.02-0.1; 0 keeps every child.
-    float cull_tolerance = 0.05f;
-    /// Absolute floor added to the denominators above, as a fraction of the mean
-    /// luminance of the root's probes, so that dark regions do not split on noise.
-    /// Typical: 0.02.
-    float absolute_floor = 0.02f;
-    /// Memory the build may use, in bytes (irradiance_volume::estimated_bytes); 0: no limit.
-    /// Before baking a level the build counts the probes and nodes the volume will hold
-    /// after it and throws parameter_error naming "settings.max_depth", with the figures,
-    /// when their estimated_bytes exceed the limit. Programs pass
-    /// the memory available (study::available_memory_bytes).
-    std::uint64_t memory_limit_bytes = 0;
-};
-
-/// Counts of a build: which heuristic split how many cells, how many were culled.
-struct irradiance_volume_build_stats {
-    std::size_t split_min_depth = 0, split_distance = 0, split_neighbour = 0, split_geometry = 0, split_gradient = 0;
-    std::size_t culled = 0;          ///< subdivisions undone by culling
-    std::size_t inside_cells = 0;    ///< cells not split because every corner is inside geometry
-    std::size_t probes_baked = 0;    ///< probes the source computed, culled ones included
-    std::size_t probes_inside = 0;   ///< probes of the final volume flagged inside
-};
 
 /// std430 layout of one octree node (80 bytes): `lo.xyz` and `size.xyz` of its box,
 /// `first_child` (-1 for a leaf; children are first_child + octant), and the probe index
@@ -263,30 +189,219 @@ private:
 
 namespace bounce::detail {
 
-inline bool finite_probe(const irradiance_probe& p) {
-    const auto ok = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-    if (!ok(p.position) || std::isnan(p.harmonic_mean_distance) || p.harmonic_mean_distance < 0) return false;
-    for (const auto& c : p.radiance)
-        if (!ok(c)) return false;
-    for (const auto& g : p.gradient)
-        for (const auto& c : g)
-            if (!ok(c)) return false;
+/// The probes of a build, each at a point of the lattice of the finest level (max_depth
+/// cells per axis), at most one per point, found by their lattice key.
+class probe_lattice {
+public:
+    probe_lattice(glm::vec3 lo, glm::vec3 hi, int max_depth)
+        : lo_(lo), extent_(hi - lo), res_(std::uint64_t(1) << max_depth) {}
+
+    /// Lattice cells per cell side at `depth`.
+    std::uint64_t step(int depth) const { return res_ >> depth; }
+    std::uint64_t key_of(std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
+        return x + (res_ + 1) * (y + (res_ + 1) * z);
+    }
+    /// The lattice keys of cell c's 8 corners (corner k at +step (k & 1, (k >> 1) & 1, (k >> 2) & 1)).
+    std::array<std::uint64_t, 8> corner_keys(const octree_cell& c, int depth) const {
+        const std::uint64_t st = step(depth);
+        std::array<std::uint64_t, 8> keys{};
+        for (int k = 0; k < 8; ++k)
+            keys[std::size_t(k)] = key_of(c.x + st * std::uint64_t(k & 1), c.y + st * std::uint64_t((k >> 1) & 1),
+                                          c.z + st * std::uint64_t((k >> 2) & 1));
+        return keys;
+    }
+    std::uint32_t index(std::uint64_t key) const { return at_key_.at(key); }
+    const std::vector<irradiance_probe>& probes() const noexcept { return all_; }
+
+    /// Bakes every corner of `cells` (cells of `depth`) not yet in the lattice, in one batch
+    /// from `source`; `nodes` is the node count the volume will have with them, for
+    /// settings.memory_limit_bytes.
+    template <class Source>
+    void bake_corners(const std::vector<octree_cell>& cells, int depth, std::size_t nodes,
+                      const irradiance_volume_settings& s, Source& source, irradiance_volume_build_stats& stats) {
+        std::vector<glm::vec3> positions;
+        const std::uint64_t st = step(depth);
+        std::size_t added = 0;
+        for (const auto& c : cells)
+            for (int k = 0; k < 8; ++k) {
+                const std::uint64_t x = c.x + st * std::uint64_t(k & 1), y = c.y + st * std::uint64_t((k >> 1) & 1),
+                                    z = c.z + st * std::uint64_t((k >> 2) & 1);
+                if (!at_key_.emplace(key_of(x, y, z), std::uint32_t(all_.size() + added)).second) continue;
+                ++added;
+                positions.push_back(lo_ + extent_ * (glm::vec3(float(x), float(y), float(z)) / float(res_)));
+            }
+        if (positions.empty()) return;
+        check_memory(all_.size() + positions.size(), nodes, depth, s);
+        std::vector<irradiance_probe> baked(positions.size());
+        source(std::span<const glm::vec3>(positions), std::span<irradiance_probe>(baked));
+        for (std::size_t i = 0; i < baked.size(); ++i) {
+            require(finite_probe(baked[i]), "probes",
+                    "the probe source returned a non-finite probe (NaN or infinite coefficient or position)");
+            require(glm::length(baked[i].position - positions[i]) <= 1e-5f * glm::length(extent_), "probes",
+                    "the probe source moved a probe away from its lattice position");
+            all_.push_back(baked[i]);
+        }
+        stats.probes_baked += baked.size();
+    }
+
+private:
+    static void check_memory(std::size_t probe_count, std::size_t node_count, int depth, const irradiance_volume_settings& s) {
+        if (s.memory_limit_bytes == 0) return;
+        const double probes = double(probe_count), nodes = double(node_count),
+                     need = irradiance_volume::estimated_bytes(probes, nodes);
+        if (need > double(s.memory_limit_bytes))
+            throw parameter_error("settings.max_depth",
+                                  "depth " + std::to_string(depth) + " would hold " + std::to_string(std::uint64_t(probes)) +
+                                      " probes, about " + std::to_string(std::uint64_t(need / 1e6)) + " MB, more than the " +
+                                      std::to_string(s.memory_limit_bytes / 1000000) + " MB allowed; choose a smaller max_depth");
+    }
+
+    glm::vec3 lo_, extent_;
+    std::uint64_t res_;
+    std::vector<irradiance_probe> all_;
+    std::unordered_map<std::uint64_t, std::uint32_t> at_key_;
+};
+
+/// Whether the parent box [lo, lo + size] with corner probes `corner` predicts every probe
+/// of its children `family` (cells of `child_depth`, their corners baked) outside
+/// geometry, as parent_predicts_probe says: then culling undoes the split.
+inline bool parent_predicts_children(const probe_lattice& lattice, const std::array<std::uint32_t, 8>& corner,
+                                     glm::vec3 lo, glm::vec3 size, const std::vector<octree_cell>& family,
+                                     int child_depth, float floor_level, const irradiance_volume_settings& s) {
+    const std::vector<irradiance_probe>& all = lattice.probes();
+    std::array<std::array<float, 6>, 8> corner_e{};
+    std::array<float, 8> corner_valid{};
+    for (int k = 0; k < 8; ++k) {
+        const auto& p = all[corner[std::size_t(k)]];
+        corner_e[std::size_t(k)] = axis_irradiance(p.radiance);
+        corner_valid[std::size_t(k)] = p.inside ? 0.f : 1.f;
+    }
+    for (const auto& ch : family)
+        for (const std::uint64_t key : lattice.corner_keys(ch, child_depth)) {
+            const auto& p = all[lattice.index(key)];
+            if (!p.inside && !parent_predicts_probe(p, lo, size, corner_e, corner_valid, floor_level, s)) return false;
+        }
     return true;
 }
 
-/// Band-0 irradiance luminance of a probe: pi * c_00 * Y_00 (the irradiance averaged over
-/// all normals), the scalar the split heuristics compare.
-inline float probe_level(const irradiance_probe::coefficients& c) {
-    constexpr float y00 = 0.28209479177387814f;
-    return std::numbers::pi_v<float> * y00 * rec709_luminance<float, glm::vec3>(c[0]);
+/// Throws parameter_error for the arguments irradiance_volume::build refuses.
+inline void validate_volume_build(const scene_view& scene, glm::vec3 lo, glm::vec3 hi, const irradiance_volume_settings& s) {
+    require(!scene.triangles.empty(), "scene", "the scene has no triangles: nothing to light, no geometry to test");
+    const auto finite3 = [](glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    require(finite3(lo) && finite3(hi), "lo", "volume bounds must be finite");
+    require(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z, "hi", "volume bounds must enclose a non-empty box (hi > lo)");
+    require(s.max_depth >= 0 && s.max_depth <= irradiance_volume::depth_limit, "settings.max_depth", "must lie in 0 .. 10");
+    require(s.min_depth >= 0 && s.min_depth <= s.max_depth, "settings.min_depth", "must lie in 0 .. max_depth");
+    const auto threshold = [](float v, const char* name) {
+        require(std::isfinite(v) && v >= 0, name, "threshold must be finite and >= 0 (0: off)");
+    };
+    threshold(s.distance_ratio, "settings.distance_ratio");
+    threshold(s.neighbour_change, "settings.neighbour_change");
+    threshold(s.gradient_ratio, "settings.gradient_ratio");
+    threshold(s.cull_tolerance, "settings.cull_tolerance");
+    threshold(s.absolute_floor, "settings.absolute_floor");
 }
 
-/// Irradiance of a probe's coefficients at the six axis normals (luminance).
-inline std::array<float, 6> axis_irradiance(const irradiance_probe::coefficients& c) {
-    static const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-    std::array<float, 6> e{};
-    for (int k = 0; k < 6; ++k) e[std::size_t(k)] = rec709_luminance<float, glm::vec3>(sh_irradiance<irradiance_volume_bands, float, glm::vec3>(c, axes[k]));
-    return e;
+/// The root cell over [lo, hi] with the scene's triangles that overlap it.
+inline octree_cell root_cell(const scene_view& scene, glm::vec3 lo, glm::vec3 hi) {
+    octree_cell root{0, 0, 0, 0, {}};
+    root.triangles.reserve(scene.triangles.size());
+    const glm::dvec3 c = glm::dvec3(lo + hi) * 0.5, h = glm::dvec3(hi - lo) * 0.5;
+    for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
+        if (triangle_overlaps_box(scene, t, c, h)) root.triangles.push_back(t);
+    return root;
+}
+
+/// The 8 nodes of a split node's children (octant k at octant_lo(lo, size, k)), appended
+/// to `nodes`; returns the first one's index.
+inline std::uint32_t add_child_nodes(std::vector<irradiance_volume::node>& nodes, std::uint32_t parent) {
+    const irradiance_volume::node p = nodes[parent];
+    const std::uint32_t first = std::uint32_t(nodes.size());
+    nodes[parent].first_child = std::int32_t(first);
+    for (int k = 0; k < 8; ++k) nodes.push_back({octant_lo(p.lo, p.size, k), p.size * 0.5f, p.depth + 1, -1, {}});
+    return first;
+}
+
+/// The next level of the octree: the cells of `level` (at `depth`, their corners set) that
+/// a heuristic splits and culling keeps, as nodes and cells with their corners baked.
+template <class Source>
+std::vector<octree_cell> grow_level(const scene_view& scene, const std::vector<octree_cell>& level, int depth,
+                                    float floor_level, const irradiance_volume_settings& s, Source& source,
+                                    probe_lattice& lattice, std::vector<irradiance_volume::node>& nodes,
+                                    irradiance_volume_build_stats& stats) {
+    std::vector<std::size_t> split_cells;
+    for (std::size_t ci = 0; ci < level.size(); ++ci)
+        if (cell_splits(level[ci], nodes[level[ci].node].corner, nodes[level[ci].node].size, lattice.probes(), depth,
+                        floor_level, s, stats))
+            split_cells.push_back(ci);
+    // Children of the splitting cells, with their triangles; bake their corners.
+    std::vector<std::vector<octree_cell>> families(split_cells.size());
+    std::vector<octree_cell> batch;
+    for (std::size_t si = 0; si < split_cells.size(); ++si) {
+        const octree_cell& c = level[split_cells[si]];
+        families[si] = child_cells(scene, c, nodes[c.node].lo, nodes[c.node].size, lattice.step(depth + 1));
+        for (const auto& ch : families[si]) batch.push_back(octree_cell{0, ch.x, ch.y, ch.z, {}});
+    }
+    lattice.bake_corners(batch, depth + 1, nodes.size() + batch.size(), s, source, stats);
+    // Culling: undo a split whose new probes the parent already predicts.
+    std::vector<octree_cell> children;
+    for (std::size_t si = 0; si < split_cells.size(); ++si) {
+        const irradiance_volume::node& parent = nodes[level[split_cells[si]].node];
+        const bool keep = depth < s.min_depth || s.cull_tolerance <= 0 ||
+                          !parent_predicts_children(lattice, parent.corner, parent.lo, parent.size, families[si],
+                                                    depth + 1, floor_level, s);
+        if (!keep) {
+            ++stats.culled;
+            continue;
+        }
+        const std::uint32_t first = add_child_nodes(nodes, level[split_cells[si]].node);
+        for (int k = 0; k < 8; ++k) {
+            families[si][std::size_t(k)].node = first + std::uint32_t(k);
+            children.push_back(std::move(families[si][std::size_t(k)]));
+        }
+    }
+    return children;
+}
+
+/// The probes some leaf uses, renumbered in order of first use, and every node's corners
+/// renumbered to them (inner nodes keep a corner only where its probe survived, else 0).
+inline std::vector<irradiance_probe> used_probes(const std::vector<irradiance_probe>& all,
+                                                 std::vector<irradiance_volume::node>& nodes) {
+    std::vector<irradiance_probe> used;
+    std::vector<std::uint32_t> remap(all.size(), std::numeric_limits<std::uint32_t>::max());
+    for (auto& nd : nodes) {
+        if (!nd.leaf()) continue;
+        for (auto& idx : nd.corner) {
+            if (remap[idx] == std::numeric_limits<std::uint32_t>::max()) {
+                remap[idx] = std::uint32_t(used.size());
+                used.push_back(all[idx]);
+            }
+            idx = remap[idx];
+        }
+    }
+    for (auto& nd : nodes) {
+        if (nd.leaf()) continue;
+        for (auto& idx : nd.corner) idx = remap[idx] == std::numeric_limits<std::uint32_t>::max() ? 0u : remap[idx];
+    }
+    return used;
+}
+
+/// Sets each probe's reach (half the diagonal of the largest leaf it is a corner of) and
+/// owner (that leaf; the first in node order among equals); returns the smallest reach.
+inline float set_reach_and_owners(const std::vector<irradiance_volume::node>& nodes,
+                                  std::vector<irradiance_probe>& probes, std::vector<std::uint32_t>& owner) {
+    owner.assign(probes.size(), 0);
+    for (auto& p : probes) p.reach = 0.f;
+    for (std::uint32_t i = 0; i < nodes.size(); ++i) {
+        const irradiance_volume::node& nd = nodes[i];
+        if (!nd.leaf()) continue;
+        const float half_diagonal = 0.5f * glm::length(nd.size);
+        for (std::uint32_t idx : nd.corner)
+            if (half_diagonal > probes[idx].reach) probes[idx].reach = half_diagonal, owner[idx] = i;
+    }
+    float smallest = std::numeric_limits<float>::infinity();
+    for (const auto& p : probes) smallest = std::min(smallest, p.reach);
+    return smallest;
 }
 
 }  // namespace bounce::detail
@@ -297,302 +412,31 @@ template <probe_source Source>
 irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
                                            const irradiance_volume_settings& s, Source&& source,
                                            irradiance_volume_build_stats* stats_out) {
-    require(!scene.triangles.empty(), "scene", "the scene has no triangles: nothing to light, no geometry to test");
-    const auto finite3 = [](glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-    require(finite3(lo) && finite3(hi), "lo", "volume bounds must be finite");
-    require(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z, "hi", "volume bounds must enclose a non-empty box (hi > lo)");
-    require(s.max_depth >= 0 && s.max_depth <= depth_limit, "settings.max_depth", "must lie in 0 .. 10");
-    require(s.min_depth >= 0 && s.min_depth <= s.max_depth, "settings.min_depth", "must lie in 0 .. max_depth");
-    const auto threshold = [](float v, const char* name) {
-        require(std::isfinite(v) && v >= 0, name, "threshold must be finite and >= 0 (0: off)");
-    };
-    threshold(s.distance_ratio, "settings.distance_ratio");
-    threshold(s.neighbour_change, "settings.neighbour_change");
-    threshold(s.gradient_ratio, "settings.gradient_ratio");
-    threshold(s.cull_tolerance, "settings.cull_tolerance");
-    threshold(s.absolute_floor, "settings.absolute_floor");
-
+    detail::validate_volume_build(scene, lo, hi, s);
     irradiance_volume_build_stats stats;
     irradiance_volume v;
-    const std::uint64_t res = std::uint64_t(1) << s.max_depth;  // lattice cells per axis at max depth
-    const glm::vec3 extent = hi - lo;
-    // Probe store: lattice key -> index into `all`.
-    std::vector<irradiance_probe> all;
-    std::unordered_map<std::uint64_t, std::uint32_t> at_key;
-    const auto key_of = [&](std::uint64_t x, std::uint64_t y, std::uint64_t z) { return x + (res + 1) * (y + (res + 1) * z); };
-    const auto lattice_position = [&](std::uint64_t x, std::uint64_t y, std::uint64_t z) {
-        return lo + extent * (glm::vec3(float(x), float(y), float(z)) / float(res));
-    };
-
-    // Cells under construction carry their lattice origin and the triangles that overlap them.
-    struct cell {
-        std::uint32_t node;
-        std::uint64_t x, y, z;  // lattice origin (finest-level units)
-        std::vector<std::uint32_t> triangles;
-    };
-    const auto corner_keys = [&](const cell& c, int depth) {
-        const std::uint64_t step = res >> depth;
-        std::array<std::uint64_t, 8> keys{};
-        for (int k = 0; k < 8; ++k)
-            keys[std::size_t(k)] = key_of(c.x + step * std::uint64_t(k & 1), c.y + step * std::uint64_t((k >> 1) & 1),
-                                          c.z + step * std::uint64_t((k >> 2) & 1));
-        return keys;
-    };
-    // Bakes every corner of `cells` not yet in the store, in one batch.
-    const auto bake_corners = [&](const std::vector<cell>& cells, int depth) {
-        std::vector<std::uint64_t> new_keys;
-        std::vector<glm::vec3> positions;
-        const std::uint64_t step = res >> depth;
-        for (const auto& c : cells)
-            for (int k = 0; k < 8; ++k) {
-                const std::uint64_t x = c.x + step * std::uint64_t(k & 1), y = c.y + step * std::uint64_t((k >> 1) & 1),
-                                    z = c.z + step * std::uint64_t((k >> 2) & 1);
-                const std::uint64_t key = key_of(x, y, z);
-                if (at_key.count(key)) continue;
-                at_key.emplace(key, std::uint32_t(all.size() + new_keys.size()));
-                new_keys.push_back(key);
-                positions.push_back(lattice_position(x, y, z));
-            }
-        if (positions.empty()) return;
-        if (s.memory_limit_bytes > 0) {
-            const double probes = double(all.size() + positions.size()), nodes = double(v.nodes_.size() + cells.size()),
-                         need = estimated_bytes(probes, nodes);
-            if (need > double(s.memory_limit_bytes))
-                throw parameter_error("settings.max_depth",
-                                      "depth " + std::to_string(depth) + " would hold " + std::to_string(std::uint64_t(probes)) +
-                                          " probes, about " + std::to_string(std::uint64_t(need / 1e6)) + " MB, more than the " +
-                                          std::to_string(s.memory_limit_bytes / 1000000) + " MB allowed; choose a smaller max_depth");
-        }
-        std::vector<irradiance_probe> baked(positions.size());
-        source(std::span<const glm::vec3>(positions), std::span<irradiance_probe>(baked));
-        for (std::size_t i = 0; i < baked.size(); ++i) {
-            require(detail::finite_probe(baked[i]), "probes",
-                    "the probe source returned a non-finite probe (NaN or infinite coefficient or position)");
-            require(glm::length(baked[i].position - positions[i]) <= 1e-5f * glm::length(extent), "probes",
-                    "the probe source moved a probe away from its lattice position");
-            all.push_back(baked[i]);
-        }
-        stats.probes_baked += baked.size();
-    };
-
-    // Root.
-    cell root{0, 0, 0, 0, {}};
-    root.triangles.reserve(scene.triangles.size());
-    {
-        const glm::dvec3 c = glm::dvec3(lo + hi) * 0.5, h = glm::dvec3(hi - lo) * 0.5;
-        for (std::uint32_t t = 0; t < scene.triangles.size(); ++t) {
-            const auto& tri = scene.triangles[t];
-            if (triangle_box_overlap(c, h, glm::dvec3(scene.positions[tri.x]), glm::dvec3(scene.positions[tri.y]),
-                                     glm::dvec3(scene.positions[tri.z])))
-                root.triangles.push_back(t);
-        }
-    }
-    v.nodes_.push_back(node{lo, extent, 0, -1, {}});
-    std::vector<cell> level{std::move(root)};
-    bake_corners(level, 0);
-    float floor_level = 0;
-    {
-        double sum = 0;
-        int n = 0;
-        for (const auto& p : all)
-            if (!p.inside) sum += detail::probe_level(p.radiance), ++n;
-        floor_level = n ? float(sum / n) * s.absolute_floor : 0.f;
-    }
-
+    detail::probe_lattice lattice(lo, hi, s.max_depth);
+    v.nodes_.push_back(node{lo, hi - lo, 0, -1, {}});
+    std::vector<detail::octree_cell> level{detail::root_cell(scene, lo, hi)};
+    lattice.bake_corners(level, 0, v.nodes_.size() + level.size(), s, source, stats);
+    const float floor_level = detail::absolute_floor_level(lattice.probes(), s.absolute_floor);
     for (int depth = 0; depth <= s.max_depth; ++depth) {
         for (const auto& c : level) {
-            const auto keys = corner_keys(c, depth);
-            for (int k = 0; k < 8; ++k) v.nodes_[c.node].corner[std::size_t(k)] = at_key.at(keys[std::size_t(k)]);
+            const auto keys = lattice.corner_keys(c, depth);
+            for (int k = 0; k < 8; ++k) v.nodes_[c.node].corner[std::size_t(k)] = lattice.index(keys[std::size_t(k)]);
         }
         if (depth == s.max_depth) break;
-        // Decide which cells split.
-        std::vector<cell> children;
-        std::vector<std::size_t> split_cells;
-        for (std::size_t ci = 0; ci < level.size(); ++ci) {
-            const cell& c = level[ci];
-            const node& nd = v.nodes_[c.node];
-            bool split = false;
-            bool any_usable = false;
-            for (std::uint32_t idx : nd.corner) any_usable = any_usable || !all[idx].inside;
-            if (depth < s.min_depth) {
-                split = true;
-                ++stats.split_min_depth;
-            } else if (!any_usable) {
-                // Every corner inside geometry: nothing here to light, nothing to refine.
-                ++stats.inside_cells;
-            } else {
-                const float diagonal = glm::length(nd.size), edge = std::max({nd.size.x, nd.size.y, nd.size.z});
-                std::array<const irradiance_probe*, 8> corners{};
-                for (int k = 0; k < 8; ++k) corners[std::size_t(k)] = &all[nd.corner[std::size_t(k)]];
-                if (!split && s.distance_ratio > 0)
-                    for (const auto* p : corners)
-                        if (!p->inside && p->harmonic_mean_distance < s.distance_ratio * diagonal) {
-                            split = true;
-                            ++stats.split_distance;
-                            break;
-                        }
-                if (!split && s.neighbour_change > 0)
-                    for (int a = 0; a < 8 && !split; ++a)
-                        for (int b = a + 1; b < 8; ++b) {
-                            const auto* pa = corners[std::size_t(a)];
-                            const auto* pb = corners[std::size_t(b)];
-                            if (pa->inside || pb->inside) continue;
-                            const float ea = detail::probe_level(pa->radiance), eb = detail::probe_level(pb->radiance);
-                            if (std::abs(ea - eb) > s.neighbour_change * (0.5f * (ea + eb) + floor_level)) {
-                                split = true;
-                                ++stats.split_neighbour;
-                                break;
-                            }
-                        }
-                if (!split && s.geometry_triangles > 0 && c.triangles.size() >= s.geometry_triangles) {
-                    split = true;
-                    ++stats.split_geometry;
-                }
-                if (!split && s.gradient_ratio > 0)
-                    for (const auto* p : corners) {
-                        if (p->inside) continue;
-                        const float e = detail::probe_level(p->radiance);
-                        const glm::vec3 g(detail::probe_level(p->gradient[0]), detail::probe_level(p->gradient[1]),
-                                          detail::probe_level(p->gradient[2]));
-                        if (glm::length(g) * edge > s.gradient_ratio * (e + floor_level)) {
-                            split = true;
-                            ++stats.split_gradient;
-                            break;
-                        }
-                    }
-            }
-            if (!split) continue;
-            split_cells.push_back(ci);
-        }
-        // Children of the splitting cells, with their triangles; bake their corners.
-        std::vector<std::vector<cell>> families(split_cells.size());
-        const std::uint64_t half_step = res >> (depth + 1);
-        for (std::size_t si = 0; si < split_cells.size(); ++si) {
-            const cell& c = level[split_cells[si]];
-            const node& nd = v.nodes_[c.node];
-            for (int k = 0; k < 8; ++k) {
-                cell ch{0, c.x + half_step * std::uint64_t(k & 1), c.y + half_step * std::uint64_t((k >> 1) & 1),
-                        c.z + half_step * std::uint64_t((k >> 2) & 1), {}};
-                const glm::vec3 centre = nd.lo + nd.size * 0.5f;
-                const glm::vec3 clo = glm::vec3((k & 1) ? centre.x : nd.lo.x, (k & 2) ? centre.y : nd.lo.y,
-                                                (k & 4) ? centre.z : nd.lo.z);
-                const glm::vec3 csize = nd.size * 0.5f;
-                const glm::dvec3 cc = glm::dvec3(clo) + glm::dvec3(csize) * 0.5, ch_half = glm::dvec3(csize) * 0.5;
-                for (std::uint32_t t : c.triangles) {
-                    const auto& tri = scene.triangles[t];
-                    if (triangle_box_overlap(cc, ch_half, glm::dvec3(scene.positions[tri.x]),
-                                             glm::dvec3(scene.positions[tri.y]), glm::dvec3(scene.positions[tri.z])))
-                        ch.triangles.push_back(t);
-                }
-                families[si].push_back(std::move(ch));
-            }
-        }
-        {
-            std::vector<cell> batch;
-            for (const auto& f : families)
-                for (const auto& ch : f) batch.push_back(cell{0, ch.x, ch.y, ch.z, {}});
-            bake_corners(batch, depth + 1);
-        }
-        // Culling: undo a split whose new probes the parent already predicts.
-        for (std::size_t si = 0; si < split_cells.size(); ++si) {
-            const cell& c = level[split_cells[si]];
-            const node parent = v.nodes_[c.node];
-            bool keep = depth < s.min_depth || s.cull_tolerance <= 0;
-            if (!keep) {
-                std::array<std::array<float, 6>, 8> corner_e{};
-                std::array<float, 8> corner_valid{};
-                for (int k = 0; k < 8; ++k) {
-                    const auto& p = all[parent.corner[std::size_t(k)]];
-                    corner_e[std::size_t(k)] = detail::axis_irradiance(p.radiance);
-                    corner_valid[std::size_t(k)] = p.inside ? 0.f : 1.f;
-                }
-                for (const auto& ch : families[si]) {
-                    const auto keys = corner_keys(ch, depth + 1);
-                    for (int k = 0; k < 8 && !keep; ++k) {
-                        const std::uint32_t idx = at_key.at(keys[std::size_t(k)]);
-                        const auto& p = all[idx];
-                        if (p.inside) continue;
-                        const auto w = trilinear_weights<float, glm::vec3>(p.position, parent.lo, parent.size);
-                        std::array<float, 6> predicted{};
-                        float wsum = 0;
-                        for (int j = 0; j < 8; ++j) {
-                            const float wj = w[std::size_t(j)] * corner_valid[std::size_t(j)];
-                            wsum += wj;
-                            for (int a = 0; a < 6; ++a) predicted[std::size_t(a)] += wj * corner_e[std::size_t(j)][std::size_t(a)];
-                        }
-                        if (wsum <= 0) {
-                            keep = true;
-                            break;
-                        }
-                        const auto actual = detail::axis_irradiance(p.radiance);
-                        for (int a = 0; a < 6; ++a) {
-                            const float pred = predicted[std::size_t(a)] / wsum;
-                            if (std::abs(actual[std::size_t(a)] - pred) >
-                                s.cull_tolerance * (std::abs(pred) + floor_level)) {
-                                keep = true;
-                                break;
-                            }
-                        }
-                    }
-                    if (keep) break;
-                }
-            }
-            if (!keep) {
-                ++stats.culled;
-                continue;
-            }
-            const std::uint32_t first = std::uint32_t(v.nodes_.size());
-            v.nodes_[c.node].first_child = std::int32_t(first);
-            for (int k = 0; k < 8; ++k) {
-                const glm::vec3 centre = parent.lo + parent.size * 0.5f;
-                const glm::vec3 clo = glm::vec3((k & 1) ? centre.x : parent.lo.x, (k & 2) ? centre.y : parent.lo.y,
-                                                (k & 4) ? centre.z : parent.lo.z);
-                v.nodes_.push_back(node{clo, parent.size * 0.5f, depth + 1, -1, {}});
-            }
-            for (int k = 0; k < 8; ++k) {
-                families[si][std::size_t(k)].node = first + std::uint32_t(k);
-                children.push_back(std::move(families[si][std::size_t(k)]));
-            }
-        }
-        level = std::move(children);
+        level = detail::grow_level(scene, level, depth, floor_level, s, source, lattice, v.nodes_, stats);
         if (level.empty()) break;
     }
-
-    // Keep only the probes some leaf uses, renumbered in order of first use.
-    std::vector<std::uint32_t> remap(all.size(), std::numeric_limits<std::uint32_t>::max());
-    for (auto& nd : v.nodes_) {
-        if (!nd.leaf()) continue;
-        for (auto& idx : nd.corner) {
-            if (remap[idx] == std::numeric_limits<std::uint32_t>::max()) {
-                remap[idx] = std::uint32_t(v.probes_.size());
-                v.probes_.push_back(all[idx]);
-            }
-            idx = remap[idx];
-        }
-    }
-    // Inner nodes keep corner indices only where the probe survived (else the first leaf's).
-    for (auto& nd : v.nodes_) {
-        if (nd.leaf()) continue;
-        for (auto& idx : nd.corner) idx = remap[idx] == std::numeric_limits<std::uint32_t>::max() ? 0u : remap[idx];
-    }
+    v.probes_ = detail::used_probes(lattice.probes(), v.nodes_);
     for (const auto& p : v.probes_) stats.probes_inside += p.inside ? 1 : 0;
     if (stats.probes_inside == v.probes_.size())
         throw parameter_error("scene", "every one of the " + std::to_string(v.probes_.size()) +
                                            " probes is inside geometry (its rays hit the backs of triangles), so the volume "
                                            "would light nothing; are the scene's triangles wound the wrong way, facing away "
                                            "from the volume and the lights?");
-    // Reach and owner: the largest leaf each probe is a corner of.
-    v.owner_.assign(v.probes_.size(), 0);
-    for (auto& p : v.probes_) p.reach = 0.f;
-    for (std::uint32_t i = 0; i < v.nodes_.size(); ++i) {
-        const node& nd = v.nodes_[i];
-        if (!nd.leaf()) continue;
-        const float half_diagonal = 0.5f * glm::length(nd.size);
-        for (std::uint32_t idx : nd.corner)
-            if (half_diagonal > v.probes_[idx].reach) v.probes_[idx].reach = half_diagonal, v.owner_[idx] = i;
-    }
-    v.reference_reach_ = std::numeric_limits<float>::infinity();
-    for (const auto& p : v.probes_) v.reference_reach_ = std::min(v.reference_reach_, p.reach);
+    v.reference_reach_ = detail::set_reach_and_owners(v.nodes_, v.probes_, v.owner_);
     if (stats_out) *stats_out = stats;
     return v;
 }
