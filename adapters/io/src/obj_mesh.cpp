@@ -242,28 +242,33 @@ std::string plural(std::size_t n, const char* one, const char* many) {
     return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
-}  // namespace
-
-void load_obj_mesh(const fs::path& file, const bounce::material& default_material, scene& out) {
-    const std::string text = read_text_file(file, max_obj_bytes);
-    const obj_survey survey = survey_obj(file, text);
-
+// What tinyobjloader read from an OBJ and its MTL files.
+struct obj_data {
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
-    std::vector<tinyobj::material_t> tmaterials;
-    std::string warn, err;
+    std::vector<tinyobj::material_t> materials;
+    std::string warnings;
+};
+
+obj_data parse_obj(const fs::path& file, const std::string& text, const obj_survey& survey) {
+    obj_data d;
+    std::string err;
     checked_mtl_reader mtl_reader(file, survey);
     std::istringstream in(text);
-    const bool ok = tinyobj::LoadObj(&attrib, &shapes, &tmaterials, &warn, &err, &in, &mtl_reader,
+    const bool ok = tinyobj::LoadObj(&d.attrib, &d.shapes, &d.materials, &d.warnings, &err, &in, &mtl_reader,
                                      /*triangulate=*/true, /*default_vcols_fallback=*/false);
     if (!ok || !err.empty()) {
         const std::string first = err.substr(0, err.find('\n'));
         throw scene_error(file, line_in_message(err), "tinyobjloader: " + (first.empty() ? "failed" : first));
     }
+    return d;
+}
 
-    // Materials: a `usemtl` naming no material of the mtllib files is a fault (a truncated
-    // or wrong MTL); without any mtllib it only means "default material".
-    std::istringstream warn_lines(warn);
+// tinyobjloader's warnings into out.warnings, but a `usemtl` naming no material of the
+// mtllib files is a fault (a truncated or wrong MTL); without any mtllib it only means
+// "default material".
+void take_warnings(const fs::path& file, const std::string& warnings, const obj_survey& survey, scene& out) {
+    std::istringstream warn_lines(warnings);
     std::string w;
     // tinyobjloader: "material [ 'NAME' ] not found in .mtl"
     constexpr std::string_view not_found_head = "material [ '", not_found_tail = "' ] not found";
@@ -285,29 +290,62 @@ void load_obj_mesh(const fs::path& file, const bounce::material& default_materia
             out.warnings.push_back("tinyobjloader: " + w);
         }
     }
+}
 
-    out.materials.clear();
-    out.material_names.clear();
-    for (const auto& tm : tmaterials) {
-        out.materials.push_back({{tm.diffuse[0], tm.diffuse[1], tm.diffuse[2]},
-                                 {tm.emission[0], tm.emission[1], tm.emission[2]}});
-        out.material_names.push_back(tm.name);
+// Builds out's vertices, triangles and materials from tinyobjloader's faces: one vertex
+// per (position index, normal index) pair; degenerate triangles dropped; vertices without
+// a usable normal get the area-weighted normal of their faces.
+class mesh_assembly {
+public:
+    mesh_assembly(const fs::path& file, const obj_data& d, const bounce::material& default_material, scene& out)
+        : file_(file), attrib_(d.attrib), default_material_(default_material), out_(out),
+          npos_(d.attrib.vertices.size() / 3), nnorm_(d.attrib.normals.size() / 3) {
+        out.materials.clear();
+        out.material_names.clear();
+        for (const auto& tm : d.materials) {
+            out.materials.push_back({{tm.diffuse[0], tm.diffuse[1], tm.diffuse[2]},
+                                     {tm.emission[0], tm.emission[1], tm.emission[2]}});
+            out.material_names.push_back(tm.name);
+        }
+        out.positions.clear();
+        out.normals.clear();
+        out.triangles.clear();
+        out.material_of.clear();
     }
-    std::uint32_t default_index = std::numeric_limits<std::uint32_t>::max();  // appended when used
 
-    const std::size_t npos = attrib.vertices.size() / 3, nnorm = attrib.normals.size() / 3;
-    const auto position = [&](int i) {
-        return glm::dvec3(attrib.vertices[3 * std::size_t(i)], attrib.vertices[3 * std::size_t(i) + 1],
-                          attrib.vertices[3 * std::size_t(i) + 2]);
-    };
+    void add_shape(const tinyobj::mesh_t& mesh) {
+        std::size_t offset = 0;
+        for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+            const std::size_t fv = mesh.num_face_vertices[f];
+            const std::size_t first = offset;
+            offset += fv;
+            if (fv != 3 || offset > mesh.indices.size()) continue;  // tinyobjloader triangulated already
+            const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
+            add_triangle({mesh.indices[first], mesh.indices[first + 1], mesh.indices[first + 2]}, mid);
+        }
+    }
 
-    // One output vertex per (position index, normal index) pair.
-    std::unordered_map<std::uint64_t, std::uint32_t> vertex_of;
-    std::vector<glm::dvec3> area_normal;  // sum of face cross products, for vertices to smooth
-    std::vector<glm::dvec3> first_face;   // unit normal of the first face using the vertex
-    std::vector<char> smooth;             // 1 where no usable vn was given
-    std::size_t degenerate = 0, repaired_normals = 0, repeated = 0;
+    // Smooth normals where none was given, then the warnings of what was repaired.
+    void finish() {
+        for (std::size_t v = 0; v < out_.positions.size(); ++v) {
+            if (!smooth_[v]) continue;
+            const double len = glm::length(area_normal_[v]);
+            // Opposite faces can cancel; the first face's normal is then the honest choice.
+            out_.normals[v] = std::isfinite(len) && len > 0.0 ? glm::vec3(area_normal_[v] / len) : glm::vec3(first_face_[v]);
+        }
+        if (out_.triangles.empty())
+            throw scene_error(file_, 0, "no triangles: every face is degenerate (zero area)");
+        if (degenerate_)
+            out_.warnings.push_back("dropped " + plural(degenerate_, "degenerate (zero-area) triangle",
+                                                        "degenerate (zero-area) triangles"));
+        if (repaired_normals_)
+            out_.warnings.push_back(plural(repaired_normals_, "vertex normal", "vertex normals") +
+                                    " zero or not finite: replaced by the area-weighted normal of their faces");
+        if (repeated_)
+            out_.warnings.push_back(plural(repeated_, "triangle repeats", "triangles repeat") + " an earlier one (kept)");
+    }
 
+private:
     struct triple_hash {
         std::size_t operator()(const std::array<int, 3>& t) const noexcept {
             std::uint64_t h = 1469598103934665603ull;
@@ -315,93 +353,99 @@ void load_obj_mesh(const fs::path& file, const bounce::material& default_materia
             return std::size_t(h);
         }
     };
-    std::unordered_set<std::array<int, 3>, triple_hash> seen;
 
-    out.positions.clear();
-    out.normals.clear();
-    out.triangles.clear();
-    out.material_of.clear();
-    for (const auto& shape : shapes) {
-        const auto& mesh = shape.mesh;
-        std::size_t offset = 0;
-        for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
-            const std::size_t fv = mesh.num_face_vertices[f];
-            const std::size_t first = offset;
-            offset += fv;
-            if (fv != 3 || offset > mesh.indices.size()) continue;  // tinyobjloader triangulated already
-            std::array<tinyobj::index_t, 3> c{mesh.indices[first], mesh.indices[first + 1], mesh.indices[first + 2]};
-            for (const auto& k : c)
-                if (k.vertex_index < 0 || std::size_t(k.vertex_index) >= npos || k.normal_index >= int(nnorm))
-                    throw scene_error(file, 0, "tinyobjloader returned an index out of range");
-            const glm::dvec3 p0 = position(c[0].vertex_index), p1 = position(c[1].vertex_index),
-                             p2 = position(c[2].vertex_index);
-            // Zero area up to float resolution: the third vertex lies within one float
-            // epsilon (relative to the longest edge) of the line through the other two,
-            // i.e. |e1 x e2| <= eps * max |e|^2; its face normal would be noise.
-            const glm::dvec3 cross = glm::cross(p1 - p0, p2 - p0);
-            const double longest2 = std::max({glm::dot(p1 - p0, p1 - p0), glm::dot(p2 - p1, p2 - p1), glm::dot(p0 - p2, p0 - p2)});
-            const double area2 = glm::length(cross);
-            if (!(area2 > double(std::numeric_limits<float>::epsilon()) * longest2)) {
-                ++degenerate;
-                continue;
-            }
-            std::array<int, 3> key3{c[0].vertex_index, c[1].vertex_index, c[2].vertex_index};
-            std::sort(key3.begin(), key3.end());
-            if (!seen.insert(key3).second) ++repeated;
+    glm::dvec3 position(int i) const {
+        return glm::dvec3(attrib_.vertices[3 * std::size_t(i)], attrib_.vertices[3 * std::size_t(i) + 1],
+                          attrib_.vertices[3 * std::size_t(i) + 2]);
+    }
 
-            glm::uvec3 tri;
-            for (int k = 0; k < 3; ++k) {
-                const std::uint64_t key = (std::uint64_t(std::uint32_t(c[k].vertex_index)) << 32) |
-                                          std::uint32_t(c[k].normal_index + 1);
-                auto [it, inserted] = vertex_of.try_emplace(key, std::uint32_t(out.positions.size()));
-                const std::uint32_t v = it->second;
-                if (inserted) {
-                    out.positions.emplace_back(position(c[k].vertex_index));
-                    first_face.push_back(cross / area2);
-                    area_normal.emplace_back(0.0);
-                    glm::dvec3 n(0.0);
-                    if (c[k].normal_index >= 0) {
-                        const std::size_t j = 3 * std::size_t(c[k].normal_index);
-                        n = {attrib.normals[j], attrib.normals[j + 1], attrib.normals[j + 2]};
-                    }
-                    const double len = glm::length(n);
-                    const bool usable = std::isfinite(len) && len > 0.0;
-                    if (c[k].normal_index >= 0 && !usable) ++repaired_normals;
-                    smooth.push_back(usable ? 0 : 1);
-                    out.normals.emplace_back(usable ? n / len : glm::dvec3(0.0));
-                }
-                // Area-weighted average: |e1 x e2| is twice the area.
-                if (smooth[v]) area_normal[v] += cross;
-                tri[k] = v;
-            }
-            out.triangles.push_back(tri);
-            const int mid = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
-            if (mid >= 0 && std::size_t(mid) < out.materials.size()) {
-                out.material_of.push_back(std::uint32_t(mid));
-            } else {
-                if (default_index == std::numeric_limits<std::uint32_t>::max()) {
-                    default_index = std::uint32_t(out.materials.size());
-                    out.materials.push_back(default_material);
-                    out.material_names.push_back("default");
-                }
-                out.material_of.push_back(default_index);
-            }
+    void add_triangle(const std::array<tinyobj::index_t, 3>& c, int material_id) {
+        for (const auto& k : c)
+            if (k.vertex_index < 0 || std::size_t(k.vertex_index) >= npos_ || k.normal_index >= int(nnorm_))
+                throw scene_error(file_, 0, "tinyobjloader returned an index out of range");
+        const glm::dvec3 p0 = position(c[0].vertex_index), p1 = position(c[1].vertex_index),
+                         p2 = position(c[2].vertex_index);
+        // Zero area up to float resolution: the third vertex lies within one float
+        // epsilon (relative to the longest edge) of the line through the other two,
+        // i.e. |e1 x e2| <= eps * max |e|^2; its face normal would be noise.
+        const glm::dvec3 cross = glm::cross(p1 - p0, p2 - p0);
+        const double longest2 = std::max({glm::dot(p1 - p0, p1 - p0), glm::dot(p2 - p1, p2 - p1), glm::dot(p0 - p2, p0 - p2)});
+        const double area2 = glm::length(cross);
+        if (!(area2 > double(std::numeric_limits<float>::epsilon()) * longest2)) {
+            ++degenerate_;
+            return;
         }
-    }
-    for (std::size_t v = 0; v < out.positions.size(); ++v) {
-        if (!smooth[v]) continue;
-        const double len = glm::length(area_normal[v]);
-        // Opposite faces can cancel; the first face's normal is then the honest choice.
-        out.normals[v] = std::isfinite(len) && len > 0.0 ? glm::vec3(area_normal[v] / len) : glm::vec3(first_face[v]);
+        std::array<int, 3> key3{c[0].vertex_index, c[1].vertex_index, c[2].vertex_index};
+        std::sort(key3.begin(), key3.end());
+        if (!seen_.insert(key3).second) ++repeated_;
+        glm::uvec3 tri;
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = vertex(c[std::size_t(k)], cross / area2);
+            // Area-weighted average: |e1 x e2| is twice the area.
+            if (smooth_[v]) area_normal_[v] += cross;
+            tri[k] = v;
+        }
+        out_.triangles.push_back(tri);
+        out_.material_of.push_back(material_index(material_id));
     }
 
-    if (out.triangles.empty())
-        throw scene_error(file, 0, "no triangles: every face is degenerate (zero area)");
-    if (degenerate) out.warnings.push_back("dropped " + plural(degenerate, "degenerate (zero-area) triangle", "degenerate (zero-area) triangles"));
-    if (repaired_normals)
-        out.warnings.push_back(plural(repaired_normals, "vertex normal", "vertex normals") +
-                               " zero or not finite: replaced by the area-weighted normal of their faces");
-    if (repeated) out.warnings.push_back(plural(repeated, "triangle repeats", "triangles repeat") + " an earlier one (kept)");
+    // The output vertex of corner c, added on first use (face_normal: the unit normal of
+    // the face that adds it).
+    std::uint32_t vertex(const tinyobj::index_t& c, const glm::dvec3& face_normal) {
+        const std::uint64_t key = (std::uint64_t(std::uint32_t(c.vertex_index)) << 32) | std::uint32_t(c.normal_index + 1);
+        auto [it, inserted] = vertex_of_.try_emplace(key, std::uint32_t(out_.positions.size()));
+        if (!inserted) return it->second;
+        out_.positions.emplace_back(position(c.vertex_index));
+        first_face_.push_back(face_normal);
+        area_normal_.emplace_back(0.0);
+        glm::dvec3 n(0.0);
+        if (c.normal_index >= 0) {
+            const std::size_t j = 3 * std::size_t(c.normal_index);
+            n = {attrib_.normals[j], attrib_.normals[j + 1], attrib_.normals[j + 2]};
+        }
+        const double len = glm::length(n);
+        const bool usable = std::isfinite(len) && len > 0.0;
+        if (c.normal_index >= 0 && !usable) ++repaired_normals_;
+        smooth_.push_back(usable ? 0 : 1);
+        out_.normals.emplace_back(usable ? n / len : glm::dvec3(0.0));
+        return it->second;
+    }
+
+    // The material of a face: its MTL material, else the default material, appended on first use.
+    std::uint32_t material_index(int material_id) {
+        if (material_id >= 0 && std::size_t(material_id) < out_.materials.size()) return std::uint32_t(material_id);
+        if (default_index_ == std::numeric_limits<std::uint32_t>::max()) {
+            default_index_ = std::uint32_t(out_.materials.size());
+            out_.materials.push_back(default_material_);
+            out_.material_names.push_back("default");
+        }
+        return default_index_;
+    }
+
+    const fs::path& file_;
+    const tinyobj::attrib_t& attrib_;
+    const bounce::material& default_material_;
+    scene& out_;
+    std::size_t npos_, nnorm_;
+    std::uint32_t default_index_ = std::numeric_limits<std::uint32_t>::max();
+    std::unordered_map<std::uint64_t, std::uint32_t> vertex_of_;
+    std::vector<glm::dvec3> area_normal_;  // sum of face cross products, for vertices to smooth
+    std::vector<glm::dvec3> first_face_;   // unit normal of the first face using the vertex
+    std::vector<char> smooth_;             // 1 where no usable vn was given
+    std::unordered_set<std::array<int, 3>, triple_hash> seen_;
+    std::size_t degenerate_ = 0, repaired_normals_ = 0, repeated_ = 0;
+};
+
+}  // namespace
+
+void load_obj_mesh(const fs::path& file, const bounce::material& default_material, scene& out) {
+    const std::string text = read_text_file(file, max_obj_bytes);
+    const obj_survey survey = survey_obj(file, text);
+    const obj_data d = parse_obj(file, text, survey);
+    take_warnings(file, d.warnings, survey, out);
+    mesh_assembly mesh(file, d, default_material, out);
+    for (const auto& shape : d.shapes) mesh.add_shape(shape.mesh);
+    mesh.finish();
     if (survey.lines_or_points)
         out.warnings.push_back("ignored " + plural(survey.lines_or_points, "line/point element", "line/point elements"));
 }
