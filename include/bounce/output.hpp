@@ -11,7 +11,8 @@
 /// surface, with an albedo texture finer than the technique's records, probes or texels).
 /// Asked for `output_quantity::radiance`, a family returns rho/pi * E with the albedo the
 /// caller gave it (the G-buffer's, the scene's materials for radiosity, a span for the
-/// volume), computed by the one kernel lambertian_radiance (direct_light.hpp).
+/// volume), computed by the one kernel lambertian_radiance (direct_light.hpp): apply_output
+/// here on the CPU, gl::output_pass on GL textures.
 ///
 /// Only radiosity also computes direct light (the scene's point, spot and directional lights,
 /// shot in its constructor); it offers `light_paths` so that a renderer with its own direct

@@ -34,6 +34,7 @@
 #include <bounce/gbuffer.hpp>
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/objects.hpp>
+#include <bounce/gl/output_pass.hpp>
 #include <bounce/gl/rsm_textures.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/indirect/options.hpp>
@@ -79,10 +80,20 @@ public:
     /// unoccluded; 0 where the G-buffer sees nothing. Throws parameter_error naming the
     /// texture or map at fault (sizes, formats, zero-sized textures). The SII shade stage
     /// includes reading the maps back and selecting the VPLs on the host; fallback_pixels
-    /// is counted by an occlusion query. Irradiance only (output.hpp's default): for radiance
-    /// multiply by the albedo over pi in your shading pass.
+    /// is counted by an occlusion query.
     indirect_timings render(const gbuffer_textures& g, const camera& cam, std::span<const rsm_textures> maps,
                             const texture_ref& irradiance);
+    /// The same as `quantity` (output.hpp): radiance is rho/pi E with g's albedo, made in
+    /// `out` after the frame by gl::output_pass (compiled on first use; not in the timings).
+    indirect_timings render(const gbuffer_textures& g, const camera& cam, std::span<const rsm_textures> maps,
+                            const texture_ref& out, output_quantity quantity) {
+        const indirect_timings t = render(g, cam, maps, out);
+        if (quantity == output_quantity::radiance) {
+            if (!output_) output_.emplace();
+            output_->apply(quantity, g.albedo, out);
+        }
+        return t;
+    }
 
     /// The last frame's VPLs (SII), in the order of their light groups (sub-buffer 0's
     /// first), each with its interleaving weight already applied to the flux.
@@ -99,6 +110,7 @@ private:
     bool time_stages_ = false;
     std::unique_ptr<passes> passes_;
     std::vector<vpl> splatted_;
+    std::optional<output_pass> output_;
 };
 
 /// `gl::indirect_renderer` in an EGL context of its own, on a G-buffer and maps held in host
