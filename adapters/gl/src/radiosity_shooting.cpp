@@ -24,12 +24,12 @@ progressive_radiosity::state::reduction progressive_radiosity::state::reduce() {
         bind_common();
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         glUseProgram(reduce_program->id());
-        reduce_program->set(0, int(width));
-        reduce_program->set(1, unsigned(first.size() - 1));
+        reduce_program->set(radiosity_glsl::reduce_uniform::atlas_width, int(width));
+        reduce_program->set(radiosity_glsl::reduce_uniform::shooter_count, unsigned(first.size() - 1));
         glDispatchCompute(GLuint((first.size() - 1 + reduce_group - 1) / reduce_group), 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glUseProgram(finish_program->id());
-        finish_program->set(0, unsigned(first.size() - 1));
+        finish_program->set(radiosity_glsl::finish_uniform::shooter_count, unsigned(first.size() - 1));
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         check_error("progressive_radiosity: the shooter reduction");
@@ -108,8 +108,8 @@ void progressive_radiosity::state::draw_item_buffer() {
     glViewport(0, 0, options.resolution, options.resolution);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, planes_binding, planes.id());
     glUseProgram(item_program->id());
-    item_program->set(0, res);
-    item_program->set(1, far_distance * 1.01f + 1e-6f * diagonal);
+    item_program->set(radiosity_glsl::item_uniform::resolution, res);
+    item_program->set(radiosity_glsl::item_uniform::depth_scale, far_distance * 1.01f + 1e-6f * diagonal);
     glBindVertexArray(item_vao.id());
     if (!pieces.empty()) glDrawArrays(GL_TRIANGLES, 0, GLsizei(pieces.size()));
     check_error("progressive_radiosity: drawing the item buffer");
@@ -178,14 +178,15 @@ void progressive_radiosity::state::draw_parallel() {
     glViewport(0, 0, res, res);
     const program& p = *parallel_program;
     glUseProgram(p.id());
-    p.set(0, t);
-    p.set(1, b);
-    p.set(2, shot_axis);
-    p.set(3, ortho_lo);
-    p.set(4, ortho_scale);
-    p.set(5, float(res));
-    p.set(6, d0 - margin);
-    p.set(7, d1 + margin);
+    namespace u = radiosity_glsl::parallel_uniform;
+    p.set(u::shot_t, t);
+    p.set(u::shot_b, b);
+    p.set(u::shot_n, shot_axis);
+    p.set(u::ortho_lo, ortho_lo);
+    p.set(u::ortho_scale, ortho_scale);
+    p.set(u::parallel_resolution, float(res));
+    p.set(u::depth_lo, d0 - margin);
+    p.set(u::depth_hi, d1 + margin);
     glBindVertexArray(cube_vao.id());
     glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
     drawn = cube_vertex_count / 3;
@@ -217,21 +218,22 @@ void progressive_radiosity::state::draw_hemicube() {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
     const program& p = *cube_program;
     glUseProgram(p.id());
-    p.set(0, shot_position);
-    p.set(1, t);
-    p.set(2, b);
-    p.set(3, shot_axis);
-    p.set(8, near_z);
-    p.set(9, far_z);
-    p.set(10, shot_chart);
+    namespace u = radiosity_glsl::hemicube_uniform;
+    p.set(u::shot_position, shot_position);
+    p.set(u::shot_t, t);
+    p.set(u::shot_b, b);
+    p.set(u::shot_n, shot_axis);
+    p.set(u::near_z, near_z);
+    p.set(u::far_z, far_z);
+    p.set(u::shot_chart, shot_chart);
     glBindVertexArray(cube_vao.id());
     const int res = options.resolution;
     for (int face = 0; face < 5; ++face) {
         const auto axes = face_axes(face);
-        p.set(4, axes[0]);
-        p.set(5, axes[1]);
-        p.set(6, axes[2]);
-        p.set(7, face == 0 ? 0 : 1);
+        p.set(u::face_right, axes[0]);
+        p.set(u::face_up, axes[1]);
+        p.set(u::face_forward, axes[2]);
+        p.set(u::side_face, face == 0 ? 0 : 1);
         if (face == 0) glViewport(0, 0, res, res);
         else glViewport(0, res + (face - 1) * (res / 2), res, res / 2);
         glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
@@ -336,20 +338,10 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         const program& p = *distribute_program;
         glUseProgram(p.id());
-        p.set(0, int(width));
-        p.set(1, int(height));
-        p.set(2, shot_position);
-        p.set(3, t);
-        p.set(4, b);
-        p.set(5, shot_axis);
-        p.set(6, chart);
-        p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
-        p.set(8, float(options.resolution));
-        p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
-        p.set(21, unsigned(atlas.size()));
-        p.set(9, diagonal);
-        p.set(10, int(near.size()));
-        p.set(11, float(options.shooting.near_field * options.shooting.near_field));
+        set_shot_uniforms(p, chart, options.visibility == radiosity_visibility::hemicube);
+        p.set(radiosity_glsl::distribute_uniform::node_count, int(near.size()));
+        p.set(radiosity_glsl::distribute_uniform::near2,
+              float(options.shooting.near_field * options.shooting.near_field));
         glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
         check_error("progressive_radiosity: the distribution pass");
     }
@@ -360,6 +352,37 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     escaped += power - got.intercepted;
     intercepted_power += got.intercepted;
     ++shots;
+}
+
+void progressive_radiosity::state::set_shot_uniforms(const program& p, float chart, bool hemicube) const {
+    namespace u = radiosity_glsl::shot_uniform;
+    p.set(u::atlas_width, int(width));
+    p.set(u::atlas_height, int(height));
+    p.set(u::shot_position, shot_position);
+    p.set(u::shot_t, t);
+    p.set(u::shot_b, b);
+    p.set(u::shot_n, shot_axis);
+    p.set(u::shot_chart, chart);
+    p.set(u::occlusion, options.visibility != radiosity_visibility::none ? 1 : 0);
+    p.set(u::resolution, float(options.resolution));
+    p.set(u::diagonal, diagonal);
+    p.set(u::hemicube, hemicube ? 1 : 0);
+    p.set(u::element_count, unsigned(atlas.size()));
+}
+
+void progressive_radiosity::state::set_light_uniforms(const program& p, const packed_light& l, bool spot,
+                                                      bool strict_side, bool parallel) const {
+    namespace u = radiosity_glsl::light_uniform;
+    p.set(u::spot, spot ? 1 : 0);
+    p.set(u::light_axis, l.direction());
+    p.set(u::intensity, l.intensity());
+    p.set(u::cos_cone, l.cos_cone());
+    p.set(u::cosine_falloff, l.cosine_falloff());
+    p.set(u::strict_side, strict_side ? 1 : 0);
+    p.set(u::parallel, parallel ? 1 : 0);
+    p.set(u::ortho_lo, ortho_lo);
+    p.set(u::ortho_scale, ortho_scale);
+    p.set(u::parallel_resolution, float(options.parallel_resolution));
 }
 
 void progressive_radiosity::state::shoot_light(const packed_light& l) {
@@ -375,28 +398,8 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             glMemoryBarrier(GL_ALL_BARRIER_BITS);
             const program& p = *light_program;
             glUseProgram(p.id());
-            p.set(0, int(width));
-            p.set(1, int(height));
-            p.set(2, shot_position);
-            p.set(3, t);
-            p.set(4, b);
-            p.set(5, shot_axis);
-            p.set(6, -2.f);
-            p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
-            p.set(8, float(options.resolution));
-            p.set(9, diagonal);
-            p.set(10, 0);
-            p.set(11, l.direction());
-            p.set(12, l.intensity());
-            p.set(13, l.cos_cone());
-            p.set(14, l.cosine_falloff());
-            p.set(15, 0);
-            p.set(16, 1);
-            p.set(17, ortho_lo);
-            p.set(18, ortho_scale);
-            p.set(19, float(options.parallel_resolution));
-            p.set(20, 0);
-            p.set(21, unsigned(atlas.size()));
+            set_shot_uniforms(p, -2.f, false);
+            set_light_uniforms(p, l, false, false, true);
             glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
             check_error("progressive_radiosity: shooting a directional light");
         }
@@ -419,29 +422,8 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
             glMemoryBarrier(GL_ALL_BARRIER_BITS);
             const program& p = *light_program;
             glUseProgram(p.id());
-            p.set(0, int(width));
-            p.set(1, int(height));
-            p.set(2, shot_position);
-            p.set(3, t);
-            p.set(4, b);
-            p.set(5, shot_axis);
-            p.set(6, -2.f);
-            p.set(7, options.visibility != radiosity_visibility::none ? 1 : 0);
-            p.set(8, float(options.resolution));
-            p.set(20, options.visibility == radiosity_visibility::hemicube ? 1 : 0);
-            p.set(21, unsigned(atlas.size()));
-        p.set(21, unsigned(atlas.size()));
-            p.set(9, diagonal);
-            p.set(10, kind == light_kind::spot ? 1 : 0);
-            p.set(11, l.direction());
-            p.set(12, l.intensity());
-            p.set(13, l.cos_cone());
-            p.set(14, l.cosine_falloff());
-            p.set(15, h == 0 ? 0 : 1);
-            p.set(16, 0);
-            p.set(17, ortho_lo);
-            p.set(18, ortho_scale);
-            p.set(19, float(options.parallel_resolution));
+            set_shot_uniforms(p, -2.f, options.visibility == radiosity_visibility::hemicube);
+            set_light_uniforms(p, l, kind == light_kind::spot, h != 0, false);
             glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
             check_error("progressive_radiosity: shooting a light");
         }

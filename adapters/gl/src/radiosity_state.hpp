@@ -12,6 +12,7 @@
 #include <bounce/sampling.hpp>
 #include <bounce/radiosity/stereographic_tessellation.hpp>
 
+#include "radiosity_shaders.hpp"
 #include "saved_state.hpp"
 
 #include <algorithm>
@@ -206,6 +207,11 @@ struct progressive_radiosity::state {
     void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
     void shoot(std::uint32_t k);
     void shoot_light(const packed_light& l);
+    // The uniforms of shot_uniform on the distribution or light program p, for a shot from
+    // chart `chart` (-2: a light) whose visibility is looked up on the hemicube or not.
+    void set_shot_uniforms(const program& p, float chart, bool hemicube) const;
+    // light_uniform: the light l, its kind flags and the directional light's buffer.
+    void set_light_uniforms(const program& p, const packed_light& l, bool spot, bool strict_side, bool parallel) const;
     std::vector<glm::vec3> read_elements(const texture& t) const;
     void bind_common() const;
 };

@@ -1,0 +1,425 @@
+// The GLSL of gl::progressive_radiosity's passes: the item buffer (stereographic map), the
+// hemicube faces, a directional light's orthographic buffer, the distribution of a shot,
+// the shot of a light, and the two-pass reduction that picks the next shooter. The
+// projections, form factors, visibility tests and light irradiances are emitted from the
+// kernels of radiosity/kernels.hpp and direct_light.hpp; the rest is fetches, loops and writes.
+#include "radiosity_shaders.hpp"
+
+#include <bounce/direct_light.hpp>
+#include <bounce/glsl/emit.hpp>
+#include <bounce/radiosity/kernels.hpp>
+
+#include <initializer_list>
+#include <utility>
+
+namespace bounce::gl::radiosity_glsl {
+
+namespace {
+
+using glsl::f32;
+using glsl::vec2;
+using glsl::vec3;
+
+const std::string version_line = "#version 450 core\n";
+
+// One "layout(location = L) uniform DECLARATION;" line per (L, declaration).
+std::string uniforms(std::initializer_list<std::pair<int, const char*>> declarations) {
+    std::string out;
+    for (const auto& [location, declaration] : declarations)
+        out += "layout(location = " + std::to_string(location) + ") uniform " + declaration + ";\n";
+    return out;
+}
+
+// The kernels the visibility lookups of the distribution and light passes call.
+std::string lookup_functions() {
+    glsl::function_set fs;
+    fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
+    fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
+    fs.add("radiosity_hemicube_coords", hemicube_face_coords<f32, vec3>, "local_direction");
+    fs.add("radiosity_parallel_sees", parallel_item_sees<f32, vec3>, "element", "element_chart", "shown_chart",
+           "plane_normal", "plane_offset", "shown_depth", "direction", "diagonal");
+    fs.add("radiosity_item_sees", item_buffer_sees<f32, vec3>, "element", "element_chart", "shown_chart",
+           "plane_normal", "plane_offset", "shown_depth", "diagonal");
+    return fs.source();
+}
+
+// The distribution and light passes' uniforms (shot_uniform).
+std::string shot_uniforms() {
+    using namespace shot_uniform;
+    return uniforms({{element_count, "uint element_count"},
+                     {atlas_width, "int atlas_width"},
+                     {atlas_height, "int atlas_height"},
+                     {shot_position, "vec3 shot_position"},
+                     {shot_t, "vec3 shot_t"},
+                     {shot_b, "vec3 shot_b"},
+                     {shot_n, "vec3 shot_n"},
+                     {shot_chart, "float shot_chart"},
+                     {occlusion, "int occlusion"},
+                     {resolution, "float resolution"},
+                     {diagonal, "float diagonal"},
+                     {hemicube, "int hemicube"}});
+}
+
+// What the distribution and light passes share: the element texels, the images, the
+// visibility of an element from the shot, and an element's receiving of it.
+const char* const shot_common = R"(
+struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
+layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
+layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
+layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
+layout(rgba32f, binding = 0) uniform image2D radiosity_image;
+layout(rgba32f, binding = 1) uniform image2D unshot_image;
+layout(rgba32f, binding = 2) uniform writeonly image2D intercepted_image;
+layout(rgba32f, binding = 3) uniform readonly image2D item_image;
+// Visibility of the element at world position p (chart `chart`) from the shot: its pixel in
+// the stereographic buffer, or on its hemicube face (top face in rows [0, res), side face f
+// in rows res + (f - 1) res / 2 on).
+float shot_visibility(vec3 p, float chart) {
+    if (occlusion == 0) return 1.0;
+    vec3 l = radiosity_to_shooter_frame(p, shot_position, shot_t, shot_b, shot_n);
+    int res = int(resolution);
+    ivec2 pixel;
+    if (hemicube != 0) {
+        vec3 f = radiosity_hemicube_coords(l);
+        int face = clamp(int(f.x + 0.5), 0, 4);
+        int rows = face == 0 ? res : res / 2;
+        pixel = ivec2(clamp(int(floor(f.y * resolution)), 0, res - 1),
+                      clamp(int(floor(f.z * float(rows))), 0, rows - 1) + (face == 0 ? 0 : res + (face - 1) * (res / 2)));
+    } else {
+        vec2 uv = radiosity_item_coords(l);
+        pixel = clamp(ivec2(floor(uv * resolution)), ivec2(0), ivec2(res - 1));
+    }
+    vec4 item = imageLoad(item_image, pixel);
+    vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
+    return radiosity_item_sees(l, chart, item.x, plane.xyz, plane.w, item.z, diagonal);
+}
+void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
+    imageStore(radiosity_image, xy, imageLoad(radiosity_image, xy) + vec4(gain, 0.0));
+    imageStore(unshot_image, xy, imageLoad(unshot_image, xy) + vec4(gain, 0.0));
+    imageStore(intercepted_image, xy, vec4(intercepted, 0.0));
+}
+)";
+
+}  // namespace
+
+// Item buffer: the pieces projected by the emitted stereographic map; depth exact at each
+// pixel centre along its direction (stereographic_direction, emitted).
+std::string item_buffer_vertex() {
+    glsl::function_set fs;
+    fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
+    return version_line + fs.source() + R"(
+layout(location = 0) in vec3 piece_corner;
+layout(location = 1) in vec2 ids;
+layout(location = 0) noperspective out float radial;
+layout(location = 1) flat out vec2 item_ids;
+void main() {
+    vec2 uv = radiosity_item_coords(piece_corner);
+    gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
+    radial = length(piece_corner);
+    item_ids = ids;
+}
+)";
+}
+
+std::string item_buffer_fragment() {
+    glsl::function_set fs;
+    fs.add("radiosity_pixel_direction", stereographic_direction<f32, vec3, vec2>, "q");
+    fs.add("radiosity_plane_depth", item_plane_depth<f32, vec3>, "plane_normal", "plane_offset", "w", "interpolated");
+    return version_line + fs.source() +
+           uniforms({{item_uniform::resolution, "float resolution"}, {item_uniform::depth_scale, "float depth_scale"}}) +
+           R"(
+layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
+layout(location = 0) noperspective in float radial;
+layout(location = 1) flat in vec2 item_ids;
+layout(location = 0) out vec4 item;
+void main() {
+    vec3 w = radiosity_pixel_direction(gl_FragCoord.xy / resolution * 2.0 - 1.0);
+    vec4 plane = local_plane[int(item_ids.y)];
+    float depth = radiosity_plane_depth(plane.xyz, plane.w, w, radial);
+    gl_FragDepth = depth / depth_scale;
+    item = vec4(item_ids, depth, 1.0);
+}
+)";
+}
+
+// Hemicube faces (Cohen and Greenberg 1985): perspective views of the untessellated
+// triangles, 1/z interpolated by the rasterizer (exact under perspective), depth the
+// distance along the face's forward axis, as cpu::item_buffer_visibility stores it. Side
+// faces keep their upper half: clip y = 2 up - forward maps up / forward in [0, 1] onto
+// the viewport.
+std::string hemicube_vertex() {
+    using namespace hemicube_uniform;
+    glsl::function_set fs;
+    fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
+    return version_line + fs.source() +
+           uniforms({{shot_position, "vec3 shot_position"},
+                     {shot_t, "vec3 shot_t"},
+                     {shot_b, "vec3 shot_b"},
+                     {shot_n, "vec3 shot_n"},
+                     {face_right, "vec3 face_right"},
+                     {face_up, "vec3 face_up"},
+                     {face_forward, "vec3 face_forward"},
+                     {side_face, "int side_face"},
+                     {near_z, "float near_z"},
+                     {far_z, "float far_z"}}) +
+           R"(
+layout(location = 0) in vec3 world_position;
+layout(location = 1) in vec2 ids;
+layout(location = 0) out float forward_depth;
+layout(location = 1) flat out vec2 item_ids;
+void main() {
+    vec3 l = radiosity_to_shooter_frame(world_position, shot_position, shot_t, shot_b, shot_n);
+    vec3 q = vec3(dot(l, face_right), dot(l, face_up), dot(l, face_forward));
+    float y = side_face != 0 ? 2.0 * q.y - q.z : q.y;
+    float a = (far_z + near_z) / (far_z - near_z), b = -2.0 * far_z * near_z / (far_z - near_z);
+    gl_Position = vec4(q.x, y, a * q.z + b, q.z);
+    forward_depth = q.z;
+    item_ids = ids;
+}
+)";
+}
+
+std::string hemicube_fragment() {
+    using namespace hemicube_uniform;
+    return version_line + uniforms({{far_z, "float far_z"}, {shot_chart, "float shot_chart"}}) + R"(
+layout(location = 0) in float forward_depth;
+layout(location = 1) flat in vec2 item_ids;
+layout(location = 0) out vec4 item;
+void main() {
+    if (item_ids.x == shot_chart) discard;
+    gl_FragDepth = forward_depth / far_z;
+    item = vec4(item_ids, forward_depth, 1.0);
+}
+)";
+}
+
+// A directional light: an orthographic view along it over the scene's box; the depth is
+// the distance along the light, linear, so the rasterizer's depth is exact.
+std::string parallel_vertex() {
+    using namespace parallel_uniform;
+    return version_line +
+           uniforms({{shot_t, "vec3 shot_t"},
+                     {shot_b, "vec3 shot_b"},
+                     {shot_n, "vec3 shot_n"},
+                     {ortho_lo, "vec2 ortho_lo"},
+                     {ortho_scale, "float ortho_scale"},
+                     {parallel_resolution, "float parallel_resolution"},
+                     {depth_lo, "float depth_lo"},
+                     {depth_hi, "float depth_hi"}}) +
+           R"(
+layout(location = 0) in vec3 world_position;
+layout(location = 1) in vec2 ids;
+layout(location = 0) out float along;
+layout(location = 1) flat out vec2 item_ids;
+void main() {
+    vec2 pixel = (vec2(dot(world_position, shot_t), dot(world_position, shot_b)) - ortho_lo) * ortho_scale;
+    along = dot(world_position, shot_n);
+    gl_Position = vec4(pixel / parallel_resolution * 2.0 - 1.0, (along - depth_lo) / (depth_hi - depth_lo) * 2.0 - 1.0, 1.0);
+    item_ids = ids;
+}
+)";
+}
+
+std::string parallel_fragment() {
+    return version_line + R"(
+layout(location = 0) in float along;
+layout(location = 1) flat in vec2 item_ids;
+layout(location = 0) out vec4 item;
+void main() { item = vec4(item_ids, along, 1.0); }
+)";
+}
+
+// The distribution of a shot: every element receives from the shooter's near-field tree
+// (disc form factors), times its visibility.
+std::string distribute_compute(int max_nodes, int stack_size) {
+    glsl::function_set fs;
+    fs.add("radiosity_form_factor", disc_form_factor<f32, vec3>, "receiver_position", "receiver_normal",
+           "shooter_position", "shooter_normal", "shooter_area");
+    fs.add("radiosity_shot", shot_radiosity<f32, vec3>, "receiver_position", "receiver_normal", "receiver_albedo",
+           "shooter_position", "shooter_normal", "shooter_area", "shooter_unshot", "visibility");
+    fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
+    return version_line + "layout(local_size_x = 64) in;\n" + shot_uniforms() +
+           uniforms({{distribute_uniform::node_count, "int node_count"}, {distribute_uniform::near2, "float near2"}}) +
+           lookup_functions() + fs.source() + shot_common + "const int max_nodes = " + std::to_string(max_nodes) +
+           ";\n" + "const int stack_size = " + std::to_string(stack_size) + ";\n" + R"(
+struct near_node { vec4 position_area; vec4 unshot; ivec4 meta; };
+layout(std430, binding = 1) readonly buffer nodes_block { near_node node[]; };
+void main() {
+    // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
+    if (gl_GlobalInvocationID.x >= element_count) return;
+    uint code = element_texel[gl_GlobalInvocationID.x];
+    ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
+    texel_attributes a = texel[xy.y * atlas_width + xy.x];
+    if (!(a.position_area.w > 0.0)) return;
+    if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    vec3 pr = a.position_area.xyz, nr = a.normal_chart.xyz, rho = a.albedo.rgb;
+    vec3 gain = vec3(0.0), incident = vec3(0.0);
+    // The block as one disc where the receiver is farther than near_field times its side,
+    // else as its four quadrants, recursively, down to elements: the CPU solver's traversal
+    // (a stack, children pushed in order, so terms are summed in its order). Each node is
+    // visited at most once, so max_nodes bounds the loop.
+    // Most receivers are far from the whole block: one disc, no stack.
+    near_node root = node[node_count - 1];
+    if (root.meta.y == 0 || !(radiosity_near_field(pr, root.position_area.xyz, root.position_area.w, near2) > 0.5)) {
+        float f = radiosity_form_factor(pr, nr, root.position_area.xyz, shot_n, root.position_area.w);
+        if (f > 0.0) {
+            incident = root.unshot.xyz * f;
+            gain = radiosity_shot(pr, nr, rho, root.position_area.xyz, shot_n, root.position_area.w, root.unshot.xyz, 1.0);
+        }
+    } else {
+        int stack[stack_size];
+        int top = 0;
+        for (int c = 0; c < root.meta.y; ++c) stack[top++] = root.meta.x + c;
+        for (int visit = 0; visit < max_nodes && top > 0; ++visit) {
+            near_node nd = node[stack[--top]];
+            bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
+            if (nd.meta.y == 0 || !near_node_) {
+                float f = radiosity_form_factor(pr, nr, nd.position_area.xyz, shot_n, nd.position_area.w);
+                if (f > 0.0) {
+                    incident += nd.unshot.xyz * f;
+                    gain += radiosity_shot(pr, nr, rho, nd.position_area.xyz, shot_n, nd.position_area.w, nd.unshot.xyz, 1.0);
+                }
+            } else {
+                for (int c = 0; c < nd.meta.y && top < stack_size; ++c) stack[top++] = nd.meta.x + c;
+            }
+        }
+    }
+    if (!(incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    float v = shot_visibility(pr, a.normal_chart.w);
+    if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    receive(xy, gain * v, incident * (v * a.position_area.w));
+}
+)";
+}
+
+// The shot of a point, spot or directional light: every element's irradiance from it,
+// times its visibility (the item buffer, or the directional light's orthographic buffer).
+std::string light_compute() {
+    using namespace light_uniform;
+    glsl::function_set fs;
+    fs.add("radiosity_point_irradiance", point_light_irradiance<f32, vec3>, "p", "n", "light_position", "intensity");
+    fs.add("radiosity_directional_irradiance", directional_light_irradiance<f32, vec3>, "n", "direction", "irradiance");
+    fs.add("radiosity_spot_irradiance", spot_light_irradiance<f32, vec3>, "p", "n", "light_position", "axis",
+           "intensity", "cos_cone", "cosine_falloff");
+    return version_line + "layout(local_size_x = 64) in;\n" + shot_uniforms() +
+           uniforms({{spot, "int spot"},
+                     {light_axis, "vec3 light_axis"},
+                     {intensity, "vec3 intensity"},
+                     {cos_cone, "float cos_cone"},
+                     {cosine_falloff, "float cosine_falloff"},
+                     {strict_side, "int strict_side"},
+                     {parallel, "int parallel"},
+                     {ortho_lo, "vec2 ortho_lo"},
+                     {ortho_scale, "float ortho_scale"},
+                     {parallel_resolution, "float parallel_resolution"}}) +
+           lookup_functions() + fs.source() + shot_common + R"(
+// Visibility along a directional light: the element's pixel in the orthographic buffer,
+// whose planes are the triangles' world planes.
+float parallel_visibility(vec3 p, float chart) {
+    if (occlusion == 0) return 1.0;
+    vec3 l = radiosity_to_shooter_frame(p, vec3(0.0), shot_t, shot_b, shot_n);
+    int res = int(parallel_resolution);
+    ivec2 pixel = clamp(ivec2(floor((l.xy - ortho_lo) * ortho_scale)), ivec2(0), ivec2(res - 1));
+    vec4 item = imageLoad(item_image, pixel);
+    vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
+    return radiosity_parallel_sees(p, chart, item.x, plane.xyz, plane.w, item.z, shot_n, diagonal);
+}
+void main() {
+    // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
+    if (gl_GlobalInvocationID.x >= element_count) return;
+    uint code = element_texel[gl_GlobalInvocationID.x];
+    ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
+    texel_attributes a = texel[xy.y * atlas_width + xy.x];
+    if (!(a.position_area.w > 0.0)) return;
+    if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    vec3 p = a.position_area.xyz, n = a.normal_chart.xyz;
+    // Each element belongs to one hemisphere of the light: z >= 0 of the first, z > 0 of the second.
+    float z = dot(p - shot_position, shot_n);
+    bool side = parallel != 0 || (strict_side != 0 ? z > 0.0 : z >= 0.0);
+    vec3 e = parallel != 0 ? radiosity_directional_irradiance(n, light_axis, intensity)
+           : spot != 0     ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
+                           : radiosity_point_irradiance(p, n, shot_position, intensity);
+    if (!side || !(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    float v = parallel != 0 ? parallel_visibility(p, a.normal_chart.w) : shot_visibility(p, a.normal_chart.w);
+    if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    receive(xy, a.albedo.rgb * (e * v), e * (v * a.position_area.w));
+}
+)";
+}
+
+// Reduction, in two passes with few barriers (llvmpipe runs a barrier as a switch of
+// every invocation): per shooter (one invocation each) its unshot power, the channel sums
+// times area in double and in element order (the CPU solver's sum), with its elements'
+// intercepted and absorbed power; then one work group of 64 striding over the shooters
+// (ties to the lowest index) and a shared-memory tree over its 64 partial results.
+std::string reduce_compute() {
+    using namespace reduce_uniform;
+    return version_line + uniforms({{atlas_width, "int atlas_width"}, {shooter_count, "uint shooter_count"}}) + R"(
+layout(local_size_x = 64) in;
+struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
+layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
+layout(std430, binding = 3) readonly buffer first_block { uint shooter_first[]; };
+layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
+layout(std430, binding = 5) buffer partial_block { double partial[]; };
+layout(rgba32f, binding = 1) uniform readonly image2D unshot_image;
+layout(rgba32f, binding = 2) uniform readonly image2D intercepted_image;
+void main() {
+    uint k = gl_GlobalInvocationID.x;
+    if (k >= shooter_count) return;
+    double power = 0.0;
+    dvec3 ic = dvec3(0.0), ab = dvec3(0.0);
+    for (uint e = shooter_first[k]; e < shooter_first[k + 1u]; ++e) {
+        uint code = element_texel[e];
+        ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
+        texel_attributes a = texel[xy.y * atlas_width + xy.x];
+        vec4 u = imageLoad(unshot_image, xy);
+        power += (double(u.r) + double(u.g) + double(u.b)) * double(a.position_area.w);
+        dvec3 got = dvec3(imageLoad(intercepted_image, xy).rgb);
+        ic += got;
+        ab += (dvec3(1.0) - dvec3(a.albedo.rgb)) * got;
+    }
+    uint at = (k + 2u) * 8u;
+    partial[at] = power;
+    partial[at + 1u] = ic.x; partial[at + 2u] = ic.y; partial[at + 3u] = ic.z;
+    partial[at + 4u] = ab.x; partial[at + 5u] = ab.y; partial[at + 6u] = ab.z;
+}
+)";
+}
+
+std::string finish_compute() {
+    return version_line + uniforms({{finish_uniform::shooter_count, "uint shooter_count"}}) + R"(
+layout(local_size_x = 64) in;
+layout(std430, binding = 5) buffer partial_block { double partial[]; };
+shared double s[64 * 9];
+void main() {
+    uint i = gl_LocalInvocationID.x;
+    double best = -1.0, index = 4294967295.0, total = 0.0;
+    dvec3 ic = dvec3(0.0), ab = dvec3(0.0);
+    for (uint k = i; k < shooter_count; k += 64u) {
+        uint at = (k + 2u) * 8u;
+        double p = partial[at];
+        if (p > best) { best = p; index = double(k); }
+        total += p;
+        ic += dvec3(partial[at + 1u], partial[at + 2u], partial[at + 3u]);
+        ab += dvec3(partial[at + 4u], partial[at + 5u], partial[at + 6u]);
+    }
+    s[i * 9u] = best; s[i * 9u + 1u] = index; s[i * 9u + 2u] = total;
+    s[i * 9u + 3u] = ic.x; s[i * 9u + 4u] = ic.y; s[i * 9u + 5u] = ic.z;
+    s[i * 9u + 6u] = ab.x; s[i * 9u + 7u] = ab.y; s[i * 9u + 8u] = ab.z;
+    for (uint stride = 32u; stride > 0u; stride >>= 1u) {
+        barrier();
+        if (i < stride) {
+            uint j = i + stride;
+            bool take = s[j * 9u] > s[i * 9u] || (s[j * 9u] == s[i * 9u] && s[j * 9u + 1u] < s[i * 9u + 1u]);
+            if (take) { s[i * 9u] = s[j * 9u]; s[i * 9u + 1u] = s[j * 9u + 1u]; }
+            for (uint c = 2u; c < 9u; ++c) s[i * 9u + c] += s[j * 9u + c];
+        }
+    }
+    barrier();
+    if (i == 0u)
+        for (uint c = 0u; c < 9u; ++c) partial[c] = s[c];
+}
+)";
+}
+
+}  // namespace bounce::gl::radiosity_glsl

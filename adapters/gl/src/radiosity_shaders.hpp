@@ -1,0 +1,106 @@
+#pragma once
+// The GLSL texts of gl::progressive_radiosity's passes (private to adapters/gl/src) and the
+// locations of their uniforms. Each location is named once, here: the shader texts declare
+// their uniforms from these names (radiosity_shaders.cpp) and the passes set them by the
+// same names (radiosity_shooting.cpp), so the two cannot drift apart.
+#include <string>
+
+namespace bounce::gl::radiosity_glsl {
+
+// The item buffer's fragment shader (stereographic visibility).
+namespace item_uniform {
+enum : int { resolution = 0, depth_scale = 1 };
+}
+
+// The hemicube's vertex and fragment shaders: the shooter's frame, the face drawn, and the
+// depth range.
+namespace hemicube_uniform {
+enum : int {
+    shot_position = 0,
+    shot_t = 1,
+    shot_b = 2,
+    shot_n = 3,
+    face_right = 4,
+    face_up = 5,
+    face_forward = 6,
+    side_face = 7,
+    near_z = 8,
+    far_z = 9,
+    shot_chart = 10,
+};
+}
+
+// A directional light's orthographic buffer.
+namespace parallel_uniform {
+enum : int {
+    shot_t = 0,
+    shot_b = 1,
+    shot_n = 2,
+    ortho_lo = 3,
+    ortho_scale = 4,
+    parallel_resolution = 5,
+    depth_lo = 6,
+    depth_hi = 7,
+};
+}
+
+// What the distribution and the light passes share: the atlas, the shot, the visibility lookup.
+namespace shot_uniform {
+enum : int {
+    atlas_width = 0,
+    atlas_height = 1,
+    shot_position = 2,
+    shot_t = 3,
+    shot_b = 4,
+    shot_n = 5,
+    shot_chart = 6,
+    occlusion = 7,
+    resolution = 8,
+    diagonal = 9,
+    hemicube = 20,
+    element_count = 21,
+};
+}
+
+// The distribution pass, beside shot_uniform: the shooter's near-field tree.
+namespace distribute_uniform {
+enum : int { node_count = 10, near2 = 11 };
+}
+
+// The light pass, beside shot_uniform: the light and a directional light's buffer.
+namespace light_uniform {
+enum : int {
+    spot = 10,
+    light_axis = 11,
+    intensity = 12,
+    cos_cone = 13,
+    cosine_falloff = 14,
+    strict_side = 15,
+    parallel = 16,
+    ortho_lo = 17,
+    ortho_scale = 18,
+    parallel_resolution = 19,
+};
+}
+
+// The reduction's two passes.
+namespace reduce_uniform {
+enum : int { atlas_width = 0, shooter_count = 1 };
+}
+namespace finish_uniform {
+enum : int { shooter_count = 0 };
+}
+
+std::string item_buffer_vertex();
+std::string item_buffer_fragment();
+std::string hemicube_vertex();
+std::string hemicube_fragment();
+std::string parallel_vertex();
+std::string parallel_fragment();
+// The compute passes; max_nodes and stack_size bound the near-field traversal.
+std::string distribute_compute(int max_nodes, int stack_size);
+std::string light_compute();
+std::string reduce_compute();
+std::string finish_compute();
+
+}  // namespace bounce::gl::radiosity_glsl
