@@ -60,6 +60,53 @@ struct gpu_vpl {
     glm::vec4 position, normal, flux;
 };
 
+// SII's VPLs of one frame: how many were selected, and those whose splat covers a pixel
+// with their rectangles in the split buffer, in group order.
+struct vpl_splats {
+    std::size_t selected = 0;
+    std::vector<gpu_vpl> packed;
+    std::vector<glm::vec4> rects;
+};
+
+// VPLs from the read-back maps, selected and grouped as the CPU renderer does, each with its
+// rectangle in the split buffer (as cpu::splat_vpls: indirect/rsm_sampling.hpp's
+// vpl_splat_rect and split_buffer_rect), flux times `scale`; `splatted` gets every one in
+// group order.
+vpl_splats place_vpl_splats(std::span<const rsm_textures> maps, const camera& cam, std::size_t w, std::size_t h,
+                            const indirect_options& o, float scale, std::vector<vpl>& splatted) {
+    const interleave_pattern& pattern = o.pattern;
+    std::vector<rsm_images> images;
+    images.reserve(maps.size());
+    for (const auto& m : maps) images.emplace_back(m);
+    std::vector<rsm_view> views;
+    for (const auto& im : images) views.push_back(im.view());
+    const std::vector<vpl> all = select_vpls(views, o);
+    std::vector<glm::vec3> positions;
+    if (o.assignment == light_assignment::similarity)
+        for (const auto& l : all) positions.push_back(l.position);
+    const light_groups groups = assign_lights(all.size(), pattern.cells(), o.assignment, positions, o.shift);
+    const glm::mat4 view = cam.view_matrix();
+    vpl_splats out;
+    out.selected = all.size();
+    splatted.clear();
+    for (int s = 0; s < pattern.cells(); ++s) {
+        const int i = s % pattern.n, j = s / pattern.n;
+        const sub_buffer_rect sub = sub_buffer_of(pattern, i, j, w, h);
+        for (std::uint32_t k = groups.begin[std::size_t(s)]; k < groups.begin[std::size_t(s) + 1]; ++k) {
+            const vpl& l = all[groups.order[k]];
+            const vpl scaled{l.position, l.normal, l.flux * scale};
+            splatted.push_back(scaled);
+            const pixel_rect q = split_buffer_rect(
+                vpl_splat_rect(cam, view, l, all.size(), o.sii_cutoff, o.light.offset, w, h), pattern, i, j, sub);
+            if (q.empty()) continue;
+            out.packed.push_back(
+                {glm::vec4(scaled.position, 0.f), glm::vec4(scaled.normal, 0.f), glm::vec4(scaled.flux, 0.f)});
+            out.rects.emplace_back(float(q.x0), float(q.y0), float(q.x1), float(q.y1));
+        }
+    }
+    return out;
+}
+
 }  // namespace
 
 // ---- the passes -------------------------------------------------------------------------
@@ -180,6 +227,114 @@ struct indirect_renderer::passes {
         glBindVertexArray(empty_vao.id());
         glDrawArrays(GL_TRIANGLES, 0, 3);
     }
+
+    static void additive_blending() {
+        glEnable(GL_BLEND);
+        glBlendEquation(GL_FUNC_ADD);
+        glBlendFunc(GL_ONE, GL_ONE);
+    }
+
+    // Interleaved frames: g split into the sub-buffers of `pattern` (split_position_depth,
+    // split_normal); returns the G-buffer the shading passes read.
+    gbuffer_textures split_gbuffer(const gbuffer_textures& g, std::size_t w, std::size_t h,
+                                   const interleave_pattern& pattern) {
+        ensure_scratch(w, h);
+        target({split_position_depth->id(), split_normal->id()}, w, h);
+        textures({g.position_depth.id, g.normal.id});
+        frame_uniforms(split, w, h, pattern);
+        fullscreen(split);
+        gbuffer_textures shaded = g;
+        shaded.position_depth = *split_position_depth;
+        shaded.normal = *split_normal;
+        return shaded;
+    }
+
+    // The RSM gather's disc pattern for maps of `texels` texels, grouped by sub-buffer, and
+    // the same pattern as one group; made again only when the count or the map size changes.
+    void ensure_disc(const indirect_options& o, std::size_t texels) {
+        if (disc && disc_count == o.count && disc_texels == texels) return;
+        const auto full = rsm_disc_pattern(o.count, o.r_max, texels, o.seed, o.disc);
+        const light_groups g = assign_lights(full.size(), o.pattern.cells(), light_assignment::interleaved, {}, o.shift);
+        std::vector<glm::vec4> grouped(full.size());
+        for (std::size_t k = 0; k < full.size(); ++k) grouped[k] = glm::vec4(full[g.order[k]], 0.f);
+        disc.emplace(std::span<const glm::vec4>(grouped));
+        groups.emplace(std::span<const std::uint32_t>(g.begin));
+        std::vector<glm::vec4> whole(full.size());
+        for (std::size_t k = 0; k < full.size(); ++k) whole[k] = glm::vec4(full[k], 0.f);
+        const std::uint32_t one_group[2] = {0u, std::uint32_t(full.size())};
+        whole_disc.emplace(std::span<const glm::vec4>(whole));
+        whole_group.emplace(std::span<const std::uint32_t>(one_group));
+        disc_count = o.count;
+        disc_texels = texels;
+    }
+
+    // The RSM gather of every map into `out`, added; each VPL's flux times `scale`.
+    void gather_maps(const gbuffer_textures& shaded, object_id out, std::size_t w, std::size_t h,
+                     std::span<const rsm_textures> maps, const indirect_options& o, float scale) {
+        ensure_disc(o, maps[0].width() * maps[0].height());
+        target({out}, w, h);
+        additive_blending();
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, disc->id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, groups->id());
+        const program& prog = gather_rsm;
+        frame_uniforms(prog, w, h, o.pattern);
+        prog.set(loc_weight_scale, scale);
+        prog.set(loc_offset, o.light.offset);
+        prog.set(loc_min_distance2, o.light.min_distance2);
+        for (const auto& m : maps) {
+            textures({shaded.position_depth.id, shaded.normal.id, m.position.id, m.normal.id, m.flux.id});
+            prog.set(loc_light_view_projection, m.light_view_projection);
+            prog.set(loc_map_size, glm::vec2(float(m.width()), float(m.height())));
+            fullscreen(prog);
+        }
+        glDisable(GL_BLEND);
+    }
+
+    // SII: the VPLs as instanced quads over their rectangles, added into `out`.
+    void draw_splats(const gbuffer_textures& shaded, object_id out, std::size_t w, std::size_t h,
+                     const std::vector<gpu_vpl>& packed, const std::vector<glm::vec4>& rect_list,
+                     const indirect_options& o) {
+        vpls.emplace(std::span<const gpu_vpl>(packed));
+        rects.emplace(std::span<const glm::vec4>(rect_list));
+        target({out}, w, h);
+        additive_blending();
+        textures({shaded.position_depth.id, shaded.normal.id});
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, vpls->id());
+        const program& prog = splat;
+        prog.set(loc_size, glm::vec2(float(w), float(h)));
+        prog.set(loc_offset, o.light.offset);
+        prog.set(loc_min_distance2, o.light.min_distance2);
+        glUseProgram(prog.id());
+        glVertexArrayVertexBuffer(rect_vao.id(), 0, rects->id(), 0, sizeof(glm::vec4));
+        glBindVertexArray(rect_vao.id());
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(packed.size()));
+        glDisable(GL_BLEND);
+    }
+
+    // The geometry-aware blur of `gathered` into `out`: the discontinuity buffer of g, then
+    // the separable tent across and along.
+    void blur(const gbuffer_textures& g, object_id out, std::size_t w, std::size_t h, const indirect_options& o) {
+        const interleave_pattern& pattern = o.pattern;
+        target({edges->id()}, w, h);
+        textures({g.position_depth.id, g.normal.id});
+        frame_uniforms(discontinuity, w, h, pattern);
+        discontinuity.set(loc_relative_depth, o.discontinuity.relative_depth);
+        discontinuity.set(loc_cos_normal, o.discontinuity.cos_normal);
+        fullscreen(discontinuity);
+
+        ensure_tent(tent_radius(pattern));
+        target({scratch->id()}, w, h);
+        textures({gathered->id(), edges->id(), g.position_depth.id});
+        frame_uniforms(*tent_x, w, h, pattern);
+        tent_x->set(loc_pattern_width, float(pattern.n));
+        fullscreen(*tent_x);
+
+        target({out}, w, h);
+        textures({scratch->id(), edges->id(), g.position_depth.id});
+        frame_uniforms(*tent_y, w, h, pattern);
+        tent_y->set(loc_pattern_width, float(pattern.m));
+        fullscreen(*tent_y);
+    }
 };
 
 indirect_renderer::indirect_renderer(const indirect_options& options, bool time_stages)
@@ -256,9 +411,7 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
         p.fullscreen(up);
         if (!maps.empty()) {
             p.target({irradiance.id}, w, h);
-            glEnable(GL_BLEND);
-            glBlendEquation(GL_FUNC_ADD);
-            glBlendFunc(GL_ONE, GL_ONE);
+            passes::additive_blending();
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, p.whole_disc->id());
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, p.whole_group->id());
             const program& prog = p.gather_rsm;
@@ -298,18 +451,8 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
     passes& p = *passes_;
     const interleave_pattern& pattern = options_.pattern;
     const bool interleaved = pattern.cells() > 1;
-    gbuffer_textures shaded = g;
-    object_id shaded_out = out;
-    if (interleaved) {
-        p.ensure_scratch(w, h);
-        p.target({p.split_position_depth->id(), p.split_normal->id()}, w, h);
-        passes::textures({g.position_depth.id, g.normal.id});
-        passes::frame_uniforms(p.split, w, h, pattern);
-        p.fullscreen(p.split);
-        shaded.position_depth = *p.split_position_depth;
-        shaded.normal = *p.split_normal;
-        shaded_out = p.split_out->id();
-    }
+    const gbuffer_textures shaded = interleaved ? p.split_gbuffer(g, w, h, pattern) : g;
+    const object_id shaded_out = interleaved ? p.split_out->id() : out;
     check_error("indirect_renderer split");
     t.split_ms += lap(start);
 
@@ -320,99 +463,11 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
         options_.energy_correct ? interleaved_weight_scale<float>(float(pattern.n), float(pattern.m)) : 1.f;
     if (options_.technique == indirect_technique::rsm_gather) {
         t.vpls = options_.count;
-        if (!maps.empty()) {
-            const std::size_t texels = maps[0].width() * maps[0].height();
-            if (!p.disc || p.disc_count != options_.count || p.disc_texels != texels) {
-                const auto full =
-                    rsm_disc_pattern(options_.count, options_.r_max, texels, options_.seed, options_.disc);
-                const light_groups groups =
-                    assign_lights(full.size(), pattern.cells(), light_assignment::interleaved, {}, options_.shift);
-                std::vector<glm::vec4> grouped(full.size());
-                for (std::size_t k = 0; k < full.size(); ++k) grouped[k] = glm::vec4(full[groups.order[k]], 0.f);
-                p.disc.emplace(std::span<const glm::vec4>(grouped));
-                p.groups.emplace(std::span<const std::uint32_t>(groups.begin));
-                std::vector<glm::vec4> whole(full.size());
-                for (std::size_t k = 0; k < full.size(); ++k) whole[k] = glm::vec4(full[k], 0.f);
-                const std::uint32_t one_group[2] = {0u, std::uint32_t(full.size())};
-                p.whole_disc.emplace(std::span<const glm::vec4>(whole));
-                p.whole_group.emplace(std::span<const std::uint32_t>(one_group));
-                p.disc_count = options_.count;
-                p.disc_texels = texels;
-            }
-            p.target({shaded_out}, w, h);
-            glEnable(GL_BLEND);
-            glBlendEquation(GL_FUNC_ADD);
-            glBlendFunc(GL_ONE, GL_ONE);
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, p.disc->id());
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, p.groups->id());
-            const program& prog = p.gather_rsm;
-            passes::frame_uniforms(prog, w, h, pattern);
-            prog.set(loc_weight_scale, scale);
-            prog.set(loc_offset, options_.light.offset);
-            prog.set(loc_min_distance2, options_.light.min_distance2);
-            for (const auto& m : maps) {
-                passes::textures({shaded.position_depth.id, shaded.normal.id, m.position.id, m.normal.id, m.flux.id});
-                prog.set(loc_light_view_projection, m.light_view_projection);
-                prog.set(loc_map_size, glm::vec2(float(m.width()), float(m.height())));
-                p.fullscreen(prog);
-            }
-            glDisable(GL_BLEND);
-        }
+        if (!maps.empty()) p.gather_maps(shaded, shaded_out, w, h, maps, options_, scale);
     } else {
-        // VPLs from the read-back maps, selected as the CPU renderer selects them.
-        std::vector<rsm_images> images;
-        images.reserve(maps.size());
-        for (const auto& m : maps) images.emplace_back(m);
-        std::vector<rsm_view> views;
-        for (const auto& im : images) views.push_back(im.view());
-        const std::vector<vpl> all = select_vpls(views, options_);
-        t.vpls = all.size();
-        std::vector<glm::vec3> positions;
-        if (options_.assignment == light_assignment::similarity)
-            for (const auto& l : all) positions.push_back(l.position);
-        const light_groups groups =
-            assign_lights(all.size(), pattern.cells(), options_.assignment, positions, options_.shift);
-        // Each VPL's rectangle in the split buffer (as cpu::splat_vpls: indirect/rsm_sampling.hpp's
-        // vpl_splat_rect and split_buffer_rect), in group order.
-        const glm::mat4 view = cam.view_matrix();
-        splatted_.clear();
-        std::vector<gpu_vpl> packed;
-        std::vector<glm::vec4> rects;
-        for (int s = 0; s < pattern.cells(); ++s) {
-            const int i = s % pattern.n, j = s / pattern.n;
-            const sub_buffer_rect sub = sub_buffer_of(pattern, i, j, w, h);
-            for (std::uint32_t k = groups.begin[std::size_t(s)]; k < groups.begin[std::size_t(s) + 1]; ++k) {
-                const vpl& l = all[groups.order[k]];
-                const vpl scaled{l.position, l.normal, l.flux * scale};
-                splatted_.push_back(scaled);
-                const pixel_rect q = split_buffer_rect(
-                    vpl_splat_rect(cam, view, l, all.size(), options_.sii_cutoff, options_.light.offset, w, h), pattern,
-                    i, j, sub);
-                if (q.empty()) continue;
-                packed.push_back({glm::vec4(scaled.position, 0.f), glm::vec4(scaled.normal, 0.f),
-                                  glm::vec4(scaled.flux, 0.f)});
-                rects.emplace_back(float(q.x0), float(q.y0), float(q.x1), float(q.y1));
-            }
-        }
-        if (!packed.empty()) {
-            p.vpls.emplace(std::span<const gpu_vpl>(packed));
-            p.rects.emplace(std::span<const glm::vec4>(rects));
-            p.target({shaded_out}, w, h);
-            glEnable(GL_BLEND);
-            glBlendEquation(GL_FUNC_ADD);
-            glBlendFunc(GL_ONE, GL_ONE);
-            passes::textures({shaded.position_depth.id, shaded.normal.id});
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, p.vpls->id());
-            const program& prog = p.splat;
-            prog.set(loc_size, glm::vec2(float(w), float(h)));
-            prog.set(loc_offset, options_.light.offset);
-            prog.set(loc_min_distance2, options_.light.min_distance2);
-            glUseProgram(prog.id());
-            glVertexArrayVertexBuffer(p.rect_vao.id(), 0, p.rects->id(), 0, sizeof(glm::vec4));
-            glBindVertexArray(p.rect_vao.id());
-            glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(packed.size()));
-            glDisable(GL_BLEND);
-        }
+        const vpl_splats splats = place_vpl_splats(maps, cam, w, h, options_, scale, splatted_);
+        t.vpls = splats.selected;
+        if (!splats.packed.empty()) p.draw_splats(shaded, shaded_out, w, h, splats.packed, splats.rects, options_);
     }
     check_error("indirect_renderer shade");
     t.shade_ms += lap(start);
@@ -426,25 +481,7 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
         check_error("indirect_renderer gather");
         t.gather_ms += lap(start);
         if (options_.blur) {
-            p.target({p.edges->id()}, w, h);
-            passes::textures({g.position_depth.id, g.normal.id});
-            passes::frame_uniforms(p.discontinuity, w, h, pattern);
-            p.discontinuity.set(loc_relative_depth, options_.discontinuity.relative_depth);
-            p.discontinuity.set(loc_cos_normal, options_.discontinuity.cos_normal);
-            p.fullscreen(p.discontinuity);
-
-            p.ensure_tent(tent_radius(pattern));
-            p.target({p.scratch->id()}, w, h);
-            passes::textures({p.gathered->id(), p.edges->id(), g.position_depth.id});
-            passes::frame_uniforms(*p.tent_x, w, h, pattern);
-            p.tent_x->set(loc_pattern_width, float(pattern.n));
-            p.fullscreen(*p.tent_x);
-
-            p.target({out}, w, h);
-            passes::textures({p.scratch->id(), p.edges->id(), g.position_depth.id});
-            passes::frame_uniforms(*p.tent_y, w, h, pattern);
-            p.tent_y->set(loc_pattern_width, float(pattern.m));
-            p.fullscreen(*p.tent_y);
+            p.blur(g, out, w, h, options_);
             check_error("indirect_renderer blur");
             t.blur_ms += lap(start);
         }
