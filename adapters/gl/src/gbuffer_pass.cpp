@@ -6,6 +6,7 @@
 #include <bounce/surface.hpp>
 
 #include "saved_state.hpp"
+#include "vertex_shaders.hpp"
 
 #include <glm/geometric.hpp>
 
@@ -17,21 +18,6 @@
 namespace bounce::gl {
 
 namespace {
-
-std::string vertex_shader() {
-    return R"(#version 450 core
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec3 normal;
-layout(location = 0) uniform mat4 view_projection;
-out vec3 world_position;
-out vec3 world_normal;
-void main() {
-    world_position = position;
-    world_normal = normal;
-    gl_Position = view_projection * vec4(position, 1.0);
-}
-)";
-}
 
 std::string fragment_shader() {
     glsl::function_set kernels;
@@ -114,7 +100,7 @@ scene_mesh::scene_mesh(const scene_view& s)
 // ---- gbuffer_pass -----------------------------------------------------------------------
 
 gbuffer_pass::gbuffer_pass()
-    : vertex_source_(vertex_shader()), fragment_source_(fragment_shader()), program_(vertex_source_, fragment_source_) {}
+    : vertex_source_(detail::mesh_vertex), fragment_source_(fragment_shader()), program_(vertex_source_, fragment_source_) {}
 
 void gbuffer_pass::render(const scene_mesh& mesh, const camera& cam, std::size_t width, std::size_t height) {
     require(width > 0 && height > 0, "width/height", "the G-buffer must have a positive size");

@@ -7,7 +7,7 @@
 #include <bounce/glsl/emit.hpp>
 #include <bounce/splat_bounds.hpp>
 
-#include "fullscreen_triangle.hpp"
+#include "vertex_shaders.hpp"
 #include "saved_state.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
