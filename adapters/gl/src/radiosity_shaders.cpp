@@ -30,6 +30,19 @@ std::string uniforms(std::initializer_list<std::pair<int, const char*>> declarat
     return out;
 }
 
+// A std430 storage block at `binding`: "layout(std430, binding = B) DECLARATION;".
+std::string storage_block(unsigned binding, const char* declaration) {
+    return "layout(std430, binding = " + std::to_string(binding) + ") " + declaration + ";\n";
+}
+
+// An RGBA32F image at `unit`: "layout(rgba32f, binding = U) uniform DECLARATION;".
+std::string image(unsigned unit, const char* declaration) {
+    return "layout(rgba32f, binding = " + std::to_string(unit) + ") uniform " + declaration + ";\n";
+}
+
+const char* const texel_attributes_struct =
+    "struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };\n";
+
 // The kernels the visibility lookups of the distribution and light passes call.
 std::string lookup_functions() {
     glsl::function_set fs;
@@ -62,15 +75,14 @@ std::string shot_uniforms() {
 
 // What the distribution and light passes share: the element texels, the images, the
 // visibility of an element from the shot, and an element's receiving of it.
-const char* const shot_common = R"(
-struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
-layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
-layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
-layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
-layout(rgba32f, binding = 0) uniform image2D radiosity_image;
-layout(rgba32f, binding = 1) uniform image2D unshot_image;
-layout(rgba32f, binding = 2) uniform writeonly image2D intercepted_image;
-layout(rgba32f, binding = 3) uniform readonly image2D item_image;
+std::string shot_common() {
+    return std::string("\n") + texel_attributes_struct +
+           storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
+           storage_block(planes_binding, "readonly buffer planes_block { vec4 local_plane[]; }") +
+           storage_block(element_binding, "readonly buffer element_block { uint element_texel[]; }") +
+           image(radiosity_unit, "image2D radiosity_image") + image(unshot_unit, "image2D unshot_image") +
+           image(intercepted_unit, "writeonly image2D intercepted_image") +
+           image(item_unit, "readonly image2D item_image") + R"(
 // Visibility of the element at world position p (chart `chart`) from the shot: its pixel in
 // the stereographic buffer, or on its hemicube face (top face in rows [0, res), side face f
 // in rows res + (f - 1) res / 2 on).
@@ -99,6 +111,7 @@ void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
     imageStore(intercepted_image, xy, vec4(intercepted, 0.0));
 }
 )";
+}
 
 }  // namespace
 
@@ -127,8 +140,7 @@ std::string item_buffer_fragment() {
     fs.add("radiosity_plane_depth", item_plane_depth<f32, vec3>, "plane_normal", "plane_offset", "w", "interpolated");
     return version_line + fs.source() +
            uniforms({{item_uniform::resolution, "float resolution"}, {item_uniform::depth_scale, "float depth_scale"}}) +
-           R"(
-layout(std430, binding = 2) readonly buffer planes_block { vec4 local_plane[]; };
+           "\n" + storage_block(planes_binding, "readonly buffer planes_block { vec4 local_plane[]; }") + R"(
 layout(location = 0) noperspective in float radial;
 layout(location = 1) flat in vec2 item_ids;
 layout(location = 0) out vec4 item;
@@ -240,10 +252,10 @@ std::string distribute_compute(int max_nodes, int stack_size) {
     fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
     return version_line + "layout(local_size_x = 64) in;\n" + shot_uniforms() +
            uniforms({{distribute_uniform::node_count, "int node_count"}, {distribute_uniform::near2, "float near2"}}) +
-           lookup_functions() + fs.source() + shot_common + "const int max_nodes = " + std::to_string(max_nodes) +
+           lookup_functions() + fs.source() + shot_common() + "const int max_nodes = " + std::to_string(max_nodes) +
            ";\n" + "const int stack_size = " + std::to_string(stack_size) + ";\n" + R"(
 struct near_node { vec4 position_area; vec4 unshot; ivec4 meta; };
-layout(std430, binding = 1) readonly buffer nodes_block { near_node node[]; };
+)" + storage_block(nodes_binding, "readonly buffer nodes_block { near_node node[]; }") + R"(
 void main() {
     // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
     if (gl_GlobalInvocationID.x >= element_count) return;
@@ -312,7 +324,7 @@ std::string light_compute() {
                      {ortho_lo, "vec2 ortho_lo"},
                      {ortho_scale, "float ortho_scale"},
                      {parallel_resolution, "float parallel_resolution"}}) +
-           lookup_functions() + fs.source() + shot_common + R"(
+           lookup_functions() + fs.source() + shot_common() + R"(
 // Visibility along a directional light: the element's pixel in the orthographic buffer,
 // whose planes are the triangles' world planes.
 float parallel_visibility(vec3 p, float chart) {
@@ -354,15 +366,14 @@ void main() {
 // (ties to the lowest index) and a shared-memory tree over its 64 partial results.
 std::string reduce_compute() {
     using namespace reduce_uniform;
-    return version_line + uniforms({{atlas_width, "int atlas_width"}, {shooter_count, "uint shooter_count"}}) + R"(
-layout(local_size_x = 64) in;
-struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
-layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
-layout(std430, binding = 3) readonly buffer first_block { uint shooter_first[]; };
-layout(std430, binding = 4) readonly buffer element_block { uint element_texel[]; };
-layout(std430, binding = 5) buffer partial_block { double partial[]; };
-layout(rgba32f, binding = 1) uniform readonly image2D unshot_image;
-layout(rgba32f, binding = 2) uniform readonly image2D intercepted_image;
+    return version_line + uniforms({{atlas_width, "int atlas_width"}, {shooter_count, "uint shooter_count"}}) +
+           "\nlayout(local_size_x = 64) in;\n" + texel_attributes_struct +
+           storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
+           storage_block(first_binding, "readonly buffer first_block { uint shooter_first[]; }") +
+           storage_block(element_binding, "readonly buffer element_block { uint element_texel[]; }") +
+           storage_block(partial_binding, "buffer partial_block { double partial[]; }") +
+           image(unshot_unit, "readonly image2D unshot_image") +
+           image(intercepted_unit, "readonly image2D intercepted_image") + R"(
 void main() {
     uint k = gl_GlobalInvocationID.x;
     if (k >= shooter_count) return;
@@ -387,9 +398,9 @@ void main() {
 }
 
 std::string finish_compute() {
-    return version_line + uniforms({{finish_uniform::shooter_count, "uint shooter_count"}}) + R"(
-layout(local_size_x = 64) in;
-layout(std430, binding = 5) buffer partial_block { double partial[]; };
+    return version_line + uniforms({{finish_uniform::shooter_count, "uint shooter_count"}}) +
+           "\nlayout(local_size_x = 64) in;\n" + storage_block(partial_binding, "buffer partial_block { double partial[]; }") +
+           R"(
 shared double s[64 * 9];
 void main() {
     uint i = gl_LocalInvocationID.x;

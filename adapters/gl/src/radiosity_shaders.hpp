@@ -1,11 +1,17 @@
 #pragma once
-// The GLSL texts of gl::progressive_radiosity's passes (private to adapters/gl/src) and the
-// locations of their uniforms. Each location is named once, here: the shader texts declare
-// their uniforms from these names (radiosity_shaders.cpp) and the passes set them by the
-// same names (radiosity_shooting.cpp), so the two cannot drift apart.
+// The GLSL texts of gl::progressive_radiosity's passes (private to adapters/gl/src), the
+// locations of their uniforms and the bindings of their storage buffers and images. Each
+// number is named once, here: the shader texts declare their uniforms, buffers and images
+// from these names (radiosity_shaders.cpp) and the passes set and bind them by the same
+// names (radiosity_shooting.cpp), so the two cannot drift apart.
 #include <string>
 
 namespace bounce::gl::radiosity_glsl {
+
+// Storage-buffer bindings and image units.
+constexpr unsigned texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
+                   partial_binding = 5;
+constexpr unsigned radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
 
 // The item buffer's fragment shader (stereographic visibility).
 namespace item_uniform {

@@ -35,10 +35,11 @@ namespace radiosity_detail {
 using clock_type = std::chrono::steady_clock;
 inline double ms_since(clock_type::time_point t) { return std::chrono::duration<double, std::milli>(clock_type::now() - t).count(); }
 
-// Storage-buffer bindings and image units the passes use.
-constexpr GLuint texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
-                 partial_binding = 5;
-constexpr GLuint radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
+// Storage-buffer bindings and image units the passes use (named with their shaders).
+using radiosity_glsl::texels_binding, radiosity_glsl::nodes_binding, radiosity_glsl::planes_binding,
+    radiosity_glsl::first_binding, radiosity_glsl::element_binding, radiosity_glsl::partial_binding;
+using radiosity_glsl::radiosity_unit, radiosity_glsl::unshot_unit, radiosity_glsl::intercepted_unit,
+    radiosity_glsl::item_unit;
 constexpr unsigned reduce_group = 64;
 // The reduction's buffer: the result (best power, best index, total unshot, intercepted rgb,
 // absorbed rgb) in the first 9 doubles, then from double 16 on 8 per shooter (power, intercepted rgb, absorbed rgb).
