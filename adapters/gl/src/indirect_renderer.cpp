@@ -12,6 +12,7 @@
 
 #include "indirect_shaders.hpp"
 #include "saved_state.hpp"
+#include "vertex_shaders.hpp"
 
 #include <algorithm>
 #include <array>
@@ -26,6 +27,7 @@ namespace bounce::gl {
 namespace {
 
 using namespace indirect_glsl;
+using detail::fullscreen_vertex;
 
 
 int tent_radius(const interleave_pattern& p) {

@@ -9,13 +9,6 @@
 
 namespace bounce::gl::indirect_glsl {
 
-extern const char* const fullscreen_vertex = R"(#version 450 core
-void main() {
-    vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
-    gl_Position = vec4(corner - 1.0, 0.0, 1.0);
-}
-)";
-
 // Shared declarations: the frame's size and pattern, GL rows to rows from the top, the
 // background test (depth +infinity, gbuffer_view::covered).
 extern const char* const common_glsl = R"(layout(location = 0) uniform vec2 frame_size;

@@ -1,11 +1,11 @@
 #pragma once
 // The GLSL texts of gl::indirect_renderer's passes (private to adapters/gl/src): plumbing
 // around the kernels emitted from indirect/rsm.hpp and indirect/interleaved_sampling.hpp.
+// The full-screen passes draw with vertex_shaders.hpp's full-screen triangle.
 #include <string>
 
 namespace bounce::gl::indirect_glsl {
 
-extern const char* const fullscreen_vertex;
 extern const char* const common_glsl;
 extern const char* const downsample_fragment;
 extern const char* const splat_vertex;
