@@ -4,11 +4,12 @@
 
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
-#include <bounce/direct_light.hpp>
+#include <bounce/output.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 namespace bounce::study::bench {
 
@@ -71,12 +72,10 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
     r.timings_ms = {{"maps", maps_ms}};
     for (const auto& stage : timer.stages()) r.timings_ms[stage] = timer.median_ms(stage);
     r.timings_ms["total"] = r.ms;
-    // The renderer gives irradiance; the references hold radiance rho / pi E.
-    const gbuffer_view<float> g = s.g.view();
-    r.radiance = image<glm::vec3>(g.width(), g.height());
-    for (std::size_t y = 0; y < g.height(); ++y)
-        for (std::size_t x = 0; x < g.width(); ++x)
-            r.radiance(x, y) = lambertian_radiance<float, glm::vec3>(g.albedo(x, y), e(x, y));
+    // The frames give irradiance (timed as a renderer runs them); the references hold
+    // radiance rho / pi E, made as the renderer makes it when asked (output.hpp).
+    r.radiance = std::move(e);
+    apply_output(output_quantity::radiance, image_view<const glm::vec3>(s.g.view().albedo), r.radiance.view());
     r.counts = {{"vpls", last.vpls}, {"maps", caster.maps().size()}};
     r.parameters = {{"count", lights_per_frame},
                     {"pattern", t == bench_technique::sii_interleaved ? "4x4" : "1x1"},

@@ -1,6 +1,7 @@
 // Error figures of an image against its reference, through OpenImageIO's compare.
 #include <bounce/study/image_comparison.hpp>
 #include <bounce/io/detail/imagebuf_view.hpp>
+#include <bounce/luminance.hpp>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -9,6 +10,8 @@
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include <glm/geometric.hpp>  // the vec3_of concept of rec709_luminance
 
 namespace bounce::study {
 
@@ -27,8 +30,10 @@ error_figures compare_luminance(image_view<const glm::vec3> x, image_view<const 
     if (!mask.empty()) require_finite(mask, "mask");
 
     namespace iba = OIIO::ImageBufAlgo;
-    // Rec. 709 / sRGB primaries: Y = 0.2126 R + 0.7152 G + 0.0722 B.
-    const float rec709[3] = {0.2126f, 0.7152f, 0.0722f};
+    // The weights of rec709_luminance (luminance.hpp), as OpenImageIO's channel sum takes them.
+    const float rec709[3] = {rec709_luminance<float, glm::vec3>(glm::vec3(1, 0, 0)),
+                             rec709_luminance<float, glm::vec3>(glm::vec3(0, 1, 0)),
+                             rec709_luminance<float, glm::vec3>(glm::vec3(0, 0, 1))};
     OIIO::ImageBuf lx = iba::channel_sum(to_imagebuf(x, 3), rec709);
     OIIO::ImageBuf lr = iba::channel_sum(to_imagebuf(ref, 3), rec709);
 
@@ -70,7 +75,7 @@ error_figures compare_luminance(image_view<const glm::vec3> x, image_view<const 
 }
 
 namespace {
-double luminance(glm::vec3 c) { return 0.2126 * double(c.r) + 0.7152 * double(c.g) + 0.0722 * double(c.b); }
+double luminance(glm::vec3 c) { return rec709_luminance<double, glm::dvec3>(glm::dvec3(c)); }
 }  // namespace
 
 noisy_reference_error compare_luminance_debiased(image_view<const glm::vec3> x, image_view<const glm::vec3> half_a,

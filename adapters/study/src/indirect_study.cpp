@@ -3,7 +3,7 @@
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
-#include <bounce/direct_light.hpp>
+#include <bounce/output.hpp>
 
 #include <fmt/core.h>
 
@@ -80,8 +80,8 @@ image<glm::vec3> radiance_image(const gbuffer_view<float>& g, image_view<const g
     require(e.width() == g.width() && e.height() == g.height(), "e", "size differs from the G-buffer");
     image<glm::vec3> out(g.width(), g.height());
     for (std::size_t y = 0; y < g.height(); ++y)
-        for (std::size_t x = 0; x < g.width(); ++x)
-            out(x, y) = lambertian_radiance<float, glm::vec3>(g.albedo(x, y), e(x, y));
+        for (std::size_t x = 0; x < g.width(); ++x) out(x, y) = e(x, y);
+    apply_output(output_quantity::radiance, image_view<const glm::vec3>(g.albedo), out.view());
     return out;
 }
 
