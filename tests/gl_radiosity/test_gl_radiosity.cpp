@@ -104,6 +104,20 @@ TEST_CASE("the GL solver's outputs are the CPU solver's: irradiance or radiance,
                 for (std::size_t i = 0; i < c.size(); ++i)
                     for (int k = 0; k < 3; ++k) CHECK(g[i][k] == Approx(c[i][k]).margin(1e-4 * largest));
             }
+        // The output texture is lightmap(quantity, paths), alpha 1 where a chart (or its
+        // padding) is; the renderer's sampler reads it with the atlas's corner_uvs.
+        const auto expected = gl_solver.lightmap(output_quantity::radiance, light_paths::indirect);
+        const gl::texture_ref t = gl_solver.update_output_texture(output_quantity::radiance, light_paths::indirect);
+        REQUIRE(t.width == atlas.width);
+        REQUIRE(t.height == atlas.height);
+        const auto got = t.read_floats();
+        for (std::uint32_t y = 0; y < atlas.height; ++y)
+            for (std::uint32_t x = 0; x < atlas.width; ++x) {
+                const float* texel = &got[4 * (std::size_t(y) * atlas.width + x)];
+                const bool chart = atlas.element_at(x, y) >= 0;
+                CHECK(texel[3] == (chart ? 1.f : 0.f));
+                if (chart) CHECK(glm::vec3(texel[0], texel[1], texel[2]) == expected(x, y));
+            }
     }
 }
 

@@ -198,6 +198,22 @@ void main() {
     return texture_ref(*st.lightmap_texture);
 }
 
+texture_ref progressive_radiosity::update_output_texture(output_quantity quantity, light_paths paths) {
+    const lightmap_atlas& at = s_->atlas;
+    const image<glm::vec3> values = lightmap(quantity, paths);
+    // Atlas row y is texture row y, as update_lightmap_texture writes it.
+    std::vector<glm::vec4> texels(std::size_t(s_->width) * s_->height, glm::vec4(0.f));
+    for (std::uint32_t y = 0; y < at.height; ++y)
+        for (std::uint32_t x = 0; x < at.width; ++x)
+            if (at.element_at(x, y) >= 0) texels[std::size_t(y) * s_->width + x] = glm::vec4(values(x, y), 1.f);
+    if (!output_texture_) output_texture_.emplace(texel_format::rgba32f, s_->width, s_->height);
+    const detail::unpack_state unpack;
+    glTextureSubImage2D(output_texture_->id(), 0, 0, 0, GLsizei(s_->width), GLsizei(s_->height), GL_RGBA, GL_FLOAT,
+                        texels.data());
+    check_error("progressive_radiosity: the output texture");
+    return texture_ref(*output_texture_);
+}
+
 texture_ref progressive_radiosity::radiosity_texture() const noexcept { return texture_ref(s_->radiosity); }
 texture_ref progressive_radiosity::unshot_texture() const noexcept { return texture_ref(s_->unshot); }
 const radiosity_timings& progressive_radiosity::timings() const noexcept { return s_->timings; }

@@ -51,6 +51,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -165,6 +166,13 @@ public:
     /// filled from their element as radiosity_lightmap() fills them, so a renderer can sample it
     /// bilinearly with the atlas's corner_uvs; returns it (valid while the solver lives).
     texture_ref update_lightmap_texture();
+    /// lightmap(quantity, paths) at level 0 in a texture of the solver's (RGBA32F, atlas size,
+    /// alpha 1 on charts and their padding, 0 elsewhere), uploaded from the host: what a
+    /// renderer with its own light pass samples with the atlas's corner_uvs (by default the
+    /// indirect irradiance, so its direct light is not counted twice). Returns it (valid
+    /// while the solver lives; the next call overwrites it).
+    texture_ref update_output_texture(output_quantity quantity = output_quantity::irradiance,
+                                      light_paths paths = light_paths::indirect);
     /// The solver's radiosity and unshot textures (RGBA32F, atlas size, element texels only;
     /// padding texels hold 0); valid while the solver lives.
     texture_ref radiosity_texture() const noexcept;
@@ -181,6 +189,7 @@ private:
     struct state;
     std::unique_ptr<state> s_;
     std::vector<glm::vec3> direct_;  // B once the lights were shot (emission + rho E_d), per element
+    std::optional<texture> output_texture_;  // update_output_texture's
 };
 
 }  // namespace bounce::gl
