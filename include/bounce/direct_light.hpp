@@ -14,6 +14,7 @@
 /// contributes nothing (the clamped cosine of the irradiance integral, E = int L cos dw).
 
 #include <bounce/concepts.hpp>
+#include <bounce/light.hpp>
 #include <bounce/vocabulary.hpp>
 
 #include <numbers>
@@ -70,6 +71,29 @@ V spot_light_irradiance(const V& p, const V& n, const V& light_position, const V
 template <real T, vec3_of<T> V>
 V directional_light_irradiance(const V& n, const V& direction, const V& irradiance) {
     return irradiance * max(T(0), -dot(n, direction));
+}
+
+/// Irradiance (W/m^2) at `p` with unit normal `n` from a light of model `kind`, given the
+/// fields of its packed form (light.hpp): the kernel above that `kind` names. `kind` is a
+/// plain value, so with the GLSL expression types the choice is made while printing
+/// (a shader per light model, or one per light); `position` is unused for a directional
+/// light, `cos_cone` and `cosine_falloff` for all but a spot.
+template <real T, vec3_of<T> V>
+V light_irradiance(light_kind kind, const V& p, const V& n, const V& position, const V& direction, const V& intensity,
+                   T cos_cone, T cosine_falloff) {
+    switch (kind) {
+    case light_kind::point: return point_light_irradiance<T, V>(p, n, position, intensity);
+    case light_kind::spot:
+        return spot_light_irradiance<T, V>(p, n, position, direction, intensity, cos_cone, cosine_falloff);
+    default: return directional_light_irradiance<T, V>(n, direction, intensity);
+    }
+}
+
+/// Irradiance (W/m^2, RGB) at `p` with unit normal `n` from the point, spot or directional
+/// light `l`, without visibility: the form the CPU loops call.
+inline glm::vec3 light_irradiance(const packed_light& l, glm::vec3 p, glm::vec3 n) {
+    return light_irradiance<float, glm::vec3>(l.kind(), p, n, l.position(), l.direction(), l.intensity(), l.cos_cone(),
+                                              l.cosine_falloff());
 }
 
 /// One area-sampled term of the irradiance at `p` (unit normal `n`) from a Lambertian

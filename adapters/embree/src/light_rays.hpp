@@ -1,9 +1,8 @@
 #pragma once
 // What direct light at a point asks of each light, for the integrators of this adapter
-// (reference.cpp, rsm_unoccluded_reference.cpp): its unshadowed irradiance (the kernels of
-// bounce/direct_light.hpp) and the shadow ray that tests it.
+// (reference.cpp, rsm_unoccluded_reference.cpp): the shadow ray that tests the unshadowed
+// irradiance of bounce/direct_light.hpp's light_irradiance.
 
-#include <bounce/direct_light.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/light.hpp>
 
@@ -12,18 +11,6 @@
 #include <glm/geometric.hpp>
 
 namespace bounce::embree::detail {
-
-/// Irradiance (W/m^2, RGB) at `p` with unit normal `n` from the point, spot or directional
-/// light `l`, without visibility.
-inline glm::vec3 unshadowed_irradiance(const packed_light& l, glm::vec3 p, glm::vec3 n) {
-    switch (l.kind()) {
-    case light_kind::point: return point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
-    case light_kind::spot:
-        return spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(), l.cos_cone(),
-                                                        l.cosine_falloff());
-    default: return directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
-    }
-}
 
 /// The segment from `origin` to the point `q`, stopped short of q by `epsilon` (world
 /// units) so that the surface at q itself (a light's own position, an emitter's triangle)

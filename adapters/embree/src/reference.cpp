@@ -207,7 +207,7 @@ template <class Term>
 void reference_integrator::direct_terms(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal, std::uint32_t area_grid,
                                         std::uint64_t seed, bool choose_light, Term&& term) const {
     const glm::vec3 origin = p + epsilon_ * offset_normal;
-    auto unshadowed = [&](const packed_light& l) { return detail::unshadowed_irradiance(l, p, n); };
+    auto unshadowed = [&](const packed_light& l) { return light_irradiance(l, p, n); };
     auto shadow_ray = [&](const packed_light& l) { return detail::shadow_ray_towards(l, origin, epsilon_); };
     auto weight = [](glm::vec3 c) { return c.x + c.y + c.z; };
 

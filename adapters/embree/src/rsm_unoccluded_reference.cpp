@@ -48,7 +48,7 @@ glm::vec3 unoccluded_reference::direct_irradiance(glm::vec3 p, glm::vec3 n, glm:
     const glm::vec3 origin = p + epsilon_ * offset_normal;
     glm::dvec3 e(0.0);
     for (const packed_light& l : lights_) {
-        const glm::vec3 c = detail::unshadowed_irradiance(l, p, n);
+        const glm::vec3 c = light_irradiance(l, p, n);
         if (!(c.x > 0.f || c.y > 0.f || c.z > 0.f)) continue;
         if (!bvh_.occluded(detail::shadow_ray_towards(l, origin, epsilon_))) e += glm::dvec3(c);
     }

@@ -199,15 +199,6 @@ inline light_sides triangles_lit_by_lights(const scene_view& scene) {
     light_sides s;
     std::vector<packed_light> lights;
     for (const light& l : scene.lights) lights.push_back(pack(l));
-    const auto irradiance = [](const packed_light& l, glm::vec3 p, glm::vec3 n) {
-        switch (l.kind()) {
-            case light_kind::point: return point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
-            case light_kind::spot:
-                return spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
-                                                               l.cos_cone(), l.cosine_falloff());
-            default: return directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
-        }
-    };
     const auto positive = [](glm::vec3 v) { return v.x > 0.f || v.y > 0.f || v.z > 0.f; };
     for (const glm::uvec3& t : scene.triangles) {
         const glm::vec3 a = scene.positions[t.x], b = scene.positions[t.y], c = scene.positions[t.z];
@@ -216,8 +207,8 @@ inline light_sides triangles_lit_by_lights(const scene_view& scene) {
         const glm::vec3 n = glm::normalize(cr), p = (a + b + c) / 3.f;
         bool front = false, back = false;
         for (const packed_light& l : lights) {
-            front = front || positive(irradiance(l, p, n));
-            back = back || positive(irradiance(l, p, -n));
+            front = front || positive(light_irradiance(l, p, n));
+            back = back || positive(light_irradiance(l, p, -n));
         }
         ++s.triangles;
         s.front += front ? 1 : 0;

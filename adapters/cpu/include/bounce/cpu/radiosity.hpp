@@ -529,14 +529,7 @@ private:
                     const float z = glm::dot(p - frame.position, frame.axis);
                     if (h == 0 ? !(z >= 0.f) : !(z > 0.f)) return;
                 }
-                glm::vec3 e;
-                if (kind == light_kind::point)
-                    e = point_light_irradiance<float, glm::vec3>(p, n, l.position(), l.intensity());
-                else if (kind == light_kind::spot)
-                    e = spot_light_irradiance<float, glm::vec3>(p, n, l.position(), l.direction(), l.intensity(),
-                                                               l.cos_cone(), l.cosine_falloff());
-                else
-                    e = directional_light_irradiance<float, glm::vec3>(n, l.direction(), l.intensity());
+                const glm::vec3 e = light_irradiance(l, p, n);
                 if (!(e.x > 0.f || e.y > 0.f || e.z > 0.f)) return;
                 const float v = vis.visible(p, at.chart[i]);
                 if (!(v > 0.f)) return;
