@@ -20,7 +20,7 @@
 #include <bounce/io/output_files.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/study/cache_study.hpp>
-#include <bounce/study/frame_comparison.hpp>
+#include <bounce/study/camera_path.hpp>
 #include <bounce/study/record_cache.hpp>
 #include <bounce/study/run_report.hpp>
 #ifdef BOUNCE_IC_WITH_GL

@@ -12,6 +12,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/study/cache_study.hpp>
+#include <bounce/study/camera_path.hpp>
 #include <bounce/study/frame_comparison.hpp>
 #include <bounce/study/noisy_error_report.hpp>
 #ifdef BOUNCE_TEST_WITH_GL

@@ -2,11 +2,10 @@
 /// \file frame_comparison.hpp
 /// What a study needs to compare a technique's frames with reference images: the pixels
 /// where the comparison means something. (The multi-frame runs' camera path is
-/// camera_path.hpp; it is included here for the callers that still reach it this way.)
+/// camera_path.hpp.)
 
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
-#include <bounce/study/camera_path.hpp>
 
 namespace bounce::study {
 
