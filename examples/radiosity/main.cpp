@@ -122,7 +122,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
 }
 
 // One solve on the backend and visibility the options name: the one place they are chosen.
-solve_result solve_once(const options& o, const io::scene& scene, const embree::device& device,
+solve_result solve_once(const options& o, const io::scene& scene, const embree::accel& bvh,
                         study::stage_timer& timer, const comparison& cmp, bool with_curve) {
     const auto start = clock_type::now();
     lightmap_atlas atlas = build_lightmap_atlas(scene, atlas_options_for(o));
@@ -139,7 +139,7 @@ solve_result solve_once(const options& o, const io::scene& scene, const embree::
 #endif
     }
     if (o.visibility == "rays") {
-        embree::radiosity_visibility vis(device, scene, atlas.chart_of_triangle);
+        embree::radiosity_visibility vis(bvh, atlas.chart_of_triangle);  // through the run's accel
         cpu::progressive_radiosity solver(scene, atlas, std::move(vis), solver_options_for(o));
         atlas = {};  // the solver keeps its own copy
         return solve(solver, o, scene, atlas_ms, ms_since(start), timer, cmp, with_curve);
@@ -206,13 +206,12 @@ int run(const options& o) {
     }
     if (o.reference || versus)  // the pixels that see geometry, where views are compared
         cmp.mask = study::coverage_mask(embree::ray_cast_gbuffer(bvh, scene, scene.camera, o.width, o.height).view());
-    const embree::device device;
 #ifdef BOUNCE_RADIOSITY_WITH_GL
     std::optional<gl::context> gl_context;  // current on this thread while it lives
     if (o.backend == "gl") gl_context.emplace();
 #endif
     std::optional<solve_result> result;
-    for (int rep = 0; rep < o.repeat; ++rep) result = solve_once(o, scene, device, timer, cmp, rep == 0);
+    for (int rep = 0; rep < o.repeat; ++rep) result = solve_once(o, scene, bvh, timer, cmp, rep == 0);
     const solve_result& r = *result;
 
     study::run_report report;
