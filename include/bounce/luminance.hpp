@@ -4,6 +4,7 @@
 /// profiles of radiance use. A kernel, instantiated on the CPU and emitted as GLSL.
 
 #include <bounce/concepts.hpp>
+#include <bounce/vocabulary.hpp>  // the GLM vectors meet vec3_of with the geometric functions
 
 namespace bounce {
 

@@ -212,7 +212,7 @@ inline hemisphere_estimate estimate_hemisphere(const hemisphere_samples& s, cons
     bool valid = true;
     constexpr float largest = std::numeric_limits<float>::max();
     for (const glm::vec3& x : s.radiance)  // false for infinities and NaN
-        valid &= (std::abs(x.x) <= largest) & (std::abs(x.y) <= largest) & (std::abs(x.z) <= largest);
+        valid &= std::abs(x.x) <= largest && std::abs(x.y) <= largest && std::abs(x.z) <= largest;
     for (const float d : s.distance) valid &= d > 0.f;
     if (!valid) s.validate();  // throws, naming the first bad sample's field
 
