@@ -1,12 +1,11 @@
 // The CPU passes and cpu::indirect_renderer: energy-correct interleaving (the expectation
 // over relabellings of the sub-buffers is the non-interleaved value, the thesis's Section
 // 5.2 loss avoided), thread-count independence, the splat cutoff's bound, the blur and
-// upsampling at discontinuities, the core's splat rectangles (indirect/rsm_sampling.hpp) against
-// cpu::splat_rect, and bad input.
+// upsampling at discontinuities, the core's split-buffer rectangles (indirect/rsm_sampling.hpp),
+// and bad input.
 #include "corner_scene.hpp"
 
 #include <bounce/cpu/indirect_renderer.hpp>
-#include <bounce/cpu/splatting.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -294,23 +293,8 @@ TEST_CASE("the SII splat bounds cut off at most the cutoff at any pixel", "[indi
     }
 }
 
-TEST_CASE("the core's sphere rectangle rounds as cpu::splat_rect, and split rectangles hold the sub-buffer's pixels",
-          "[indirect]") {
-    // indirect/rsm_sampling.hpp's sphere_pixel_rect is what both RSM backends splat over; the
-    // irradiance splatting's cpu::splat_rect (cpu/splatting.hpp) rounds the same way.
-    const corner_scene s(61, 47);
-    const glm::mat4 view = s.cam.view_matrix();
+TEST_CASE("split rectangles hold the sub-buffer's pixels", "[indirect]") {
     pcg32 rng(3);
-    for (int k = 0; k < 2000; ++k) {
-        const glm::vec3 c(float(rng.next_double()) * 4.f - 2.f, float(rng.next_double()) * 4.f - 2.f,
-                          float(rng.next_double()) * 3.f - 0.5f);
-        const float radius = float(rng.next_double()) * 1.5f;
-        const bounce::pixel_rect a = sphere_pixel_rect(s.cam, view, c, radius, 61, 47);
-        const cpu::pixel_rect b = cpu::splat_rect(s.cam, view, c, radius, 61, 47);
-        INFO("sphere " << k);
-        CHECK(a.empty() == b.empty());
-        if (!a.empty() && !b.empty()) CHECK((a.x0 == b.x0 && a.x1 == b.x1 && a.y0 == b.y0 && a.y1 == b.y1));
-    }
     // A split rectangle holds exactly the pixels of the image rectangle in its sub-buffer.
     const interleave_pattern p{3, 2};
     const std::size_t w = 13, h = 9;

@@ -29,6 +29,7 @@
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
 #include <bounce/output.hpp>
+#include <bounce/splat_bounds.hpp>
 #include <bounce/cache/record.hpp>
 #include <bounce/cache/record_sampler.hpp>
 
@@ -353,7 +354,7 @@ private:
                 records_.push_back(rec);
                 tree.insert(rec);
                 const float zone = Weight::template influence_radius<float>(rec.radius, sp.a);
-                return guess_spacing(splat_rect(cam, view, rec.position, zone, g.width(), g.height()));
+                return guess_spacing(sphere_pixel_rect(cam, view, rec.position, zone, g.width(), g.height()));
             });
         stats.new_records += s.created;
         stats.measured += s.measured;

@@ -39,13 +39,6 @@ using bounce::splat_params;
 using bounce::pixel_rect;
 using bounce::sphere_pixel_rect;
 
-/// The pixels a record's sphere of influence (radius `zone`) can cover: sphere_pixel_rect,
-/// under the name this adapter's callers know.
-inline pixel_rect splat_rect(const camera& cam, const glm::mat4& view, const glm::vec3& centre, float zone,
-                             std::size_t width, std::size_t height) {
-    return sphere_pixel_rect(cam, view, centre, zone, width, height);
-}
-
 namespace detail {
 static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "G-buffer rows are read as packed floats");
 static_assert(sizeof(glm::vec4) == 4 * sizeof(float), "splat buffer pixels are read as four packed floats");
@@ -150,8 +143,9 @@ inline void splat_into(const gbuffer_view<float>& gb, const irradiance_record& r
 template <class Weight>
 pixel_rect splat_record(const gbuffer_view<float>& gb, const camera& cam, const irradiance_record& rec,
                         const splat_params& sp, image_view<glm::vec4> out) {
-    const pixel_rect r = splat_rect(cam, cam.view_matrix(), rec.position,
-                                    Weight::template influence_radius<float>(rec.radius, sp.a), gb.width(), gb.height());
+    const pixel_rect r = sphere_pixel_rect(cam, cam.view_matrix(), rec.position,
+                                           Weight::template influence_radius<float>(rec.radius, sp.a), gb.width(),
+                                           gb.height());
     if (!r.empty()) detail::splat_into<Weight>(gb, rec, sp, r, out);
     return r;
 }
@@ -171,9 +165,9 @@ void splat_records(const gbuffer_view<float>& gb, const camera& cam, std::span<c
     std::vector<pixel_rect> rects(records.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, records.size()), [&](const auto& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i)
-            rects[i] = splat_rect(cam, view, records[i].position,
-                                  Weight::template influence_radius<float>(records[i].radius, sp.a), gb.width(),
-                                  gb.height());
+            rects[i] = sphere_pixel_rect(cam, view, records[i].position,
+                                         Weight::template influence_radius<float>(records[i].radius, sp.a), gb.width(),
+                                         gb.height());
     });
     // Bin in record order: each tile's list is ascending, which fixes the summation order.
     std::vector<std::vector<std::uint32_t>> bins(std::size_t(tw) * th);
