@@ -61,13 +61,20 @@ struct options {
     std::filesystem::path json, out, exr, indirect_out, indirect_exr, cache_in, cache_out;
 };
 
+// --weight: the library's spellings of the weightings (weighting_name, parse_weighting).
 inline weighting_kind parse_weight(const std::string& w) {
-    if (w == "ward") return weighting_kind::ward;
-    if (w == "ward-smooth") return weighting_kind::ward_smooth;
-    if (w == "ward-gpu") return weighting_kind::ward_early_reject;
-    if (w == "ward-gpu-shader") return weighting_kind::ward_scaled_normal;
-    if (w == "tabellion") return weighting_kind::tabellion;
+    if (const auto k = parse_weighting(w)) return *k;
     throw parameter_error("--weight", "unknown weighting function '" + w + "'");
+}
+inline std::vector<std::string> weight_names() {
+    std::vector<std::string> names;
+    for (const weighting_kind k : weighting_kinds) names.emplace_back(weighting_name(k));
+    return names;
+}
+inline std::string weight_help() {  // "ward | ward-smooth | ..."
+    std::string help;
+    for (const std::string& name : weight_names()) help += (help.empty() ? "" : " | ") + name;
+    return help;
 }
 
 /// The cache settings the options ask for, at accuracy `a`.
@@ -185,8 +192,8 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(examples::finite_positive)->capture_default_str();
-    app.add_option("--weight", o.weight, "ward | ward-smooth | ward-gpu | ward-gpu-shader | tabellion")
-        ->check(CLI::IsMember({"ward", "ward-smooth", "ward-gpu", "ward-gpu-shader", "tabellion"}))->capture_default_str();
+    app.add_option("--weight", o.weight, weight_help())
+        ->check(CLI::IsMember(weight_names()))->capture_default_str();
     app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
     app.add_option("--sampler", o.sampler, "record sampler: embree | raster")->check(CLI::IsMember({"embree", "raster"}))->capture_default_str();
     app.add_option("--falloff-kappa", o.falloff_kappa,

@@ -118,6 +118,9 @@ struct cache_frame_stats {
 template <class Weight>
 class irradiance_cache {
 public:
+    /// The weighting policy (cache/weighting.hpp) the cache splats and looks up with.
+    using weight_type = Weight;
+
     /// An empty cache for a scene inside [lo, hi] (its bounds: the octree and the neighbour
     /// index are built over them; records outside still work, more slowly).
     irradiance_cache(glm::vec3 lo, glm::vec3 hi, const irradiance_cache_options& options = {})
