@@ -9,6 +9,7 @@
 
 #include <bounce/errors.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
+#include <bounce/indirect/visibility.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cmath>
@@ -100,6 +101,10 @@ struct indirect_options {
     float r_max = 1.5f;  ///< RSM gather disc radius, map units (0, 2]; 1.5 reaches the whole map
     disc_weighting disc = disc_weighting::unbiased;  ///< RSM gather sample weights (DS05's xi1^2 to compare)
     pixel_light_params light;                        ///< singularity remedies (indirect/rsm.hpp)
+    /// Receiver-sender visibility (indirect/visibility.hpp): none leaks light through walls
+    /// as DS05/DS06 do; rays tests every pair the frame sums (the renderer needs an
+    /// occlusion_query, CPU only).
+    indirect_visibility visibility = indirect_visibility::none;
     /// SII splat cutoff, W/m^2 per pixel over all VPLs (each VPL is splatted over the sphere
     /// outside which it gives less than cutoff / VPLs); 0: whole screen.
     float sii_cutoff = 0.f;

@@ -25,6 +25,7 @@
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/visibility.hpp>
 #include <bounce/indirect/vpl_sampling.hpp>
 #include <bounce/output.hpp>
 
@@ -37,15 +38,29 @@ namespace bounce::cpu {
 
 class indirect_renderer {
 public:
-    explicit indirect_renderer(const indirect_options& options = {}) : options_(options) { options_.validate(); }
+    /// `occlusion` answers the visibility queries of options.visibility == rays
+    /// (embree::occlusion_query); it must outlive the frames that use it.
+    explicit indirect_renderer(const indirect_options& options = {}, const occlusion_query* occlusion = nullptr)
+        : options_(options), occlusion_(occlusion) {
+        options_.validate();
+        require_occlusion(options_, occlusion_);
+    }
 
     const indirect_options& options() const noexcept { return options_; }
+
+    /// The occlusion query of the next frames (nullptr: none, allowed only while
+    /// options().visibility is none). Throws parameter_error otherwise (the old one stays).
+    void set_occlusion_query(const occlusion_query* occlusion) {
+        require_occlusion(options_, occlusion);
+        occlusion_ = occlusion;
+    }
 
     /// Validates and takes `options` for the next frames; the scratch buffers stay (they
     /// depend on the image size and pattern only), the disc pattern is redrawn when the
     /// options differ. Throws parameter_error naming the bad field (the old options stay).
     void set_options(const indirect_options& options) {
         options.validate();
+        require_occlusion(options, occlusion_);
         if (options == options_) return;
         options_ = options;
         full_pattern_.clear();
@@ -63,8 +78,9 @@ public:
 
     /// Fills `out` (the G-buffer's size) with the one-bounce indirect light that `maps` (one
     /// per spot or directional light, six per point light) reflect onto the G-buffer's
-    /// pixels, unoccluded, as `quantity` (output.hpp): irradiance (W/m^2, the default) or
-    /// radiance with the G-buffer's albedo; 0 where the G-buffer sees nothing.
+    /// pixels, as `quantity` (output.hpp): irradiance (W/m^2, the default) or radiance with
+    /// the G-buffer's albedo; 0 where the G-buffer sees nothing. Unoccluded (light passes
+    /// through walls, as DS05/DS06 publish it) unless options().visibility asks for rays.
     indirect_timings render(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
                             image_view<glm::vec3> out, output_quantity quantity = output_quantity::irradiance) {
         const indirect_timings t = render_irradiance(gb, cam, maps, out);
@@ -98,7 +114,7 @@ private:
         frame(low_gb_.view(), cam, maps, low_irradiance_.view(), low_, t);
         start = clock::now();
         t.fallback_pixels = upsample_or_gather(gb, cam, low_gb_.view(), low_irradiance_.view(), f, options_.upsample,
-                                               maps, full_pattern_, options_.light, irradiance);
+                                               maps, full_pattern_, options_.light, irradiance, occlusion());
         t.upsample_ms = ms_since(start);
         return t;
     }
@@ -176,7 +192,8 @@ private:
         const light_groups g = assign_lights(full_pattern_.size(), imaps.pattern.cells(), light_assignment::interleaved,
                                              {}, options_.shift);
         const auto grouped = grouped_pattern(full_pattern_, g);
-        rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out, options_.energy_correct);
+        rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out, options_.energy_correct,
+                   occlusion());
     }
 
     void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
@@ -193,7 +210,7 @@ private:
         sp.light = options_.light;
         sp.cutoff = options_.sii_cutoff;
         sp.energy_correct = options_.energy_correct;
-        splat_vpls(gb, imaps, cam, vpls_, g, sp, out);
+        splat_vpls(gb, imaps, cam, vpls_, g, sp, out, occlusion());
     }
 
     /// The groups of a pattern already reordered by grouped_pattern: run s is
@@ -206,12 +223,24 @@ private:
         return id;
     }
 
+    static void require_occlusion(const indirect_options& o, const occlusion_query* q) {
+        if (o.visibility == indirect_visibility::rays && !q)
+            throw parameter_error("visibility", "rays needs an occlusion query (embree::occlusion_query) given to the "
+                                                "renderer");
+    }
+
+    /// The query the frame asks: none unless the options ask for rays.
+    const occlusion_query* occlusion() const noexcept {
+        return options_.visibility == indirect_visibility::rays ? occlusion_ : nullptr;
+    }
+
     static void fill_zero(image_view<glm::vec3> img) {
         for (std::size_t y = 0; y < img.height(); ++y)
             for (auto& px : img.row(y)) px = glm::vec3(0.f);
     }
 
     indirect_options options_;
+    const occlusion_query* occlusion_ = nullptr;
     buffers full_, low_;
     gbuffer<float> low_gb_;
     image<glm::vec3> low_irradiance_;

@@ -20,6 +20,7 @@
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/rsm.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/visibility.hpp>
 #include <bounce/indirect/vpl_sampling.hpp>
 
 #include <algorithm>
@@ -29,6 +30,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace bounce::cpu {
@@ -40,11 +42,12 @@ inline glm::vec2 disc_centre(const rsm_view& map, const glm::vec3& p) {
     return rsm_disc_centre<float, glm::vec2>(clip.x, clip.y, clip.w);
 }
 
-/// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
-/// receiver from every map.
-inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<const rsm_view> maps,
-                           std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp) {
-    glm::vec3 e(0.f);
+/// Calls term(e, xp, np) for each sample of `pattern` (already grouped, weights times
+/// `scale`) that gives the receiver x (unit normal n) light from one of `maps`: e its
+/// irradiance, xp and np its texel's position and normal. Maps in order, samples in order.
+template <class Term>
+void for_each_gather_term(const glm::vec3& x, const glm::vec3& n, std::span<const rsm_view> maps,
+                          std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp, Term&& term) {
     for (const rsm_view& map : maps) {
         const glm::vec2 centre = disc_centre(map, x);
         const float w = float(map.width()), h = float(map.height());
@@ -54,10 +57,43 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
             const std::size_t tx = std::size_t(tu), ty = std::size_t(tv);
             const glm::vec3 flux = map.flux(tx, ty);
             if (flux.x == 0.f && flux.y == 0.f && flux.z == 0.f) continue;
-            e += pixel_light_irradiance<float, glm::vec3>(x, n, map.position(tx, ty), map.normal(tx, ty),
-                                                          flux * (s.z * scale), lp.offset, lp.min_distance2);
+            term(pixel_light_irradiance<float, glm::vec3>(x, n, map.position(tx, ty), map.normal(tx, ty),
+                                                          flux * (s.z * scale), lp.offset, lp.min_distance2),
+                 map.position(tx, ty), map.normal(tx, ty));
         }
     }
+}
+
+/// Scratch of one thread's gather with visibility.
+struct visible_gather_scratch {
+    std::vector<visibility_segment> segments;
+    std::vector<glm::vec3> terms;
+    std::vector<std::uint8_t> blocked;
+};
+
+/// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
+/// receiver from every map; with `occlusion`, only from the texels it sees (one segment a
+/// sample that gives light, asked in one batch).
+inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<const rsm_view> maps,
+                           std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp,
+                           const occlusion_query* occlusion = nullptr, visible_gather_scratch* scratch = nullptr) {
+    glm::vec3 e(0.f);
+    if (!occlusion) {
+        for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
+        return e;
+    }
+    scratch->segments.clear();
+    scratch->terms.clear();
+    for_each_gather_term(x, n, maps, pattern, scale, lp,
+                         [&](const glm::vec3& t, const glm::vec3& xp, const glm::vec3& np) {
+                             if (t.x == 0.f && t.y == 0.f && t.z == 0.f) return;
+                             scratch->segments.push_back({x, n, xp, np});
+                             scratch->terms.push_back(t);
+                         });
+    scratch->blocked.resize(scratch->terms.size());
+    occlusion->occluded(scratch->segments, scratch->blocked);
+    for (std::size_t k = 0; k < scratch->terms.size(); ++k)
+        if (!scratch->blocked[k]) e += scratch->terms[k];
     return e;
 }
 }  // namespace detail
@@ -67,10 +103,12 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
 /// uses `pattern[groups.begin[s] .. groups.begin[s + 1])` (grouped_pattern) with weights
 /// times interleaved_weight_scale(n, m) (weight 1 with `energy_correct` false, the thesis's
 /// choice, for comparison). `out` (irradiance, W/m^2) is written everywhere; 0 where the
-/// G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather.
+/// G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather. With
+/// `occlusion`, a pixel sums only the samples whose texel it sees (indirect/visibility.hpp).
 inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& imaps, std::span<const rsm_view> maps,
                        std::span<const glm::vec3> pattern, const light_groups& groups, const pixel_light_params& lp,
-                       image_view<glm::vec3> out, bool energy_correct = true) {
+                       image_view<glm::vec3> out, bool energy_correct = true,
+                       const occlusion_query* occlusion = nullptr) {
     lp.validate();
     for (const auto& m : maps) {
         m.validate();
@@ -84,7 +122,9 @@ inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& ima
             "pattern", "must be grouped for the pattern's sub-buffers");
     const float scale =
         energy_correct ? interleaved_weight_scale<float>(float(imaps.pattern.n), float(imaps.pattern.m)) : 1.f;
+    tbb::enumerable_thread_specific<detail::visible_gather_scratch> scratches;
     tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t v) {
+        auto& scratch = scratches.local();
         for (std::size_t u = 0; u < gb.width(); ++u) {
             if (!gb.covered(u, v)) {
                 out(u, v) = glm::vec3(0.f);
@@ -93,7 +133,8 @@ inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& ima
             const int s = imaps.cell(u, v);
             const auto group = pattern.subspan(groups.begin[std::size_t(s)],
                                                groups.begin[std::size_t(s) + 1] - groups.begin[std::size_t(s)]);
-            out(u, v) = detail::gather_at(gb.position(u, v), gb.normal(u, v), maps, group, scale, lp);
+            out(u, v) =
+                detail::gather_at(gb.position(u, v), gb.normal(u, v), maps, group, scale, lp, occlusion, &scratch);
         }
     });
 }
@@ -131,16 +172,20 @@ inline void downsample_gbuffer(const gbuffer_view<float>& gb, int factor, const 
 /// Geometry-aware upsampling of `low_irradiance` (computed on the downsampled G-buffer
 /// `low`) to `out`: a pixel interpolates the four low-resolution samples around it with the
 /// weights of geometry_aware_upsample_weights when at least three are suitable (DS05); the
-/// others are gathered at full resolution with the whole `pattern` (not interleaved).
-/// Returns the number of pixels gathered at full resolution.
+/// others are gathered at full resolution with the whole `pattern` (not interleaved; with
+/// `occlusion`, from the texels they see). Returns the number of pixels gathered at full
+/// resolution.
 inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camera& cam, const gbuffer_view<float>& low,
                                       image_view<const glm::vec3> low_irradiance, int factor, const upsample_params& up,
                                       std::span<const rsm_view> maps, std::span<const glm::vec3> pattern,
-                                      const pixel_light_params& lp, image_view<glm::vec3> out) {
+                                      const pixel_light_params& lp, image_view<glm::vec3> out,
+                                      const occlusion_query* occlusion = nullptr) {
     require(out.width() == gb.width() && out.height() == gb.height(), "out", "size differs from the G-buffer");
     const float f = float(factor);
     std::vector<std::size_t> fallbacks(gb.height(), 0);
+    tbb::enumerable_thread_specific<detail::visible_gather_scratch> scratches;
     tbb::parallel_for(std::size_t(0), gb.height(), [&](std::size_t y) {
+        auto& scratch = scratches.local();
         for (std::size_t x = 0; x < gb.width(); ++x) {
             if (!gb.covered(x, y)) {
                 out(x, y) = glm::vec3(0.f);
@@ -164,7 +209,8 @@ inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camer
             if (w[4] >= 3.f && w[0] + w[1] + w[2] + w[3] > 0.f) {
                 out(x, y) = es[0] * w[0] + es[1] * w[1] + es[2] * w[2] + es[3] * w[3];
             } else {
-                out(x, y) = detail::gather_at(gb.position(x, y), gb.normal(x, y), maps, pattern, 1.f, lp);
+                out(x, y) = detail::gather_at(gb.position(x, y), gb.normal(x, y), maps, pattern, 1.f, lp, occlusion,
+                                              &scratch);
                 ++fallbacks[y];
             }
         }

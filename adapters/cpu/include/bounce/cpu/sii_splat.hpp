@@ -18,14 +18,17 @@
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/rsm.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/indirect/visibility.hpp>
 #include <bounce/indirect/vpl_sampling.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace bounce::cpu {
@@ -59,12 +62,64 @@ inline bounce::pixel_rect sii_splat_rect(const camera& cam, const glm::mat4& vie
     return vpl_splat_rect(cam, view, l, vpl_count, params.cutoff, params.light.offset, width, height);
 }
 
+namespace detail {
+/// Calls add(u, v, E) for each pixel of `rect` inside `tile` (split-buffer pixels) that VPL
+/// `l` (flux times `scale`) lights, E its irradiance there, row by row.
+template <class Add>
+void splat(const gbuffer_view<float>& gb, const vpl& l, float scale, const pixel_light_params& lp,
+           const bounce::pixel_rect& rect, const bounce::pixel_rect& tile, Add&& add) {
+    const glm::vec3 flux = l.flux * scale;
+    const glm::vec3 sender = l.position - l.normal * lp.offset;
+    for (int v = std::max(rect.y0, tile.y0); v <= std::min(rect.y1, tile.y1); ++v)
+        for (int u = std::max(rect.x0, tile.x0); u <= std::min(rect.x1, tile.x1); ++u) {
+            const std::size_t uu = std::size_t(u), vv = std::size_t(v);
+            if (!gb.covered(uu, vv)) continue;
+            // Receivers behind the sender's plane get 0 from the kernel (its cos theta_p
+            // clamp): skipping them adds nothing and saves its square root.
+            if (!(glm::dot(l.normal, gb.position(uu, vv) - sender) > 0.f)) continue;
+            add(uu, vv,
+                pixel_light_irradiance<float, glm::vec3>(gb.position(uu, vv), gb.normal(uu, vv), l.position, l.normal,
+                                                         flux, lp.offset, lp.min_distance2));
+        }
+}
+
+/// Scratch of one thread's splat with visibility.
+struct visible_splat_scratch {
+    std::vector<visibility_segment> segments;
+    std::vector<std::array<std::size_t, 2>> pixels;
+    std::vector<glm::vec3> terms;
+    std::vector<std::uint8_t> blocked;
+};
+
+/// splat, adding only where `occlusion` finds the pixel sees the VPL (one batch).
+inline void splat_visible(const gbuffer_view<float>& gb, const vpl& l, float scale, const pixel_light_params& lp,
+                          const bounce::pixel_rect& rect, const bounce::pixel_rect& tile,
+                          const occlusion_query& occlusion, visible_splat_scratch& s, image_view<glm::vec3> out) {
+    s.segments.clear();
+    s.pixels.clear();
+    s.terms.clear();
+    splat(gb, l, scale, lp, rect, tile, [&](std::size_t u, std::size_t v, const glm::vec3& e) {
+        if (e.x == 0.f && e.y == 0.f && e.z == 0.f) return;
+        s.segments.push_back({gb.position(u, v), gb.normal(u, v), l.position, l.normal});
+        s.pixels.push_back({u, v});
+        s.terms.push_back(e);
+    });
+    if (s.terms.empty()) return;
+    s.blocked.resize(s.terms.size());
+    occlusion.occluded(s.segments, s.blocked);
+    for (std::size_t k = 0; k < s.terms.size(); ++k)
+        if (!s.blocked[k]) out(s.pixels[k][0], s.pixels[k][1]) += s.terms[k];
+}
+}  // namespace detail
+
 /// Adds the irradiance of `vpls` to `out` (the split buffer of `gb`'s image, or the image
 /// itself for a 1 x 1 pattern): sub-buffer s receives `groups.group(s)`. `gb` is the split
-/// G-buffer; `cam` the camera of the full image (maps.width x maps.height).
+/// G-buffer; `cam` the camera of the full image (maps.width x maps.height). With
+/// `occlusion`, a VPL lights only the pixels that see it (indirect/visibility.hpp; the
+/// pixels of one VPL and tile asked in one batch).
 inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& maps, const camera& cam,
                        std::span<const vpl> vpls, const light_groups& groups, const sii_params& params,
-                       image_view<glm::vec3> out) {
+                       image_view<glm::vec3> out, const occlusion_query* occlusion = nullptr) {
     params.validate();
     detail::require_size(gb.width(), gb.height(), maps, "gb");
     detail::require_size(out.width(), out.height(), maps, "out");
@@ -97,26 +152,20 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
             for (int tx = r.x0 / tile; tx <= r.x1 / tile; ++tx)
                 bins[std::size_t(ty) * std::size_t(tw) + std::size_t(tx)].push_back(std::uint32_t(k));
     }
+    tbb::enumerable_thread_specific<detail::visible_splat_scratch> scratches;
     tbb::parallel_for(std::size_t(0), bins.size(), [&](std::size_t t) {
         const int tx = int(t % std::size_t(tw)), ty = int(t / std::size_t(tw));
         const int x_lo = tx * tile, y_lo = ty * tile;
-        const int x_hi = std::min(int(gb.width()), x_lo + tile) - 1, y_hi = std::min(int(gb.height()), y_lo + tile) - 1;
+        const bounce::pixel_rect tile_rect{x_lo, y_lo, std::min(int(gb.width()), x_lo + tile) - 1,
+                                           std::min(int(gb.height()), y_lo + tile) - 1};
         for (const std::uint32_t k : bins[t]) {
-            const auto& r = rects[k];
             const vpl& l = vpls[groups.order[k]];
-            const glm::vec3 flux = l.flux * scale;
-            const glm::vec3 sender = l.position - l.normal * params.light.offset;
-            for (int v = std::max(r.y0, y_lo); v <= std::min(r.y1, y_hi); ++v)
-                for (int u = std::max(r.x0, x_lo); u <= std::min(r.x1, x_hi); ++u) {
-                    const std::size_t uu = std::size_t(u), vv = std::size_t(v);
-                    if (!gb.covered(uu, vv)) continue;
-                    // Receivers behind the sender's plane get 0 from the kernel (its cos
-                    // theta_p clamp): skipping them adds nothing and saves its square root.
-                    if (!(glm::dot(l.normal, gb.position(uu, vv) - sender) > 0.f)) continue;
-                    out(uu, vv) += pixel_light_irradiance<float, glm::vec3>(
-                        gb.position(uu, vv), gb.normal(uu, vv), l.position, l.normal, flux, params.light.offset,
-                        params.light.min_distance2);
-                }
+            if (occlusion)
+                detail::splat_visible(gb, l, scale, params.light, rects[k], tile_rect, *occlusion, scratches.local(),
+                                      out);
+            else
+                detail::splat(gb, l, scale, params.light, rects[k], tile_rect,
+                              [&](std::size_t u, std::size_t v, const glm::vec3& e) { out(u, v) += e; });
         }
     });
 }
@@ -124,9 +173,11 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
 /// The plain splat (no interleaving): every VPL, in index order, over the G-buffer `gb`
 /// (the image itself), added to `out`.
 inline void splat_vpls(const gbuffer_view<float>& gb, const camera& cam, std::span<const vpl> vpls,
-                       const sii_params& params, image_view<glm::vec3> out) {
+                       const sii_params& params, image_view<glm::vec3> out,
+                       const occlusion_query* occlusion = nullptr) {
     const interleave_maps maps({1, 1}, gb.width(), gb.height());
-    splat_vpls(gb, maps, cam, vpls, assign_lights(vpls.size(), 1, light_assignment::interleaved), params, out);
+    splat_vpls(gb, maps, cam, vpls, assign_lights(vpls.size(), 1, light_assignment::interleaved), params, out,
+               occlusion);
 }
 
 }  // namespace bounce::cpu
