@@ -5,6 +5,7 @@
 #include <bounce/glsl/emit.hpp>
 #include <bounce/surface.hpp>
 
+#include "mesh_draw.hpp"
 #include "saved_state.hpp"
 #include "vertex_shaders.hpp"
 
@@ -23,13 +24,9 @@ std::string fragment_shader() {
     glsl::function_set kernels;
     kernels.add("facing_normal", facing_normal<glsl::f32, glsl::vec3>, "n", "p", "eye");
     kernels.add("view_depth", view_depth<glsl::f32, glsl::vec3>, "p", "eye", "forward");
-    return R"(#version 450 core
-layout(std430, binding = 0) readonly buffer bounce_albedo { vec4 kd[]; };
-layout(location = 1) uniform vec3 camera_position;
+    return "#version 450 core\n" + detail::mesh_albedo_block() + R"(layout(location = 1) uniform vec3 camera_position;
 layout(location = 2) uniform vec3 camera_forward;
-in vec3 world_position;
-in vec3 world_normal;
-layout(location = 0) out vec4 out_position_depth;
+)" + detail::mesh_varyings + R"(layout(location = 0) out vec4 out_position_depth;
 layout(location = 1) out vec4 out_normal;
 layout(location = 2) out vec4 out_albedo;
 
@@ -142,12 +139,8 @@ void gbuffer_pass::render(const scene_mesh& mesh, const camera& cam, std::size_t
     program_.set(0, cam.projection_matrix(width, height) * cam.view_matrix());
     program_.set(1, cam.position);
     program_.set(2, cam.forward());
-    if (mesh.triangle_count() > 0) {
-        glUseProgram(program_.id());
-        glBindVertexArray(mesh.vertices().id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh.albedo_per_triangle().id());
-        glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh.triangle_count()), GL_UNSIGNED_INT, nullptr);
-    }
+    glUseProgram(program_.id());
+    detail::draw_mesh(mesh);
     check_error("gbuffer_pass::render");
 }
 

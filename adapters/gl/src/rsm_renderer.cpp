@@ -11,7 +11,9 @@
 #include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/surface.hpp>
 
+#include "mesh_draw.hpp"
 #include "saved_state.hpp"
+#include "vertex_shaders.hpp"
 
 #include <algorithm>
 #include <array>
@@ -30,19 +32,6 @@ namespace bounce::gl {
 
 namespace {
 
-constexpr const char* vertex_source = R"(#version 450 core
-layout(location = 0) in vec3 position;
-layout(location = 1) in vec3 normal;
-layout(location = 0) uniform mat4 raster_view_projection;
-out vec3 world_position;
-out vec3 world_normal;
-void main() {
-    world_position = position;
-    world_normal = normal;
-    gl_Position = raster_view_projection * vec4(position, 1.0);
-}
-)";
-
 std::string fragment_source() {
     glsl::function_set k;
     k.add("facing_normal", facing_normal<glsl::f32, glsl::vec3>, "n", "p", "eye");
@@ -52,9 +41,7 @@ std::string fragment_source() {
           "axis", "intensity", "cos_cone", "cosine_falloff", "solid_angle");
     k.add("directional_light_texel_flux", directional_light_texel_flux<glsl::f32, glsl::vec3>, "albedo", "n",
           "direction", "irradiance", "texel_area");
-    return R"(#version 450 core
-layout(std430, binding = 0) readonly buffer bounce_albedo { vec4 kd[]; };
-layout(binding = 0) uniform sampler2D texel_solid_angle;
+    return "#version 450 core\n" + detail::mesh_albedo_block() + R"(layout(binding = 0) uniform sampler2D texel_solid_angle;
 layout(location = 1) uniform vec3 light_position;
 layout(location = 2) uniform vec3 light_direction;
 layout(location = 3) uniform vec3 light_intensity;
@@ -63,9 +50,7 @@ layout(location = 5) uniform float cosine_falloff;
 layout(location = 6) uniform int kind;
 layout(location = 7) uniform float texel_area;
 layout(location = 8) uniform uint first_triangle;
-in vec3 world_position;
-in vec3 world_normal;
-layout(location = 0) out vec4 out_position;
+)" + detail::mesh_varyings + R"(layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 layout(location = 2) out vec4 out_flux;
 
@@ -112,12 +97,7 @@ glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
 
 // The built-in drawer: the mesh's vertex array and per-triangle albedo, one indexed draw.
 rsm_drawer mesh_drawer(const scene_mesh& mesh) {
-    return [&mesh](const rsm_draw&) {
-        if (mesh.triangle_count() == 0) return;
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, mesh.albedo_per_triangle().id());
-        glBindVertexArray(mesh.vertices().id());
-        glDrawElements(GL_TRIANGLES, GLsizei(3 * mesh.triangle_count()), GL_UNSIGNED_INT, nullptr);
-    };
+    return [&mesh](const rsm_draw&) { detail::draw_mesh(mesh); };
 }
 
 rsm_drawer checked_drawer(rsm_drawer draw) {
@@ -135,7 +115,7 @@ rsm_renderer::rsm_renderer(const scene_view& scene, const scene_mesh& mesh, cons
     : rsm_renderer(scene, mesh_drawer(mesh), options) {}
 
 rsm_renderer::rsm_renderer(const scene_view& scene, rsm_drawer draw, const rsm_render_options& options)
-    : scene_(scene), draw_(checked_drawer(std::move(draw))), options_(options), program_(vertex_source, fragment_source()) {
+    : scene_(scene), draw_(checked_drawer(std::move(draw))), options_(options), program_(detail::mesh_vertex, fragment_source()) {
     options_.validate();
 }
 

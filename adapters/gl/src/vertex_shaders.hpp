@@ -16,7 +16,8 @@ void main() {
 
 /// A scene mesh seen through one camera: world position (attribute 0) and vertex normal
 /// (attribute 1) passed on as world_position and world_normal, the position transformed by
-/// the mat4 at uniform location 0 (world to clip space). The raster G-buffer draws with it.
+/// the mat4 at uniform location 0 (world to clip space). The raster G-buffer and the
+/// reflective shadow maps draw with it.
 inline constexpr const char* mesh_vertex = R"(#version 450 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
@@ -29,5 +30,8 @@ void main() {
     gl_Position = view_projection * vec4(position, 1.0);
 }
 )";
+
+/// mesh_vertex's outputs as the fragment shader after it declares them.
+inline constexpr const char* mesh_varyings = "in vec3 world_position;\nin vec3 world_normal;\n";
 
 }  // namespace bounce::gl::detail
