@@ -7,7 +7,9 @@
 #include <bounce/direct_light.hpp>
 #include <bounce/shadow_mapping.hpp>
 
+#include "gbuffer_samplers.hpp"
 #include "saved_state.hpp"
+#include "vertex_shaders.hpp"
 
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -55,14 +57,6 @@ void main() {
 }
 )";
 }
-
-constexpr const char* fullscreen_vertex = R"(#version 450 core
-void main() {
-    vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
-    gl_Position = vec4(corner - 1.0, 0.0, 1.0);
-}
-)";
-
 
 // An up vector not parallel to the unit view direction `d`.
 glm::vec3 up_for(const glm::vec3& d) { return std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0); }
@@ -232,7 +226,7 @@ direct_light::direct_light(const scene_view& scene, const scene_mesh& mesh, cons
 direct_light::direct_light(const scene_view& scene, shadow_drawer draw, const direct_light_options& options)
     : draw_(checked_drawer(std::move(draw))), options_(options), lights_(prepare(scene, options)),
       window_depth_program_(shadow_vertex, window_depth_fragment), radial_depth_program_(shadow_vertex, radial_depth_fragment()),
-      radiance_program_(fullscreen_vertex, radiance_fragment_source()) {
+      radiance_program_(detail::fullscreen_vertex, radiance_fragment_source()) {
     glNamedFramebufferDrawBuffer(shadow_fbo_.id(), GL_NONE);
     glNamedFramebufferReadBuffer(shadow_fbo_.id(), GL_NONE);
     render_shadow_maps();
@@ -399,18 +393,14 @@ void direct_light::bind(const program& p, unsigned first_texture_unit) const {
 std::string direct_light::radiance_fragment_source() const {
     glsl::function_set k;
     k.add("lambertian_radiance", lambertian_radiance<glsl::f32, glsl::vec3>, "albedo", "irradiance");
-    return std::string("#version 450 core\n"
-                       "layout(binding = 0) uniform sampler2D gbuffer_position_depth;\n"
-                       "layout(binding = 1) uniform sampler2D gbuffer_normal;\n"
-                       "layout(binding = 2) uniform sampler2D gbuffer_albedo;\n"
-                       "layout(location = 0) out vec4 radiance;\n\n") +
-           glsl_source() + "\n" + k.source() +
+    return "#version 450 core\n" + detail::gbuffer_position_normal_samplers() + detail::gbuffer_albedo_sampler() +
+           "layout(location = 0) out vec4 radiance;\n\n" + glsl_source() + "\n" + k.source() + detail::gbuffer_covered +
            R"(
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     vec4 position_depth = texelFetch(gbuffer_position_depth, pixel, 0);
-    // No geometry here: depth +infinity (gbuffer_view::covered); no light either.
-    if (!(position_depth.w < uintBitsToFloat(0x7f800000u))) {
+    // No geometry here, no light either.
+    if (!covered(position_depth.w)) {
         radiance = vec4(0.0, 0.0, 0.0, 1.0);
         return;
     }
@@ -441,11 +431,7 @@ void direct_light::render(const gbuffer_textures& g) {
     glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);
     glUseProgram(radiance_program_.id());
     glBindVertexArray(empty_vao_.id());
-    const GLuint textures[3] = {g.position_depth.id, g.normal.id, g.albedo.id};
-    for (GLuint u = 0; u < 3; ++u) {
-        glBindTextureUnit(u, textures[u]);
-        glBindSampler(u, 0);
-    }
+    detail::bind_gbuffer_textures(g);
     bind(radiance_program_, 3);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     check_error("direct_light::render");

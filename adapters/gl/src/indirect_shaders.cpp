@@ -2,6 +2,7 @@
 // gather, SII's splats, the down- and upsampling, the discontinuity buffer and the tent. The
 // math in them is emitted from the core's kernels; the rest is fetches, loops and writes.
 #include "indirect_shaders.hpp"
+#include "gbuffer_samplers.hpp"
 
 #include <bounce/glsl/emit.hpp>
 #include <bounce/indirect/rsm.hpp>
@@ -9,14 +10,17 @@
 
 namespace bounce::gl::indirect_glsl {
 
+namespace {
+
 // Shared declarations: the frame's size and pattern, GL rows to rows from the top, the
-// background test (depth +infinity, gbuffer_view::covered).
-extern const char* const common_glsl = R"(layout(location = 0) uniform vec2 frame_size;
+// background test.
+const std::string common_glsl = R"(layout(location = 0) uniform vec2 frame_size;
 layout(location = 1) uniform vec2 frame_pattern;
 int top_row(int row) { return int(frame_size.y) - 1 - row; }
 ivec2 texel_of(int x, int row_from_top) { return ivec2(x, int(frame_size.y) - 1 - row_from_top); }
-bool covered(float depth) { return depth < uintBitsToFloat(0x7f800000u); }
-)";
+)" + std::string(detail::gbuffer_covered);
+
+}  // namespace
 
 std::string index_kernels() {
     glsl::function_set k;
@@ -69,9 +73,8 @@ std::string gather_rsm_fragment() {
     k.add("rsm_disc_centre", rsm_disc_centre<glsl::f32, glsl::vec2>, "clip_x", "clip_y", "clip_w");
     k.add("pixel_light_irradiance", pixel_light_irradiance<glsl::f32, glsl::vec3>, "x", "n", "xp", "np", "flux",
           "offset", "min_distance2");
-    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
-layout(binding = 1) uniform sampler2D gbuffer_normal;
-layout(binding = 2) uniform sampler2D map_position;
+    return std::string("#version 450 core\n") + common_glsl + detail::gbuffer_position_normal_samplers() +
+           R"(layout(binding = 2) uniform sampler2D map_position;
 layout(binding = 3) uniform sampler2D map_normal;
 layout(binding = 4) uniform sampler2D map_flux;
 layout(std430, binding = 0) readonly buffer bounce_disc { vec4 disc[]; };
@@ -151,9 +154,8 @@ std::string upsample_fragment() {
     glsl::function_set k;
     k.add("geometry_aware_upsample_weights", geometry_aware_upsample_weights<glsl::f32, glsl::vec3>, "x", "n",
           "positions", "normals", "frac_x", "frac_y", "max_plane_distance", "cos_normal", "result");
-    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
-layout(binding = 1) uniform sampler2D gbuffer_normal;
-layout(binding = 2) uniform sampler2D low_position_depth;
+    return std::string("#version 450 core\n") + common_glsl + detail::gbuffer_position_normal_samplers() +
+           R"(layout(binding = 2) uniform sampler2D low_position_depth;
 layout(binding = 3) uniform sampler2D low_normal;
 layout(binding = 4) uniform sampler2D low_irradiance;
 layout(location = 2) uniform vec2 low_size;
@@ -227,18 +229,16 @@ std::string splat_fragment() {
     vec4 flux;
 };
 layout(std430, binding = 0) readonly buffer bounce_vpls { bounce_vpl vpls[]; };
-layout(binding = 0) uniform sampler2D gbuffer_position_depth;
-layout(binding = 1) uniform sampler2D gbuffer_normal;
-layout(location = 5) uniform float offset;
+)" + detail::gbuffer_position_normal_samplers() + R"(layout(location = 5) uniform float offset;
 layout(location = 6) uniform float min_distance2;
 flat in int vpl_index;
 layout(location = 0) out vec4 irradiance;
 
-)" + k.source() + R"(
+)" + k.source() + detail::gbuffer_covered + R"(
 void main() {
     ivec2 g = ivec2(gl_FragCoord.xy);
     vec4 position_depth = texelFetch(gbuffer_position_depth, g, 0);
-    if (!(position_depth.w < uintBitsToFloat(0x7f800000u))) discard;
+    if (!covered(position_depth.w)) discard;
     bounce_vpl l = vpls[vpl_index];
     irradiance = vec4(pixel_light_irradiance(position_depth.xyz, texelFetch(gbuffer_normal, g, 0).xyz, l.position.xyz,
                                              l.normal.xyz, l.flux.xyz, offset, min_distance2), 0.0);
@@ -252,9 +252,8 @@ std::string discontinuity_fragment() {
     glsl::function_set k;
     k.add("geometry_discontinuity", geometry_discontinuity<glsl::f32, glsl::vec3>, "depth_a", "n_a", "depth_b", "n_b",
           "relative_depth", "cos_normal");
-    return std::string("#version 450 core\n") + common_glsl + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
-layout(binding = 1) uniform sampler2D gbuffer_normal;
-layout(location = 2) uniform float relative_depth;
+    return std::string("#version 450 core\n") + common_glsl + detail::gbuffer_position_normal_samplers() +
+           R"(layout(location = 2) uniform float relative_depth;
 layout(location = 3) uniform float cos_normal;
 layout(location = 0) out vec4 edges;
 

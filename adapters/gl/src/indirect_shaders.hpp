@@ -6,7 +6,6 @@
 
 namespace bounce::gl::indirect_glsl {
 
-extern const char* const common_glsl;
 extern const char* const downsample_fragment;
 extern const char* const splat_vertex;
 std::string index_kernels();

@@ -7,8 +7,9 @@
 #include <bounce/glsl/emit.hpp>
 #include <bounce/splat_bounds.hpp>
 
-#include "vertex_shaders.hpp"
+#include "gbuffer_samplers.hpp"
 #include "saved_state.hpp"
+#include "vertex_shaders.hpp"
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -251,22 +252,20 @@ std::string splat_pass::fragment_source(weighting_kind weighting, bool gradients
                         "tr_b", "max_extrapolation", "front_tolerance", "c");
         });
     });
-    return std::string("#version 450 core\n") + record_block + R"(layout(binding = 0) uniform sampler2D gbuffer_position_depth;
-layout(binding = 1) uniform sampler2D gbuffer_normal;
-layout(binding = 2) uniform sampler2D gbuffer_albedo;
-layout(location = 1) uniform float a;
+    return std::string("#version 450 core\n") + record_block + detail::gbuffer_position_normal_samplers() +
+           detail::gbuffer_albedo_sampler() + R"(layout(location = 1) uniform float a;
 layout(location = 7) uniform float max_extrapolation;
 layout(location = 8) uniform float front_tolerance;
 flat in uint record_index;
 layout(location = 0) out vec4 splat;
 
-)" + kernels.source() +
+)" + kernels.source() + detail::gbuffer_covered +
            R"(
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     vec4 position_depth = texelFetch(gbuffer_position_depth, pixel, 0);
-    // No geometry here: depth +infinity (gbuffer_view::covered).
-    if (!(position_depth.w < uintBitsToFloat(0x7f800000u))) discard;
+    // No geometry here.
+    if (!covered(position_depth.w)) discard;
     bounce_record r = records[record_index];
     float c[4];
     splat_contribution(position_depth.xyz, texelFetch(gbuffer_normal, pixel, 0).xyz,
@@ -403,11 +402,7 @@ void splat_pass::splat(const gbuffer_textures& g, const camera& cam, const splat
     glVertexArrayVertexBuffer(record_vao_.id(), 0, records_->id(), 0, sizeof(gpu_record));
     glBindVertexArray(record_vao_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, records_->id());
-    const GLuint textures[3] = {g.position_depth.id, g.normal.id, g.albedo.id};
-    for (GLuint u = 0; u < 3; ++u) {
-        glBindTextureUnit(u, textures[u]);
-        glBindSampler(u, 0);
-    }
+    detail::bind_gbuffer_textures(g);
     glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, 4, GLsizei(count), GLuint(first));
     check_error("splat_pass::splat");
 }
