@@ -7,6 +7,8 @@
 #include <bounce/direct_light.hpp>
 #include <bounce/shadow_mapping.hpp>
 
+#include "box_corners.hpp"
+#include "color_target.hpp"
 #include "gbuffer_samplers.hpp"
 #include "saved_state.hpp"
 #include "vertex_shaders.hpp"
@@ -61,18 +63,11 @@ void main() {
 // An up vector not parallel to the unit view direction `d`.
 glm::vec3 up_for(const glm::vec3& d) { return std::abs(d.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0); }
 
-// Corner `c` (0..7, one bit per axis) of the box [lo, hi].
-glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
-    return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
-}
-
 // Near and far planes of a map centred at `eye` that holds everything in the bounds: far is
 // the farthest corner (with 1% to spare), near 1/1000 of it (float depth keeps about
 // 6e-5 far of resolution at the far plane with that ratio).
 std::pair<float, float> depth_range(const glm::vec3& eye, const glm::vec3& lo, const glm::vec3& hi) {
-    float far_depth = 0.f;
-    for (int c = 0; c < 8; ++c) far_depth = std::max(far_depth, glm::length(box_corner(lo, hi, c) - eye));
-    far_depth = std::max(far_depth * 1.01f, 1e-3f);
+    const float far_depth = std::max(detail::farthest_corner_distance(eye, lo, hi) * 1.01f, 1e-3f);
     return {far_depth * 1e-3f, far_depth};
 }
 
@@ -164,7 +159,7 @@ std::vector<direct_light::light_entry> direct_light::prepare(const scene_view& s
             const glm::vec2 middle(view * glm::vec4(centre, 1.f));
             for (int c = 0; c < 8; ++c)
                 half_extent = glm::max(half_extent,
-                                       glm::abs(glm::vec2(view * glm::vec4(box_corner(lo, hi, c), 1.f)) - middle));
+                                       glm::abs(glm::vec2(view * glm::vec4(detail::box_corner(lo, hi, c), 1.f)) - middle));
             half_extent = glm::max(1.01f * half_extent, glm::vec2(1e-3f)) / (1.f - 6.f / float(res));
             l.near_depth = 0.5f * r;
             l.far_depth = 3.5f * r;
@@ -413,12 +408,7 @@ void main() {
 void direct_light::render(const gbuffer_textures& g) {
     g.validate();
     const std::size_t w = g.width(), h = g.height();
-    if (!radiance_ || radiance_->width() != w || radiance_->height() != h) {
-        radiance_.emplace(texel_format::rgba32f, w, h);
-        radiance_fbo_.attach_color(0, *radiance_);
-        radiance_fbo_.set_draw_buffers(1);
-        radiance_fbo_.check_complete();
-    }
+    detail::ensure_color_target(radiance_, radiance_fbo_, w, h);
     const detail::raster_state raster;
     const detail::blend_offset_state blend;
     const detail::program_and_storage_state bindings({});

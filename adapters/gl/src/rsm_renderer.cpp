@@ -11,6 +11,7 @@
 #include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/surface.hpp>
 
+#include "box_corners.hpp"
 #include "mesh_draw.hpp"
 #include "saved_state.hpp"
 #include "vertex_shaders.hpp"
@@ -88,11 +89,6 @@ enum location : int {
     loc_texel_area = 7,
     loc_first_triangle = 8,
 };
-
-// Corner `c` (0..7) of the box [lo, hi].
-glm::vec3 box_corner(const glm::vec3& lo, const glm::vec3& hi, int c) {
-    return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z};
-}
 
 
 // The built-in drawer: the mesh's vertex array and per-triangle albedo, one indexed draw.
@@ -185,11 +181,9 @@ void rsm_renderer::render_map(const rsm_map_layout& m, const packed_light& l, co
         // near and far from the scene bounds, so no geometry beyond the camera's default far
         // plane is lost.
         auto [lo, hi] = scene_.bounds();
-        float far_depth = 0.f;
-        for (int c = 0; c < 8; ++c) far_depth = std::max(far_depth, glm::length(box_corner(lo, hi, c) - m.position));
         // No absolute floor beyond what keeps the planes apart in float (a scene within a
         // millimetre of the light had its depth range stretched to 1e-3 units before).
-        far_depth = std::max(far_depth * 1.01f, 1e-15f);
+        const float far_depth = std::max(detail::farthest_corner_distance(m.position, lo, hi) * 1.01f, 1e-15f);
         raster = glm::perspective(glm::radians(m.fov_deg), 1.f, far_depth * 1e-4f, far_depth) * m.view;
     }
     const float texel_area = m.orthographic ? m.texel_size * m.texel_size : 0.f;

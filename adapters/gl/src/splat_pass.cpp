@@ -7,6 +7,7 @@
 #include <bounce/glsl/emit.hpp>
 #include <bounce/splat_bounds.hpp>
 
+#include "color_target.hpp"
 #include "gbuffer_samplers.hpp"
 #include "saved_state.hpp"
 #include "vertex_shaders.hpp"
@@ -339,11 +340,7 @@ void splat_pass::append(std::span<const irradiance_record> records) { write_reco
 
 void splat_pass::ensure_target(std::size_t width, std::size_t height) {
     require(width > 0 && height > 0, "width/height", "the splat buffer must have a positive size");
-    if (splat_ && width == width_ && height == height_) return;
-    splat_.emplace(texel_format::rgba32f, width, height);
-    fbo_.attach_color(0, *splat_);
-    fbo_.set_draw_buffers(1);
-    fbo_.check_complete();
+    detail::ensure_color_target(splat_, fbo_, width, height);
     width_ = width;
     height_ = height;
 }
@@ -470,12 +467,7 @@ void compose_pass::compose(const texture& splat, const texture* direct, const te
                 "size differs from the splat buffer");
         require(std::isfinite(lambda) && lambda > 0.f, "lambda", "must be a positive number");
     }
-    if (!result_ || result_->width() != splat.width() || result_->height() != splat.height()) {
-        result_.emplace(texel_format::rgba32f, splat.width(), splat.height());
-        fbo_.attach_color(0, *result_);
-        fbo_.set_draw_buffers(1);
-        fbo_.check_complete();
-    }
+    detail::ensure_color_target(result_, fbo_, splat.width(), splat.height());
     const program& prog = wide ? (direct ? with_direct_wide_ : without_direct_wide_) : (direct ? with_direct_ : without_direct_);
     const detail::raster_state raster;
     const detail::program_and_storage_state bindings({});
