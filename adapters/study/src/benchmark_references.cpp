@@ -33,6 +33,16 @@ namespace {
 // halves' hashed seeds), as monte_carlo_at_equal_error's.
 constexpr std::uint64_t monte_carlo_seed = 99;
 
+// An estimator's default settings with `spp` samples (the field `count` names) and the
+// sweeps' seed.
+template <class Settings>
+Settings monte_carlo_settings(std::uint32_t Settings::*count, std::uint32_t spp) {
+    Settings settings;
+    settings.*count = spp;
+    settings.seed = monte_carlo_seed;
+    return settings;
+}
+
 // A row-progress callback that reports at most every five seconds.
 std::function<void(std::size_t, std::size_t)> rows_progress(const scene_setup& s, std::string stage) {
     return [&clock = s.clock, stage = std::move(stage), last = std::chrono::steady_clock::now()](std::size_t done,
@@ -71,8 +81,7 @@ std::string halves_cache_key(const scene_setup& s, const std::string& kind, std:
     h.value(spp);
     h.text(settings_text);
     h.text(s.bvh.owner().config());
-    return s.scene.name + "-" + std::to_string(s.g.width()) + "x" + std::to_string(s.g.height()) + "-" +
-           std::to_string(spp) + "spp-" + kind + "-" + h.hex_digest();
+    return view_cache_key(s.scene.name, s.g.width(), s.g.height(), std::to_string(spp) + "spp-" + kind + "-", h);
 }
 
 halves_reference cached_halves(const scene_setup& s, const std::string& key, std::uint32_t spp,
@@ -203,25 +212,19 @@ mc_sweep quantity_monte_carlo(const scene_setup& s, bench_quantity q, const halv
         case bench_quantity::one_bounce:
         case bench_quantity::volume_points:
             render = [&](std::uint32_t spp) {
-                embree::reference_settings rs;
-                rs.hemisphere_samples = spp;
-                rs.seed = monte_carlo_seed;
+                const auto rs = monte_carlo_settings(&embree::reference_settings::hemisphere_samples, spp);
                 return embree::reference_integrator(s.bvh, s.scene, rs).indirect_image(g);
             };
             break;
         case bench_quantity::unoccluded:
             render = [&](std::uint32_t spp) {
-                embree::unoccluded_reference_settings us;
-                us.hemisphere_samples = spp;
-                us.seed = monte_carlo_seed;
+                const auto us = monte_carlo_settings(&embree::unoccluded_reference_settings::hemisphere_samples, spp);
                 return embree::unoccluded_reference(s.bvh, s.scene, us).indirect_image(g);
             };
             break;
         case bench_quantity::all_bounces:
             render = [&](std::uint32_t spp) {
-                embree::multi_bounce_settings ms;
-                ms.paths = spp;
-                ms.seed = monte_carlo_seed;
+                const auto ms = monte_carlo_settings(&embree::multi_bounce_settings::paths, spp);
                 return embree::multi_bounce_reference(s.bvh, s.scene, ms).render(s.scene.camera, g.width(), g.height()).radiance;
             };
             break;

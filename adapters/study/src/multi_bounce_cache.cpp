@@ -18,14 +18,9 @@ std::string multi_bounce_cache_key(const io::scene& scene, const bounce::camera&
     fnv1a_hash hash;
     hash.text("multi_bounce_reference v2");
     hash_scene_view(hash, scene, cam, width, height);
-    hash.value(settings.paths);
-    hash.value(settings.max_bounces);
-    hash.value(settings.roulette_after);
-    hash.value(settings.area_samples);
-    hash.value(settings.seed);
+    hash.values(settings.paths, settings.max_bounces, settings.roulette_after, settings.area_samples, settings.seed);
     hash.text(device_config);
-    return scene.name + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" + std::to_string(settings.paths) +
-           "paths-multibounce-" + hash.hex_digest();
+    return view_cache_key(scene.name, width, height, std::to_string(settings.paths) + "paths-multibounce-", hash);
 }
 
 std::optional<embree::multi_bounce_image> load_multi_bounce(const std::filesystem::path& dir, const std::string& key,

@@ -51,15 +51,11 @@ std::string settings_key(std::string_view tag, std::string_view kind, const io::
     if (!tag.empty()) h.text(tag);
     h.text(integrator_version);
     hash_scene_view(h, scene, cam, width, height);
-    h.value(settings.hemisphere_samples);
-    h.value(settings.area_samples);
-    h.value(settings.secondary_area_samples);
-    h.value(settings.environment);
-    h.value(settings.ray_epsilon);
-    h.value(settings.seed);
+    h.values(settings.hemisphere_samples, settings.area_samples, settings.secondary_area_samples, settings.environment,
+             settings.ray_epsilon, settings.seed);
     if (!device_config.empty()) h.text(device_config);  // Embree's default: the keys of earlier versions
-    return safe_name(scene.name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" +
-           std::to_string(settings.hemisphere_samples) + "spp-" + std::string(kind) + h.hex_digest();
+    return view_cache_key(safe_name(scene.name), width, height,
+                          std::to_string(settings.hemisphere_samples) + "spp-" + std::string(kind), h);
 }
 
 // What every entry's JSON says of its source: the scene, the view and the settings.
@@ -96,6 +92,27 @@ image<glm::vec3> sum_of(const image<glm::vec3>& a, const image<glm::vec3>& b) {
     for (std::size_t y = 0; y < a.height(); ++y)
         for (std::size_t x = 0; x < a.width(); ++x) s(x, y) = a(x, y) + b(x, y);
     return s;
+}
+
+// The cached_* functions: the entry `key_of` names in `dir` when `load` finds it, else
+// `render` on the view's ray-cast G-buffer, stored (the folder checked first: a cache that
+// cannot be written is reported before minutes of rendering, not at the store).
+template <class Key, class Load, class Render, class Store>
+auto load_or_render(const accel& bvh, const io::scene& scene, const bounce::camera& cam, std::size_t width,
+                    std::size_t height, const reference_settings& settings, const std::filesystem::path& dir,
+                    bool* from_cache, Key key_of, Load load, Render render, Store store) {
+    const std::string& config = bvh.owner().config();
+    const std::string key = key_of(scene, cam, width, height, settings, config);
+    if (auto cached = load(dir, key, width, height, settings)) {
+        if (from_cache) *from_cache = true;
+        return std::move(*cached);
+    }
+    check_cache_dir(dir);
+    auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
+    auto rendered = render(bvh, scene, g.view(), settings);
+    store(dir, key, rendered, scene, cam, settings, config);
+    if (from_cache) *from_cache = false;
+    return rendered;
 }
 
 }  // namespace
@@ -171,6 +188,12 @@ void hash_scene_view(fnv1a_hash& h, const io::scene& scene, const bounce::camera
     h.value(height);
 }
 
+std::string view_cache_key(std::string_view name, std::size_t width, std::size_t height, std::string_view what,
+                           const fnv1a_hash& h) {
+    return std::string(name) + "-" + std::to_string(width) + "x" + std::to_string(height) + "-" + std::string(what) +
+           h.hex_digest();
+}
+
 std::string reference_cache_key(const io::scene& scene, const bounce::camera& cam, std::size_t width,
                                 std::size_t height, const reference_settings& settings,
                                 std::string_view device_config) {
@@ -202,18 +225,8 @@ void store_cached_reference(const std::filesystem::path& dir, const std::string&
 reference_images cached_reference(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
                                   std::size_t width, std::size_t height, const reference_settings& settings,
                                   const std::filesystem::path& dir, bool* from_cache) {
-    const std::string& config = bvh.owner().config();
-    const std::string key = reference_cache_key(scene, cam, width, height, settings, config);
-    if (auto cached = load_cached_reference(dir, key, width, height, settings)) {
-        if (from_cache) *from_cache = true;
-        return std::move(*cached);
-    }
-    check_cache_dir(dir);  // before minutes of rendering, not at the store
-    auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
-    reference_images r = render_reference(bvh, scene, g.view(), settings);
-    store_cached_reference(dir, key, r, scene, cam, settings, config);
-    if (from_cache) *from_cache = false;
-    return r;
+    return load_or_render(bvh, scene, cam, width, height, settings, dir, from_cache, reference_cache_key,
+                          load_cached_reference, embree::render_reference, store_cached_reference);
 }
 
 namespace {
@@ -300,18 +313,8 @@ reference_halves render_reference_halves(const accel& bvh, const scene_view& sce
 reference_halves cached_reference_halves(const accel& bvh, const io::scene& scene, const bounce::camera& cam,
                                          std::size_t width, std::size_t height, const reference_settings& settings,
                                          const std::filesystem::path& dir, bool* from_cache) {
-    const std::string& config = bvh.owner().config();
-    const std::string key = reference_halves_cache_key(scene, cam, width, height, settings, config);
-    if (auto cached = load_cached_reference_halves(dir, key, width, height, settings)) {
-        if (from_cache) *from_cache = true;
-        return std::move(*cached);
-    }
-    check_cache_dir(dir);
-    auto g = ray_cast_gbuffer(bvh, scene, cam, width, height);
-    reference_halves h = render_reference_halves(bvh, scene, g.view(), settings);
-    store_cached_reference_halves(dir, key, h, scene, cam, settings, config);
-    if (from_cache) *from_cache = false;
-    return h;
+    return load_or_render(bvh, scene, cam, width, height, settings, dir, from_cache, reference_halves_cache_key,
+                          load_cached_reference_halves, render_reference_halves, store_cached_reference_halves);
 }
 
 }  // namespace bounce::study

@@ -27,6 +27,11 @@ public:
     void value(const T& v) noexcept {
         bytes(&v, sizeof(T));
     }
+    /// value() of each of `v`, in order.
+    template <class... T>
+    void values(const T&... v) noexcept {
+        (value(v), ...);
+    }
     /// The length, then the characters, so that ("ab", "c") and ("a", "bc") differ.
     void text(std::string_view s) noexcept {
         value(s.size());

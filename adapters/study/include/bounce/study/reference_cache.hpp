@@ -45,6 +45,11 @@ void check_cache_dir(const std::filesystem::path& dir = default_cache_dir());
 void hash_scene_view(fnv1a_hash& h, const io::scene& scene, const bounce::camera& cam, std::size_t width,
                      std::size_t height);
 
+/// The file name every cached view's key has: "<name>-<width>x<height>-<what><the 16 hex
+/// digits of h>", where `what` says the samples and the kind ("1024spp-", "256paths-multibounce-").
+std::string view_cache_key(std::string_view name, std::size_t width, std::size_t height, std::string_view what,
+                           const fnv1a_hash& h);
+
 /// The cache key of a reference render of `scene` seen by `cam` at `width` x `height` with
 /// `settings` on a device configured with `device_config` (device::config()):
 /// "<scene name>-<W>x<H>-<spp>spp-<16 hex digits>" (file-name safe).
