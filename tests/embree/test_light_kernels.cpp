@@ -119,6 +119,25 @@ TEST_CASE("a directional light delivers E cos theta to surfaces that face it", "
     CHECK(close_rel(directional_light_irradiance<double, glm::dvec3>(-d, d, e), e, 1e-14));
 }
 
+TEST_CASE("a packed light's irradiance is its model's kernel on the light's fields", "[lights]") {
+    const auto i = GENERATE(range(0, 100));
+    pcg32 rng(15000 + std::uint64_t(i));
+    const glm::vec3 p(random_point(rng, 3)), n(random_unit(rng)), position(random_point(rng, 3));
+    const glm::vec3 direction(2.f * glm::vec3(random_unit(rng))), value(1.5f, 0.5f, 2.5f);
+    const float cone_deg = float(5 + 170 * rng.next_double());
+    // Bitwise: light_irradiance only chooses the kernel and hands it the packed fields.
+    CHECK(light_irradiance(pack(point_light{position, value}), p, n) ==
+          point_light_irradiance<float, glm::vec3>(p, n, position, value));
+    for (const auto falloff : {spot_light::falloff_kind::none, spot_light::falloff_kind::cosine}) {
+        const float cos_cone = float(std::cos(glm::radians(double(cone_deg))));  // as pack rounds it
+        CHECK(light_irradiance(pack(spot_light{position, direction, value, cone_deg, falloff}), p, n) ==
+              spot_light_irradiance<float, glm::vec3>(p, n, position, glm::normalize(direction), value, cos_cone,
+                                                      falloff == spot_light::falloff_kind::cosine ? 1.f : 0.f));
+    }
+    CHECK(light_irradiance(pack(directional_light{direction, value}), p, n) ==
+          directional_light_irradiance<float, glm::vec3>(n, glm::normalize(direction), value));
+}
+
 TEST_CASE("the area-light sample is symmetric in its two ends", "[lights][area]") {
     // G(p, q) = cos cos / d^2 is symmetric: the form-factor reciprocity A_p F_pq = A_q F_qp.
     const auto i = GENERATE(range(0, 200));
