@@ -7,6 +7,7 @@
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/gl/radiosity.hpp>
+#include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/subdivision.hpp>
 
 #include <catch2/catch.hpp>
@@ -157,6 +158,22 @@ TEST_CASE("absorbed + unshot + escaped power equals emitted power on GL after ev
 
 namespace {
 
+// The CPU solver with item-buffer visibility (the hemicube or the stereographic buffer) of
+// `res` texels a side, and the GL solver's options for the same.
+cpu::progressive_radiosity<cpu::item_buffer_visibility> cpu_item_buffer_solver(const owned_scene& scene,
+                                                                              const lightmap_atlas& atlas, bool hemicube,
+                                                                              int res) {
+    return cpu::progressive_radiosity<cpu::item_buffer_visibility>(
+        scene.view(), atlas,
+        cpu::item_buffer_visibility(scene.view(), atlas,
+                                    {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
+                                     .resolution = res}));
+}
+gl::radiosity_options gl_item_buffer_options(bool hemicube, int res) {
+    return {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
+            .resolution = res};
+}
+
 // One shot (from the lamp, the first shooter on both) on GL and on the CPU with the same
 // projection and resolution: the elements answered differently, and how many of them do not
 // look through an edge pixel of the CPU's buffer (one whose 3 x 3 neighbourhood holds another
@@ -168,26 +185,14 @@ struct one_shot_comparison {
 one_shot_comparison compare_one_shot(bool hemicube, int res) {
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
-    cpu::progressive_radiosity cpu_solver(
-        scene.view(), atlas,
-        cpu::item_buffer_visibility(scene.view(), atlas,
-                                    {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
-                                     .resolution = res}));
-    gl::progressive_radiosity gl_solver(
-        scene.view(), atlas,
-        {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
-         .resolution = res});
+    auto cpu_solver = cpu_item_buffer_solver(scene, atlas, hemicube, res);
+    gl::progressive_radiosity gl_solver(scene.view(), atlas, gl_item_buffer_options(hemicube, res));
     const auto b0 = cpu_solver.radiosity();
     const std::vector<glm::vec3> before(b0.begin(), b0.end());
     // The shooter's disc: its elements' area-weighted centroid and its chart's normal.
     const std::uint32_t k = gl_solver.next_shooter();
-    glm::dvec3 c(0.0);
-    double area = 0;
-    for (std::uint32_t i = gl_solver.shooter_first(k); i < gl_solver.shooter_first(k + 1); ++i) {
-        c += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
-        area += double(atlas.area[i]);
-    }
-    const glm::vec3 centre(c / area), n = atlas.normal[gl_solver.shooter_first(k)];
+    const glm::vec3 centre = shooter_disc_of(atlas, gl_solver.shooter_first(k), gl_solver.shooter_first(k + 1)).centre;
+    const glm::vec3 n = atlas.normal[gl_solver.shooter_first(k)];
     const auto tb = orthonormal_basis<float, glm::vec3>(n);
     REQUIRE(cpu_solver.step());
     REQUIRE(gl_solver.step());
@@ -203,20 +208,19 @@ one_shot_comparison compare_one_shot(bool hemicube, int res) {
         ++out.differing;
         const glm::vec3 l = to_shooter_frame<float, glm::vec3>(atlas.position[i], centre, tb[0], tb[1], n);
         std::size_t face = 0;
-        glm::vec2 uv;
+        glm::vec2 xy;
         if (hemicube) {
-            const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
-            face = std::size_t(std::clamp(int(f.x + 0.5f), 0, 4));
-            uv = {f.y, f.z};
-        } else uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
+            const glm::vec3 f = hemicube_item_texel<float, glm::vec3>(l, float(res));
+            face = std::size_t(f.x);
+            xy = {f.y, f.z};
+        } else xy = stereographic_item_texel<float, glm::vec3, glm::vec2>(l, float(res));
         const cpu::item_buffer& buf = buffers[face];
         const auto id_at = [&](int x, int y) {
             x = std::clamp(x, 0, buf.width - 1);
             y = std::clamp(y, 0, buf.height - 1);
             return buf.id[std::size_t(y) * std::size_t(buf.width) + std::size_t(x)];
         };
-        const int x = std::clamp(int(std::floor(uv.x * float(buf.width))), 0, buf.width - 1);
-        const int y = std::clamp(int(std::floor(uv.y * float(buf.height))), 0, buf.height - 1);
+        const int x = int(xy.x), y = int(xy.y);
         bool edge = false;
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) edge = edge || id_at(x + dx, y + dy) != id_at(x, y);
@@ -258,15 +262,8 @@ TEST_CASE("with item-buffer visibility, k shots on GL and CPU agree", "[gl][radi
     const int res = 128, shots = 30;
     const bool hemicube = GENERATE(false, true);
     INFO((hemicube ? "hemicube" : "stereographic"));
-    cpu::progressive_radiosity cpu_solver(
-        scene.view(), atlas,
-        cpu::item_buffer_visibility(scene.view(), atlas,
-                                    {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
-                                     .resolution = res}));
-    gl::progressive_radiosity gl_solver(
-        scene.view(), atlas,
-        {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
-         .resolution = res});
+    auto cpu_solver = cpu_item_buffer_solver(scene, atlas, hemicube, res);
+    gl::progressive_radiosity gl_solver(scene.view(), atlas, gl_item_buffer_options(hemicube, res));
     std::size_t same_shooter = 0;
     for (int s = 0; s < shots; ++s) {
         const auto expected = largest_power(gl_solver, gl_solver.unshot());

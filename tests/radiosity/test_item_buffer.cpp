@@ -171,10 +171,10 @@ TEST_CASE("the hemicube's faces match an exact ray cast except at snapped edges"
                 differ += exact.first != buf.id[std::size_t(y) * std::size_t(buf.width) + std::size_t(x)] ? 1 : 0;
                 ++pixels;
             }
-        const auto axes = cpu::item_buffer_visibility::face_axes(face);
+        const auto axes = hemicube_face_axes<glm::vec3>(face);
         const auto local = [&](glm::vec3 p) {
             const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, position, tb[0], tb[1], normal);
-            return glm::vec3(glm::dot(l, axes[0]), glm::dot(l, axes[1]), glm::dot(l, axes[2]));
+            return frame_coords<float, glm::vec3>(l, axes[0], axes[1], axes[2]);
         };
         const auto project = [&](glm::vec3 p) {
             const glm::vec3 q = local(p);
@@ -217,17 +217,16 @@ TEST_CASE("item-buffer visibility disagrees with exact visibility only at the bu
                 const auto tb = orthonormal_basis<float, glm::vec3>(shot.axis);
                 const glm::vec3 l = to_shooter_frame<float, glm::vec3>(atlas.position[e], shot.position, tb[0], tb[1], shot.axis);
                 const cpu::item_buffer* buf;
-                glm::vec2 uv;
+                glm::vec2 xy;
                 if (projection == cpu::item_projection::stereographic) {
                     buf = &vis.buffers()[0];
-                    uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
+                    xy = stereographic_item_texel<float, glm::vec3, glm::vec2>(l, 256.f);
                 } else {
-                    const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
-                    buf = &vis.buffers()[std::size_t(f.x + 0.5f)];
-                    uv = {f.y, f.z};
+                    const glm::vec3 f = hemicube_item_texel<float, glm::vec3>(l, 256.f);
+                    buf = &vis.buffers()[std::size_t(f.x)];
+                    xy = {f.y, f.z};
                 }
-                const int x = std::clamp(int(uv.x * buf->width), 0, buf->width - 1);
-                const int y = std::clamp(int(uv.y * buf->height), 0, buf->height - 1);
+                const int x = int(xy.x), y = int(xy.y);
                 bool boundary = false;
                 for (int dy = -1; dy <= 1; ++dy)
                     for (int dx = -1; dx <= 1; ++dx) {

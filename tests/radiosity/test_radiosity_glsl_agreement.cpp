@@ -193,3 +193,171 @@ TEST_CASE("the subdivision test's second difference agrees on the GPU and the CP
     CHECK(ones > 100);
     CHECK(ones < random_count - 100);
 }
+
+namespace {
+
+// Texel numbers (whole numbers) from the GPU and the CPU agree, except where the coordinate
+// they are floored from lies within rounding (1e-5 of its size, at least 1e-5 texel) of the
+// texel boundary between them: GLSL's division and inversesqrt may round the other way.
+bool same_texel(double gpu, double cpu, double coord) {
+    if (gpu == cpu) return true;
+    return std::abs(gpu - cpu) == 1 && std::abs(coord - std::max(gpu, cpu)) <= 1e-5 * std::max(1.0, std::abs(coord));
+}
+
+// A direction on the unit sphere, behind the shooter too, but not within 25 degrees of
+// straight behind it (where the stereographic map runs off to infinity).
+glm::vec3 random_around(pcg32& rng) {
+    glm::vec3 d = random_unit(rng);
+    if (d.z < -0.9f) d.z = -d.z;
+    return d;
+}
+
+}  // namespace
+
+TEST_CASE("where an element is looked up agrees on the GPU and the CPU: face and texel edges, grazing, behind",
+          "[glsl][radiosity]") {
+    // The texel of an element in the stereographic buffer, on the hemicube, and in a
+    // directional light's buffer, and a hemicube face's first row. Points behind the shooter
+    // (which the solvers never ask about) must still land on the buffer's border.
+    gl_test::shared_context();
+    pcg32 rng(36);
+    const float res = 128.f;
+    std::vector<std::tuple<glm::vec3, float>> in;
+    for (const glm::vec3 d : {glm::vec3(0, 0, 1), glm::vec3(1, 0, 0), glm::vec3(0, -1, 0), glm::vec3(3, 4, 1e-7f),
+                              glm::vec3(1, 0, 1), glm::vec3(-1, 0, 1), glm::vec3(0, 1, 1), glm::vec3(0, -1, 1),
+                              glm::vec3(1, 1, 1), glm::vec3(1, 1, 0.5f), glm::vec3(-1, 1, 0.5f), glm::vec3(1, -1, 0.5f),
+                              glm::vec3(1, 0.3f, 1 - 1e-6f), glm::vec3(1, 0.3f, 1 + 1e-6f),
+                              glm::vec3(0.5f, 0.5f + 1e-7f, 0.2f), glm::vec3(1, 0.2f, 1e-7f), glm::vec3(0.3f, -1, 0),
+                              glm::vec3(0.3f, 0.2f, -0.5f), glm::vec3(-1, 0.2f, -0.5f), glm::vec3(0.1f, 0.2f, -1)})
+        in.emplace_back(d, res);
+    for (int k = 0; k < random_count; ++k) in.emplace_back(random_around(rng) * (0.01f + 5 * rng.next_float()), res);
+    int flips = 0, wrong = 0;
+    const auto compare = [&](double gpu, double cpu, double coord) {
+        flips += gpu != cpu ? 1 : 0;
+        wrong += same_texel(gpu, cpu, coord) ? 0 : 1;
+    };
+
+    const auto gpu_st = gl::map_kernel(stereographic_item_texel<f32, vec3, vec2>, in);
+    for (std::size_t e = 0; e < in.size(); ++e) {
+        const glm::vec3 l = std::get<0>(in[e]);
+        const glm::vec2 cpu = stereographic_item_texel<float, glm::vec3, glm::vec2>(l, res);
+        const glm::vec2 coord = stereographic_item_coords<float, glm::vec3, glm::vec2>(l) * res;
+        compare(gpu_st[e].x, cpu.x, coord.x);
+        compare(gpu_st[e].y, cpu.y, coord.y);
+    }
+    const auto gpu_cube = gl::map_kernel(hemicube_item_texel<f32, vec3>, in);
+    for (std::size_t e = 0; e < in.size(); ++e) {
+        const glm::vec3 l = std::get<0>(in[e]);
+        const glm::vec3 cpu = hemicube_item_texel<float, glm::vec3>(l, res);
+        const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
+        REQUIRE(gpu_cube[e].x == cpu.x);
+        compare(gpu_cube[e].y, cpu.y, f.y * res);
+        compare(gpu_cube[e].z, cpu.z, f.z * hemicube_face_rows(f.x, res));
+    }
+    std::vector<std::tuple<float, float>> faces;
+    for (int face = 0; face < 5; ++face) faces.emplace_back(float(face), res);
+    const auto rows = gl::map_kernel(hemicube_face_first_row<f32>, faces);
+    for (int face = 0; face < 5; ++face) CHECK(rows[std::size_t(face)] == hemicube_face_first_row(float(face), res));
+
+    // A directional light's buffer over a box of side 7 about the origin; points inside it,
+    // outside it, and on its corner.
+    const glm::vec3 light = glm::normalize(glm::vec3(0.3f, -1, 0.2f));
+    const auto tb = orthonormal_basis<float, glm::vec3>(light);
+    const glm::vec2 lo(-3.5f);
+    const float scale = res / 7.f;
+    std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec2, float, float>> par;
+    par.emplace_back(tb[0] * -3.5f + tb[1] * -3.5f, tb[0], tb[1], lo, scale, res);
+    par.emplace_back(tb[0] * 3.5f + tb[1] * 3.5f + light * 2.f, tb[0], tb[1], lo, scale, res);
+    for (int k = 0; k < random_count; ++k)
+        par.emplace_back(random_point(rng, k % 5 == 0 ? 12.f : 3.5f), tb[0], tb[1], lo, scale, res);
+    const auto gpu_par = gl::map_kernel(parallel_item_texel<f32, vec3, vec2>, par);
+    std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, glm::vec2, float>> par_coords;
+    std::vector<glm::vec2> cpu_coords;
+    for (std::size_t e = 0; e < par.size(); ++e) {
+        const auto& [p, t, b, corner, s, r] = par[e];
+        const glm::vec2 cpu = parallel_item_texel<float, glm::vec3, glm::vec2>(p, t, b, corner, s, r);
+        const glm::vec2 coord = parallel_item_coords<float, glm::vec3, glm::vec2>(p, t, b, corner, s);
+        compare(gpu_par[e].x, cpu.x, coord.x);
+        compare(gpu_par[e].y, cpu.y, coord.y);
+        par_coords.emplace_back(p, t, b, corner, s);
+        cpu_coords.push_back(coord);
+    }
+    CHECK(worst_scaled(gl::map_kernel(parallel_item_coords<f32, vec3, vec2>, par_coords), cpu_coords,
+                       [&](std::size_t e) { return (double(glm::length(std::get<0>(par[e]))) + 3.5) * scale; }) <=
+          tolerance);
+    INFO(flips << " texels differ, all within rounding of a texel edge but " << wrong);
+    CHECK(wrong == 0);
+    CHECK(flips < 10);
+}
+
+TEST_CASE("a hemicube face's clip position and coordinates and a stereographic texel's direction agree on the GPU "
+          "and the CPU",
+          "[glsl][radiosity]") {
+    gl_test::shared_context();
+    pcg32 rng(37);
+    // Points in a face's frame: inside its frustum, on its edges and corners, grazing.
+    std::vector<std::tuple<glm::vec3, float, float, float>> in;
+    for (int face = 0; face < 5; ++face) {
+        for (const glm::vec3 q : {glm::vec3(0, 0, 1), glm::vec3(1, 1, 1), glm::vec3(-1, 0, 1), glm::vec3(0.5f, 0, 0.5f),
+                                  glm::vec3(1, 1e-7f, 1e-6f), glm::vec3(-2, 0.5f, 1e-3f)})
+            in.emplace_back(q, float(face), 0.01f, 10.f);
+        for (int k = 0; k < random_count / 5; ++k) {
+            const float z = 0.01f + 5 * rng.next_float();
+            in.emplace_back(glm::vec3(rng.next_float() * 2 - 1, rng.next_float() * 2 - 1, 0) * z + glm::vec3(0, 0, z),
+                            float(face), 0.01f, 10.f);
+        }
+    }
+    std::vector<glm::vec4> cpu;
+    for (const auto& a : in) cpu.push_back(std::apply(hemicube_face_clip<float, glm::vec3, glm::vec4>, a));
+    CHECK(worst_scaled(gl::map_kernel(hemicube_face_clip<f32, vec3, glsl::vec4>, in), cpu, [&](std::size_t e) {
+              return 2 * (double(glm::length(std::get<0>(in[e]))) + 1);
+          }) <= tolerance);
+    std::vector<std::tuple<glm::vec3, float>> on_face;
+    std::vector<glm::vec3> cpu_on_face;
+    for (const auto& [q, face, near_z, far_z] : in) {
+        on_face.emplace_back(q, face);
+        cpu_on_face.push_back(hemicube_coords_on_face<float, glm::vec3>(q, face));
+    }
+    const auto gpu_on_face = gl::map_kernel(hemicube_coords_on_face<f32, vec3>, on_face);
+    // u, v of a point on the face are within [0, 1] (scale 1); off the face, s and t grow as
+    // the point's sideways distance over its forward one.
+    CHECK(worst_scaled(gpu_on_face, cpu_on_face, [&](std::size_t e) {
+              const glm::vec3 q = std::get<0>(on_face[e]);
+              return std::max(1.0, double(std::max(std::abs(q.x), std::abs(q.y)) / q.z));
+          }) <= tolerance);
+
+    std::vector<std::tuple<glm::vec2, float>> centres = {{glm::vec2(0.5f), 128.f}, {glm::vec2(127.5f), 128.f},
+                                                         {glm::vec2(64.f), 128.f}, {glm::vec2(0.5f, 127.5f), 128.f}};
+    for (int k = 0; k < random_count; ++k)
+        centres.emplace_back(glm::vec2(float(int(rng.next_float() * 256)), float(int(rng.next_float() * 256))) + 0.5f,
+                             256.f);
+    std::vector<glm::vec3> cpu_dir;
+    for (const auto& a : centres) cpu_dir.push_back(std::apply(stereographic_texel_direction<float, glm::vec3, glm::vec2>, a));
+    CHECK(worst_scaled(gl::map_kernel(stereographic_texel_direction<f32, vec3, vec2>, centres), cpu_dir, unit_scale) <=
+          tolerance);
+}
+
+TEST_CASE("the side of a light's hemisphere a receiver is on agrees on the GPU and the CPU, the plane included",
+          "[glsl][radiosity]") {
+    gl_test::shared_context();
+    pcg32 rng(38);
+    const glm::vec3 light(1, 2, 3), up(0, 0, 1);
+    std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3, float>> in = {
+        {glm::vec3(4, -2, 3), light, up, 0.f},  {glm::vec3(4, -2, 3), light, up, 1.f},
+        {glm::vec3(4, -2, 3), light, -up, 0.f}, {glm::vec3(4, -2, 3), light, -up, 1.f},
+        {glm::vec3(1, 2, 4), light, up, 1.f},   {glm::vec3(1, 2, 2), light, -up, 1.f}};
+    for (int k = 0; k < random_count; ++k) {
+        const glm::vec3 p = random_point(rng, 3.f), o = random_point(rng, 3.f), axis = random_unit(rng);
+        // Away from the plane by more than the rounding of the dot product.
+        if (std::abs(glm::dot(p - o, axis)) < 1e-4f) continue;
+        in.emplace_back(p, o, axis, float(k % 2));
+    }
+    std::vector<float> cpu;
+    for (const auto& a : in) cpu.push_back(std::apply(light_hemisphere_side<float, glm::vec3>, a));
+    const auto gpu = gl::map_kernel(light_hemisphere_side<f32, vec3>, in);
+    for (std::size_t e = 0; e < in.size(); ++e) REQUIRE(gpu[e] == cpu[e]);
+    CHECK(cpu[0] == 1.f);
+    CHECK(cpu[1] == 0.f);
+    CHECK(cpu[2] == 1.f);
+    CHECK(cpu[3] == 0.f);
+}

@@ -184,6 +184,97 @@ TEST_CASE("hemicube face coordinates invert and cover every face", "[radiosity][
     CHECK(hemicube_face_coords<double, glm::dvec3>({1, 0, 1}).x == 0.0);
 }
 
+TEST_CASE("a hemicube face's axes, texel map and clip position are hemicube_face_coords' on that face",
+          "[radiosity][kernel]") {
+    // The table the passes draw a face with (hemicube_face_axes) is the one the lookup's
+    // selects encode: a direction's coordinates in its face's frame give back, exactly, the
+    // lookup's (face, u, v); the clip position a rasterizer draws it at lands on (u, v).
+    for (const auto& w : upper_directions(41, 3000)) {
+        const glm::dvec3 l = w * 1.7;
+        const glm::dvec3 f = hemicube_face_coords<double, glm::dvec3>(l);
+        const auto axes = hemicube_face_axes<glm::dvec3>(int(f.x));
+        const glm::dvec3 q = frame_coords<double, glm::dvec3>(l, axes[0], axes[1], axes[2]);
+        REQUIRE(q.z > 0.0);
+        CHECK(hemicube_coords_on_face<double, glm::dvec3>(q, f.x) == f);
+        const glm::dvec4 clip = hemicube_face_clip<double, glm::dvec3, glm::dvec4>(q, f.x, 0.01, 10.0);
+        CHECK(clip.w == q.z);
+        CHECK(clip.x / clip.w * 0.5 + 0.5 == Approx(f.y).margin(1e-12));
+        CHECK(clip.y / clip.w * 0.5 + 0.5 == Approx(f.z).margin(1e-12));
+    }
+    double row = 0;
+    for (int face = 0; face < 5; ++face) {
+        const auto axes = hemicube_face_axes<glm::dvec3>(face);
+        CHECK(glm::cross(axes[0], axes[1]) == axes[2]);  // right x up = forward
+        // The depth range maps onto [-1, 1] along the forward axis.
+        const auto depth = [&](double z) {
+            const glm::dvec4 c = hemicube_face_clip<double, glm::dvec3, glm::dvec4>({0, 0, z}, double(face), 0.01, 10.0);
+            return c.z / c.w;
+        };
+        CHECK(depth(0.01) == Approx(-1.0));
+        CHECK(depth(10.0) == Approx(1.0));
+        // The faces tile a buffer of 3 res rows: the top face, then the four half faces.
+        CHECK(hemicube_face_first_row(double(face), 64.0) == row);
+        row += hemicube_face_rows(double(face), 64.0);
+    }
+    CHECK(row == 3 * 64.0);
+}
+
+TEST_CASE("an element's item-buffer texel is its coordinate's, floored and clamped to the buffer",
+          "[radiosity][kernel]") {
+    CHECK(item_texel(3.0, 8.0) == 3.0);
+    CHECK(item_texel(2.999, 8.0) == 2.0);
+    CHECK(item_texel(-0.5, 8.0) == 0.0);
+    CHECK(item_texel(8.0, 8.0) == 7.0);
+    CHECK(item_texel(1e30, 8.0) == 7.0);
+    // The normal looks up the stereographic buffer's centre, the horizon its rim, a point
+    // behind the shooter a texel of the buffer's border.
+    CHECK(stereographic_item_texel<double, glm::dvec3, glm::dvec2>({0, 0, 2}, 64.0) == glm::dvec2(32, 32));
+    CHECK(stereographic_item_texel<double, glm::dvec3, glm::dvec2>({1, 0, 0}, 64.0) == glm::dvec2(63, 32));
+    CHECK(stereographic_item_texel<double, glm::dvec3, glm::dvec2>({0, -1, 0}, 64.0) == glm::dvec2(32, 0));
+    CHECK(stereographic_item_texel<double, glm::dvec3, glm::dvec2>({0.1, 0.2, -1}, 64.0) == glm::dvec2(63, 63));
+    // On the hemicube: the normal in the top face's middle; a side face's axis on the horizon
+    // in its bottom row; a point behind the shooter in that bottom row too.
+    CHECK(hemicube_item_texel<double, glm::dvec3>({0, 0, 1}, 64.0) == glm::dvec3(0, 32, 32));
+    CHECK(hemicube_item_texel<double, glm::dvec3>({1, 0, 0}, 64.0) == glm::dvec3(1, 32, 0));
+    CHECK(hemicube_item_texel<double, glm::dvec3>({0, 1, 0.999}, 64.0) == glm::dvec3(3, 32, 31));
+    CHECK(hemicube_item_texel<double, glm::dvec3>({-1, 0.2, -0.5}, 64.0) == glm::dvec3(2, 25, 0));
+    // A directional light's buffer: the corner lo is texel (0, 0); beyond it, the border.
+    const glm::dvec3 t(1, 0, 0), b(0, 1, 0);
+    CHECK(parallel_item_texel<double, glm::dvec3, glm::dvec2>({-1, -1, 5}, t, b, {-1, -1}, 32.0, 64.0) == glm::dvec2(0));
+    CHECK(parallel_item_texel<double, glm::dvec3, glm::dvec2>({0.5, -2, 0}, t, b, {-1, -1}, 32.0, 64.0) ==
+          glm::dvec2(48, 0));
+    CHECK(parallel_item_coords<double, glm::dvec3, glm::dvec2>({0.5, 0.25, 7}, t, b, {-1, -1}, 32.0) ==
+          glm::dvec2(48, 40));
+}
+
+TEST_CASE("a triangle's plane in the shooter's frame holds its corners and faces away from the shooter",
+          "[radiosity][kernel]") {
+    pcg32 rng(44);
+    const auto point = [&] { return glm::dvec3(rng.next_float(), rng.next_float(), rng.next_float()) * 4.0 - 2.0; };
+    for (int k = 0; k < 1000; ++k) {
+        const glm::dvec3 a = point(), b = point(), c = point(), shooter = point();
+        const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+        const glm::dvec3 axis = glm::normalize(point());
+        const auto tb = orthonormal_basis<double, glm::dvec3>(axis);
+        const auto local = [&](glm::dvec3 p) { return to_shooter_frame<double, glm::dvec3>(p, shooter, tb[0], tb[1], axis); };
+        const glm::dvec4 plane = shooter_plane<double, glm::dvec3, glm::dvec4>(n, local(a), tb[0], tb[1], axis);
+        CHECK(plane.w >= 0.0);
+        CHECK(glm::length(glm::dvec3(plane)) == Approx(1.0));
+        for (const glm::dvec3& p : {a, b, c}) CHECK(glm::dot(glm::dvec3(plane), local(p)) == Approx(plane.w).margin(1e-9));
+    }
+}
+
+TEST_CASE("a light's two hemispheres take a receiver on the plane between them once", "[radiosity][kernel]") {
+    const glm::dvec3 light(1, 2, 3), axis(0, 0, 1);
+    for (const glm::dvec3& p : {glm::dvec3(4, -2, 3), glm::dvec3(1, 2, 3.5), glm::dvec3(0, 0, 2)}) {
+        const double first = light_hemisphere_side<double, glm::dvec3>(p, light, axis, 0.0);
+        const double second = light_hemisphere_side<double, glm::dvec3>(p, light, -axis, 1.0);
+        CHECK(first + second == 1.0);
+    }
+    CHECK(light_hemisphere_side<double, glm::dvec3>({4, -2, 3}, light, axis, 0.0) == 1.0);
+    CHECK(light_hemisphere_side<double, glm::dvec3>({4, -2, 3}, light, axis, 1.0) == 0.0);
+}
+
 TEST_CASE("hemisphere depth is the radial distance mapped from [near, far] to [0, 1]", "[radiosity][kernel]") {
     CHECK(hemisphere_depth<double, glm::dvec3>({0, 3, 4}, 1.0, 11.0) == Approx(0.4));
     CHECK(hemisphere_depth<double, glm::dvec3>({0, 0, 1}, 1.0, 11.0) == 0.0);

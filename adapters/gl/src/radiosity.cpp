@@ -142,32 +142,7 @@ image<glm::vec3> progressive_radiosity::radiosity_lightmap(int level) const {
 texture_ref progressive_radiosity::update_lightmap_texture() {
     state& st = *s_;
     if (!st.lightmap_program) {
-        using glsl::f32;
-        using glsl::vec3;
-        glsl::function_set fs;
-        fs.add("radiosity_display", radiosity_with_ambient<f32, vec3>, "radiosity", "albedo", "ambient");
-        st.lightmap_program = std::make_unique<program>(program::compute(version_header() + R"(
-layout(local_size_x = 8, local_size_y = 8) in;
-)" + fs.source() + R"(
-struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };
-layout(std430, binding = 0) readonly buffer texels_block { texel_attributes texel[]; };
-layout(std430, binding = 4) readonly buffer source_block { uint source_texel[]; };
-layout(rgba32f, binding = 0) uniform readonly image2D radiosity_image;
-layout(rgba32f, binding = 2) uniform writeonly image2D lightmap_image;
-layout(location = 0) uniform int atlas_width;
-layout(location = 1) uniform int atlas_height;
-layout(location = 2) uniform vec3 ambient;
-void main() {
-    ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
-    if (xy.x >= atlas_width || xy.y >= atlas_height) return;
-    uint code = source_texel[xy.y * atlas_width + xy.x];
-    if (code == 0xffffffffu) { imageStore(lightmap_image, xy, vec4(0.0)); return; }
-    ivec2 from = ivec2(int(code & 0xffffu), int(code >> 16u));
-    vec3 b = imageLoad(radiosity_image, from).rgb;
-    vec3 rho = texel[from.y * atlas_width + from.x].albedo.rgb;
-    imageStore(lightmap_image, xy, vec4(radiosity_display(b, rho, ambient), 1.0));
-}
-)"));
+        st.lightmap_program = std::make_unique<program>(program::compute(radiosity_glsl::lightmap_compute()));
         st.lightmap_texture = std::make_unique<texture>(texel_format::rgba32f, st.width, st.height);
         std::vector<std::uint32_t> src(std::size_t(st.width) * st.height, 0xffffffffu);
         for (std::uint32_t y = 0; y < st.atlas.height; ++y)
@@ -182,15 +157,17 @@ void main() {
     {
         binding_state saved;
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, st.texels.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, element_binding, st.source_texel->id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, radiosity_glsl::source_binding, st.source_texel->id());
         glBindImageTexture(radiosity_unit, st.radiosity.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glBindImageTexture(intercepted_unit, st.lightmap_texture->id(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glBindImageTexture(radiosity_glsl::lightmap_unit, st.lightmap_texture->id(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                           GL_RGBA32F);
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         const program& p = *st.lightmap_program;
         glUseProgram(p.id());
-        p.set(0, int(st.width));
-        p.set(1, int(st.height));
-        p.set(2, amb);
+        namespace u = radiosity_glsl::lightmap_uniform;
+        p.set(u::atlas_width, int(st.width));
+        p.set(u::atlas_height, int(st.height));
+        p.set(u::ambient, amb);
         glDispatchCompute((st.width + 7) / 8, (st.height + 7) / 8, 1);
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         check_error("progressive_radiosity: the lightmap pass");

@@ -51,25 +51,17 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     }
 
     // Shooters: blocks or elements, their centres and texel rectangles.
-    if (options.shooting.shoot_blocks) first.assign(atlas.block_first.begin(), atlas.block_first.end());
-    else {
-        first.resize(n + 1);
-        std::iota(first.begin(), first.end(), std::uint32_t(0));
-    }
+    first = shooter_ranges(atlas, options.shooting.shoot_blocks);
     const std::size_t shooters = first.size() - 1;
     centre.resize(shooters);
     rect.resize(shooters);
     for (std::size_t k = 0; k < shooters; ++k) {
-        glm::dvec3 c(0.0);
-        double area = 0;
         glm::uvec2 mn(std::numeric_limits<std::uint32_t>::max()), mx(0u);
         for (std::uint32_t i = first[k]; i < first[k + 1]; ++i) {
-            c += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
-            area += double(atlas.area[i]);
             mn = glm::min(mn, atlas.texel[i]);
             mx = glm::max(mx, atlas.texel[i]);
         }
-        centre[k] = glm::vec3(c / area);
+        centre[k] = shooter_disc_of(atlas, first[k], first[k + 1]).centre;
         rect[k] = glm::uvec4(mn, mx - mn + 1u);
     }
     std::vector<std::uint32_t> first_padded(first);
@@ -92,16 +84,11 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     }
     nodes = buffer(std::size_t(max_nodes) * sizeof(gpu_node));
 
-    // Triangles that have a chart.
-    for (std::size_t tri = 0; tri < scene.triangles.size(); ++tri) {
-        if (atlas.chart_of_triangle[tri] == lightmap_atlas::none) continue;
-        const auto& ix = scene.triangles[tri];
-        corners.push_back({scene.positions[ix.x], scene.positions[ix.y], scene.positions[ix.z]});
-        triangle_chart.push_back(atlas.chart_of_triangle[tri]);
-        const glm::dvec3 p0(corners.back()[0]), p1(corners.back()[1]), p2(corners.back()[2]);
-        const glm::dvec3 nn = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-        world_plane.emplace_back(glm::vec3(nn), float(glm::dot(nn, p0)));
-    }
+    // Triangles that have a chart (the CPU item buffer's).
+    item_triangles triangles = item_buffer_triangles(scene, atlas);
+    corners = std::move(triangles.corners);
+    triangle_chart = std::move(triangles.chart);
+    world_plane = std::move(triangles.world_plane);
     const auto [blo, bhi] = scene.bounds();
     lo = blo;
     hi = bhi;

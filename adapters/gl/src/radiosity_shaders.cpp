@@ -30,6 +30,11 @@ std::string uniforms(std::initializer_list<std::pair<int, const char*>> declarat
     return out;
 }
 
+// The shooter's frame (shot_t, shot_b, shot_n) at a pass's locations for them.
+std::string frame_uniforms(int t, int b, int n) {
+    return uniforms({{t, "vec3 shot_t"}, {b, "vec3 shot_b"}, {n, "vec3 shot_n"}});
+}
+
 // A std430 storage block at `binding`: "layout(std430, binding = B) DECLARATION;".
 std::string storage_block(unsigned binding, const char* declaration) {
     return "layout(std430, binding = " + std::to_string(binding) + ") " + declaration + ";\n";
@@ -43,12 +48,15 @@ std::string image(unsigned unit, const char* declaration) {
 const char* const texel_attributes_struct =
     "struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };\n";
 
-// The kernels the visibility lookups of the distribution and light passes call.
+// The kernels the visibility lookups of the distribution and light passes call: where an
+// element is looked up (its texel) and whether the surface shown there hides it.
 std::string lookup_functions() {
     glsl::function_set fs;
-    fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
     fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
-    fs.add("radiosity_hemicube_coords", hemicube_face_coords<f32, vec3>, "local_direction");
+    fs.add("radiosity_stereographic_texel", stereographic_item_texel<f32, vec3, vec2>, "local_position", "res");
+    fs.add("radiosity_hemicube_texel", hemicube_item_texel<f32, vec3>, "local_position", "res");
+    fs.add("radiosity_hemicube_first_row", hemicube_face_first_row<f32>, "face", "res");
+    fs.add("radiosity_parallel_texel", parallel_item_texel<f32, vec3, vec2>, "p", "t", "b", "lo", "scale", "res");
     fs.add("radiosity_parallel_sees", parallel_item_sees<f32, vec3>, "element", "element_chart", "shown_chart",
            "plane_normal", "plane_offset", "shown_depth", "direction", "diagonal");
     fs.add("radiosity_item_sees", item_buffer_sees<f32, vec3>, "element", "element_chart", "shown_chart",
@@ -62,11 +70,9 @@ std::string shot_uniforms() {
     return uniforms({{element_count, "uint element_count"},
                      {atlas_width, "int atlas_width"},
                      {atlas_height, "int atlas_height"},
-                     {shot_position, "vec3 shot_position"},
-                     {shot_t, "vec3 shot_t"},
-                     {shot_b, "vec3 shot_b"},
-                     {shot_n, "vec3 shot_n"},
-                     {shot_chart, "float shot_chart"},
+                     {shot_position, "vec3 shot_position"}}) +
+           frame_uniforms(shot_t, shot_b, shot_n) +
+           uniforms({{shot_chart, "float shot_chart"},
                      {occlusion, "int occlusion"},
                      {resolution, "float resolution"},
                      {diagonal, "float diagonal"},
@@ -83,23 +89,18 @@ std::string shot_common() {
            image(radiosity_unit, "image2D radiosity_image") + image(unshot_unit, "image2D unshot_image") +
            image(intercepted_unit, "writeonly image2D intercepted_image") +
            image(item_unit, "readonly image2D item_image") + R"(
-// Visibility of the element at world position p (chart `chart`) from the shot: its pixel in
-// the stereographic buffer, or on its hemicube face (top face in rows [0, res), side face f
-// in rows res + (f - 1) res / 2 on).
+// Visibility of the element at world position p (chart `chart`) from the shot: its texel in
+// the stereographic buffer, or on its hemicube face, whose texels start at the face's first
+// row of the buffer.
 float shot_visibility(vec3 p, float chart) {
     if (occlusion == 0) return 1.0;
     vec3 l = radiosity_to_shooter_frame(p, shot_position, shot_t, shot_b, shot_n);
-    int res = int(resolution);
     ivec2 pixel;
     if (hemicube != 0) {
-        vec3 f = radiosity_hemicube_coords(l);
-        int face = clamp(int(f.x + 0.5), 0, 4);
-        int rows = face == 0 ? res : res / 2;
-        pixel = ivec2(clamp(int(floor(f.y * resolution)), 0, res - 1),
-                      clamp(int(floor(f.z * float(rows))), 0, rows - 1) + (face == 0 ? 0 : res + (face - 1) * (res / 2)));
+        vec3 h = radiosity_hemicube_texel(l, resolution);
+        pixel = ivec2(h.yz) + ivec2(0, int(radiosity_hemicube_first_row(h.x, resolution)));
     } else {
-        vec2 uv = radiosity_item_coords(l);
-        pixel = clamp(ivec2(floor(uv * resolution)), ivec2(0), ivec2(res - 1));
+        pixel = ivec2(radiosity_stereographic_texel(l, resolution));
     }
     vec4 item = imageLoad(item_image, pixel);
     vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
@@ -136,7 +137,7 @@ void main() {
 
 std::string item_buffer_fragment() {
     glsl::function_set fs;
-    fs.add("radiosity_pixel_direction", stereographic_direction<f32, vec3, vec2>, "q");
+    fs.add("radiosity_texel_direction", stereographic_texel_direction<f32, vec3, vec2>, "centre", "res");
     fs.add("radiosity_plane_depth", item_plane_depth<f32, vec3>, "plane_normal", "plane_offset", "w", "interpolated");
     return version_line + fs.source() +
            uniforms({{item_uniform::resolution, "float resolution"}, {item_uniform::depth_scale, "float depth_scale"}}) +
@@ -145,7 +146,7 @@ layout(location = 0) noperspective in float radial;
 layout(location = 1) flat in vec2 item_ids;
 layout(location = 0) out vec4 item;
 void main() {
-    vec3 w = radiosity_pixel_direction(gl_FragCoord.xy / resolution * 2.0 - 1.0);
+    vec3 w = radiosity_texel_direction(gl_FragCoord.xy, resolution);
     vec4 plane = local_plane[int(item_ids.y)];
     float depth = radiosity_plane_depth(plane.xyz, plane.w, w, radial);
     gl_FragDepth = depth / depth_scale;
@@ -157,21 +158,20 @@ void main() {
 // Hemicube faces (Cohen and Greenberg 1985): perspective views of the untessellated
 // triangles, 1/z interpolated by the rasterizer (exact under perspective), depth the
 // distance along the face's forward axis, as cpu::item_buffer_visibility stores it. Side
-// faces keep their upper half: clip y = 2 up - forward maps up / forward in [0, 1] onto
-// the viewport.
+// faces keep their upper half; hemicube_face_clip puts each corner where the face's (u, v)
+// (the lookup's) lands in the face's viewport.
 std::string hemicube_vertex() {
     using namespace hemicube_uniform;
     glsl::function_set fs;
     fs.add("radiosity_to_shooter_frame", to_shooter_frame<f32, vec3>, "p", "origin", "t", "b", "n");
-    return version_line + fs.source() +
-           uniforms({{shot_position, "vec3 shot_position"},
-                     {shot_t, "vec3 shot_t"},
-                     {shot_b, "vec3 shot_b"},
-                     {shot_n, "vec3 shot_n"},
-                     {face_right, "vec3 face_right"},
+    fs.add("radiosity_frame_coords", frame_coords<f32, vec3>, "d", "t", "b", "n");
+    fs.add("radiosity_face_clip", hemicube_face_clip<f32, vec3, glsl::vec4>, "q", "face", "near_z", "far_z");
+    return version_line + fs.source() + uniforms({{shot_position, "vec3 shot_position"}}) +
+           frame_uniforms(shot_t, shot_b, shot_n) +
+           uniforms({{face_right, "vec3 face_right"},
                      {face_up, "vec3 face_up"},
                      {face_forward, "vec3 face_forward"},
-                     {side_face, "int side_face"},
+                     {face, "float face"},
                      {near_z, "float near_z"},
                      {far_z, "float far_z"}}) +
            R"(
@@ -181,10 +181,8 @@ layout(location = 0) out float forward_depth;
 layout(location = 1) flat out vec2 item_ids;
 void main() {
     vec3 l = radiosity_to_shooter_frame(world_position, shot_position, shot_t, shot_b, shot_n);
-    vec3 q = vec3(dot(l, face_right), dot(l, face_up), dot(l, face_forward));
-    float y = side_face != 0 ? 2.0 * q.y - q.z : q.y;
-    float a = (far_z + near_z) / (far_z - near_z), b = -2.0 * far_z * near_z / (far_z - near_z);
-    gl_Position = vec4(q.x, y, a * q.z + b, q.z);
+    vec3 q = radiosity_frame_coords(l, face_right, face_up, face_forward);
+    gl_Position = radiosity_face_clip(q, face, near_z, far_z);
     forward_depth = q.z;
     item_ids = ids;
 }
@@ -205,15 +203,15 @@ void main() {
 )";
 }
 
-// A directional light: an orthographic view along it over the scene's box; the depth is
-// the distance along the light, linear, so the rasterizer's depth is exact.
+// A directional light: an orthographic view along it over the scene's box, each corner at
+// its texel coordinates (parallel_item_coords, as the lookup finds them); the depth is the
+// distance along the light, linear, so the rasterizer's depth is exact.
 std::string parallel_vertex() {
     using namespace parallel_uniform;
-    return version_line +
-           uniforms({{shot_t, "vec3 shot_t"},
-                     {shot_b, "vec3 shot_b"},
-                     {shot_n, "vec3 shot_n"},
-                     {ortho_lo, "vec2 ortho_lo"},
+    glsl::function_set fs;
+    fs.add("radiosity_parallel_coords", parallel_item_coords<f32, vec3, vec2>, "p", "t", "b", "lo", "scale");
+    return version_line + fs.source() + frame_uniforms(shot_t, shot_b, shot_n) +
+           uniforms({{ortho_lo, "vec2 ortho_lo"},
                      {ortho_scale, "float ortho_scale"},
                      {parallel_resolution, "float parallel_resolution"},
                      {depth_lo, "float depth_lo"},
@@ -224,7 +222,7 @@ layout(location = 1) in vec2 ids;
 layout(location = 0) out float along;
 layout(location = 1) flat out vec2 item_ids;
 void main() {
-    vec2 pixel = (vec2(dot(world_position, shot_t), dot(world_position, shot_b)) - ortho_lo) * ortho_scale;
+    vec2 pixel = radiosity_parallel_coords(world_position, shot_t, shot_b, ortho_lo, ortho_scale);
     along = dot(world_position, shot_n);
     gl_Position = vec4(pixel / parallel_resolution * 2.0 - 1.0, (along - depth_lo) / (depth_hi - depth_lo) * 2.0 - 1.0, 1.0);
     item_ids = ids;
@@ -309,6 +307,7 @@ void main() {
 std::string light_compute() {
     using namespace light_uniform;
     glsl::function_set fs;
+    fs.add("radiosity_light_side", light_hemisphere_side<f32, vec3>, "p", "light_position", "axis", "strict");
     fs.add("radiosity_point_irradiance", point_light_irradiance<f32, vec3>, "p", "n", "light_position", "intensity");
     fs.add("radiosity_directional_irradiance", directional_light_irradiance<f32, vec3>, "n", "direction", "irradiance");
     fs.add("radiosity_spot_irradiance", spot_light_irradiance<f32, vec3>, "p", "n", "light_position", "axis",
@@ -329,9 +328,7 @@ std::string light_compute() {
 // whose planes are the triangles' world planes.
 float parallel_visibility(vec3 p, float chart) {
     if (occlusion == 0) return 1.0;
-    vec3 l = radiosity_to_shooter_frame(p, vec3(0.0), shot_t, shot_b, shot_n);
-    int res = int(parallel_resolution);
-    ivec2 pixel = clamp(ivec2(floor((l.xy - ortho_lo) * ortho_scale)), ivec2(0), ivec2(res - 1));
+    ivec2 pixel = ivec2(radiosity_parallel_texel(p, shot_t, shot_b, ortho_lo, ortho_scale, parallel_resolution));
     vec4 item = imageLoad(item_image, pixel);
     vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
     return radiosity_parallel_sees(p, chart, item.x, plane.xyz, plane.w, item.z, shot_n, diagonal);
@@ -346,8 +343,7 @@ void main() {
     if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
     vec3 p = a.position_area.xyz, n = a.normal_chart.xyz;
     // Each element belongs to one hemisphere of the light: z >= 0 of the first, z > 0 of the second.
-    float z = dot(p - shot_position, shot_n);
-    bool side = parallel != 0 || (strict_side != 0 ? z > 0.0 : z >= 0.0);
+    bool side = parallel != 0 || radiosity_light_side(p, shot_position, shot_n, float(strict_side)) > 0.5;
     vec3 e = parallel != 0 ? radiosity_directional_irradiance(n, light_axis, intensity)
            : spot != 0     ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
                            : radiosity_point_irradiance(p, n, shot_position, intensity);
@@ -429,6 +425,33 @@ void main() {
     barrier();
     if (i == 0u)
         for (uint c = 0u; c < 9u; ++c) partial[c] = s[c];
+}
+)";
+}
+
+// The display lightmap: each lightmap texel shows its element's radiosity with the ambient
+// term (radiosity_with_ambient, emitted); source_texel holds the element's atlas texel packed
+// as x | y << 16, or 0xffffffff where the texel shows no element.
+std::string lightmap_compute() {
+    using namespace lightmap_uniform;
+    glsl::function_set fs;
+    fs.add("radiosity_display", radiosity_with_ambient<f32, vec3>, "radiosity", "albedo", "ambient");
+    return version_line + "layout(local_size_x = 8, local_size_y = 8) in;\n" + fs.source() + texel_attributes_struct +
+           storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
+           storage_block(source_binding, "readonly buffer source_block { uint source_texel[]; }") +
+           image(radiosity_unit, "readonly image2D radiosity_image") +
+           image(lightmap_unit, "writeonly image2D lightmap_image") +
+           uniforms({{atlas_width, "int atlas_width"}, {atlas_height, "int atlas_height"}, {ambient, "vec3 ambient"}}) +
+           R"(
+void main() {
+    ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
+    if (xy.x >= atlas_width || xy.y >= atlas_height) return;
+    uint code = source_texel[xy.y * atlas_width + xy.x];
+    if (code == 0xffffffffu) { imageStore(lightmap_image, xy, vec4(0.0)); return; }
+    ivec2 from = ivec2(int(code & 0xffffu), int(code >> 16u));
+    vec3 b = imageLoad(radiosity_image, from).rgb;
+    vec3 rho = texel[from.y * atlas_width + from.x].albedo.rgb;
+    imageStore(lightmap_image, xy, vec4(radiosity_display(b, rho, ambient), 1.0));
 }
 )";
 }

@@ -12,14 +12,17 @@ namespace bounce::gl::radiosity_glsl {
 constexpr unsigned texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
                    partial_binding = 5;
 constexpr unsigned radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
+// The lightmap pass's: the atlas texel each lightmap texel shows, where the passes keep the
+// element texels, and the lightmap image, where they keep the intercepted power.
+constexpr unsigned source_binding = element_binding, lightmap_unit = intercepted_unit;
 
 // The item buffer's fragment shader (stereographic visibility).
 namespace item_uniform {
 enum : int { resolution = 0, depth_scale = 1 };
 }
 
-// The hemicube's vertex and fragment shaders: the shooter's frame, the face drawn, and the
-// depth range.
+// The hemicube's vertex and fragment shaders: the shooter's frame, the face drawn (its axes
+// and its number), and the depth range.
 namespace hemicube_uniform {
 enum : int {
     shot_position = 0,
@@ -29,7 +32,7 @@ enum : int {
     face_right = 4,
     face_up = 5,
     face_forward = 6,
-    side_face = 7,
+    face = 7,
     near_z = 8,
     far_z = 9,
     shot_chart = 10,
@@ -89,6 +92,11 @@ enum : int {
 };
 }
 
+// The display lightmap's pass (update_lightmap_texture).
+namespace lightmap_uniform {
+enum : int { atlas_width = 0, atlas_height = 1, ambient = 2 };
+}
+
 // The reduction's two passes.
 namespace reduce_uniform {
 enum : int { atlas_width = 0, shooter_count = 1 };
@@ -108,5 +116,6 @@ std::string distribute_compute(int max_nodes, int stack_size);
 std::string light_compute();
 std::string reduce_compute();
 std::string finish_compute();
+std::string lightmap_compute();
 
 }  // namespace bounce::gl::radiosity_glsl

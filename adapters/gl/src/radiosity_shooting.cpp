@@ -4,6 +4,32 @@
 
 namespace bounce::gl {
 
+namespace {
+
+// Clears an item buffer's framebuffer to "nothing drawn" (no chart, no triangle, the largest
+// depth in the colour; the depth attachment to 1) and binds it for drawing.
+void clear_and_bind_item_target(GLuint framebuffer_id) {
+    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
+    glClearNamedFramebufferfv(framebuffer_id, GL_COLOR, 0, none.data());
+    const float far_depth = 1.f;
+    glClearNamedFramebufferfv(framebuffer_id, GL_DEPTH, 0, &far_depth);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer_id);
+}
+
+// Points the vertex array `vao` at `vertices`, a stream of item_vertex: attribute 0 the
+// position, attribute 1 the (chart, triangle) pair.
+void attach_item_vertices(GLuint vao, GLuint vertices) {
+    glVertexArrayVertexBuffer(vao, 0, vertices, 0, GLsizei(sizeof(item_vertex)));
+    glEnableVertexArrayAttrib(vao, 0);
+    glEnableVertexArrayAttrib(vao, 1);
+    glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribFormat(vao, 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
+    glVertexArrayAttribBinding(vao, 0, 0);
+    glVertexArrayAttribBinding(vao, 1, 0);
+}
+
+}  // namespace
+
 void progressive_radiosity::state::bind_common() const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, texels.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, nodes_binding, nodes.id());
@@ -52,6 +78,22 @@ void progressive_radiosity::state::set_shot(glm::vec3 position, glm::vec3 axis, 
     b = tb[1];
 }
 
+void progressive_radiosity::state::set_frame_uniforms(const program& p, int t_location, int b_location,
+                                                      int n_location) const {
+    p.set(t_location, t);
+    p.set(b_location, b);
+    p.set(n_location, shot_axis);
+}
+
+float progressive_radiosity::state::farthest_from_shot() const {
+    float far_distance = 0.f;
+    for (int m = 0; m < 8; ++m) {
+        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
+        far_distance = std::max(far_distance, glm::length(corner - shot_position));
+    }
+    return far_distance;
+}
+
 void progressive_radiosity::state::draw_item_buffer() {
     // The triangles in the shooter's frame, clipped above its plane and tessellated until no
     // projected edge bends more than tolerance_px from its chord (cpu::item_buffer_visibility).
@@ -66,10 +108,7 @@ void progressive_radiosity::state::draw_item_buffer() {
         for (int m = 0; m < 3; ++m)
             l[std::size_t(m)] = to_shooter_frame<float, glm::vec3>(corners[k][std::size_t(m)], shot_position, t, b, shot_axis);
         if (l[0].z < z_min && l[1].z < z_min && l[2].z < z_min) continue;
-        const glm::vec3 nl(glm::dot(glm::vec3(world_plane[k]), t), glm::dot(glm::vec3(world_plane[k]), b),
-                           glm::dot(glm::vec3(world_plane[k]), shot_axis));
-        const float d = glm::dot(nl, l[0]);
-        local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
+        local_plane[k] = shooter_plane<float, glm::vec3, glm::vec4>(glm::vec3(world_plane[k]), l[0], t, b, shot_axis);
         const float chart = float(triangle_chart[k]), id = float(k);
         // The CPU's pieces in the CPU's order (radiosity/stereographic_tessellation.hpp).
         clip_and_tessellate_stereographic(l, z_min, how, poly, scratch,
@@ -82,29 +121,15 @@ void progressive_radiosity::state::draw_item_buffer() {
     if (pieces.size() > vertex_capacity) {
         vertex_capacity = std::max<std::size_t>(pieces.size() * 2, 1024);
         vertices = std::make_unique<buffer>(vertex_capacity * sizeof(item_vertex));
-        glVertexArrayVertexBuffer(item_vao.id(), 0, vertices->id(), 0, GLsizei(sizeof(item_vertex)));
-        glEnableVertexArrayAttrib(item_vao.id(), 0);
-        glEnableVertexArrayAttrib(item_vao.id(), 1);
-        glVertexArrayAttribFormat(item_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribFormat(item_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
-        glVertexArrayAttribBinding(item_vao.id(), 0, 0);
-        glVertexArrayAttribBinding(item_vao.id(), 1, 0);
+        attach_item_vertices(item_vao.id(), vertices->id());
     }
     if (!pieces.empty()) vertices->write(0, pieces.data(), pieces.size() * sizeof(item_vertex));
 
     // The farthest the scene can be from the shooter: the depth attachment's scale.
-    float far_distance = 0.f;
-    for (int m = 0; m < 8; ++m) {
-        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
-        far_distance = std::max(far_distance, glm::length(corner - shot_position));
-    }
+    const float far_distance = farthest_from_shot();
     detail::raster_state raster;
     binding_state saved;
-    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
-    glClearNamedFramebufferfv(item_fbo.id(), GL_COLOR, 0, none.data());
-    const float far_depth = 1.f;
-    glClearNamedFramebufferfv(item_fbo.id(), GL_DEPTH, 0, &far_depth);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
+    clear_and_bind_item_target(item_fbo.id());
     glViewport(0, 0, options.resolution, options.resolution);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, planes_binding, planes.id());
     glUseProgram(item_program->id());
@@ -127,13 +152,7 @@ void progressive_radiosity::state::world_vertices() {
         for (int m = 0; m < 3; ++m) v.push_back({corners[k][std::size_t(m)], float(triangle_chart[k]), float(k)});
     cube_vertex_count = v.size();
     cube_vertices = std::make_unique<buffer>(std::max<std::size_t>(v.size(), 1) * sizeof(item_vertex), v.data());
-    glVertexArrayVertexBuffer(cube_vao.id(), 0, cube_vertices->id(), 0, GLsizei(sizeof(item_vertex)));
-    glEnableVertexArrayAttrib(cube_vao.id(), 0);
-    glEnableVertexArrayAttrib(cube_vao.id(), 1);
-    glVertexArrayAttribFormat(cube_vao.id(), 0, 3, GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribFormat(cube_vao.id(), 1, 2, GL_FLOAT, GL_FALSE, GLuint(offsetof(item_vertex, chart)));
-    glVertexArrayAttribBinding(cube_vao.id(), 0, 0);
-    glVertexArrayAttribBinding(cube_vao.id(), 1, 0);
+    attach_item_vertices(cube_vao.id(), cube_vertices->id());
 }
 
 void progressive_radiosity::state::draw_parallel() {
@@ -153,35 +172,24 @@ void progressive_radiosity::state::draw_parallel() {
     wp.resize(local_plane.size(), glm::vec4(0.f, 0.f, 1.f, 0.f));
     planes.write(0, wp.data(), wp.size() * sizeof(glm::vec4));
     // The scene's box projected across the light, widened by a pixel each side
-    // (cpu::item_buffer_visibility's parallel buffer); its extent along the light.
-    glm::vec2 mn(std::numeric_limits<float>::max()), mx(-std::numeric_limits<float>::max());
+    // (radiosity/kernels.hpp, cpu::item_buffer_visibility's parallel buffer); its extent
+    // along the light.
+    std::tie(ortho_lo, ortho_scale) = parallel_item_window<float, glm::vec3, glm::vec2>(lo, hi, t, b, float(res));
     float d0 = std::numeric_limits<float>::max(), d1 = -std::numeric_limits<float>::max();
     for (int m = 0; m < 8; ++m) {
         const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
-        const glm::vec2 q(glm::dot(corner, t), glm::dot(corner, b));
-        mn = glm::min(mn, q);
-        mx = glm::max(mx, q);
         d0 = std::min(d0, glm::dot(corner, shot_axis));
         d1 = std::max(d1, glm::dot(corner, shot_axis));
     }
-    const float side = std::max(std::max(mx.x - mn.x, mx.y - mn.y), 1e-30f) * (1.f + 2.f / float(res));
-    ortho_lo = 0.5f * (mn + mx) - glm::vec2(0.5f * side);
-    ortho_scale = float(res) / side;
     const float margin = 0.01f * diagonal;
     detail::raster_state raster;
     binding_state saved;
-    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
-    glClearNamedFramebufferfv(parallel_fbo->id(), GL_COLOR, 0, none.data());
-    const float far_depth = 1.f;
-    glClearNamedFramebufferfv(parallel_fbo->id(), GL_DEPTH, 0, &far_depth);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, parallel_fbo->id());
+    clear_and_bind_item_target(parallel_fbo->id());
     glViewport(0, 0, res, res);
     const program& p = *parallel_program;
     glUseProgram(p.id());
     namespace u = radiosity_glsl::parallel_uniform;
-    p.set(u::shot_t, t);
-    p.set(u::shot_b, b);
-    p.set(u::shot_n, shot_axis);
+    set_frame_uniforms(p, u::shot_t, u::shot_b, u::shot_n);
     p.set(u::ortho_lo, ortho_lo);
     p.set(u::ortho_scale, ortho_scale);
     p.set(u::parallel_resolution, float(res));
@@ -195,47 +203,35 @@ void progressive_radiosity::state::draw_parallel() {
 
 void progressive_radiosity::state::draw_hemicube() {
     // Each triangle's plane in the shooter's frame, facing away from it, for the lookup.
-    for (std::size_t k = 0; k < corners.size(); ++k) {
-        const glm::vec3 nl(glm::dot(glm::vec3(world_plane[k]), t), glm::dot(glm::vec3(world_plane[k]), b),
-                           glm::dot(glm::vec3(world_plane[k]), shot_axis));
-        const float d = glm::dot(nl, to_shooter_frame<float, glm::vec3>(corners[k][0], shot_position, t, b, shot_axis));
-        local_plane[k] = d >= 0.f ? glm::vec4(nl, d) : glm::vec4(-nl, -d);
-    }
+    for (std::size_t k = 0; k < corners.size(); ++k)
+        local_plane[k] = shooter_plane<float, glm::vec3, glm::vec4>(
+            glm::vec3(world_plane[k]), to_shooter_frame<float, glm::vec3>(corners[k][0], shot_position, t, b, shot_axis), t,
+            b, shot_axis);
     planes.write(0, local_plane.data(), local_plane.size() * sizeof(glm::vec4));
     world_vertices();
-    float far_distance = 0.f;
-    for (int m = 0; m < 8; ++m) {
-        const glm::vec3 corner((m & 1) ? hi.x : lo.x, (m & 2) ? hi.y : lo.y, (m & 4) ? hi.z : lo.z);
-        far_distance = std::max(far_distance, glm::length(corner - shot_position));
-    }
-    const float far_z = far_distance * 1.01f + 1e-6f * diagonal, near_z = 1e-6f * diagonal;
+    const float far_z = farthest_from_shot() * 1.01f + 1e-6f * diagonal, near_z = 1e-6f * diagonal;
     detail::raster_state raster;
     binding_state saved;
-    const std::array<float, 4> none{-1.f, -1.f, std::numeric_limits<float>::max(), 0.f};
-    glClearNamedFramebufferfv(item_fbo.id(), GL_COLOR, 0, none.data());
-    const float far_depth = 1.f;
-    glClearNamedFramebufferfv(item_fbo.id(), GL_DEPTH, 0, &far_depth);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, item_fbo.id());
+    clear_and_bind_item_target(item_fbo.id());
     const program& p = *cube_program;
     glUseProgram(p.id());
     namespace u = radiosity_glsl::hemicube_uniform;
     p.set(u::shot_position, shot_position);
-    p.set(u::shot_t, t);
-    p.set(u::shot_b, b);
-    p.set(u::shot_n, shot_axis);
+    set_frame_uniforms(p, u::shot_t, u::shot_b, u::shot_n);
     p.set(u::near_z, near_z);
     p.set(u::far_z, far_z);
     p.set(u::shot_chart, shot_chart);
     glBindVertexArray(cube_vao.id());
-    const int res = options.resolution;
+    const float res = float(options.resolution);
     for (int face = 0; face < 5; ++face) {
-        const auto axes = face_axes(face);
+        // The face's axes and number, drawn into its rows of the buffer (radiosity/kernels.hpp).
+        const auto axes = hemicube_face_axes<glm::vec3>(face);
         p.set(u::face_right, axes[0]);
         p.set(u::face_up, axes[1]);
         p.set(u::face_forward, axes[2]);
-        p.set(u::side_face, face == 0 ? 0 : 1);
-        if (face == 0) glViewport(0, 0, res, res);
-        else glViewport(0, res + (face - 1) * (res / 2), res, res / 2);
+        p.set(u::face, float(face));
+        glViewport(0, GLint(hemicube_face_first_row(float(face), res)), GLsizei(res),
+                   GLsizei(hemicube_face_rows(float(face), res)));
         glDrawArrays(GL_TRIANGLES, 0, GLsizei(cube_vertex_count));
     }
     drawn = 5 * cube_vertex_count / 3;
@@ -269,59 +265,21 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
                            &zero);
         check_error("progressive_radiosity: reading the shooter back");
     }
-    glm::dvec3 power(0.0);
-    struct node_sum {
-        glm::uvec2 cell;
-        glm::dvec3 moment, power;
-        double area;
-        std::int32_t first_child, child_count;
-    };
-    std::vector<node_sum> level, up;
-    glm::vec4 block_rect(0.f, 0.f, 1.f, 1.f);
-    glm::uvec2 grid(1u);
-    if (options.shooting.shoot_blocks) {
-        block_rect = atlas.block_rect[k];
-        grid = atlas.block_grid[k];
-    }
-    const lightmap_chart& ch = atlas.charts[atlas.chart[i0]];
-    for (std::uint32_t i = i0; i < i1; ++i) {
+    // The shooter's unshot radiosity per element, from the texels read back.
+    const auto unshot_of = [&](std::uint32_t i) {
         const glm::uvec2 tx = atlas.texel[i] - glm::uvec2(r.x, r.y);
-        const glm::vec3 u(texels_back[std::size_t(tx.y) * r.z + tx.x]);
-        const double a = double(atlas.area[i]);
-        power += glm::dvec3(u) * a;
-        const glm::vec3 d = atlas.position[i] - ch.origin;
-        const glm::vec2 g((glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u) - block_rect.x) /
-                              (block_rect.z / float(grid.x)),
-                          (glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v) - block_rect.y) /
-                              (block_rect.w / float(grid.y)));
-        const glm::uvec2 cell(std::uint32_t(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1)),
-                              std::uint32_t(std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1)));
-        level.push_back({cell, glm::dvec3(atlas.position[i]) * a, glm::dvec3(u) * a, a, 0, 0});
-    }
+        return glm::dvec3(glm::vec3(texels_back[std::size_t(tx.y) * r.z + tx.x]));
+    };
+    glm::dvec3 power(0.0);
+    for (std::uint32_t i = i0; i < i1; ++i) power += unshot_of(i) * double(atlas.area[i]);
     near.clear();
-    const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
-    for (;;) {
-        std::stable_sort(level.begin(), level.end(),
-                         [&](const node_sum& x, const node_sum& y) { return key(x.cell / 2u) < key(y.cell / 2u); });
-        const std::int32_t base = std::int32_t(near.size());
-        for (const node_sum& p : level) {
-            near.push_back({glm::vec4(glm::vec3(p.moment / p.area), float(p.area)), glm::vec4(glm::vec3(p.power / p.area), 0.f),
-                            {p.first_child, p.child_count, 0, 0}});
-        }
-        if (level.size() == 1) break;
-        up.clear();
-        for (std::size_t j = 0; j < level.size(); ++j) {
-            const glm::uvec2 pc = level[j].cell / 2u;
-            if (up.empty() || key(up.back().cell) != key(pc))
-                up.push_back({pc, glm::dvec3(0.0), glm::dvec3(0.0), 0.0, base + std::int32_t(j), 0});
-            node_sum& q = up.back();
-            q.moment += level[j].moment;
-            q.power += level[j].power;
-            q.area += level[j].area;
-            ++q.child_count;
-        }
-        level.swap(up);
-    }
+    build_near_field_tree(atlas, i0, i1, options.shooting.shoot_blocks, k, unshot_of,
+                          [&](glm::dvec3 position, double area, glm::dvec3 mean_unshot, std::uint32_t first_child,
+                              std::uint32_t children) {
+                              near.push_back({glm::vec4(glm::vec3(position), float(area)),
+                                              glm::vec4(glm::vec3(mean_unshot), 0.f),
+                                              {std::int32_t(first_child), std::int32_t(children), 0, 0}});
+                          });
     require(near.size() <= std::size_t(max_nodes), "atlas", "a shooter's near-field tree outgrew its bound");
     nodes.write(0, near.data(), near.size() * sizeof(gpu_node));
 
@@ -359,9 +317,7 @@ void progressive_radiosity::state::set_shot_uniforms(const program& p, float cha
     p.set(u::atlas_width, int(width));
     p.set(u::atlas_height, int(height));
     p.set(u::shot_position, shot_position);
-    p.set(u::shot_t, t);
-    p.set(u::shot_b, b);
-    p.set(u::shot_n, shot_axis);
+    set_frame_uniforms(p, u::shot_t, u::shot_b, u::shot_n);
     p.set(u::shot_chart, chart);
     p.set(u::occlusion, options.visibility != radiosity_visibility::none ? 1 : 0);
     p.set(u::resolution, float(options.resolution));

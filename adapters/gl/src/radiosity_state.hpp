@@ -8,6 +8,7 @@
 #include <bounce/light.hpp>
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/solve.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/radiosity/stereographic_tessellation.hpp>
@@ -22,6 +23,7 @@
 #include <limits>
 #include <numeric>
 #include <string>
+#include <tuple>
 #include <utility>
 
 #include <glm/geometric.hpp>
@@ -115,23 +117,10 @@ struct gpu_node {
     std::array<std::int32_t, 4> meta;  // first child, child count (0: a leaf)
 };
 
-inline std::string version_header() { return "#version 450 core\n"; }
-
 // Rows of the item buffer: one square, or the hemicube's top face (res rows) above its four
 // half side faces (res / 2 rows each).
 inline std::size_t item_rows(const radiosity_options& o) {
     return std::size_t(o.resolution) * (o.visibility == radiosity_visibility::hemicube ? 3 : 1);
-}
-
-// The hemicube faces' (right, up, forward) in the shooter's frame: radiosity/kernels.hpp's table.
-inline std::array<glm::vec3, 3> face_axes(int face) {
-    switch (face) {
-        case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};
-        case 2: return {glm::vec3(0, -1, 0), glm::vec3(0, 0, 1), glm::vec3(-1, 0, 0)};
-        case 3: return {glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 1, 0)};
-        case 4: return {glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)};
-        default: return {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
-    }
 }
 
 
@@ -213,6 +202,10 @@ struct progressive_radiosity::state {
     void set_shot_uniforms(const program& p, float chart, bool hemicube) const;
     // light_uniform: the light l, its kind flags and the directional light's buffer.
     void set_light_uniforms(const program& p, const packed_light& l, bool spot, bool strict_side, bool parallel) const;
+    // The shooter's frame (t, b, shot_axis) at p's locations for shot_t, shot_b, shot_n.
+    void set_frame_uniforms(const program& p, int t_location, int b_location, int n_location) const;
+    // The farthest corner of the scene's box from the shot's position.
+    float farthest_from_shot() const;
     std::vector<glm::vec3> read_elements(const texture& t) const;
     void bind_common() const;
 };

@@ -32,7 +32,10 @@
 #include <bounce/concepts.hpp>
 #include <bounce/vocabulary.hpp>
 
+#include <array>
+#include <limits>
 #include <numbers>
+#include <utility>
 
 namespace bounce::inline radiosity {
 
@@ -87,12 +90,30 @@ V radiosity_with_ambient(const V& radiosity, const V& albedo, const V& ambient) 
 // ---------------------------------------------------------------------------------------
 // The shooter's frame and the hemispherical (stereographic) projection
 
+/// Components of `d` along the orthonormal axes `t`, `b`, `n`: (d . t, d . b, d . n). A
+/// normal in the shooter's frame, or a point of the shooter's frame in a hemicube face's
+/// frame (the axes of hemicube_face_axes).
+template <real T, vec3_of<T> V>
+V frame_coords(const V& d, const V& t, const V& b, const V& n) {
+    return V(dot(d, t), dot(d, b), dot(d, n));
+}
+
 /// Coordinates of `p` (world) in the shooter's frame: origin `origin`, axes `t`, `b`, `n`
 /// (orthonormal, n the shooter's normal = local +z).
 template <real T, vec3_of<T> V>
 V to_shooter_frame(const V& p, const V& origin, const V& t, const V& b, const V& n) {
-    const V d = p - origin;
-    return V(dot(d, t), dot(d, b), dot(d, n));
+    return frame_coords<T, V>(p - origin, t, b, n);
+}
+
+/// A triangle's plane in the shooter's frame (axes `t`, `b`, `n`), as the item-buffer lookups
+/// take it (item_plane_beyond): (m, d) with m . x = d and d >= 0, m the triangle's unit
+/// `world_normal` in that frame, turned to face away from the shooter; `local_corner` is one
+/// of its corners in the shooter's frame. `V4` is constructed from (V, T).
+template <real T, vec3_of<T> V, class V4>
+V4 shooter_plane(const V& world_normal, const V& local_corner, const V& t, const V& b, const V& n) {
+    const V m = frame_coords<T, V>(world_normal, t, b, n);
+    const T d = dot(m, local_corner);
+    return select(d >= T(0), V4(m, d), V4(-m, -d));
 }
 
 /// Stereographic projection of the direction of `local` (shooter frame, non-zero; need not
@@ -129,6 +150,14 @@ V2 stereographic_item_coords(const V& local) {
     return V2(q.x * T(0.5) + T(0.5), q.y * T(0.5) + T(0.5));
 }
 
+/// The unit direction through the point `centre` (texel coordinates; a texel's centre is
+/// (x + 1/2, y + 1/2)) of a `res` x `res` stereographic item buffer: stereographic_direction
+/// of the inverse of stereographic_item_coords.
+template <real T, vec3_of<T> V, vec2_of<T> V2>
+V stereographic_texel_direction(const V2& centre, T res) {
+    return stereographic_direction<T, V, V2>(V2(centre.x / res * T(2) - T(1), centre.y / res * T(2) - T(1)));
+}
+
 /// Depth stored beside the projected position, projected separately as Listing 39-2 does so
 /// that depth order is exact whatever the (non-linear) (x, y) projection: the distance from
 /// the shooter, mapped from [near, far] (scene units) to [0, 1]. The chapter uses the axial
@@ -156,6 +185,57 @@ enum class hemicube_face : int { top = 0, pos_x = 1, neg_x = 2, pos_y = 3, neg_y
 /// (u = (s + 1) / 2; v = (t + 1) / 2 on the top face, v = t on a side face, s and t the
 /// perspective coordinates right.w / forward.w and up.w / forward.w). Ties go to the top
 /// face, then to the x faces; directions below the horizon land on a side face with v < 0.
+/// The faces' axes (right, up, forward) in the shooter's frame, face 0..4 (the table above):
+/// frame_coords along them gives a point's coordinates in that face's frame.
+template <class V>
+std::array<V, 3> hemicube_face_axes(int face) {
+    switch (face) {
+        case 1: return {V(0, 1, 0), V(0, 0, 1), V(1, 0, 0)};
+        case 2: return {V(0, -1, 0), V(0, 0, 1), V(-1, 0, 0)};
+        case 3: return {V(-1, 0, 0), V(0, 0, 1), V(0, 1, 0)};
+        case 4: return {V(1, 0, 0), V(0, 0, 1), V(0, -1, 0)};
+        default: return {V(1, 0, 0), V(0, 1, 0), V(0, 0, 1)};
+    }
+}
+
+/// (face, u, v) of the point `q` given in the frame of face `face` (0..4 as a number; q's
+/// components along the face's right, up and forward axes, q.z > 0): u = (s + 1) / 2, and
+/// v = (t + 1) / 2 on the top face, v = t on a side face, with s = q.x / q.z, t = q.y / q.z
+/// (hemicube_face_coords on a face already chosen, as a rasterizer of that face needs it).
+template <real T, vec3_of<T> V>
+V hemicube_coords_on_face(const V& q, T face) {
+    const T s = q.x / q.z, t = q.y / q.z;
+    const T v = select(face < T(0.5), t * T(0.5) + T(0.5), t);
+    return V(face, s * T(0.5) + T(0.5), v);
+}
+
+/// Rows of face `face`'s stored texels in a hemicube of `res` texels a side (res even): res
+/// on the top face, res / 2 on a side face.
+template <real T>
+T hemicube_face_rows(T face, T res) {
+    return select(face < T(0.5), res, res * T(0.5));
+}
+
+/// First row of face `face` where the five faces share one buffer `res` wide and 3 res tall:
+/// the top face in rows [0, res), side face f (1..4) from row res + (f - 1) res / 2 on.
+template <real T>
+T hemicube_face_first_row(T face, T res) {
+    return select(face < T(0.5), T(0), res + (face - T(1)) * (res * T(0.5)));
+}
+
+/// The clip-space position (V4, constructed from four T) at which a rasterizer drawing face
+/// `face` into a viewport over that face's stored texels puts the point `q` (face frame, as
+/// hemicube_coords_on_face): divided by w = q.z, its (x, y) are 2 (u, v) - 1 of
+/// hemicube_coords_on_face, so the viewport maps it to (u, v) times the face's texels
+/// (y = q.y on the top face, 2 q.y - q.z on a side face); z maps the distance along the
+/// forward axis from [near_z, far_z] onto [-1, 1] (the perspective depth).
+template <real T, vec3_of<T> V, class V4>
+V4 hemicube_face_clip(const V& q, T face, T near_z, T far_z) {
+    const T y = select(face < T(0.5), q.y, T(2) * q.y - q.z);
+    const T a = (far_z + near_z) / (far_z - near_z), b = T(-2) * far_z * near_z / (far_z - near_z);
+    return V4(q.x, y, a * q.z + b, q.z);
+}
+
 template <real T, vec3_of<T> V>
 V hemicube_face_coords(const V& local) {
     const T ax = abs(local.x), ay = abs(local.y);
@@ -170,9 +250,7 @@ V hemicube_face_coords(const V& local) {
     const T side_s = select(x_major, select(x_pos, local.y, -local.y), select(y_pos, -local.x, local.x));
     const T s_num = select(top, local.x, side_s);
     const T t_num = select(top, local.y, local.z);
-    const T s = s_num / major, t = t_num / major;
-    const T v = select(top, t * T(0.5) + T(0.5), t);
-    return V(face, s * T(0.5) + T(0.5), v);
+    return hemicube_coords_on_face<T, V>(V(s_num, t_num, major), face);
 }
 
 /// Inverse of hemicube_face_coords: the direction (not unit; its component along the face's
@@ -235,6 +313,69 @@ T item_buffer_sees(const V& element, T element_chart, T shown_chart, const V& pl
     return select(own || beyond, T(1), T(0));
 }
 
+/// The texel (a whole number, as T) in which the buffer coordinate `coord` (texels from the
+/// buffer's edge) falls, clamped to the `size` texels of the buffer: an element is looked up
+/// at the buffer's border when it projects beyond it (by rounding, at a face's edge).
+template <real T>
+T item_texel(T coord, T size) {
+    return clamp(floor(coord), T(0), size - T(1));
+}
+
+/// The texel (x, y) of a `res` x `res` stereographic item buffer at which the element at
+/// `local` (shooter frame) is looked up.
+template <real T, vec3_of<T> V, vec2_of<T> V2>
+V2 stereographic_item_texel(const V& local, T res) {
+    const V2 uv = stereographic_item_coords<T, V, V2>(local);
+    return V2(item_texel<T>(uv.x * res, res), item_texel<T>(uv.y * res, res));
+}
+
+/// (face, x, y): the hemicube face (0..4 as a number) and the texel of that face's stored
+/// texels (res wide, hemicube_face_rows tall) at which the element at `local` (shooter
+/// frame) is looked up.
+template <real T, vec3_of<T> V>
+V hemicube_item_texel(const V& local, T res) {
+    const V f = hemicube_face_coords<T, V>(local);
+    const T rows = hemicube_face_rows<T>(f.x, res);
+    return V(f.x, item_texel<T>(f.y * res, res), item_texel<T>(f.z * rows, rows));
+}
+
+/// Coordinates (texels) of the world point `p` in a directional light's orthographic buffer:
+/// its components across the light (unit axes `t`, `b`) less the buffer's corner `lo`, times
+/// `scale` texels per scene unit. Where the buffer's pass draws a corner and where an element
+/// is looked up.
+template <real T, vec3_of<T> V, vec2_of<T> V2>
+V2 parallel_item_coords(const V& p, const V& t, const V& b, const V2& lo, T scale) {
+    return (V2(dot(p, t), dot(p, b)) - lo) * scale;
+}
+
+/// The square a directional light's `res` x `res` buffer covers across the light (unit axes
+/// `t`, `b`): the scene's box [box_lo, box_hi] projected across it, squared about its middle
+/// and widened by a texel each side. Returns its corner `lo` (in (t, b) coordinates) and its
+/// `scale` in texels per scene unit, as parallel_item_coords takes them; both backends draw
+/// and look up the same buffer.
+template <real T, vec3_of<T> V, vec2_of<T> V2>
+std::pair<V2, T> parallel_item_window(const V& box_lo, const V& box_hi, const V& t, const V& b, T res) {
+    T lo_t = std::numeric_limits<T>::max(), lo_b = lo_t, hi_t = -lo_t, hi_b = -lo_t;
+    for (int m = 0; m < 8; ++m) {
+        const V corner((m & 1) ? box_hi.x : box_lo.x, (m & 2) ? box_hi.y : box_lo.y, (m & 4) ? box_hi.z : box_lo.z);
+        const T qt = dot(corner, t), qb = dot(corner, b);
+        lo_t = min(lo_t, qt);
+        lo_b = min(lo_b, qb);
+        hi_t = max(hi_t, qt);
+        hi_b = max(hi_b, qb);
+    }
+    const T side = max(max(hi_t - lo_t, hi_b - lo_b), T(1e-30)) * (T(1) + T(2) / res);
+    return {V2(T(0.5) * (lo_t + hi_t) - T(0.5) * side, T(0.5) * (lo_b + hi_b) - T(0.5) * side), res / side};
+}
+
+/// The texel (x, y) of a directional light's `res` x `res` buffer at which the element at
+/// world position `p` is looked up (parallel_item_coords).
+template <real T, vec3_of<T> V, vec2_of<T> V2>
+V2 parallel_item_texel(const V& p, const V& t, const V& b, const V2& lo, T scale, T res) {
+    const V2 c = parallel_item_coords<T, V, V2>(p, t, b, lo, scale);
+    return V2(item_texel<T>(c.x, res), item_texel<T>(c.y, res));
+}
+
 /// The plane part of parallel_item_sees (a truth value): for a directional light's
 /// orthographic buffer (rays along the unit `direction` the light travels), whether the shown
 /// surface's plane (world: unit `plane_normal`, n . x = `plane_offset`) is met downstream of
@@ -269,6 +410,17 @@ template <real T, vec3_of<T> V>
 T near_field_opens(const V& receiver, const V& node_position, T node_area, T near2) {
     const V r = node_position - receiver;
     return select(dot(r, r) < near2 * node_area, T(1), T(0));
+}
+
+/// Whether a receiver at `p` lies on the side of a light's hemisphere (apex `position`, unit
+/// `axis`) that this hemisphere's shot serves (1) or not (0): dot(p - position, axis) >= 0, or
+/// > 0 where `strict` is 1, so that a point light's two opposite hemispheres take a receiver
+/// on the plane between them once (the first does).
+template <real T, vec3_of<T> V>
+T light_hemisphere_side(const V& p, const V& position, const V& axis, T strict) {
+    const T z = dot(p - position, axis);
+    const auto strictly = strict > T(0.5);
+    return select((strictly && z > T(0)) || (!strictly && z >= T(0)), T(1), T(0));
 }
 
 }  // namespace bounce::radiosity

@@ -12,19 +12,26 @@
 ///    edge and the midpoint of its projected chord) is at most the tolerance, or the depth cap
 ///    is reached (halving an edge quarters its sagitta);
 ///  - clip_and_tessellate_stereographic: a triangle in the shooter's frame clipped just above
-///    the shooter's plane (z >= z_min), fanned, and each fan triangle tessellated.
+///    the shooter's plane (z >= z_min), fanned, and each fan triangle tessellated;
+///  - item_buffer_triangles: the triangles every item buffer draws (those with a chart) with
+///    the world planes its lookups test, for the stereographic buffer, the hemicube and a
+///    directional light's buffer alike.
 /// Pure geometry on GLM floats: no threads, no I/O.
 
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/scene_view.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 namespace bounce::inline radiosity {
 
@@ -106,6 +113,27 @@ void clip_and_tessellate_stereographic(const std::array<glm::vec3, 3>& local, fl
     poly.assign(local.begin(), local.end());
     clip_polygon(poly, glm::vec3(0, 0, 1), z_min, scratch);
     for (std::size_t f = 1; f + 1 < poly.size(); ++f) tessellate_stereographic(poly[0], poly[f], poly[f + 1], how, emit);
+}
+
+/// The scene's triangles that have a chart in `atlas`, in scene order: their corners, chart,
+/// and world plane (unit normal n, n . corner), the plane computed in double from the corners.
+struct item_triangles {
+    std::vector<std::array<glm::vec3, 3>> corners;
+    std::vector<std::uint32_t> chart;
+    std::vector<glm::vec4> world_plane;
+};
+inline item_triangles item_buffer_triangles(const scene_view& scene, const lightmap_atlas& atlas) {
+    item_triangles out;
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+        if (atlas.chart_of_triangle[t] == lightmap_atlas::none) continue;
+        const auto& tri = scene.triangles[t];
+        out.corners.push_back({scene.positions[tri.x], scene.positions[tri.y], scene.positions[tri.z]});
+        out.chart.push_back(atlas.chart_of_triangle[t]);
+        const glm::dvec3 a(out.corners.back()[0]), b(out.corners.back()[1]), c(out.corners.back()[2]);
+        const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+        out.world_plane.emplace_back(glm::vec3(n), float(glm::dot(n, a)));
+    }
+    return out;
 }
 
 }  // namespace bounce::radiosity

@@ -44,6 +44,7 @@
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/options.hpp>
 #include <bounce/radiosity/solve.hpp>
 #include <bounce/radiosity/subdivision.hpp>
@@ -323,25 +324,15 @@ private:
 
     // Shooters: the atlas's blocks, or one per element; their centres, areas and powers.
     void build_shooters() {
-        const std::size_t n = atlas_.size();
-        if (options_.shoot_blocks) first_.assign(atlas_.block_first.begin(), atlas_.block_first.end());
-        else {
-            first_.resize(n + 1);
-            std::iota(first_.begin(), first_.end(), std::uint32_t(0));
-        }
+        first_ = shooter_ranges(atlas_, options_.shoot_blocks);
         const std::size_t shooters = first_.size() - 1;
         centre_.resize(shooters);
         shooter_area_.resize(shooters);
         power_.resize(shooters);
         for (std::size_t k = 0; k < shooters; ++k) {
-            glm::dvec3 c(0);
-            double a = 0;
-            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
-                c += glm::dvec3(atlas_.position[i]) * double(atlas_.area[i]);
-                a += double(atlas_.area[i]);
-            }
-            centre_[k] = glm::vec3(c / a);
-            shooter_area_[k] = Real(a);
+            const shooter_disc disc = shooter_disc_of(atlas_, first_[k], first_[k + 1]);
+            centre_[k] = disc.centre;
+            shooter_area_[k] = Real(disc.area);
         }
         refresh_powers();
     }
@@ -525,9 +516,9 @@ private:
                 const glm::vec3 p = at.position[i], n = at.normal[i];
                 if (!frame.parallel) {
                     // Each element belongs to exactly one of the hemispheres: z >= 0 of the
-                    // first, z < 0 of the second.
-                    const float z = glm::dot(p - frame.position, frame.axis);
-                    if (h == 0 ? !(z >= 0.f) : !(z > 0.f)) return;
+                    // first, z < 0 of the second (z > 0 along the second's axis).
+                    if (!(light_hemisphere_side<float, glm::vec3>(p, frame.position, frame.axis, h == 0 ? 0.f : 1.f) > 0.5f))
+                        return;
                 }
                 const glm::vec3 e = light_irradiance(l, p, n);
                 if (!(e.x > 0.f || e.y > 0.f || e.z > 0.f)) return;
@@ -574,56 +565,16 @@ private:
     };
     std::vector<near_node> near_;
 
+    // The tree of radiosity/shooters.hpp (the GL solver builds the same).
     void build_near_tree(std::uint32_t k) {
-        const lightmap_atlas& at = atlas_;
-        const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
         near_.clear();
-        struct pending {
-            glm::uvec2 cell;
-            glm::dvec3 moment, power;
-            double area;
-            std::uint32_t first_child, child_count;
-        };
-        std::vector<pending> level, next;
-        glm::vec4 rect(0.f, 0.f, 1.f, 1.f);
-        glm::uvec2 grid(1u);
-        if (options_.shoot_blocks) {
-            rect = at.block_rect[k];
-            grid = at.block_grid[k];
-        }
-        const lightmap_chart& ch = at.charts[at.chart[i0]];
-        for (std::uint32_t i = i0; i < i1; ++i) {
-            const glm::vec3 d = at.position[i] - ch.origin;
-            const glm::vec2 g((glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u) - rect.x) / (rect.z / float(grid.x)),
-                              (glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v) - rect.y) / (rect.w / float(grid.y)));
-            const glm::uvec2 cell(std::uint32_t(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1)),
-                                  std::uint32_t(std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1)));
-            const double a = double(at.area[i]);
-            level.push_back({cell, glm::dvec3(at.position[i]) * a, glm::dvec3(unshot_[i]) * a, a, 0, 0});
-        }
-        const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
-        while (true) {
-            // Siblings next to each other, then this level's nodes appended.
-            std::stable_sort(level.begin(), level.end(), [&](const pending& a, const pending& b) {
-                return key(a.cell / 2u) < key(b.cell / 2u);
+        build_near_field_tree(
+            atlas_, first_[k], first_[k + 1], options_.shoot_blocks, k,
+            [&](std::uint32_t i) { return glm::dvec3(unshot_[i]); },
+            [&](glm::dvec3 centre, double node_area, glm::dvec3 mean_unshot, std::uint32_t first_child,
+                std::uint32_t children) {
+                near_.push_back({vec(centre), Real(node_area), vec(mean_unshot), first_child, children});
             });
-            const std::uint32_t base = std::uint32_t(near_.size());
-            for (const pending& p : level)
-                near_.push_back({vec(p.moment / p.area), Real(p.area), vec(p.power / p.area), p.first_child, p.child_count});
-            if (level.size() == 1) break;
-            next.clear();
-            for (std::size_t j = 0; j < level.size(); ++j) {
-                const glm::uvec2 parent = level[j].cell / 2u;
-                if (next.empty() || key(next.back().cell) != key(parent))
-                    next.push_back({parent, glm::dvec3(0), glm::dvec3(0), 0.0, base + std::uint32_t(j), 0});
-                pending& q = next.back();
-                q.moment += level[j].moment;
-                q.power += level[j].power;
-                q.area += level[j].area;
-                ++q.child_count;
-            }
-            level.swap(next);
-        }
     }
     double unshot_total_ = 0, total_area_ = 0;
     glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, intercepted_{0}, albedo_area_{0};

@@ -50,6 +50,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -238,24 +239,19 @@ public:
                                                                   "positions at this scene's scale), so it would only "
                                                                   "tessellate deeper for nothing");
         }
-        for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
-            if (atlas.chart_of_triangle[t] == lightmap_atlas::none) continue;
-            const auto& tri = scene.triangles[t];
-            corners_.push_back({scene.positions[tri.x], scene.positions[tri.y], scene.positions[tri.z]});
-            triangle_chart_.push_back(atlas.chart_of_triangle[t]);
-            const glm::dvec3 a(corners_.back()[0]), b(corners_.back()[1]), c(corners_.back()[2]);
-            const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
-            world_plane_.emplace_back(glm::vec3(n), float(glm::dot(n, a)));
-        }
+        item_triangles triangles = item_buffer_triangles(scene, atlas);
+        corners_ = std::move(triangles.corners);
+        triangle_chart_ = std::move(triangles.chart);
+        world_plane_ = std::move(triangles.world_plane);
         if (opt.projection == item_projection::stereographic) {
             // The unit direction through each pixel centre (inverse projection), for depths.
             const int res = opt.resolution;
             pixel_direction_.resize(std::size_t(res) * std::size_t(res));
             for (int y = 0; y < res; ++y)
                 for (int x = 0; x < res; ++x) {
-                    const glm::dvec2 q((x + 0.5) / res * 2 - 1, (y + 0.5) / res * 2 - 1);
                     pixel_direction_[std::size_t(y) * std::size_t(res) + std::size_t(x)] =
-                        glm::vec3(stereographic_direction<double, glm::dvec3, glm::dvec2>(q));
+                        glm::vec3(stereographic_texel_direction<double, glm::dvec3, glm::dvec2>(
+                            glm::dvec2(x + 0.5, y + 0.5), double(res)));
                 }
         }
         const auto [lo, hi] = scene.bounds();
@@ -278,29 +274,21 @@ public:
     }
 
     /// 1 if the point `p` (world) of chart `chart` is seen from the current shot, else 0.
+    /// Its texel is radiosity/kernels.hpp's (the GL passes emit the same kernels).
     float visible(const glm::vec3& p, std::uint32_t chart) const {
         if (shot_.parallel) {
-            const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, glm::vec3(0.f), t_, b_, shot_.axis);
-            const int x = pixel_of((l.x - ortho_lo_.x) * ortho_scale_, buffers_[0].width);
-            const int y = pixel_of((l.y - ortho_lo_.y) * ortho_scale_, buffers_[0].height);
-            return seen(buffers_[0], x, y, chart, p, true) ? 1.f : 0.f;
+            const glm::vec2 xy = parallel_item_texel<float, glm::vec3, glm::vec2>(p, t_, b_, ortho_lo_, ortho_scale_,
+                                                                                float(opt_.parallel_resolution));
+            return seen(buffers_[0], int(xy.x), int(xy.y), chart, p, true) ? 1.f : 0.f;
         }
         const glm::vec3 l = to_shooter_frame<float, glm::vec3>(p, shot_.position, t_, b_, shot_.axis);
+        const float res = float(opt_.resolution);
         if (opt_.projection == item_projection::stereographic) {
-            const glm::vec2 uv = stereographic_item_coords<float, glm::vec3, glm::vec2>(l);
-            const item_buffer& buf = buffers_[0];
-            return seen(buf, pixel_of(uv.x * float(buf.width), buf.width), pixel_of(uv.y * float(buf.height), buf.height),
-                        chart, l, false)
-                       ? 1.f
-                       : 0.f;
+            const glm::vec2 xy = stereographic_item_texel<float, glm::vec3, glm::vec2>(l, res);
+            return seen(buffers_[0], int(xy.x), int(xy.y), chart, l, false) ? 1.f : 0.f;
         }
-        const glm::vec3 f = hemicube_face_coords<float, glm::vec3>(l);
-        const int face = std::clamp(int(f.x + 0.5f), 0, 4);
-        const item_buffer& buf = buffers_[std::size_t(face)];
-        return seen(buf, pixel_of(f.y * float(buf.width), buf.width), pixel_of(f.z * float(buf.height), buf.height),
-                    chart, l, false)
-                   ? 1.f
-                   : 0.f;
+        const glm::vec3 f = hemicube_item_texel<float, glm::vec3>(l, res);
+        return seen(buffers_[std::size_t(f.x)], int(f.y), int(f.z), chart, l, false) ? 1.f : 0.f;
     }
 
     /// The buffers of the last shot: one (stereographic, parallel) or five (hemicube faces,
@@ -312,20 +300,7 @@ public:
     std::size_t drawn_triangles() const noexcept { return drawn_; }
     const options& settings() const noexcept { return opt_; }
 
-    /// The hemicube face frames (right, up, forward) of radiosity/kernels.hpp's table.
-    static std::array<glm::vec3, 3> face_axes(int face) {
-        switch (face) {
-            case 1: return {glm::vec3(0, 1, 0), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0)};
-            case 2: return {glm::vec3(0, -1, 0), glm::vec3(0, 0, 1), glm::vec3(-1, 0, 0)};
-            case 3: return {glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 1, 0)};
-            case 4: return {glm::vec3(1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, -1, 0)};
-            default: return {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)};
-        }
-    }
-
 private:
-    static int pixel_of(float coord, int size) { return std::clamp(int(std::floor(coord)), 0, size - 1); }
-
     // Whether the element at `p` (shooter frame, or world for a parallel shot) of chart `chart`
     // is seen through pixel (x, y): the pixel shows its chart, or nothing, or a surface whose
     // plane, met along the element's own ray, lies beyond the element (less a relative 1e-4
@@ -348,8 +323,6 @@ private:
         return item_plane_beyond<float, glm::vec3>(p, glm::vec3(plane), plane.w, buf.depth[i], diagonal_);
     }
 
-    glm::vec3 n_local(glm::vec3 n) const { return {glm::dot(n, t_), glm::dot(n, b_), glm::dot(n, shot_.axis)}; }
-
     void to_local() {
         local_.clear();
         local_chart_.clear();
@@ -366,9 +339,8 @@ private:
             local_.push_back(l);
             local_chart_.push_back(triangle_chart_[k]);
             // Its plane n . x = d in the shooter's frame, d >= 0.
-            const glm::vec3 n = n_local(glm::vec3(world_plane_[k]));
-            const float d = glm::dot(n, l[0]);
-            local_plane_.push_back(d >= 0.f ? glm::vec4(n, d) : glm::vec4(-n, -d));
+            local_plane_.push_back(shooter_plane<float, glm::vec3, glm::vec4>(glm::vec3(world_plane_[k]), l[0], t_, b_,
+                                                                              shot_.axis));
         }
     }
 
@@ -425,8 +397,8 @@ private:
         // Faces are independent: one task each, so the result does not depend on threads.
         tbb::parallel_for(0, 5, [&](int face) {
             item_buffer& buf = buffers_[std::size_t(face)];
-            buf.reset(res, face == 0 ? res : res / 2);
-            const auto axes = face_axes(face);
+            buf.reset(res, int(hemicube_face_rows(float(face), float(res))));
+            const auto axes = hemicube_face_axes<glm::vec3>(face);
             // Clip to the face's frustum widened by two pixels (so no covered centre is lost),
             // and in front of the near plane; side faces keep the half above the horizon.
             const float near_z = 1e-6f * diagonal_;
@@ -436,7 +408,7 @@ private:
             for (std::size_t t = 0; t < local_.size(); ++t) {
                 poly.clear();
                 for (const glm::vec3& l : local_[t])
-                    poly.emplace_back(glm::dot(l, axes[0]), glm::dot(l, axes[1]), glm::dot(l, axes[2]));
+                    poly.push_back(frame_coords<float, glm::vec3>(l, axes[0], axes[1], axes[2]));
                 // Most triangles miss most faces: reject those wholly outside one clip plane
                 // before clipping.
                 const auto outside = [&](auto plane_value) {
@@ -452,10 +424,10 @@ private:
                 detail::clip_polygon(poly, glm::vec3(0, -1, k), 0.f, scratch);
                 detail::clip_polygon(poly, glm::vec3(0, 1, bottom), 0.f, scratch);
                 if (poly.size() < 3) continue;
+                // (u, v) on the face (radiosity/kernels.hpp, as the lookup finds it) times its texels.
                 const auto project = [&](glm::vec3 q) {
-                    const float s = q.x / q.z, tt = q.y / q.z;
-                    const float v = face == 0 ? tt * 0.5f + 0.5f : tt;
-                    return raster_vertex{glm::vec2((s * 0.5f + 0.5f) * float(res), v * float(buf.height)), 1.f / q.z};
+                    const glm::vec3 f = hemicube_coords_on_face<float, glm::vec3>(q, float(face));
+                    return raster_vertex{glm::vec2(f.y * float(res), f.z * float(buf.height)), 1.f / q.z};
                 };
                 for (std::size_t f = 1; f + 1 < poly.size(); ++f) {
                     scan_triangle(buf, project(poly[0]), project(poly[f]), project(poly[f + 1]), local_chart_[t], true,
@@ -468,21 +440,14 @@ private:
     }
 
     void draw_parallel() {
-        // Orthographic view along the light: the scene's bounding box projected across it.
+        // Orthographic view along the light: the scene's bounding box projected across it
+        // (radiosity/kernels.hpp, the GL solver's buffer too).
         const auto tb = orthonormal_basis<float, glm::vec3>(shot_.axis);
         t_ = tb[0];
         b_ = tb[1];
-        glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-        for (int m = 0; m < 8; ++m) {
-            const glm::vec3 corner((m & 1) ? hi_.x : lo_.x, (m & 2) ? hi_.y : lo_.y, (m & 4) ? hi_.z : lo_.z);
-            const glm::vec2 q(glm::dot(corner, t_), glm::dot(corner, b_));
-            lo = glm::min(lo, q);
-            hi = glm::max(hi, q);
-        }
         const int res = opt_.parallel_resolution;
-        const float side = std::max(std::max(hi.x - lo.x, hi.y - lo.y), 1e-30f) * (1.f + 2.f / float(res));
-        ortho_lo_ = 0.5f * (lo + hi) - glm::vec2(0.5f * side);
-        ortho_scale_ = float(res) / side;
+        std::tie(ortho_lo_, ortho_scale_) =
+            parallel_item_window<float, glm::vec3, glm::vec2>(lo_, hi_, t_, b_, float(res));
         item_buffer& buf = buffers_[0];
         buf.reset(res, res);
         drawn_ = 0;
@@ -490,7 +455,7 @@ private:
             std::array<raster_vertex, 3> v;
             for (int m = 0; m < 3; ++m) {
                 const glm::vec3 p = corners_[k][std::size_t(m)];
-                v[std::size_t(m)] = {(glm::vec2(glm::dot(p, t_), glm::dot(p, b_)) - ortho_lo_) * ortho_scale_,
+                v[std::size_t(m)] = {parallel_item_coords<float, glm::vec3, glm::vec2>(p, t_, b_, ortho_lo_, ortho_scale_),
                                      glm::dot(p, shot_.axis)};
             }
             scan_triangle(buf, v[0], v[1], v[2], triangle_chart_[k], false, std::uint32_t(k));

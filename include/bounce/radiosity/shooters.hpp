@@ -1,0 +1,114 @@
+#pragma once
+/// \file radiosity/shooters.hpp
+/// What a shot comes from, the same on both backends: the shooters (the atlas's blocks, or
+/// one element each) and a shooter's near-field tree (a substructuring refinement of Cohen et
+/// al. 1986, the mipmap pyramid of the residual texture in Coombe and Harris 2005): its
+/// elements, then groups of 2 x 2, 4 x 4 ... cells of its block's grid, the whole block last.
+/// A node's position and unshot radiosity are its elements' area-weighted means, so every
+/// level carries the same power. cpu::progressive_radiosity and gl::progressive_radiosity
+/// build both here, in the same order, and walk the tree the same way (near_field_opens,
+/// radiosity/kernels.hpp): a receiver takes a node as one disc unless it lies in the node's
+/// near field, where it takes the node's children.
+
+#include <bounce/radiosity/lightmap_atlas.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace bounce::inline radiosity {
+
+/// The shooters' element ranges: shooter k is the elements [first[k], first[k + 1]) of
+/// `atlas`, its blocks with `blocks` (substructuring), else one element each.
+inline std::vector<std::uint32_t> shooter_ranges(const lightmap_atlas& atlas, bool blocks) {
+    if (blocks) return {atlas.block_first.begin(), atlas.block_first.end()};
+    std::vector<std::uint32_t> first(atlas.size() + 1);
+    std::iota(first.begin(), first.end(), std::uint32_t(0));
+    return first;
+}
+
+/// A shooter as one disc: the area-weighted mean position of its elements [i0, i1) (world)
+/// and their total area (m^2), summed in double in element order.
+struct shooter_disc {
+    glm::vec3 centre{0.f};
+    double area = 0;
+};
+inline shooter_disc shooter_disc_of(const lightmap_atlas& atlas, std::uint32_t i0, std::uint32_t i1) {
+    glm::dvec3 moment(0);
+    double area = 0;
+    for (std::uint32_t i = i0; i < i1; ++i) {
+        moment += glm::dvec3(atlas.position[i]) * double(atlas.area[i]);
+        area += double(atlas.area[i]);
+    }
+    return {glm::vec3(moment / area), area};
+}
+
+/// Builds the near-field tree of the shooter made of the elements [i0, i1) of `atlas` (one
+/// chart's): with `block` (the shooter is atlas block `block_index`, shot as one) its cells
+/// are the block's grid cells, else the shooter is one element, a tree of one node.
+/// `unshot(i)` gives element i's unshot radiosity (W/m^2 per channel, as glm::dvec3). Calls
+/// `node(position, area, unshot, first_child, child_count)` once per node, in the order the
+/// nodes are numbered (children before parents, siblings together, the root last), with the
+/// node's area-weighted mean position (world), its area (m^2), its area-weighted mean unshot
+/// radiosity (all in double), and the number of its first child and its child count (0: an
+/// element). The sums are in double and in element order, so both backends get the same
+/// nodes from the same unshot radiosities.
+template <class Unshot, class Node>
+void build_near_field_tree(const lightmap_atlas& atlas, std::uint32_t i0, std::uint32_t i1, bool block,
+                           std::size_t block_index, const Unshot& unshot, const Node& node) {
+    struct pending {
+        glm::uvec2 cell;
+        glm::dvec3 moment, power;
+        double area;
+        std::uint32_t first_child, child_count;
+    };
+    std::vector<pending> level, next;
+    glm::vec4 rect(0.f, 0.f, 1.f, 1.f);
+    glm::uvec2 grid(1u);
+    if (block) {
+        rect = atlas.block_rect[block_index];
+        grid = atlas.block_grid[block_index];
+    }
+    const lightmap_chart& ch = atlas.charts[atlas.chart[i0]];
+    for (std::uint32_t i = i0; i < i1; ++i) {
+        const glm::vec3 d = atlas.position[i] - ch.origin;
+        const glm::vec2 g((glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u) - rect.x) / (rect.z / float(grid.x)),
+                          (glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v) - rect.y) / (rect.w / float(grid.y)));
+        const glm::uvec2 cell(std::uint32_t(std::clamp(int(std::floor(g.x)), 0, int(grid.x) - 1)),
+                              std::uint32_t(std::clamp(int(std::floor(g.y)), 0, int(grid.y) - 1)));
+        const double a = double(atlas.area[i]);
+        level.push_back({cell, glm::dvec3(atlas.position[i]) * a, glm::dvec3(unshot(i)) * a, a, 0, 0});
+    }
+    const auto key = [](glm::uvec2 c) { return std::uint64_t(c.y) << 32 | c.x; };
+    std::uint32_t count = 0;
+    while (true) {
+        // Siblings next to each other, then this level's nodes numbered.
+        std::stable_sort(level.begin(), level.end(),
+                         [&](const pending& a, const pending& b) { return key(a.cell / 2u) < key(b.cell / 2u); });
+        const std::uint32_t base = count;
+        for (const pending& p : level) node(p.moment / p.area, p.area, p.power / p.area, p.first_child, p.child_count);
+        count += std::uint32_t(level.size());
+        if (level.size() == 1) break;
+        next.clear();
+        for (std::size_t j = 0; j < level.size(); ++j) {
+            const glm::uvec2 parent = level[j].cell / 2u;
+            if (next.empty() || key(next.back().cell) != key(parent))
+                next.push_back({parent, glm::dvec3(0), glm::dvec3(0), 0.0, base + std::uint32_t(j), 0});
+            pending& q = next.back();
+            q.moment += level[j].moment;
+            q.power += level[j].power;
+            q.area += level[j].area;
+            ++q.child_count;
+        }
+        level.swap(next);
+    }
+}
+
+}  // namespace bounce::radiosity
