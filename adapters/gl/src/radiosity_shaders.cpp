@@ -45,6 +45,17 @@ std::string image(unsigned unit, const char* declaration) {
     return "layout(rgba32f, binding = " + std::to_string(unit) + ") uniform " + declaration + ";\n";
 }
 
+// The item passes' stage interfaces: the vertex stream (item_vertex, as the state attaches
+// it: attribute 0 a position named `position`, attribute 1 the (chart, triangle) ids), the
+// ids handed on flat, and what every item fragment shader reads and writes (the item:
+// chart, triangle, depth, 1).
+std::string item_vertex_inputs(const char* position) {
+    return std::string("layout(location = 0) in vec3 ") + position + ";\nlayout(location = 1) in vec2 ids;\n";
+}
+const char* const item_ids_out = "layout(location = 1) flat out vec2 item_ids;\n";
+const char* const item_fragment_interface =
+    "layout(location = 1) flat in vec2 item_ids;\nlayout(location = 0) out vec4 item;\n";
+
 const char* const texel_attributes_struct =
     "struct texel_attributes { vec4 position_area; vec4 normal_chart; vec4 albedo; };\n";
 
@@ -121,12 +132,8 @@ void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
 std::string item_buffer_vertex() {
     glsl::function_set fs;
     fs.add("radiosity_item_coords", stereographic_item_coords<f32, vec3, vec2>, "local_position");
-    return version_line + fs.source() + R"(
-layout(location = 0) in vec3 piece_corner;
-layout(location = 1) in vec2 ids;
-layout(location = 0) noperspective out float radial;
-layout(location = 1) flat out vec2 item_ids;
-void main() {
+    return version_line + fs.source() + "\n" + item_vertex_inputs("piece_corner") +
+           "layout(location = 0) noperspective out float radial;\n" + item_ids_out + R"(void main() {
     vec2 uv = radiosity_item_coords(piece_corner);
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
     radial = length(piece_corner);
@@ -141,11 +148,8 @@ std::string item_buffer_fragment() {
     fs.add("radiosity_plane_depth", item_plane_depth<f32, vec3>, "plane_normal", "plane_offset", "w", "interpolated");
     return version_line + fs.source() +
            uniforms({{item_uniform::resolution, "float resolution"}, {item_uniform::depth_scale, "float depth_scale"}}) +
-           "\n" + storage_block(planes_binding, "readonly buffer planes_block { vec4 local_plane[]; }") + R"(
-layout(location = 0) noperspective in float radial;
-layout(location = 1) flat in vec2 item_ids;
-layout(location = 0) out vec4 item;
-void main() {
+           "\n" + storage_block(planes_binding, "readonly buffer planes_block { vec4 local_plane[]; }") +
+           "layout(location = 0) noperspective in float radial;\n" + item_fragment_interface + R"(void main() {
     vec3 w = radiosity_texel_direction(gl_FragCoord.xy, resolution);
     vec4 plane = local_plane[int(item_ids.y)];
     float depth = radiosity_plane_depth(plane.xyz, plane.w, w, radial);
@@ -174,12 +178,8 @@ std::string hemicube_vertex() {
                      {face, "float face"},
                      {near_z, "float near_z"},
                      {far_z, "float far_z"}}) +
-           R"(
-layout(location = 0) in vec3 world_position;
-layout(location = 1) in vec2 ids;
-layout(location = 0) out float forward_depth;
-layout(location = 1) flat out vec2 item_ids;
-void main() {
+           "\n" + item_vertex_inputs("world_position") + "layout(location = 0) out float forward_depth;\n" +
+           item_ids_out + R"(void main() {
     vec3 l = radiosity_to_shooter_frame(world_position, shot_position, shot_t, shot_b, shot_n);
     vec3 q = radiosity_frame_coords(l, face_right, face_up, face_forward);
     gl_Position = radiosity_face_clip(q, face, near_z, far_z);
@@ -191,11 +191,8 @@ void main() {
 
 std::string hemicube_fragment() {
     using namespace hemicube_uniform;
-    return version_line + uniforms({{far_z, "float far_z"}, {shot_chart, "float shot_chart"}}) + R"(
-layout(location = 0) in float forward_depth;
-layout(location = 1) flat in vec2 item_ids;
-layout(location = 0) out vec4 item;
-void main() {
+    return version_line + uniforms({{far_z, "float far_z"}, {shot_chart, "float shot_chart"}}) +
+           "\nlayout(location = 0) in float forward_depth;\n" + item_fragment_interface + R"(void main() {
     if (item_ids.x == shot_chart) discard;
     gl_FragDepth = forward_depth / far_z;
     item = vec4(item_ids, forward_depth, 1.0);
@@ -216,12 +213,8 @@ std::string parallel_vertex() {
                      {parallel_resolution, "float parallel_resolution"},
                      {depth_lo, "float depth_lo"},
                      {depth_hi, "float depth_hi"}}) +
-           R"(
-layout(location = 0) in vec3 world_position;
-layout(location = 1) in vec2 ids;
-layout(location = 0) out float along;
-layout(location = 1) flat out vec2 item_ids;
-void main() {
+           "\n" + item_vertex_inputs("world_position") + "layout(location = 0) out float along;\n" + item_ids_out +
+           R"(void main() {
     vec2 pixel = radiosity_parallel_coords(world_position, shot_t, shot_b, ortho_lo, ortho_scale);
     along = dot(world_position, shot_n);
     gl_Position = vec4(pixel / parallel_resolution * 2.0 - 1.0, (along - depth_lo) / (depth_hi - depth_lo) * 2.0 - 1.0, 1.0);
@@ -231,11 +224,8 @@ void main() {
 }
 
 std::string parallel_fragment() {
-    return version_line + R"(
-layout(location = 0) in float along;
-layout(location = 1) flat in vec2 item_ids;
-layout(location = 0) out vec4 item;
-void main() { item = vec4(item_ids, along, 1.0); }
+    return version_line + "\nlayout(location = 0) in float along;\n" + item_fragment_interface +
+           R"(void main() { item = vec4(item_ids, along, 1.0); }
 )";
 }
 

@@ -341,28 +341,33 @@ void progressive_radiosity::state::set_light_uniforms(const program& p, const pa
     p.set(u::parallel_resolution, float(options.parallel_resolution));
 }
 
+void progressive_radiosity::state::light_pass(const packed_light& l, bool spot, bool strict_side, bool parallel) {
+    {
+        binding_state saved;
+        bind_common();
+        // A directional light looks its elements up in its own orthographic buffer.
+        if (parallel && parallel_color)
+            glBindImageTexture(item_unit, parallel_color->id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        const program& p = *light_program;
+        glUseProgram(p.id());
+        set_shot_uniforms(p, -2.f, !parallel && options.visibility == radiosity_visibility::hemicube);
+        set_light_uniforms(p, l, spot, strict_side, parallel);
+        glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
+        check_error(parallel ? "progressive_radiosity: shooting a directional light" : "progressive_radiosity: shooting a light");
+    }
+    const reduction got = reduce();
+    emitted += got.intercepted;
+    intercepted_power += got.intercepted;
+    absorbed += got.absorbed;
+}
+
 void progressive_radiosity::state::shoot_light(const packed_light& l) {
     const light_kind kind = l.kind();
     if (kind == light_kind::directional) {
         set_shot(glm::vec3(0.f), l.direction(), -2.f);
         if (options.visibility != radiosity_visibility::none) draw_parallel();
-        {
-            binding_state saved;
-            bind_common();
-            if (parallel_color)
-                glBindImageTexture(item_unit, parallel_color->id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-            glMemoryBarrier(GL_ALL_BARRIER_BITS);
-            const program& p = *light_program;
-            glUseProgram(p.id());
-            set_shot_uniforms(p, -2.f, false);
-            set_light_uniforms(p, l, false, false, true);
-            glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
-            check_error("progressive_radiosity: shooting a directional light");
-        }
-        const reduction got = reduce();
-        emitted += got.intercepted;
-        intercepted_power += got.intercepted;
-        absorbed += got.absorbed;
+        light_pass(l, false, false, true);
         return;
     }
     const glm::vec3 axis = kind == light_kind::spot ? l.direction() : glm::vec3(0, 0, 1);
@@ -372,21 +377,7 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
     for (std::size_t h = 0; h < axes.size(); ++h) {
         set_shot(l.position(), axes[h], -2.f);
         draw_visibility();
-        {
-            binding_state saved;
-            bind_common();
-            glMemoryBarrier(GL_ALL_BARRIER_BITS);
-            const program& p = *light_program;
-            glUseProgram(p.id());
-            set_shot_uniforms(p, -2.f, options.visibility == radiosity_visibility::hemicube);
-            set_light_uniforms(p, l, kind == light_kind::spot, h != 0, false);
-            glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
-            check_error("progressive_radiosity: shooting a light");
-        }
-        const reduction got = reduce();
-        emitted += got.intercepted;
-        intercepted_power += got.intercepted;
-        absorbed += got.absorbed;
+        light_pass(l, kind == light_kind::spot, h != 0, false);
     }
 }
 

@@ -197,6 +197,9 @@ struct progressive_radiosity::state {
     void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
     void shoot(std::uint32_t k);
     void shoot_light(const packed_light& l);
+    // The light pass for the current shot of light l (the uniforms of set_light_uniforms),
+    // then the reduction, whose intercepted power the light emitted.
+    void light_pass(const packed_light& l, bool spot, bool strict_side, bool parallel);
     // The uniforms of shot_uniform on the distribution or light program p, for a shot from
     // chart `chart` (-2: a light) whose visibility is looked up on the hemicube or not.
     void set_shot_uniforms(const program& p, float chart, bool hemicube) const;
