@@ -93,6 +93,9 @@ TEST_CASE("techniques are parsed by name, in order, without repeats", "[benchmar
     CHECK_THROWS_WITH(parse_techniques("sii,photon_mapping"), Catch::Contains("--techniques") &&
                                                                  Catch::Contains("unknown technique 'photon_mapping'"));
     CHECK_THROWS_WITH(parse_techniques(""), Catch::Contains("unknown technique ''"));
+    CHECK(parse_visibilities("rays,none,rays") == std::vector{indirect_visibility::rays, indirect_visibility::none});
+    CHECK_THROWS_WITH(parse_visibilities("rays,ism"), Catch::Contains("--visibility") &&
+                                                          Catch::Contains("unknown visibility 'ism'"));
 }
 
 TEST_CASE("benchmark settings refuse what cannot run", "[benchmark]") {
@@ -106,6 +109,9 @@ TEST_CASE("benchmark settings refuse what cannot run", "[benchmark]") {
     s = benchmark_settings::defaults(false, 256, 256);
     s.techniques.clear();
     CHECK_THROWS_WITH(s.validate(), Catch::Contains("--techniques"));
+    s = benchmark_settings::defaults(false, 256, 256);
+    s.visibility.clear();
+    CHECK_THROWS_WITH(s.validate(), Catch::Contains("--visibility"));
 }
 
 TEST_CASE("a scene argument that names nothing is refused with the path tried", "[benchmark]") {
@@ -176,13 +182,22 @@ TEST_CASE("one scene: every technique runs and the results have their shape", "[
         }
         CHECK(mc.back().at("spp").get<std::uint32_t>() == settings.samples_of(q).mc_max);
     }
+    // The RSM techniques run once per visibility (none, rays: the defaults), the others once.
+    std::vector<std::pair<std::string, std::string>> expected;
+    for (const auto x : all_bench_techniques) {
+        const std::string name(technique_name(x));
+        const bool rsm = name == "rsm_gather" || name == "sii" || name == "sii_interleaved";
+        expected.emplace_back(name, "none");
+        if (rsm) expected.emplace_back(name, "rays");
+    }
     const auto& techniques = j.at("techniques");
-    REQUIRE(techniques.size() == all_bench_techniques.size());
+    REQUIRE(techniques.size() == expected.size());
     for (std::size_t k = 0; k < techniques.size(); ++k) {
         const auto& t = techniques[k];
-        const std::string name(technique_name(all_bench_techniques[k]));
+        const auto& [name, visibility] = expected[k];
         INFO(name << ": " << t.dump());
         REQUIRE(t.at("technique") == name);
+        REQUIRE(t.at("visibility") == visibility);
         REQUIRE_FALSE(t.contains("failed"));
         CHECK(t.at("quantity").is_string());
         REQUIRE(finite_number(t.at("ms")));
@@ -198,9 +213,18 @@ TEST_CASE("one scene: every technique runs and the results have their shape", "[
             require_equal_error(t.at("mc_equal_error_unoccluded"));
         }
     }
+    // Issue 29's figure per RSM technique: rays against the occluded reference over none
+    // against the unoccluded one.
+    REQUIRE(j.at("visibility").size() == 3);
+    for (const auto& v : j["visibility"]) {
+        INFO(v.dump());
+        CHECK(finite_number(v.at("rays_vs_occluded")));
+        CHECK(finite_number(v.at("none_vs_unoccluded")));
+        CHECK(finite_number(v.at("ratio")));
+    }
     CHECK(techniques[0]["counts"]["records"].get<std::size_t>() > 0);
-    CHECK(techniques[4]["counts"]["elements"].get<std::size_t>() > 0);
-    CHECK(techniques[5]["counts"]["probes"].get<std::size_t>() > 0);
+    CHECK(techniques[7]["counts"]["elements"].get<std::size_t>() > 0);
+    CHECK(techniques[8]["counts"]["probes"].get<std::size_t>() > 0);
 
     // The references come from the cache the second time.
     benchmark_settings again = settings;
@@ -215,6 +239,7 @@ TEST_CASE("the results file carries its provenance and settings", "[benchmark]")
     temporary_folder cache;
     benchmark_settings settings = tiny_settings(cache.path);
     settings.techniques = {bench_technique::rsm_gather};
+    settings.visibility = {indirect_visibility::rays};
     std::size_t scenes_seen = 0;
     const auto j = run_benchmark({"cornell"}, settings, "benchmark --test",
                                  [&](const nlohmann::ordered_json& so_far) { scenes_seen = so_far.at("scenes").size(); });
@@ -226,8 +251,11 @@ TEST_CASE("the results file carries its provenance and settings", "[benchmark]")
     CHECK(p.at("settings").at("width") == 16);
     CHECK(p.at("settings").at("quick") == true);
     CHECK(p.at("settings").at("reference_spp").at("one_bounce") == 64);
+    CHECK(p.at("settings").at("visibility") == nlohmann::ordered_json::array({"rays"}));
     REQUIRE(j.at("scenes").size() == 1);
-    CHECK(j["scenes"][0]["techniques"].size() == 1);
+    REQUIRE(j["scenes"][0]["techniques"].size() == 1);
+    CHECK(j["scenes"][0]["techniques"][0]["visibility"] == "rays");
+    CHECK(j["scenes"][0]["visibility"].empty());  // no run without visibility to compare with
     CHECK_FALSE(any_technique_failed(j));
     CHECK_FALSE(scene_summary(j["scenes"][0]).empty());
     CHECK_THROWS_WITH(run_benchmark({"cornell", "no-such-scene-here"}, settings, ""), Catch::Contains("no-such-scene-here"));

@@ -54,7 +54,7 @@ double technique_work(bench_technique t) {
 double scene_work(const benchmark_settings& s) {
     double w = 0;
     for (const bench_quantity q : bench::quantities_for(s.techniques)) w += reference_work(s, q) + sweep_work(s, q);
-    for (const bench_technique t : s.techniques) w += technique_work(t);
+    for (const bench_technique t : s.techniques) w += technique_work(t) * double(is_rsm(t) ? s.visibility.size() : 1);
     return w;
 }
 
@@ -77,23 +77,47 @@ double cpu_seconds() {
 std::string_view technique_name(bench_technique t) { return technique_names[std::size_t(t)]; }
 std::string_view quantity_name(bench_quantity q) { return quantity_names[std::size_t(q)]; }
 
-std::vector<bench_technique> parse_techniques(std::string_view list) {
-    std::vector<bench_technique> out;
+namespace {
+
+// The comma-separated names of `list`, each turned into a T by `parse` (nullopt: unknown), in
+// the order given and without repeats; parameter_error naming `option` for an unknown name
+// (listing `known`). An empty list is one empty, unknown name.
+template <class T, class Parse>
+std::vector<T> parse_list(std::string_view list, const char* option, const char* what, Parse parse,
+                          const std::string& known) {
+    std::vector<T> out;
     std::size_t start = 0;
     while (start <= list.size()) {
         const std::size_t comma = std::min(list.find(',', start), list.size());
         const std::string_view name = list.substr(start, comma - start);
-        const auto it = std::find(technique_names.begin(), technique_names.end(), name);
-        if (it == technique_names.end()) {
-            std::string known;
-            for (const auto n : technique_names) known += (known.empty() ? "" : ", ") + std::string(n);
-            throw parameter_error("--techniques", "unknown technique '" + std::string(name) + "' (known: " + known + ")");
-        }
-        const auto t = bench_technique(it - technique_names.begin());
-        if (std::find(out.begin(), out.end(), t) == out.end()) out.push_back(t);
+        const std::optional<T> t = parse(name);
+        if (!t)
+            throw parameter_error(option, fmt::format("unknown {} '{}' (known: {})", what, name, known));
+        if (std::find(out.begin(), out.end(), *t) == out.end()) out.push_back(*t);
         start = comma + 1;
     }
     return out;
+}
+
+}  // namespace
+
+std::vector<bench_technique> parse_techniques(std::string_view list) {
+    std::string known;
+    for (const auto n : technique_names) known += (known.empty() ? "" : ", ") + std::string(n);
+    return parse_list<bench_technique>(
+        list, "--techniques", "technique",
+        [](std::string_view name) -> std::optional<bench_technique> {
+            const auto it = std::find(technique_names.begin(), technique_names.end(), name);
+            if (it == technique_names.end()) return std::nullopt;
+            return bench_technique(it - technique_names.begin());
+        },
+        known);
+}
+
+std::vector<indirect_visibility> parse_visibilities(std::string_view list) {
+    std::string known;
+    for (const auto v : indirect_visibilities) known += (known.empty() ? "" : ", ") + std::string(visibility_name(v));
+    return parse_list<indirect_visibility>(list, "--visibility", "visibility", parse_visibility, known);
 }
 
 // ---- settings ---------------------------------------------------------------------------------
@@ -126,6 +150,7 @@ void benchmark_settings::validate() const {
     require(width >= 1 && width <= 16384, "--width", "must lie in [1, 16384]");
     require(height >= 1 && height <= 16384, "--height", "must lie in [1, 16384]");
     require(!techniques.empty(), "--techniques", "names no technique");
+    require(!visibility.empty(), "--visibility", "names no visibility");
     for (const bench_quantity q : all_bench_quantities) {
         const quantity_samples& n = samples_of(q);
         const std::string what = "reference samples of " + std::string(quantity_name(q));
@@ -148,12 +173,15 @@ nlohmann::ordered_json benchmark_settings::to_json() const {
     }
     ojson names = ojson::array();
     for (const bench_technique t : techniques) names.push_back(std::string(technique_name(t)));
+    ojson visibilities = ojson::array();
+    for (const indirect_visibility v : visibility) visibilities.push_back(std::string(visibility_name(v)));
     return {{"width", width},
             {"height", height},
             {"quick", quick},
             {"reference_spp", spp},
             {"mc_max_spp", mc},
             {"techniques", names},
+            {"visibility", visibilities},
             {"volume_offset", volume_offset},
             {"radiosity_max_seconds", radiosity_max_seconds},
             {"repeat", repeat}};
@@ -238,12 +266,13 @@ struct quantity_figures {
     mc_sweep sweep;
 };
 
-bench::technique_run run_technique(const bench::scene_setup& s, bench_technique t, const gbuffer_view<float>* points) {
+bench::technique_run run_technique(const bench::scene_setup& s, bench_technique t, indirect_visibility visibility,
+                                   const gbuffer_view<float>* points) {
     switch (t) {
         case bench_technique::irradiance_cache: return bench::run_irradiance_cache(s);
         case bench_technique::radiosity: return bench::run_radiosity(s);
         case bench_technique::irradiance_volume: return bench::run_irradiance_volume(s, *points);
-        default: return bench::run_rsm_sii(s, t);
+        default: return bench::run_rsm_sii(s, t, visibility);
     }
 }
 
@@ -252,6 +281,7 @@ bench::technique_run run_technique(const bench::scene_setup& s, bench_technique 
 ojson technique_entry(const bench::scene_setup& s, const bench::technique_run& r,
                       const std::map<bench_quantity, quantity_figures>& figures) {
     ojson j = {{"technique", std::string(technique_name(r.technique))},
+               {"visibility", std::string(visibility_name(r.visibility))},
                {"quantity", std::string(quantity_name(r.quantity))},
                {"ms", bench::number_or_null(r.ms)},
                {"parameters", r.parameters},
@@ -268,6 +298,32 @@ ojson technique_entry(const bench::scene_setup& s, const bench::technique_run& r
     j["mc_equal_error"] = bench::mc_equal_error_json(f.sweep, e, r.ms);
     if (eu) j["mc_equal_error_unoccluded"] = bench::mc_equal_error_json(figures.at(bench_quantity::unoccluded).sweep, *eu, r.ms);
     return j;
+}
+
+// Issue 29's headline per RSM technique run both ways: its debiased error with rays against
+// the occluded reference, without visibility against the unoccluded one, and their ratio
+// (at most 1.2 when visibility adds no error of its own).
+ojson visibility_figures(const ojson& techniques) {
+    ojson out = ojson::array();
+    const auto find = [&](const std::string& name, std::string_view v) -> const ojson* {
+        for (const auto& t : techniques)
+            if (t["technique"] == name && t["visibility"] == v && !t.contains("failed")) return &t;
+        return nullptr;
+    };
+    for (const auto& t : techniques) {
+        if (t["visibility"] != "rays" || t.contains("failed")) continue;
+        const std::string name = t["technique"];
+        const ojson* plain = find(name, "none");
+        if (!plain) continue;
+        const auto& with = t["error"]["rel_rms_debiased"];
+        const auto& without = (*plain)["error_unoccluded"]["rel_rms_debiased"];
+        ojson e = {{"technique", name}, {"rays_vs_occluded", with}, {"none_vs_unoccluded", without}};
+        e["ratio"] = with.is_number() && without.is_number() && without.get<double>() > 0
+                         ? bench::number_or_null(with.get<double>() / without.get<double>())
+                         : ojson();
+        out.push_back(e);
+    }
+    return out;
 }
 
 ojson scene_with(const io::scene& scene, const benchmark_settings& settings, bench::run_clock& clock) {
@@ -306,15 +362,19 @@ ojson scene_with(const io::scene& scene, const benchmark_settings& settings, ben
     ojson techniques = ojson::array();
     for (const bench_technique t : settings.techniques) {
         const std::string name(technique_name(t));
-        try {
-            techniques.push_back(technique_entry(s, run_technique(s, t, points ? &*points : nullptr), figures));
-        } catch (const bounce::error& e) {
-            // Reported, not fatal: the other techniques' figures still count.
-            clock.report(name, std::string("FAILED: ") + e.what());
-            techniques.push_back({{"technique", name}, {"failed", e.what()}});
+        const std::vector<indirect_visibility> none{indirect_visibility::none};
+        for (const indirect_visibility v : is_rsm(t) ? settings.visibility : none) {
+            try {
+                techniques.push_back(technique_entry(s, run_technique(s, t, v, points ? &*points : nullptr), figures));
+            } catch (const bounce::error& e) {
+                // Reported, not fatal: the other techniques' figures still count.
+                clock.report(name, std::string("FAILED: ") + e.what());
+                techniques.push_back({{"technique", name}, {"visibility", visibility_name(v)}, {"failed", e.what()}});
+            }
+            clock.advance(technique_work(t));
         }
-        clock.advance(technique_work(t));
     }
+    out["visibility"] = visibility_figures(techniques);
     out["references"] = references;
     out["techniques"] = techniques;
     out["monte_carlo"] = monte_carlo;
@@ -389,17 +449,19 @@ std::string scene_summary(const nlohmann::ordered_json& scene) {
     };
     std::string out = fmt::format("{} ({} triangles, {} lights)\n", scene.at("scene").get<std::string>(),
                                   scene.at("triangles").get<std::size_t>(), scene.at("lights").get<std::size_t>());
-    out += fmt::format("  {:<18} {:>10} {:>8} {:>9} {:>6} {:>9} {:>9}  {}\n", "technique", "ms", "rel_rms", "debiased",
+    out += fmt::format("  {:<21} {:>10} {:>8} {:>9} {:>6} {:>9} {:>9}  {}\n", "technique", "ms", "rel_rms", "debiased",
                        "ssim", "mc x rms", "mc x ssim", "unoccluded rel_rms / mc x");
     for (const auto& t : scene.at("techniques")) {
-        const std::string name = t.at("technique").get<std::string>();
+        const std::string visibility = t.value("visibility", "none");
+        const std::string name = fmt::format("{}{}{}", t.at("technique").get<std::string>(),
+                                             visibility == "none" ? "" : "+", visibility == "none" ? "" : visibility);
         if (t.contains("failed")) {
-            out += fmt::format("  {:<18} failed: {}\n", name, t["failed"].get<std::string>());
+            out += fmt::format("  {:<21} failed: {}\n", name, t["failed"].get<std::string>());
             continue;
         }
         const auto& e = t.at("error");
         const auto& m = t.at("mc_equal_error");
-        out += fmt::format("  {:<18} {:>10} {:>8} {:>9} {:>6} {:>9} {:>9}", name, num(t["ms"], "{:.1f}"),
+        out += fmt::format("  {:<21} {:>10} {:>8} {:>9} {:>6} {:>9} {:>9}", name, num(t["ms"], "{:.1f}"),
                            num(e["rel_rms"], "{:.4f}"), num(e["rel_rms_debiased"], "{:.4f}"), num(e["ssim"], "{:.3f}"),
                            speedup(m["rel_rms"]), speedup(m["ssim"]));
         if (t.contains("error_unoccluded"))
@@ -407,6 +469,11 @@ std::string scene_summary(const nlohmann::ordered_json& scene) {
                                speedup(t["mc_equal_error_unoccluded"]["rel_rms"]));
         out += "\n";
     }
+    if (scene.contains("visibility"))
+        for (const auto& v : scene["visibility"])
+            out += fmt::format("  visibility {}: rays vs occluded {} / none vs unoccluded {} = {} (at most 1.2)\n",
+                               v["technique"].get<std::string>(), num(v["rays_vs_occluded"], "{:.4f}"),
+                               num(v["none_vs_unoccluded"], "{:.4f}"), num(v["ratio"], "{:.2f}"));
     for (const auto& [q, r] : scene.at("references").items())
         out += fmt::format("  reference {}: {} spp, noise {}{}\n", q, r["spp"].get<std::uint32_t>(),
                            num(r["noise_rel_rms"], "{:.4f}"), r["cached"].get<bool>() ? " (cached)" : "");

@@ -3,6 +3,7 @@
 #include <bounce/study/benchmark_parts.hpp>
 
 #include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/embree/occlusion_rays.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/output.hpp>
 #include <bounce/study/stage_timer.hpp>
@@ -22,25 +23,26 @@ namespace {
 constexpr std::size_t lights_per_frame = 1024;
 constexpr std::size_t map_resolution = 256;
 
-indirect_options options_for(bench_technique t, float clamp_distance) {
+indirect_options options_for(bench_technique t, float clamp_distance, indirect_visibility visibility) {
     indirect_options o;
     o.technique = t == bench_technique::rsm_gather ? indirect_technique::rsm_gather : indirect_technique::sii;
     o.count = lights_per_frame;
     o.pattern = t == bench_technique::sii_interleaved ? interleave_pattern{4, 4} : interleave_pattern{1, 1};
     o.light.min_distance2 = clamp_distance * clamp_distance;
+    o.visibility = visibility;
     o.validate();
     return o;
 }
 
 }  // namespace
 
-technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
+technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visibility visibility) {
     require(t == bench_technique::rsm_gather || t == bench_technique::sii || t == bench_technique::sii_interleaved,
             "technique", "is not an RSM technique");
     require(!s.scene.lights.empty(), "scene", "has no point, spot or directional light: reflective shadow maps need one");
-    const std::string name(technique_name(t));
+    const std::string name = std::string(technique_name(t)) + (visibility == indirect_visibility::none ? "" : "+rays");
     const float clamp_distance = scene_clamp_distance(s.scene);
-    const indirect_options options = options_for(t, clamp_distance);
+    const indirect_options options = options_for(t, clamp_distance, visibility);
 
     // The maps are part of every frame's cost (the lights may move); cast once timed.
     s.clock.report(name, "maps");
@@ -52,7 +54,8 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
     const double maps_ms = ms_since(t0);
 
     s.clock.report(name, "frames");
-    cpu::indirect_renderer renderer(options);
+    const embree::occlusion_rays rays(s.bvh);
+    cpu::indirect_renderer renderer(options, &rays);
     image<glm::vec3> e(s.g.width(), s.g.height());
     stage_timer timer;
     indirect_timings last;
@@ -67,6 +70,7 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
 
     technique_run r;
     r.technique = t;
+    r.visibility = visibility;
     r.quantity = bench_quantity::one_bounce;
     r.ms = maps_ms + timer.median_ms("frame");
     r.timings_ms = {{"maps", maps_ms}};
@@ -83,6 +87,7 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t) {
                     {"clamp", clamp_distance},
                     {"r_max", options.r_max},
                     {"blur", options.blur},
+                    {"visibility", visibility_name(visibility)},
                     {"selection", "warping"},
                     {"repeat", std::max(1, s.settings.repeat)}};
     return r;

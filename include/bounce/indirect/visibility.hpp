@@ -10,9 +10,12 @@
 ///
 /// Units: positions in scene units, offsets in scene units.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <string_view>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -24,6 +27,19 @@ enum class indirect_visibility {
     none,  ///< none, as published (DS05, DS06): light leaks through walls and partitions
     rays,  ///< every pair the frame sums, by an occlusion ray (exact; needs an occlusion_query)
 };
+
+inline constexpr std::array<indirect_visibility, 2> indirect_visibilities = {indirect_visibility::none,
+                                                                           indirect_visibility::rays};
+
+/// "none", "rays": the spelling of programs' --visibility and of results files.
+constexpr std::string_view visibility_name(indirect_visibility v) { return v == indirect_visibility::rays ? "rays" : "none"; }
+
+/// The policy spelled `name` (visibility_name's inverse); nullopt for a name none has.
+constexpr std::optional<indirect_visibility> parse_visibility(std::string_view name) {
+    for (const indirect_visibility v : indirect_visibilities)
+        if (visibility_name(v) == name) return v;
+    return std::nullopt;
+}
 
 /// One receiver-sender pair: two surface points and their unit normals (either side; the
 /// query offsets each end towards the other end's side).

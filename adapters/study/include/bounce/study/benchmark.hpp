@@ -10,7 +10,11 @@
 /// - one_bounce: one-bounce indirect radiance with visibility (cached_reference_halves);
 ///   the irradiance cache computes it, and the RSM gather and SII are measured against it.
 /// - unoccluded: one bounce without the receiver-sender visibility
-///   (embree::unoccluded_reference), what the RSM gather and SII approximate: reported beside.
+///   (embree::unoccluded_reference), what the RSM gather and SII without visibility
+///   approximate: reported beside. The RSM techniques run once per visibility policy of the
+///   settings (none as published, rays: exact, issue 29); the scene's "visibility" entry
+///   sets each one's error with rays against the occluded reference beside its error without
+///   visibility against the unoccluded one (their ratio: what visibility adds).
 /// - all_bounces: the view's radiance after every diffuse bounce
 ///   (embree::multi_bounce_reference), what radiosity computes.
 /// - volume_points: one-bounce indirect irradiance (times rho / pi) at points off the
@@ -28,18 +32,20 @@
 ///                  "machine_use": {"wall_s", "cpu_s", "load_average_start", "load_average_end"}},
 ///   "scenes": [ { "scene", "triangles", "lights", "bounds_diagonal",
 ///       "references": { "<quantity>": {"spp", "ms", "cached", "noise_rel_rms"} },
-///       "techniques": [ { "technique", "quantity", "ms", "parameters", "counts", "timings_ms",
+///       "techniques": [ { "technique", "visibility", "quantity", "ms", "parameters", "counts", "timings_ms",
 ///             "error": {"rel_rms", "rel_rms_debiased", "rel_rms_debiased_se", "ssim"},
 ///             "error_unoccluded": {...}                  // RSM gather and SII only
 ///             "mc_equal_error": {"rel_rms": {"spp", "ms", "reached", "speedup"},
 ///                                "ssim": {...}},
 ///             "mc_equal_error_unoccluded": {...} } ],    // RSM gather and SII only
-///       "monte_carlo": { "<quantity>": [ {"spp", "ms", "rel_rms", "rel_rms_debiased", "ssim"} ] } } ] }
+///       "monte_carlo": { "<quantity>": [ {"spp", "ms", "rel_rms", "rel_rms_debiased", "ssim"} ] },
+///       "visibility": [ {"technique", "rays_vs_occluded", "none_vs_unoccluded", "ratio"} ] } ] }
 /// ```
 /// Non-finite numbers are written as null. A technique that fails on a scene is listed with
 /// `failed` (the message) instead of its figures.
 
 #include <bounce/errors.hpp>
+#include <bounce/indirect/visibility.hpp>
 #include <bounce/io/scene.hpp>
 
 #include <array>
@@ -66,6 +72,9 @@ std::string_view technique_name(bench_technique t);
 /// parameter_error naming "--techniques" for an empty list or an unknown name (listing the
 /// known ones).
 std::vector<bench_technique> parse_techniques(std::string_view list);
+/// A comma-separated list of visibility names ("none", "rays"), in the order given, without
+/// repeats. Throws parameter_error naming "--visibility" for an empty list or an unknown name.
+std::vector<indirect_visibility> parse_visibilities(std::string_view list);
 
 /// The quantities techniques compute (see the file comment).
 enum class bench_quantity { one_bounce, unoccluded, all_bounces, volume_points };
@@ -95,6 +104,8 @@ struct benchmark_settings {
     std::size_t width = 256, height = 256;
     bool quick = false;  ///< the settings of quick_settings (recorded in the results)
     std::vector<bench_technique> techniques{all_bench_techniques.begin(), all_bench_techniques.end()};
+    /// The RSM techniques' visibility policies, each a run of its own (`--visibility`).
+    std::vector<indirect_visibility> visibility{indirect_visibilities.begin(), indirect_visibilities.end()};
     quantity_samples one_bounce{1024, 512}, unoccluded{512, 256}, all_bounces{256, 128}, volume_points{512, 256};
     /// The volume's points: each surface point moved this fraction of the scene's bounding
     /// diagonal along its normal (at most half the free distance along it).

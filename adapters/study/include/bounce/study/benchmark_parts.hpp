@@ -9,6 +9,7 @@
 #include <bounce/image.hpp>
 #include <bounce/io/scene.hpp>
 #include <bounce/study/benchmark.hpp>
+#include <bounce/indirect/visibility.hpp>
 
 #include <chrono>
 #include <cstdint>
@@ -172,15 +173,18 @@ struct technique_run {
     double ms = 0;
     ojson parameters = ojson::object(), counts = ojson::object(), timings_ms = ojson::object();
     image<glm::vec3> radiance;  ///< the view's image of the quantity (g's size)
+    /// The RSM techniques' receiver-sender visibility (none for the others).
+    indirect_visibility visibility = indirect_visibility::none;
 };
 
 /// The CPU irradiance cache (cpu::irradiance_cache, Ward's smooth weight, Embree's record
 /// sampler) with ic_splatting's defaults: one frame from an empty cache.
 technique_run run_irradiance_cache(const scene_setup& s);
 /// The RSM gather (1,024 disc samples), SII (1,024 VPLs) or SII interleaved 4 x 4 on maps
-/// embree::rsm_ray_caster casts, through cpu::indirect_renderer with rsm_sii's defaults.
-/// Throws parameter_error for a scene without a point, spot or directional light.
-technique_run run_rsm_sii(const scene_setup& s, bench_technique t);
+/// embree::rsm_ray_caster casts, through cpu::indirect_renderer with rsm_sii's defaults and
+/// `visibility` (rays: embree::occlusion_rays on the scene's accel). Throws parameter_error
+/// for a scene without a point, spot or directional light.
+technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visibility visibility);
 /// cpu::progressive_radiosity with radiosity's defaults (10,000 elements in 8 x 8 blocks,
 /// the stereographic item buffer, 90% of the power shot), seen through embree::lightmap_view.
 technique_run run_radiosity(const scene_setup& s);
