@@ -13,7 +13,7 @@
 #include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
 
-#ifdef BOUNCE_STUDY_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
@@ -53,7 +53,7 @@ struct raster_run {
     double per_s(double ms) const { return 1000.0 * double(cpu.size()) / ms; }
 };
 
-#ifdef BOUNCE_STUDY_WITH_GL
+#ifdef BOUNCE_WITH_GL
 
 // The raster sampler three ways over the same batches: read-back overlapping the next batch
 // with CPU sums; gl::raster_record_sampler's running fall-off (whose kappas the CPU sums
@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
     std::size_t points = 10000, sweep_points = 1000, batch = 64, texel_points = 0;
     study::point_reference_settings rs;
     int shadow_resolution = 4096;
-#ifdef BOUNCE_STUDY_WITH_GL
+#ifdef BOUNCE_WITH_GL
     gl::direct_light_options shadows;  // its resolution comes from shadow_resolution
 #endif
     fs::path json_path, points_csv;
@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
     app.add_option("--shadow-resolution", shadow_resolution, "texels per side of the raster sampler's shadow maps")
         ->check(CLI::Range(64, 8192))
         ->capture_default_str();
-#ifdef BOUNCE_STUDY_WITH_GL
+#ifdef BOUNCE_WITH_GL
     app.add_option("--shadow-normal-offset", shadows.normal_offset_texels,
                    "raster sampler: shadow lookups moved this many texels along n")
         ->check(examples::finite_non_negative)->capture_default_str();
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
         std::vector<study::plane_sweep_sampler> samplers;
         std::optional<raster_run> raster_main;
         std::optional<study::plane_estimates> ray_main;
-#ifdef BOUNCE_STUDY_WITH_GL
+#ifdef BOUNCE_WITH_GL
         std::optional<gl::context> context;
         std::optional<gl::scene_mesh> mesh;
         std::optional<gl::direct_light> light;
@@ -255,7 +255,7 @@ int main(int argc, char** argv) {
             report.parameters = {{"resolution", resolution}, {"aperture_deg", aperture}, {"plane_turn_deg", turn},
                                  {"hashed_turn", hashed_turn}, {"points", points}, {"seed", rs.seed}, {"batch", batch},
                                  {"embree_config", bvh.owner().config()}, {"shadow_resolution", shadow_resolution}};
-#ifdef BOUNCE_STUDY_WITH_GL
+#ifdef BOUNCE_WITH_GL
             report.parameters["shadow_normal_offset"] = shadows.normal_offset_texels;
             report.parameters["shadow_slope_bias"] = shadows.slope_bias;
             if (context && !no_raster) report.gl_renderer = context->renderer();

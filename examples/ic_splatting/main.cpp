@@ -23,7 +23,7 @@
 #include <bounce/study/camera_path.hpp>
 #include <bounce/study/record_cache.hpp>
 #include <bounce/study/run_report.hpp>
-#ifdef BOUNCE_IC_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/hemisphere_raster.hpp>
 #include <bounce/gl/irradiance_splatter.hpp>
@@ -46,7 +46,7 @@ using namespace bounce::examples;
 
 namespace {
 
-#ifdef BOUNCE_IC_WITH_GL
+#ifdef BOUNCE_WITH_GL
 constexpr bool with_gl = true;
 // What GL frames keep: the context, the scene on the GPU, the renderer's passes, the splatter
 // and the raster record sampler's hemisphere planes.
@@ -126,7 +126,7 @@ int run_with(const options& o) {
         const auto ray_cast = [&](const camera& c) { return embree::ray_cast_gbuffer(bvh, scene, c, o.width, o.height); };
         return cpu::render_frame(cache, cam, ray_cast, sampler);
     };
-#ifdef BOUNCE_IC_WITH_GL
+#ifdef BOUNCE_WITH_GL
     std::optional<gl_frames> gl_state;
     std::optional<gl::raster_record_sampler> raster_sampler;
     if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene, o); });
@@ -165,7 +165,7 @@ int run_with(const options& o) {
     report.width = o.width;
     report.height = o.height;
     report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
-#ifdef BOUNCE_IC_WITH_GL
+#ifdef BOUNCE_WITH_GL
     if (gl_state) report.gl_renderer = gl_state->context.renderer();
 #endif
     report.parameters = report_parameters(o, cache_options, bvh.owner().config(), monte_carlo_max_spp(o));

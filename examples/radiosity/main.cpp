@@ -27,7 +27,7 @@
 #include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
 
-#ifdef BOUNCE_RADIOSITY_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include <bounce/gl/context.hpp>
 #include <bounce/gl/radiosity.hpp>
 #endif
@@ -131,7 +131,7 @@ solve_result solve_once(const options& o, const io::scene& scene, const embree::
         fmt::print(stderr, "radiosity: {} elements for the {} asked: each of the scene's {} charts takes at least one texel\n",
                    atlas.size(), o.elements, atlas.charts.size());
     if (o.backend == "gl") {
-#ifdef BOUNCE_RADIOSITY_WITH_GL
+#ifdef BOUNCE_WITH_GL
         gl::progressive_radiosity solver(scene, atlas, gl_options_for(o));
         return solve(solver, o, scene, atlas_ms, ms_since(start), timer, cmp, with_curve);
 #else
@@ -206,7 +206,7 @@ int run(const options& o) {
     }
     if (o.reference || versus)  // the pixels that see geometry, where views are compared
         cmp.mask = study::coverage_mask(embree::ray_cast_gbuffer(bvh, scene, scene.camera, o.width, o.height).view());
-#ifdef BOUNCE_RADIOSITY_WITH_GL
+#ifdef BOUNCE_WITH_GL
     std::optional<gl::context> gl_context;  // current on this thread while it lives
     if (o.backend == "gl") gl_context.emplace();
 #endif
@@ -220,7 +220,7 @@ int run(const options& o) {
     report.width = o.width;
     report.height = o.height;
     report.backend = o.backend;
-#ifdef BOUNCE_RADIOSITY_WITH_GL
+#ifdef BOUNCE_WITH_GL
     if (gl_context) report.gl_renderer = gl_context->renderer();
 #endif
     report.parameters = parameters_json(o);

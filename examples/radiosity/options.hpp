@@ -9,7 +9,7 @@
 #include <bounce/radiosity/options.hpp>
 #include <bounce/radiosity/subdivision.hpp>
 
-#ifdef BOUNCE_RADIOSITY_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include <bounce/gl/radiosity.hpp>
 #endif
 
@@ -157,7 +157,7 @@ inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
     return v;
 }
 
-#ifdef BOUNCE_RADIOSITY_WITH_GL
+#ifdef BOUNCE_WITH_GL
 inline gl::radiosity_options gl_options_for(const options& o) {
     gl::radiosity_options g;
     g.shooting = solver_options_for(o);  // --shooters-per-step is refused unless 1

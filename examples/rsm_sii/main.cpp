@@ -24,7 +24,7 @@
 #include <bounce/study/reference_cache.hpp>
 #include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
-#ifdef BOUNCE_RSM_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include <bounce/gl/indirect_renderer.hpp>
 #endif
 
@@ -55,7 +55,7 @@ json parameters_json(const options& o, float clamp_distance, std::size_t maps) {
 /// Every flag and output checked before the scene is loaded: nothing below fails for a
 /// reason the command line already showed.
 void check_arguments(const options& o) {
-#ifndef BOUNCE_RSM_WITH_GL
+#ifndef BOUNCE_WITH_GL
     if (o.backend == "gl") throw parameter_error("--backend", "'gl': this build has no GL adapter; use --backend cpu");
 #endif
     if (o.study) require(!o.json.empty(), "--study", "needs --json for the study's report");
@@ -100,7 +100,7 @@ int run(const options& o) {
         return cpu_renderer.render(opts, g.view(), cam, caster.views(), out);
     };
     std::string gl_name;
-#ifdef BOUNCE_RSM_WITH_GL
+#ifdef BOUNCE_WITH_GL
     std::optional<gl::offscreen_indirect_renderer> gl_renderer;
     if (o.backend == "gl") {
         gl_renderer.emplace();

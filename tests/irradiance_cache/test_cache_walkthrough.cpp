@@ -15,7 +15,7 @@
 #include <bounce/study/camera_path.hpp>
 #include <bounce/study/frame_comparison.hpp>
 #include <bounce/study/noisy_error_report.hpp>
-#ifdef BOUNCE_TEST_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/direct_light.hpp>
@@ -304,7 +304,7 @@ TEST_CASE("the noisy-error report: JSON keys, nulls for infinities, resolved and
     CHECK(study::error_text(e) == "0.0312 (debiased < " + std::string("0.0046") + ", unresolved)");
 }
 
-#ifdef BOUNCE_TEST_WITH_GL
+#ifdef BOUNCE_WITH_GL
 TEST_CASE("the GL frame makes the CPU frame's records and follows a cache whose records were replaced",
           "[irradiance_cache][walkthrough][gl]") {
     gl_test::shared_context();

@@ -8,7 +8,7 @@
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/io/scene.hpp>
-#ifdef BOUNCE_TEST_WITH_GL
+#ifdef BOUNCE_WITH_GL
 #include "../gl/shared_context.hpp"
 
 #include <bounce/gl/direct_light.hpp>
@@ -207,7 +207,7 @@ TEST_CASE("the cache refuses options outside their domains, naming them", "[irra
     CHECK_THROWS_AS(tree.scan(f.g.view(), f.scene.camera, f.sampler, splat.view()), parameter_error);
 }
 
-#ifdef BOUNCE_TEST_WITH_GL
+#ifdef BOUNCE_WITH_GL
 TEST_CASE("the GL splatter around the cache's scan makes the CPU frame's records and image",
           "[irradiance_cache][gl]") {
     gl_test::shared_context();

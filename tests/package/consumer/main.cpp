@@ -2,6 +2,10 @@
 // record splatted with the CPU adapter. Exits non-zero if the result is wrong.
 #include <bounce/cpu/splatting.hpp>
 
+#ifdef BOUNCE_WITH_GL
+#error "BOUNCE_WITH_GL comes with bounce::gl, which this consumer does not link"
+#endif
+
 #include <cstdio>
 #include <vector>
 

@@ -8,6 +8,10 @@
 
 #include <epoxy/gl.h>  // the renderer's own GL calls: libepoxy comes with bounce::gl
 
+#ifndef BOUNCE_WITH_GL
+#error "the installed bounce::gl defines BOUNCE_WITH_GL for what links it"
+#endif
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
