@@ -41,7 +41,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-TECHNIQUES = ["irradiance_cache", "rsm_gather", "sii", "sii_interleaved", "radiosity", "irradiance_volume"]
+TECHNIQUES = ["irradiance_cache", "rsm_gather", "rsm_gather+rays", "sii", "sii+rays", "sii_interleaved",
+              "sii_interleaved+rays", "radiosity", "irradiance_volume"]
 QUANTITIES = {
     "one_bounce": "one bounce with visibility",
     "unoccluded": "one bounce without visibility",
@@ -53,6 +54,9 @@ STYLE = {  # marker and colour per technique, the same on every figure
     "rsm_gather": ("s", "tab:orange"),
     "sii": ("^", "tab:green"),
     "sii_interleaved": ("v", "tab:red"),
+    "rsm_gather+rays": ("X", "tab:orange"),
+    "sii+rays": ("<", "tab:green"),
+    "sii_interleaved+rays": (">", "tab:red"),
     "radiosity": ("D", "tab:purple"),
     "irradiance_volume": ("P", "tab:brown"),
 }
@@ -194,7 +198,15 @@ def scene_name(scene, index):
 
 
 def techniques_of(scene):
-    return [t for t in scene.get("techniques") or [] if isinstance(t, dict)]
+    """The scene's technique entries, an RSM technique run with visibility named `<technique>+<visibility>`."""
+    out = []
+    for t in scene.get("techniques") or []:
+        if not isinstance(t, dict):
+            continue
+        if t.get("visibility") not in (None, "none"):
+            t = dict(t, technique=f"{t.get('technique')}+{t['visibility']}")
+        out.append(t)
+    return out
 
 
 # ---- figures ---------------------------------------------------------------------------------------
@@ -376,6 +388,17 @@ def scene_lines(scene, index, figure_path, left_off, md_dir):
                      f"{fmt_fixed(get(err, 'ssim'), 3)} | {fmt_mc(mc.get('rel_rms'))} | {fmt_speedup(mc.get('rel_rms'))} | "
                      f"{fmt_mc(mc.get('ssim'))} | {fmt_speedup(mc.get('ssim'))} | {unocc} | {fmt_counts(t.get('counts'))} |")
     lines.append("")
+    visibility = [v for v in scene.get("visibility") or [] if isinstance(v, dict)]
+    if visibility:
+        lines += ["What indirect visibility adds (issue 29's headline, at most 1.2): each RSM technique's debiased "
+                  "rel_rms with occlusion rays against the reference with visibility, over its rel_rms without "
+                  "visibility against the unoccluded reference.", "",
+                  "| technique | with rays, against the occluded reference | without, against the unoccluded one | "
+                  "ratio |", "|---|---|---|---|"]
+        for v in visibility:
+            lines.append(f"| {cell(v.get('technique', DASH))} | {fmt_fixed(v.get('rays_vs_occluded'), 4)} | "
+                         f"{fmt_fixed(v.get('none_vs_unoccluded'), 4)} | {fmt_fixed(v.get('ratio'), 2)} |")
+        lines.append("")
     if figure_path:
         rel = os.path.relpath(figure_path, md_dir).replace(os.sep, "/")
         lines += [f"![{name}: speed against error]({rel})", ""]
