@@ -58,7 +58,7 @@ struct gl_frames {
     gl::irradiance_splatter splatter;
     std::optional<gl::hemisphere_raster> raster;
     gl_frames(const io::scene& s, const options& o)
-        : mesh(s), light(s, mesh, o.shadow_resolution), splatter({{}, parse_weight(o.weight), 0.f, true}) {}
+        : mesh(s), light(s, mesh, o.shadow_resolution), splatter({{}, o.weight, 0.f, true}) {}
 };
 #else
 constexpr bool with_gl = false;
@@ -129,8 +129,9 @@ int run_with(const options& o) {
 #ifdef BOUNCE_WITH_GL
     std::optional<gl_frames> gl_state;
     std::optional<gl::raster_record_sampler> raster_sampler;
-    if (o.interp == "splat-gl" || o.sampler == "raster") setup.time("gl_setup", [&] { gl_state.emplace(scene, o); });
-    if (o.sampler == "raster") {
+    const bool gl_frame = o.interp == interpolation::splat_gl, raster = o.sampler == record_source::raster;
+    if (gl_frame || raster) setup.time("gl_setup", [&] { gl_state.emplace(scene, o); });
+    if (raster) {
         // Records from 64 x 64 planes of 126 degrees with border stretching (Gautron 2008,
         // section 8.4), or fall-off stretching with a fixed kappa (docs/hemisphere-sampling.md),
         // one atlas per batch of the scan's guesses (16 planes unless --scan-batch says).
@@ -144,11 +145,11 @@ int run_with(const options& o) {
         cache_options.batch.max_records = planes;
         cache.set_options(cache_options);
     }
-    if (o.interp == "splat-gl")
+    if (gl_frame)
         frame = [&](const camera& cam) {
             gl_frames& gs = *gl_state;
             const gl::splatting_passes passes{gs.mesh, gs.gbuffer, gs.light};
-            if (o.sampler != "embree") return gs.splatter.frame(passes, cache, cam, o.width, o.height, sampler);
+            if (raster) return gs.splatter.frame(passes, cache, cam, o.width, o.height, sampler);
             // The Embree sampler starts its rays at its own hits of the pixels.
             return gs.splatter.frame(passes, cache, cam, o.width, o.height, sampler,
                                      [&](gbuffer_view<float> p) { embree::snap_to_ray_hits(bvh, scene, cam, p); });
@@ -164,7 +165,7 @@ int run_with(const options& o) {
     report.scene = scene.name;
     report.width = o.width;
     report.height = o.height;
-    report.backend = o.interp.starts_with("octree") ? "cpu-" + o.interp : o.interp == "splat-gl" ? "gl" : "cpu";
+    report.backend = report_backend(o.interp);
 #ifdef BOUNCE_WITH_GL
     if (gl_state) report.gl_renderer = gl_state->context.renderer();
 #endif
@@ -176,7 +177,7 @@ int run_with(const options& o) {
     settings.reference_spp = o.ref_spp;
     settings.measure = o.raw_equal_error ? study::error_measure::raw : study::error_measure::debiased;
     settings.mc_max_spp = monte_carlo_max_spp(o);
-    settings.rasterized_gbuffer = o.interp == "splat-gl";
+    settings.rasterized_gbuffer = o.interp == interpolation::splat_gl;
     const study::cache_frame_study measure(bvh, scene, settings);
 
     // --indirect-exr and --indirect-out: the indirect image, and it beside the reference's.
@@ -238,7 +239,7 @@ int run_with(const options& o) {
     report.set_count("records", cache.records().size());
 
     if (!o.cache_out.empty()) study::save_records(o.cache_out, cache.records(), cache_params);
-    if (o.sampler == "embree") {
+    if (o.sampler == record_source::embree) {
         // Hemisphere rays per record measured in this run (adaptive or fixed; --ray-rates' re-measures included).
         const auto t = embree_sampler.rays_cast();
         extra["rays_per_record"] = {{"mean", t.mean()}, {"fewest", t.fewest}, {"most", t.most}, {"records", t.records},
@@ -281,7 +282,7 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     finish_options(app, o, gradients);
     try {
-        return with_weighting(parse_weight(o.weight), [&](auto w) { return run_with<decltype(w)>(o); });
+        return with_weighting(o.weight, [&](auto w) { return run_with<decltype(w)>(o); });
     } catch (const bounce::error& e) {
         fmt::print(stderr, "ic_splatting: {}\n", e.what());
         return 2;

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include "../common/cli_choices.hpp"
 #include "../common/cli_number_checks.hpp"
 
 #include <algorithm>
@@ -19,18 +20,42 @@
 
 namespace bounce::examples {
 
+/// Where records come from: Embree's rays or the GL raster of hemisphere planes.
+enum class record_source { embree, raster };
+inline const choices<record_source> sampler_names{{"embree", record_source::embree}, {"raster", record_source::raster}};
+
+/// How the frame interpolates the records: splatting on the CPU or GL, or the octree baseline.
+enum class interpolation { splat_cpu, splat_gl, octree, octree_lanes };
+inline const choices<interpolation> interp_names{{"splat-cpu", interpolation::splat_cpu},
+                                                 {"splat-gl", interpolation::splat_gl},
+                                                 {"octree", interpolation::octree},
+                                                 {"octree-lanes", interpolation::octree_lanes}};
+
+// The spellings of the library's choices.
+inline const choices<radius_policy> radius_names{{"split-sphere", radius_policy::split_sphere},
+                                                 {"hessian", radius_policy::hessian}};
+inline const choices<cpu::scan_kind> scan_names{{"batched", cpu::scan_kind::batched},
+                                                {"sequential", cpu::scan_kind::sequential}};
+inline const choices<cpu::scan_order> scan_order_names{{"linear", cpu::scan_order::linear},
+                                                       {"coarse-to-fine", cpu::scan_order::coarse_to_fine}};
+inline choices<weighting_kind> weight_names() {  // the library's (weighting_name)
+    choices<weighting_kind> names;
+    for (const weighting_kind k : weighting_kinds) names.emplace_back(weighting_name(k), k);
+    return names;
+}
+
 struct options {
     std::string scene = "cornell";
     std::size_t width = 512, height = 512;
     float a = 0.4f;  // the best speed at equal error on Sponza and the Cornell box (docs/irradiance-splatting.md)
-    std::string weight = "ward-smooth";
+    weighting_kind weight = weighting_kind::ward_smooth;
     bool gradients = true;
-    std::string sampler = "embree";
+    record_source sampler = record_source::embree;
     float falloff_kappa = 1.f;  // raster sampler: fall-off stretching's band factor (1: border stretching)
     double plane_turn = 0.0;    // raster sampler: plane_camera::turn_deg
     bool hashed_turn = false;   // raster sampler: plane_camera::hashed_turn
     int shadow_resolution = 2048;  // GL: texels per side of the shadow maps (raster records, GL frames' direct light)
-    std::string interp = "splat-cpu";
+    interpolation interp = interpolation::splat_cpu;
     std::size_t progressive = 0;  // records per frame; 0: two-pass quality mode
     float fill_holes = 4.f;       // progressive: wide splat's a / a (0: leave holes black)
     std::size_t frames = 8;
@@ -40,14 +65,14 @@ struct options {
     std::vector<float> a_sweep;
     std::uint32_t record_samples = 1024, ref_spp = 1024;
     float min_pixels = 1.5f, max_pixels = 64.f;
-    std::string radius = "split-sphere";  // split-sphere | hessian (radius_policy)
+    radius_policy radius = radius_policy::split_sphere;
     bool adaptive_rays = false;              // records from min_record_samples up to record_samples rays
     std::uint32_t min_record_samples = 256;  // adaptive: the first round's rays
     float record_error = 0.2f;               // adaptive: target relative standard error of E, times a
     float record_error_floor = 1.f;          // adaptive: irradiance floor, times the scene's mean irradiance
     bool neighbour_clamp = true;
-    std::string scan = "batched";
-    std::string scan_order;  // linear | coarse-to-fine; empty: linear, coarse-to-fine when progressive
+    cpu::scan_kind scan = cpu::scan_kind::batched;
+    cpu::scan_order scan_order = cpu::scan_order::linear;  // unless given: coarse-to-fine when progressive
     std::size_t scan_batch = 0;
     bool gradient_limit = true;
     float max_extrapolation = 1.f;
@@ -61,20 +86,16 @@ struct options {
     std::filesystem::path json, out, exr, indirect_out, indirect_exr, cache_in, cache_out;
 };
 
-// --weight: the library's spellings of the weightings (weighting_name, parse_weighting).
-inline weighting_kind parse_weight(const std::string& w) {
-    if (const auto k = parse_weighting(w)) return *k;
-    throw parameter_error("--weight", "unknown weighting function '" + w + "'");
-}
-inline std::vector<std::string> weight_names() {
-    std::vector<std::string> names;
-    for (const weighting_kind k : weighting_kinds) names.emplace_back(weighting_name(k));
-    return names;
-}
 inline std::string weight_help() {  // "ward | ward-smooth | ..."
     std::string help;
-    for (const std::string& name : weight_names()) help += (help.empty() ? "" : " | ") + name;
+    for (const auto& [name, k] : weight_names()) help += (help.empty() ? "" : " | ") + name;
     return help;
+}
+
+/// The report's `backend`: gl, cpu, or cpu-octree and cpu-octree-lanes for the baseline.
+inline std::string report_backend(interpolation i) {
+    if (i == interpolation::octree || i == interpolation::octree_lanes) return "cpu-" + name_of(interp_names, i);
+    return i == interpolation::splat_gl ? "gl" : "cpu";
 }
 
 /// The cache settings the options ask for, at accuracy `a`.
@@ -85,13 +106,12 @@ inline cpu::irradiance_cache_options cache_options_for(const options& o, float a
     c.splat.max_extrapolation = o.max_extrapolation;
     c.splat.front_tolerance = o.front_tolerance;
     c.min_weight = o.min_weight;
-    c.interpolation = o.interp == "octree"         ? cpu::cache_interpolation::octree
-                      : o.interp == "octree-lanes" ? cpu::cache_interpolation::octree_lanes
-                                                   : cpu::cache_interpolation::splat;
-    c.scan = o.scan == "sequential" ? cpu::scan_kind::sequential : cpu::scan_kind::batched;
+    c.interpolation = o.interp == interpolation::octree         ? cpu::cache_interpolation::octree
+                      : o.interp == interpolation::octree_lanes ? cpu::cache_interpolation::octree_lanes
+                                                                : cpu::cache_interpolation::splat;
+    c.scan = o.scan;
     c.batch.max_records = o.scan_batch;
-    const std::string order = !o.scan_order.empty() ? o.scan_order : (o.progressive > 0 ? "coarse-to-fine" : "linear");
-    c.order = order == "coarse-to-fine" ? cpu::scan_order::coarse_to_fine : cpu::scan_order::linear;
+    c.order = o.scan_order;
     if (o.progressive > 0) c.max_new_records = o.progressive;
     c.fill_holes = c.interpolation == cpu::cache_interpolation::splat ? o.fill_holes : 0.f;
     c.neighbour_clamp = o.neighbour_clamp;
@@ -102,15 +122,17 @@ inline cpu::irradiance_cache_options cache_options_for(const options& o, float a
 // and the plane's turn keep their defaults unless the raster sampler takes them (run()
 // refuses them with the Embree sampler).
 inline nlohmann::json cache_parameters(const options& o, const std::string& scene) {
-    return {{"scene", scene},         {"sampler", o.sampler},           {"record_samples", o.record_samples},
+    const bool hessian = o.radius == radius_policy::hessian;
+    const bool raster = o.sampler == record_source::raster;  // the raster's records see the shadow maps
+    return {{"scene", scene},         {"sampler", name_of(sampler_names, o.sampler)}, {"record_samples", o.record_samples},
             {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
-            {"shadow_resolution", o.sampler == "raster" ? o.shadow_resolution : 0},  // the raster's records see the maps
+            {"shadow_resolution", raster ? o.shadow_resolution : 0},
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
-            {"gradient_limit", o.gradient_limit}, {"height", o.height}, {"radius", o.radius},
-            {"hessian_a", o.radius == "hessian" ? o.a : 0.f},
+            {"gradient_limit", o.gradient_limit}, {"height", o.height}, {"radius", name_of(radius_names, o.radius)},
+            {"hessian_a", hessian ? o.a : 0.f},
             // Radii of the first, edge-bound Hessian rule differ. Adaptive rays: the three
             // fields below are 0 without them (no key of its own, so saved caches still load).
-            {"hessian_rule", o.radius == "hessian" ? "total-error" : ""},
+            {"hessian_rule", hessian ? "total-error" : ""},
             {"min_record_samples", o.adaptive_rays ? o.min_record_samples : 0u},
             {"record_error", o.adaptive_rays ? o.record_error * o.a : 0.f},
             {"record_error_floor", o.adaptive_rays ? o.record_error_floor : 0.f}};
@@ -122,7 +144,7 @@ inline radius_limits radius_limits_for(const options& o) {
     limits.min_pixels = o.min_pixels;
     limits.max_pixels = o.max_pixels;
     limits.gradient_limit = o.gradient_limit;
-    if (o.radius == "hessian") {
+    if (o.radius == radius_policy::hessian) {
         limits.policy = radius_policy::hessian;
         limits.hessian_a = o.a;
         limits.hessian_gradients = o.gradients;  // the error model follows the interpolation in use
@@ -139,27 +161,28 @@ inline std::uint32_t monte_carlo_max_spp(const options& o) {
 /// Options that do not go together, refused before any work (parameter_error naming one).
 /// `with_gl`: whether this build has the GL adapter.
 inline void check_combinations(const options& o, bool with_gl) {
-    if (o.falloff_kappa != 1.f && o.sampler != "raster")
+    const bool raster = o.sampler == record_source::raster, hessian = o.radius == radius_policy::hessian;
+    if (o.falloff_kappa != 1.f && !raster)
         throw parameter_error("--falloff-kappa", "applies to --sampler raster only");
     if (o.walkthrough > 0 && (o.progressive > 0 || !o.a_sweep.empty()))
         throw parameter_error("--walkthrough", "renders its own frames: not with --progressive or --a-sweep");
-    if ((o.plane_turn != 0.0 || o.hashed_turn) && o.sampler != "raster")
+    if ((o.plane_turn != 0.0 || o.hashed_turn) && !raster)
         throw parameter_error("--plane-turn/--hashed-turn", "apply to --sampler raster only");
     if (o.ref_spp % 2 != 0)
         throw parameter_error("--ref-spp", "must be even: the reference is two independent halves of N/2 samples");
-    if (o.radius == "hessian" && o.sampler != "embree")
+    if (hessian && raster)
         throw parameter_error("--radius", "'hessian' needs the Embree sampler (the raster's reduction has no Hessian)");
-    if (o.radius == "hessian" && !o.a_sweep.empty())
+    if (hessian && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
-    if (o.adaptive_rays && o.sampler != "embree") throw parameter_error("--adaptive-rays", "needs the Embree sampler");
+    if (o.adaptive_rays && raster) throw parameter_error("--adaptive-rays", "needs the Embree sampler");
     if (o.adaptive_rays && o.ray_rates)
         throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --adaptive-rays");
     if (o.adaptive_rays && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "adaptive rays aim at a standard error tied to a: sweep a over separate runs");
-    if (o.ray_rates && o.sampler != "embree") throw parameter_error("--ray-rates", "applies to --sampler embree only");
-    if (!with_gl && o.sampler != "embree")
+    if (o.ray_rates && raster) throw parameter_error("--ray-rates", "applies to --sampler embree only");
+    if (!with_gl && raster)
         throw parameter_error("--sampler", "'raster' needs the GL adapter, which this build does not have");
-    if (!with_gl && o.interp == "splat-gl")
+    if (!with_gl && o.interp == interpolation::splat_gl)
         throw parameter_error("--interp", "'splat-gl' needs the GL adapter, which this build does not have");
 }
 
@@ -167,11 +190,13 @@ inline void check_combinations(const options& o, bool with_gl) {
 /// raster sampler's batch; `embree_config` the device's; `mc_max_spp` monte_carlo_max_spp).
 inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irradiance_cache_options& cache,
                                                 const std::string& embree_config, std::uint32_t mc_max_spp) {
-    return {{"a", o.a}, {"weight", o.weight}, {"gradients", o.gradients}, {"sampler", o.sampler},
+    return {{"a", o.a}, {"weight", weighting_name(o.weight)}, {"gradients", o.gradients},
+            {"sampler", name_of(sampler_names, o.sampler)},
             {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
             {"shadow_resolution", o.shadow_resolution},
-            {"interp", o.interp}, {"record_samples", o.record_samples}, {"reference_spp", o.ref_spp},
-            {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"radius", o.radius},
+            {"interp", name_of(interp_names, o.interp)}, {"record_samples", o.record_samples},
+            {"reference_spp", o.ref_spp}, {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
+            {"radius", name_of(radius_names, o.radius)},
             {"adaptive_rays", o.adaptive_rays}, {"min_record_samples", o.min_record_samples},
             {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
             {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
@@ -179,8 +204,8 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
             {"front_tolerance", o.front_tolerance},
             {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
             {"fill_holes", o.progressive > 0 ? o.fill_holes : 0.f},
-            {"scan", o.scan}, {"scan_batch", cache.batch.max_records},
-            {"scan_order", cache.order == cpu::scan_order::linear ? "linear" : "coarse-to-fine"},
+            {"scan", name_of(scan_names, o.scan)}, {"scan_batch", cache.batch.max_records},
+            {"scan_order", name_of(scan_order_names, cache.order)},
             {"embree_config", embree_config},
             {"equal_error_measure", o.raw_equal_error ? "raw" : "debiased"},
             {"mc_max_spp", mc_max_spp}};
@@ -192,10 +217,9 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(examples::finite_positive)->capture_default_str();
-    app.add_option("--weight", o.weight, weight_help())
-        ->check(CLI::IsMember(weight_names()))->capture_default_str();
+    add_choice(app, "--weight", o.weight, weight_names(), weight_help())->capture_default_str();
     app.add_option("--gradients", gradients, "on | off")->check(CLI::IsMember({"on", "off"}))->capture_default_str();
-    app.add_option("--sampler", o.sampler, "record sampler: embree | raster")->check(CLI::IsMember({"embree", "raster"}))->capture_default_str();
+    add_choice(app, "--sampler", o.sampler, sampler_names, "record sampler: embree | raster")->capture_default_str();
     app.add_option("--falloff-kappa", o.falloff_kappa,
                    "raster sampler: fall-off stretching with this band factor (hemisphere_study's falloff_kappa for the "
                    "scene); 1: border stretching")
@@ -211,9 +235,9 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                    "GL: texels per side of the shadow maps (raster sampler's records, splat-gl's direct light)")
         ->check(CLI::Range(64, 8192))
         ->capture_default_str();
-    app.add_option("--interp", o.interp,
-                   "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
-        ->check(CLI::IsMember({"splat-cpu", "splat-gl", "octree", "octree-lanes"}))->capture_default_str();
+    add_choice(app, "--interp", o.interp, interp_names,
+               "splat-cpu | splat-gl | octree (classical, one record at a time) | octree-lanes (four at a time)")
+        ->capture_default_str();
     // Unsigned counts get a range: CLI11 reads "-1" into a std::size_t as its largest value.
     app.add_option("--progressive", o.progressive, "at most N new records per frame over a camera path (0: two-pass quality mode)")
         ->check(CLI::Range(0, 1 << 24));
@@ -246,19 +270,17 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                    "measures the reference's own noise, which the debiased error takes out)")
         ->check(CLI::Range(2u, 1u << 20))
         ->capture_default_str();
-    app.add_option("--radius", o.radius,
-                   "record radius: split-sphere (harmonic mean distance, Ward et al. 1988) | hessian (occlusion Hessian, "
-                   "Schwarzhaupt et al. 2012: a is the relative error at the zone's edge)")
-        ->check(CLI::IsMember({"split-sphere", "hessian"}))
+    add_choice(app, "--radius", o.radius, radius_names,
+               "record radius: split-sphere (harmonic mean distance, Ward et al. 1988) | hessian (occlusion Hessian, "
+               "Schwarzhaupt et al. 2012: a is the relative error at the zone's edge)")
         ->capture_default_str();
     app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints (--walkthrough: 0 unless given)")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(examples::finite_positive)->capture_default_str();
-    app.add_option("--scan", o.scan, "batched: measure records ahead in parallel (same result); sequential: one at a time")
-        ->check(CLI::IsMember({"batched", "sequential"}))
+    add_choice(app, "--scan", o.scan, scan_names,
+               "batched: measure records ahead in parallel (same result); sequential: one at a time")
         ->capture_default_str();
-    app.add_option("--scan-order", o.scan_order,
-                   "cache-miss scan order: linear | coarse-to-fine (default: linear; coarse-to-fine when progressive)")
-        ->check(CLI::IsMember({"linear", "coarse-to-fine"}));
+    add_choice(app, "--scan-order", o.scan_order, scan_order_names,
+               "cache-miss scan order: linear | coarse-to-fine (default: linear; coarse-to-fine when progressive)");
     app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread; 16 planes per atlas for --sampler raster)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
@@ -303,9 +325,12 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--cache-out", o.cache_out, "save the records to this file");
 }
 
-/// What the parsed command line implies: `gradients` read, and a walkthrough's radius floor.
+/// What the parsed command line implies: `gradients` read, the scan order unless given, and
+/// a walkthrough's radius floor.
 inline void finish_options(const CLI::App& app, options& o, const std::string& gradients) {
     o.gradients = gradients == "on";
+    if (app.count("--scan-order") == 0)  // a budget of records per frame spreads over the image
+        o.scan_order = o.progressive > 0 ? cpu::scan_order::coarse_to_fine : cpu::scan_order::linear;
     // A radius floor of pixel footprints ties a record to the camera that made it: another
     // camera's pixels take its inflated zone as coverage (docs/irradiance-splatting.md,
     // "Many frames"), so a walkthrough has none unless asked.

@@ -16,6 +16,7 @@
 // and popping_excess (the part of the change the true field does not have), for every
 // lookup under "lookups".
 // --sh-study instead captures environments along the path and prints SH errors per order.
+#include "../common/cli_choices.hpp"
 #include "../common/cli_number_checks.hpp"
 
 #include <bounce/embree/probe_baker.hpp>
@@ -45,8 +46,16 @@ using ojson = nlohmann::ordered_json;
 
 namespace {
 
+/// --mode: a uniform grid of probes, or an octree refined where the light changes.
+enum class volume_mode { uniform, adaptive };
+const examples::choices<volume_mode> mode_names{{"uniform", volume_mode::uniform}, {"adaptive", volume_mode::adaptive}};
+const examples::choices<cpu::volume_interpolation> interp_names{{"trilinear", cpu::volume_interpolation::trilinear},
+                                                                {"weighted", cpu::volume_interpolation::weighted}};
+
 struct options {
-    std::string scene = "cornell", mode = "adaptive", interp = "weighted", gradients = "on", json, out;
+    volume_mode mode = volume_mode::adaptive;
+    cpu::volume_interpolation interp = cpu::volume_interpolation::weighted;
+    std::string scene = "cornell", gradients = "on", json, out;
     int max_depth = 4, min_depth = -1;  // -1: 1 (adaptive) or max_depth (uniform)
     float b = 2.f, support = 1.5f;
     std::uint32_t rays = 512, geometry_triangles = 1;
@@ -124,7 +133,9 @@ int run(const options& o) {
     // Bake.
     irradiance_volume_settings vs;
     vs.max_depth = o.max_depth;
-    vs.min_depth = o.mode == "uniform" ? o.max_depth : (o.min_depth >= 0 ? o.min_depth : std::min(1, o.max_depth));
+    vs.min_depth = o.mode == volume_mode::uniform ? o.max_depth
+                   : o.min_depth >= 0            ? o.min_depth
+                                                 : std::min(1, o.max_depth);
     vs.distance_ratio = o.distance_ratio;
     vs.neighbour_change = o.neighbour_change;
     vs.geometry_triangles = o.geometry_triangles;
@@ -158,7 +169,9 @@ int run(const options& o) {
         {"weighted", {cpu::volume_interpolation::weighted, {o.b, false, o.support}}},
         {"weighted_gradients", {cpu::volume_interpolation::weighted, {o.b, true, o.support}}},
     };
-    const std::string chosen = o.interp == "trilinear" ? "trilinear" : (o.gradients == "on" ? "weighted_gradients" : "weighted");
+    const std::string chosen = o.interp == cpu::volume_interpolation::trilinear ? "trilinear"
+                               : o.gradients == "on"                          ? "weighted_gradients"
+                                                                              : "weighted";
     ojson lookups = ojson::object();
     study::volume_lookup_figures best;
     cpu::volume_lookup chosen_how;
@@ -171,7 +184,8 @@ int run(const options& o) {
         if (name == chosen) best = std::move(f), chosen_how = how;
     }
     std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms; reference popping %.4f\n",
-                scene.name.c_str(), o.mode.c_str(), volume.depth(), volume.probes().size(), stats.probes_inside,
+                scene.name.c_str(), examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(),
+                stats.probes_inside,
                 volume.leaf_count(), bake_ms, sphere.reference_popping());
 
     std::size_t strip_w = 0, strip_h = 0;
@@ -188,7 +202,8 @@ int run(const options& o) {
     report.width = strip_w ? strip_w : o.sphere.sphere_points;  // the strip, or the sphere's points per frame
     report.height = strip_h ? strip_h : o.sphere.frames;        // the strip, or the frames
     report.backend = "cpu";
-    report.parameters = {{"mode", o.mode}, {"max_depth", o.max_depth}, {"min_depth", vs.min_depth}, {"interp", o.interp},
+    report.parameters = {{"mode", examples::name_of(mode_names, o.mode)}, {"max_depth", o.max_depth},
+                         {"min_depth", vs.min_depth}, {"interp", examples::name_of(interp_names, o.interp)},
                          {"b", o.b}, {"gradients", o.gradients}, {"support", o.support}, {"rays", o.rays},
                          {"gradient_step", bs.gradient_step}, {"reference_samples", o.sphere.reference_samples},
                          {"frames", o.sphere.frames}, {"sphere_points", o.sphere.sphere_points}, {"sphere_radius", path.radius},
@@ -233,12 +248,12 @@ int main(int argc, char** argv) {
     using examples::detail::number_in;
     using examples::seed_u64;
     app.add_option("--scene", o.scene, "cornell, a scene folder name under BOUNCE_SCENES, or a path");
-    app.add_option("--mode", o.mode, "uniform or adaptive")->check(CLI::IsMember({"uniform", "adaptive"}));
+    examples::add_choice(app, "--mode", o.mode, mode_names, "uniform or adaptive");
     app.add_option("--max-depth", o.max_depth, "deepest octree level (uniform: the grid's depth), 0..10")
         ->check(CLI::Range(0, irradiance_volume::depth_limit));
     app.add_option("--min-depth", o.min_depth, "shallowest leaf level of an adaptive octree (default 1)")
         ->check(CLI::Range(0, irradiance_volume::depth_limit));
-    app.add_option("--interp", o.interp, "trilinear or weighted")->check(CLI::IsMember({"trilinear", "weighted"}));
+    examples::add_choice(app, "--interp", o.interp, interp_names, "trilinear or weighted");
     app.add_option("--b", o.b, "distance exponent of the weighted average, (0, 4]")->check(number_in(0, 4, true, "an exponent", /*lo_included=*/false));
     app.add_option("--support", o.support, "a probe's weight reaches 0 at support * half the diagonal of its largest leaf, > 1")
         ->check(number_in(1, 16, true, "a support", /*lo_included=*/false));

@@ -130,15 +130,13 @@ solve_result solve_once(const options& o, const io::scene& scene, const embree::
     if (!o.quiet && double(atlas.size()) > 1.1 * double(o.elements))
         fmt::print(stderr, "radiosity: {} elements for the {} asked: each of the scene's {} charts takes at least one texel\n",
                    atlas.size(), o.elements, atlas.charts.size());
-    if (o.backend == "gl") {
-#ifdef BOUNCE_WITH_GL
+#ifdef BOUNCE_WITH_GL  // (check_options refused --backend gl without it)
+    if (o.backend == backend::gl) {
         gl::progressive_radiosity solver(scene, atlas, gl_options_for(o));
         return solve(solver, o, scene, atlas_ms, ms_since(start), timer, cmp, with_curve);
-#else
-        throw parameter_error("--backend", "'gl' needs the GL adapter, which this build does not have");
-#endif
     }
-    if (o.visibility == "rays") {
+#endif
+    if (o.visibility == visibility_kind::rays) {
         embree::radiosity_visibility vis(bvh, atlas.chart_of_triangle);  // through the run's accel
         cpu::progressive_radiosity solver(scene, atlas, std::move(vis), solver_options_for(o));
         atlas = {};  // the solver keeps its own copy
@@ -161,7 +159,7 @@ std::optional<image<glm::vec3>> check_before_work(const options& o, const io::sc
         io::check_image_output(name, file);
     }
     if (!o.lightmaps.empty()) io::check_image_output("--lightmaps", o.lightmaps / "radiosity.exr");
-    if (o.visibility == "stereo") {
+    if (o.visibility == visibility_kind::stereo) {
         const float finest = stereographic_tolerance_floor(scene, o.elements, o.resolution);
         if (o.tolerance_px < finest)
             throw parameter_error("--tolerance-px", fmt::format("{:g} px cannot change an item buffer of {} pixels over {}: "
@@ -208,7 +206,7 @@ int run(const options& o) {
         cmp.mask = study::coverage_mask(embree::ray_cast_gbuffer(bvh, scene, scene.camera, o.width, o.height).view());
 #ifdef BOUNCE_WITH_GL
     std::optional<gl::context> gl_context;  // current on this thread while it lives
-    if (o.backend == "gl") gl_context.emplace();
+    if (o.backend == backend::gl) gl_context.emplace();
 #endif
     std::optional<solve_result> result;
     for (int rep = 0; rep < o.repeat; ++rep) result = solve_once(o, scene, bvh, timer, cmp, rep == 0);
@@ -219,7 +217,7 @@ int run(const options& o) {
     report.scene = scene.name;
     report.width = o.width;
     report.height = o.height;
-    report.backend = o.backend;
+    report.backend = name_of(backend_names, o.backend);
 #ifdef BOUNCE_WITH_GL
     if (gl_context) report.gl_renderer = gl_context->renderer();
 #endif
@@ -251,7 +249,8 @@ int run(const options& o) {
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
     fmt::print("radiosity {} {} {}: {} elements, {} iterations, {:.1f}% converged ({}), total {:.0f} ms (visibility {:.0f}, "
                "reconstruction {:.0f}, choice {:.1f}), rel_rms {}\n",
-               scene.name, o.visibility, o.adaptive ? "adaptive" : "uniform", r.elements, r.report.steps,
+               scene.name, name_of(visibility_names, o.visibility), o.adaptive ? "adaptive" : "uniform", r.elements,
+               r.report.steps,
                100.0 * (1.0 - r.report.unshot_fraction), to_string(r.report.stop), timer.median_ms("total"),
                timer.median_ms("visibility"), timer.median_ms("reconstruction"), timer.median_ms("shooter_choice"),
                report.error ? fmt::format("{:.4f}", report.error->rel_rms) : std::string("-"));

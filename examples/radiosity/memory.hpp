@@ -18,8 +18,8 @@ namespace bounce::examples {
 /// machine can give it, with both figures.
 inline void check_memory(const options& o, const io::scene& scene) {
     double need = cpu::radiosity_memory_estimate(scene, atlas_options_for(o));
-    if (o.visibility != "rays") {
-        const double faces = o.visibility == "hemicube" ? 3 : 1;  // five faces of res x res/2 or res
+    if (o.visibility != visibility_kind::rays) {
+        const double faces = o.visibility == visibility_kind::hemicube ? 3 : 1;  // five faces of res x res/2 or res
         need += 112.0 * double(scene.triangles.size()) + faces * 12.0 * double(o.resolution) * double(o.resolution);
     } else {
         need += 150.0 * double(scene.triangles.size());  // Embree's own copy of the scene and its BVH

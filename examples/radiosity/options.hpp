@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include "../common/cli_choices.hpp"
 #include "../common/cli_number_checks.hpp"
 
 #include <algorithm>
@@ -24,18 +25,23 @@
 
 namespace bounce::examples {
 
+/// Where a shot's visibility comes from: a stereographic or hemicube item buffer, or rays.
+enum class visibility_kind { stereo, hemicube, rays };
+inline const choices<visibility_kind> visibility_names{
+    {"stereo", visibility_kind::stereo}, {"hemicube", visibility_kind::hemicube}, {"rays", visibility_kind::rays}};
+
 struct options {
     std::string scene = "cornell";
     std::size_t elements = 10000;     // target element count of the atlas (before subdivision)
     int block = 8;                    // shooting block side, texels (substructuring)
-    std::string visibility = "stereo";  // stereo | hemicube | rays
+    visibility_kind visibility = visibility_kind::stereo;
     int resolution = 128;             // item buffer side (hemicube: per face)
     float tolerance_px = 0.25f;       // stereographic tessellation: largest edge sagitta, pixels
     bool adaptive = false;
     int max_level = 2;                // adaptive: deepest level
     double threshold = 0.25;          // adaptive: second-difference threshold
     int subdivide_steps = 200;        // adaptive: subdivide after each of the first N steps
-    std::string backend = "cpu";      // cpu | gl
+    examples::backend backend = backend::cpu;
     double converge = 0.9;            // stop when this fraction of the emitted power is shot
     double max_seconds = 0;           // also stop after this much solving (0: no limit)
     int shooters_per_step = 1;
@@ -63,8 +69,7 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(CLI::Range(std::size_t(16), std::size_t(50000000)))->capture_default_str();
     app.add_option("--block", o.block, "side of a shooting block in texels (substructuring; 1: shoot elements)")
         ->check(CLI::Range(1, 256))->capture_default_str();
-    app.add_option("--visibility", o.visibility, "stereo | hemicube | rays")
-        ->check(CLI::IsMember({"stereo", "hemicube", "rays"}))->capture_default_str();
+    add_choice(app, "--visibility", o.visibility, visibility_names, "stereo | hemicube | rays")->capture_default_str();
     app.add_option("--resolution", o.resolution, "item buffer side in pixels (hemicube: per face, even)")
         ->check(CLI::Range(8, 8192))->capture_default_str();
     app.add_option("--tolerance-px", o.tolerance_px, "stereographic tessellation: largest edge sagitta, pixels")
@@ -76,7 +81,7 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(examples::finite_positive)->capture_default_str();
     app.add_option("--subdivide-steps", o.subdivide_steps, "adaptive: subdivide after each of the first N steps")
         ->check(CLI::Range(0, 1000000))->capture_default_str();
-    app.add_option("--backend", o.backend, "cpu | gl")->check(CLI::IsMember({"cpu", "gl"}))->capture_default_str();
+    add_choice(app, "--backend", o.backend, backend_names, "cpu | gl")->capture_default_str();
     app.add_option("--converge", o.converge, "stop when this fraction of the emitted power has been shot, in [0, 1)")
         ->check(examples::detail::number_in(0, 1, false, "a fraction"))->capture_default_str();
     app.add_option("--max-seconds", o.max_seconds, "also stop after this many seconds of shooting (0: no limit)")
@@ -140,18 +145,21 @@ inline embree::multi_bounce_settings reference_settings_for(const options& o) {
 
 /// What the chosen backend and visibility do not offer, refused before any work.
 inline void check_options(const options& o) {
-    if (o.visibility == "hemicube" && o.resolution % 2 != 0)
+    if (o.visibility == visibility_kind::hemicube && o.resolution % 2 != 0)
         throw parameter_error("--resolution", "a hemicube needs an even resolution");
-    if (o.backend != "gl") return;
+    check_backend_built(o.backend);
+    if (o.backend != backend::gl) return;
     // What the GL solver does not offer (docs/radiosity-gl.md).
-    if (o.visibility == "rays") throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
+    if (o.visibility == visibility_kind::rays)
+        throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
     if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
     if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
 }
 
 inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
     cpu::item_buffer_visibility::options v;
-    v.projection = o.visibility == "hemicube" ? cpu::item_projection::hemicube : cpu::item_projection::stereographic;
+    v.projection = o.visibility == visibility_kind::hemicube ? cpu::item_projection::hemicube
+                                                              : cpu::item_projection::stereographic;
     v.resolution = o.resolution;
     v.tolerance_px = o.tolerance_px;
     return v;
@@ -161,7 +169,8 @@ inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
 inline gl::radiosity_options gl_options_for(const options& o) {
     gl::radiosity_options g;
     g.shooting = solver_options_for(o);  // --shooters-per-step is refused unless 1
-    g.visibility = o.visibility == "hemicube" ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic;
+    g.visibility = o.visibility == visibility_kind::hemicube ? gl::radiosity_visibility::hemicube
+                                                              : gl::radiosity_visibility::stereographic;
     g.resolution = o.resolution;
     g.tolerance_px = o.tolerance_px;
     return g;
@@ -170,7 +179,7 @@ inline gl::radiosity_options gl_options_for(const options& o) {
 
 /// The run's parameters as the report lists them.
 inline nlohmann::ordered_json parameters_json(const options& o) {
-    return {{"elements", o.elements}, {"block", o.block}, {"visibility", o.visibility},
+    return {{"elements", o.elements}, {"block", o.block}, {"visibility", name_of(visibility_names, o.visibility)},
             {"resolution", o.resolution}, {"tolerance_px", o.tolerance_px},
             {"adaptive", o.adaptive ? "on" : "off"}, {"max_level", o.max_level},
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},

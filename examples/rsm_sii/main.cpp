@@ -43,21 +43,26 @@ using json = nlohmann::ordered_json;
 namespace {
 
 json parameters_json(const options& o, float clamp_distance, std::size_t maps) {
-    return {{"technique", o.technique},     {"vpls", o.vpls},
-            {"pattern", o.pattern},         {"assign", o.assign},
-            {"selection", o.selection},     {"rsm_resolution", o.rsm_resolution},
-            {"maps", maps},                 {"r_max", o.r_max},
-            {"clamp", clamp_distance},      {"offset", o.offset},
-            {"blur", o.blur},               {"energy_correct", !o.thesis_weights},
-            {"seed", o.seed},               {"reference_spp", o.ref_spp}};
+    return {{"technique", name_of(technique_names, o.technique)},
+            {"vpls", o.vpls},
+            {"pattern", o.pattern},
+            {"assign", name_of(assignment_names, o.assign)},
+            {"selection", name_of(selection_names, o.selection)},
+            {"rsm_resolution", o.rsm_resolution},
+            {"maps", maps},
+            {"r_max", o.r_max},
+            {"clamp", clamp_distance},
+            {"offset", o.offset},
+            {"blur", o.blur},
+            {"energy_correct", !o.thesis_weights},
+            {"seed", o.seed},
+            {"reference_spp", o.ref_spp}};
 }
 
 /// Every flag and output checked before the scene is loaded: nothing below fails for a
 /// reason the command line already showed.
 void check_arguments(const options& o) {
-#ifndef BOUNCE_WITH_GL
-    if (o.backend == "gl") throw parameter_error("--backend", "'gl': this build has no GL adapter; use --backend cpu");
-#endif
+    check_backend_built(o.backend);
     if (o.study) require(!o.json.empty(), "--study", "needs --json for the study's report");
     if (o.study)
         require(o.out.empty() && o.indirect_out.empty(), "--out/--indirect-out",
@@ -102,7 +107,7 @@ int run(const options& o) {
     std::string gl_name;
 #ifdef BOUNCE_WITH_GL
     std::optional<gl::offscreen_indirect_renderer> gl_renderer;
-    if (o.backend == "gl") {
+    if (o.backend == backend::gl) {
         gl_renderer.emplace();
         gl_name = gl_renderer->gl_renderer();
         frame = [&](const indirect_options& opts, image_view<glm::vec3> out) {
@@ -125,7 +130,7 @@ int run(const options& o) {
     report.scene = scene.name;
     report.width = o.width;
     report.height = o.height;
-    report.backend = o.backend;
+    report.backend = name_of(backend_names, o.backend);
     report.gl_renderer = gl_name;
     report.parameters = parameters_json(o, clamp_distance, caster.maps().size());
     report.parameters["embree_config"] = bvh.owner().config();

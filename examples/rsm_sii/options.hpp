@@ -5,6 +5,7 @@
 #include <bounce/errors.hpp>
 
 #include <CLI/CLI.hpp>
+#include "../common/cli_choices.hpp"
 #include "../common/cli_number_checks.hpp"
 
 #include <algorithm>
@@ -15,16 +16,25 @@
 
 namespace bounce::examples {
 
+// The spellings of the library's choices on the command line and in the reports.
+inline const choices<indirect_technique> technique_names{{"rsm", indirect_technique::rsm_gather},
+                                                         {"sii", indirect_technique::sii}};
+inline const choices<light_assignment> assignment_names{{"interleaved", light_assignment::interleaved},
+                                                        {"blocked", light_assignment::blocked},
+                                                        {"similar", light_assignment::similarity}};
+inline const choices<vpl_selection> selection_names{{"warping", vpl_selection::flux_warping},
+                                                    {"grid", vpl_selection::grid}};
+
 struct options {
-    std::string technique = "sii";     // rsm (the gather, DS05) | sii (splatting, DS06)
+    indirect_technique technique = indirect_technique::sii;  // rsm (the gather, DS05) | sii (splatting, DS06)
     std::size_t vpls = 1024;           // SII: VPLs; RSM: disc samples per pixel and map
     std::string pattern = "4x4";       // N x M interleave pattern; 1x1: none
-    std::string assign = "interleaved";
-    std::string backend = "cpu";
+    light_assignment assign = light_assignment::interleaved;
+    examples::backend backend = backend::cpu;
     std::string scene = "cornell";
     std::size_t width = 512, height = 384;
     std::size_t rsm_resolution = 256;  // texels per side of each map (cube face)
-    std::string selection = "warping"; // SII VPLs: warping (DS06 section 3.3) | grid
+    vpl_selection selection = vpl_selection::flux_warping;  // SII VPLs: warping (DS06 section 3.3) | grid
     float r_max = 1.5f;                // RSM gather disc radius, map units
     float clamp = -1.f;                // d^2 clamped at clamp^2 (scene units); unset (< 0): scene_clamp_distance
     float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
@@ -54,26 +64,19 @@ inline interleave_pattern parse_pattern(const std::string& s) {
     return p;
 }
 
-inline light_assignment parse_assign(const std::string& s) {
-    if (s == "interleaved") return light_assignment::interleaved;
-    if (s == "blocked") return light_assignment::blocked;
-    if (s == "similar") return light_assignment::similarity;
-    throw parameter_error("--assign", "unknown assignment '" + s + "'");
-}
-
 /// The renderer's options for a run of `technique` with `count` lights and `pattern`,
 /// validated; a refusal names the flag that set the field (--vpls, --pattern, --r-max,
 /// --clamp, --offset, --seed) rather than the library's field.
-inline indirect_options indirect_options_for(const options& o, const std::string& technique, std::size_t count,
+inline indirect_options indirect_options_for(const options& o, indirect_technique technique, std::size_t count,
                                              interleave_pattern pattern, float clamp_distance) {
     indirect_options c;
-    c.technique = technique == "rsm" ? indirect_technique::rsm_gather : indirect_technique::sii;
+    c.technique = technique;
     c.count = count;
     c.pattern = pattern;
-    c.assignment = parse_assign(o.assign);
+    c.assignment = o.assign;
     c.blur = o.blur;
     c.energy_correct = !o.thesis_weights;
-    c.selection = o.selection == "grid" ? vpl_selection::grid : vpl_selection::flux_warping;
+    c.selection = o.selection;
     c.r_max = o.r_max;
     c.light.offset = o.offset;
     c.light.min_distance2 = clamp_distance * clamp_distance;
@@ -107,17 +110,16 @@ inline const CLI::Validator even_ref_spp = CLI::Validator(
     "EVEN IN [4, 1048576]");
 
 inline void add_options(CLI::App& app, options& o) {
-    app.add_option("--technique", o.technique, "rsm (the RSM gather, DS05) | sii (splatting indirect illumination, DS06)")
-        ->check(CLI::IsMember({"rsm", "sii"}))
+    add_choice(app, "--technique", o.technique, technique_names,
+               "rsm (the RSM gather, DS05) | sii (splatting indirect illumination, DS06)")
         ->capture_default_str();
     app.add_option("--vpls", o.vpls, "SII: VPLs per frame; RSM: disc samples per pixel and map")
         ->check(CLI::Range(std::size_t(1), std::size_t(1) << 24))
         ->capture_default_str();
     app.add_option("--pattern", o.pattern, "interleave pattern NxM: 1x1 (none), 2x2, 2x4, 4x4, 8x8 ...")->capture_default_str();
-    app.add_option("--assign", o.assign, "VPLs to sub-buffers: interleaved | blocked | similar")
-        ->check(CLI::IsMember({"interleaved", "blocked", "similar"}))
+    add_choice(app, "--assign", o.assign, assignment_names, "VPLs to sub-buffers: interleaved | blocked | similar")
         ->capture_default_str();
-    app.add_option("--backend", o.backend, "cpu | gl")->check(CLI::IsMember({"cpu", "gl"}))->capture_default_str();
+    add_choice(app, "--backend", o.backend, backend_names, "cpu | gl")->capture_default_str();
     app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
@@ -125,8 +127,7 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--rsm-resolution", o.rsm_resolution, "texels per side of each reflective shadow map (cube face)")
         ->check(CLI::Range(1, 8192))
         ->capture_default_str();
-    app.add_option("--selection", o.selection, "SII's VPLs: warping (importance on the flux) | grid")
-        ->check(CLI::IsMember({"warping", "grid"}))
+    add_choice(app, "--selection", o.selection, selection_names, "SII's VPLs: warping (importance on the flux) | grid")
         ->capture_default_str();
     app.add_option("--r-max", o.r_max, "RSM gather disc radius in map units, (0, 2]; 1.5 reaches the whole map")
         ->check(examples::detail::number_in(0, 2, true, "a radius", /*lo_included=*/false))

@@ -55,3 +55,9 @@ foreach(option a falloff-kappa plane-turn fill-holes record-error record-error-f
                scan-batch shadow-resolution min-record-samples mc-max-spp)
   bounce_cli_refusal(${option}-nan PROGRAM ic_splatting MATCH "--${option}.*nan" ARGS --${option} nan)
 endforeach()
+
+# Named choices are read into enums at parse time: an unknown name (or an enum's number) is
+# refused there, listing the names (examples/common/cli_choices.hpp).
+bounce_cli_refusal(interp-unknown PROGRAM ic_splatting
+  MATCH "--interp: splat-vulkan not in .splat-cpu,splat-gl,octree,octree-lanes." ARGS --interp splat-vulkan)
+bounce_cli_refusal(sampler-number PROGRAM ic_splatting MATCH "--sampler: 1 not in .embree,raster." ARGS --sampler 1)

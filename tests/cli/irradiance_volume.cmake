@@ -33,3 +33,5 @@ file(WRITE ${iv_fx}/reversed/scene.json "{ \"obj\": \"box.obj\",
   \"lights\": [{\"type\": \"point\", \"position\": [0, 1.8, 0], \"intensity\": [1, 1, 1]}] }\n")
 bounce_cli_refusal("a scene whose triangles all face away" PROGRAM irradiance_volume MATCH "every one of the [0-9]+ probes is inside geometry"
                    ARGS --max-depth 2 --rays 64 --ref-samples 4096 --scene ${iv_fx}/reversed/scene.json)
+bounce_cli_refusal("an unknown --interp" PROGRAM irradiance_volume MATCH "--interp: nearest not in .trilinear,weighted."
+                   ARGS --interp nearest)

@@ -50,3 +50,10 @@ if(TARGET radiosity AND PRLIMIT)
   set_tests_properties("${name}" PROPERTIES LABELS default TIMEOUT 60
                        ENVIRONMENT "BOUNCE_SCENES=${BOUNCE_TEST_SCENES};BOUNCE_CACHE=${CMAKE_CURRENT_BINARY_DIR}/cache")
 endif()
+
+# Named choices are read into enums at parse time: an unknown name is refused there, listing
+# the names (examples/common/cli_choices.hpp).
+bounce_cli_refusal("an unknown --backend" PROGRAM radiosity MATCH "--backend: vulkan not in .cpu,gl."
+  SECONDS 10 ARGS ${quick} --backend vulkan)
+bounce_cli_refusal("an unknown --visibility" PROGRAM radiosity MATCH "--visibility: raster not in .stereo,hemicube,rays."
+  SECONDS 10 ARGS ${quick} --visibility raster)

@@ -34,45 +34,69 @@ TEST_CASE("rsm_sii patterns parse as N x M and bad ones are refused naming --pat
 
 TEST_CASE("rsm_sii's options make the renderer's options, and bad values are refused by name", "[rsm][examples]") {
     examples::options o;
-    o.assign = "similar";
-    o.selection = "grid";
+    o.assign = light_assignment::similarity;
+    o.selection = vpl_selection::grid;
     o.thesis_weights = true;
-    const auto c = examples::indirect_options_for(o, "rsm", 512, {8, 8}, 0.01f);
+    const auto rsm = indirect_technique::rsm_gather, sii = indirect_technique::sii;
+    const auto c = examples::indirect_options_for(o, rsm, 512, {8, 8}, 0.01f);
     CHECK(c.technique == indirect_technique::rsm_gather);
     CHECK(c.count == 512);
     CHECK(c.assignment == light_assignment::similarity);
     CHECK(c.selection == vpl_selection::grid);
     CHECK_FALSE(c.energy_correct);
     CHECK(c.light.min_distance2 == Approx(1e-4f));
-    o.assign = "random";
-    CHECK(refused([&] { examples::indirect_options_for(o, "sii", 512, {4, 4}, 0.f); }) == "--assign");
-    o.assign = "interleaved";
-    CHECK(refused([&] { examples::indirect_options_for(o, "sii", 0, {4, 4}, 0.f); }) == "--vpls");
+    o.assign = light_assignment::interleaved;
+    CHECK(refused([&] { examples::indirect_options_for(o, sii, 0, {4, 4}, 0.f); }) == "--vpls");
     // More sub-buffers than VPLs: the library's refusal, under the program's flag.
-    CHECK(refused([&] { examples::indirect_options_for(o, "sii", 16, {64, 64}, 0.f); }) == "--vpls");
+    CHECK(refused([&] { examples::indirect_options_for(o, sii, 16, {64, 64}, 0.f); }) == "--vpls");
     try {
-        examples::indirect_options_for(o, "sii", 16, {64, 64}, 0.f);
+        examples::indirect_options_for(o, sii, 16, {64, 64}, 0.f);
     } catch (const parameter_error& e) {
         CHECK_THAT(e.what(), Catch::Contains("'--vpls': 16 VPLs are fewer than the 4096 sub-buffers"));
     }
-    CHECK(refused([&] { examples::indirect_options_for(o, "rsm", 16, {4, 4}, 0.f); }) == "");
+    CHECK(refused([&] { examples::indirect_options_for(o, rsm, 16, {4, 4}, 0.f); }) == "");
     o.offset = -1.f;
-    CHECK(refused([&] { examples::indirect_options_for(o, "sii", 16, {4, 4}, 0.f); }) == "--offset");
+    CHECK(refused([&] { examples::indirect_options_for(o, sii, 16, {4, 4}, 0.f); }) == "--offset");
+}
+
+namespace {
+// "ok" when rsm_sii's command line `args` parses (into *out when given), else "refused: " and why.
+std::string parse(std::vector<std::string> args, examples::options* out = nullptr) {
+    CLI::App app;
+    examples::options o;
+    examples::add_options(app, o);
+    std::reverse(args.begin(), args.end());
+    try {
+        app.parse(args);
+    } catch (const CLI::ParseError& e) {
+        return std::string("refused: ") + e.what();
+    }
+    if (out) *out = o;
+    return std::string("ok");
+}
+}  // namespace
+
+TEST_CASE("rsm_sii's named choices read into the library's enums; other spellings are refused", "[rsm][examples]") {
+    examples::options o;
+    REQUIRE(parse({"--technique", "rsm", "--assign", "similar", "--selection", "grid", "--backend", "gl"}, &o) == "ok");
+    CHECK(o.technique == indirect_technique::rsm_gather);
+    CHECK(o.assign == light_assignment::similarity);
+    CHECK(o.selection == vpl_selection::grid);
+    CHECK(o.backend == examples::backend::gl);
+    REQUIRE(parse({}, &o) == "ok");
+    CHECK(o.technique == indirect_technique::sii);
+    CHECK(o.assign == light_assignment::interleaved);
+    CHECK(o.selection == vpl_selection::flux_warping);
+    CHECK(o.backend == examples::backend::cpu);
+    CHECK(examples::name_of(examples::assignment_names, o.assign) == "interleaved");
+    CHECK_THAT(parse({"--assign", "random"}), Catch::Contains("random not in {interleaved,blocked,similar}"));
+    CHECK_THAT(parse({"--backend", "vulkan"}), Catch::Contains("vulkan not in {cpu,gl}"));
+    // The enums' numbers are not spellings.
+    CHECK_THAT(parse({"--technique", "0"}), Catch::Contains("0 not in {rsm,sii}"));
+    CHECK_THAT(parse({"--backend", "1"}), Catch::StartsWith("refused"));
 }
 
 TEST_CASE("rsm_sii's number flags refuse what would wrap or be ignored", "[rsm][examples]") {
-    const auto parse = [](std::vector<std::string> args) {
-        CLI::App app;
-        examples::options o;
-        examples::add_options(app, o);
-        std::reverse(args.begin(), args.end());
-        try {
-            app.parse(args);
-        } catch (const CLI::ParseError& e) {
-            return std::string("refused: ") + e.what();
-        }
-        return std::string("ok");
-    };
     CHECK(parse({"--seed", "18446744073709551615"}) == "ok");
     CHECK_THAT(parse({"--seed", "-1"}), Catch::Contains("'-1' is not a whole number"));
     CHECK_THAT(parse({"--seed", "18446744073709551616"}), Catch::StartsWith("refused"));
