@@ -30,6 +30,7 @@
 #include <bounce/gl/raster_record_sampler.hpp>
 #endif
 
+#include "../common/run_program.hpp"
 #include "options.hpp"
 
 #include <fmt/core.h>
@@ -256,9 +257,7 @@ int run_with(const options& o) {
     j["timings_ms"]["bvh"] = setup.median_ms("bvh");
     // The debiased figures join `error` (the single frame's), and `reference` says what the
     // errors were measured against.
-    if (extra.contains("error_debiased") && j.contains("error"))
-        for (auto it = extra["error_debiased"].begin(); it != extra["error_debiased"].end(); ++it)
-            j["error"][it.key()] = it.value();
+    if (extra.contains("error_debiased") && j.contains("error")) j["error"].update(extra["error_debiased"]);
     extra.erase("error_debiased");
     j["reference"] = {{"spp", o.ref_spp},
                       {"halves", 2},
@@ -267,7 +266,7 @@ int run_with(const options& o) {
                       {"noise_of", o.walkthrough > 0   ? "mean over the walkthrough's frames"
                                    : o.progressive > 0 ? "the last frame"
                                                        : "the frame"}};
-    for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
+    j.update(extra);
     io::write_text_file(o.json, j.dump(2) + "\n");
     return 0;
 }
@@ -281,10 +280,6 @@ int main(int argc, char** argv) {
     add_options(app, o, gradients);
     CLI11_PARSE(app, argc, argv);
     finish_options(app, o, gradients);
-    try {
-        return with_weighting(o.weight, [&](auto w) { return run_with<decltype(w)>(o); });
-    } catch (const bounce::error& e) {
-        fmt::print(stderr, "ic_splatting: {}\n", e.what());
-        return 2;
-    }
+    return run_program("ic_splatting",
+                       [&] { return with_weighting(o.weight, [&](auto w) { return run_with<decltype(w)>(o); }); });
 }

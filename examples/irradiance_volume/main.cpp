@@ -18,6 +18,7 @@
 // --sh-study instead captures environments along the path and prints SH errors per order.
 #include "../common/cli_choices.hpp"
 #include "../common/cli_number_checks.hpp"
+#include "../common/run_program.hpp"
 
 #include <bounce/embree/probe_baker.hpp>
 #include <bounce/io/image_io.hpp>
@@ -36,7 +37,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -289,13 +289,6 @@ int main(int argc, char** argv) {
     app.add_flag("--sh-study", o.sh_study, "SH projection and irradiance errors per order of environments along the path");
     CLI11_PARSE(app, argc, argv);
     o.sphere.seed = o.seed + 6;  // the reference on the sphere: 7 with the default seed, as before
-    try {
-        return run(o);
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "irradiance_volume: out of memory (std::bad_alloc): choose a smaller --max-depth, fewer --rays, "
-                             "--frames or --sphere-points\n");
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "irradiance_volume: %s\n", e.what());
-    }
-    return 1;
+    return examples::run_program("irradiance_volume", [&] { return run(o); },
+                                 "choose a smaller --max-depth, fewer --rays, --frames or --sphere-points");
 }

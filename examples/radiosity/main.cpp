@@ -32,6 +32,7 @@
 #include <bounce/gl/radiosity.hpp>
 #endif
 
+#include "../common/run_program.hpp"
 #include "memory.hpp"
 #include "options.hpp"
 #include "report.hpp"
@@ -40,7 +41,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <new>
 #include <optional>
 #include <span>
 #include <tuple>
@@ -265,15 +265,6 @@ int main(int argc, char** argv) {
     options o;
     add_options(app, o);
     CLI11_PARSE(app, argc, argv);
-    try {
-        return run(o);
-    } catch (const bounce::error& e) {
-        fmt::print(stderr, "radiosity: {}\n", e.what());
-    } catch (const std::bad_alloc&) {
-        fmt::print(stderr, "radiosity: out of memory (std::bad_alloc): ask for fewer --elements, a smaller view, or "
-                           "a smaller --resolution\n");
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "radiosity: {}\n", e.what());
-    }
-    return 2;
+    return run_program("radiosity", [&] { return run(o); },
+                       "ask for fewer --elements, a smaller view, or a smaller --resolution");
 }

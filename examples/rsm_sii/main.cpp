@@ -28,6 +28,7 @@
 #include <bounce/gl/indirect_renderer.hpp>
 #endif
 
+#include "../common/run_program.hpp"
 #include "options.hpp"
 
 #include <fmt/core.h>
@@ -189,7 +190,7 @@ int run(const options& o) {
             j["error"]["rel_rms_occluded"] = r["error"]["rel_rms_occluded"];
             if (r["error"].contains("vs_plain")) j["error"]["vs_plain"] = r["error"]["vs_plain"];
         }
-        for (auto it = extra.begin(); it != extra.end(); ++it) j[it.key()] = it.value();
+        j.update(extra);
         io::write_text_file(o.json, j.dump(2) + "\n");
     }
     return 0;
@@ -202,13 +203,5 @@ int main(int argc, char** argv) {
     options o;
     add_options(app, o);
     CLI11_PARSE(app, argc, argv);
-    try {
-        return run(o);
-    } catch (const bounce::error& e) {
-        fmt::print(stderr, "rsm_sii: {}\n", e.what());
-        return 2;
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "rsm_sii: {}\n", e.what());
-        return 1;
-    }
+    return run_program("rsm_sii", [&] { return run(o); });
 }

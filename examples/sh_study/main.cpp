@@ -11,6 +11,7 @@
 //     gradient extrapolation (study::sh_accuracy_table, study::sh_gradient_table).
 // --json PATH writes one object with the figures and provenance (study::collect_provenance).
 #include "../common/cli_number_checks.hpp"
+#include "../common/run_program.hpp"
 
 #include <bounce/cpu/sh_projection_benchmark.hpp>
 #include <bounce/io/output_files.hpp>
@@ -24,8 +25,6 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include <cstdio>
-#include <new>
 #include <string>
 
 using namespace bounce;
@@ -152,12 +151,5 @@ int main(int argc, char** argv) {
     app.add_option("--threads", o.threads, "TBB threads (0: all)")->check(CLI::Range(0, 1024));
     app.add_option("--json", o.json_path, "write the figures and provenance to this file");
     CLI11_PARSE(app, argc, argv);
-    try {
-        return run(o);
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "sh_study: out of memory (std::bad_alloc): choose fewer --maps or a smaller --size\n");
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "sh_study: %s\n", e.what());
-    }
-    return 1;
+    return examples::run_program("sh_study", [&] { return run(o); }, "choose fewer --maps or a smaller --size");
 }
