@@ -23,11 +23,11 @@
 
 #include <CLI/CLI.hpp>
 #include "../common/cli_number_checks.hpp"
+#include "../common/run_program.hpp"
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <chrono>
-#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -147,7 +147,9 @@ int main(int argc, char** argv) {
     app.add_option("--points-csv", points_csv, "per-point luminance of the reference and of every estimate (CSV)");
     CLI11_PARSE(app, argc, argv);
 
-    try {
+    const std::string out_of_memory = fmt::format("{} points, planes of {}^2, batches of {}",
+                                                  std::max(points, sweep_points), resolution, batch);
+    return examples::run_program("hemisphere_study", [&] {
         // Every output before the work: a run of minutes must not end in an unwritable file.
         if (!json_path.empty()) io::check_output_file("--json", json_path);
         if (!points_csv.empty()) io::check_output_file("--points-csv", points_csv);
@@ -286,13 +288,6 @@ int main(int argc, char** argv) {
             io::write_text_file(json_path, j.dump(2) + "\n");
             fmt::print("wrote {}\n", json_path.string());
         }
-    } catch (const bounce::error& e) {
-        fmt::print(stderr, "hemisphere_study: {}\n", e.what());
-        return 1;
-    } catch (const std::bad_alloc&) {
-        fmt::print(stderr, "hemisphere_study: out of memory ({} points, planes of {}^2, batches of {})\n",
-                   std::max(points, sweep_points), resolution, batch);
-        return 1;
-    }
-    return 0;
+        return 0;
+    }, out_of_memory);
 }

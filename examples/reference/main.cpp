@@ -14,11 +14,11 @@
 
 #include <CLI/CLI.hpp>
 #include "../common/cli_number_checks.hpp"
+#include "../common/run_program.hpp"
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <filesystem>
-#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,7 +91,11 @@ int main(int argc, char** argv) {
     app.add_flag("--quiet", quiet, "no progress output");
     CLI11_PARSE(app, argc, argv);
 
-    try {
+    // A G-buffer (40 bytes a pixel) and three float RGB images (36) at the least.
+    const std::string out_of_memory =
+        fmt::format("{}x{} pixels need about {:.1f} GiB of images; try a smaller --width/--height", width, height,
+                    76.0 * double(width) * double(height) / double(1ull << 30));
+    return examples::run_program("reference", [&] {
         // Every output before the work: the images, their siblings, the report and the cache.
         io::check_image_output("--out", out);
         for (const char* stage : {"direct", "indirect"}) io::check_image_output("--out", sibling(out, stage));
@@ -189,15 +193,6 @@ int main(int argc, char** argv) {
                    height, images.grid.m, images.grid.n, images.grid.count(), cache_state, key);
         for (const auto& stage : timer.stages()) fmt::print("  {:<10} {:10.1f} ms\n", stage, timer.median_ms(stage));
         fmt::print("wrote {}, {}, {}\n", out.string(), sibling(out, "direct").string(), sibling(out, "indirect").string());
-    } catch (const bounce::error& e) {
-        fmt::print(stderr, "reference: {}\n", e.what());
-        return 1;
-    } catch (const std::bad_alloc&) {
-        // A G-buffer (40 bytes a pixel) and three float RGB images (36) at the least.
-        fmt::print(stderr, "reference: out of memory for {}x{} pixels (about {:.1f} GiB of images); try a smaller "
-                           "--width/--height\n",
-                   width, height, 76.0 * double(width) * double(height) / double(1ull << 30));
-        return 1;
-    }
-    return 0;
+        return 0;
+    }, out_of_memory);
 }
