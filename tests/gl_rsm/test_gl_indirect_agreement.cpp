@@ -252,6 +252,11 @@ TEST_CASE("the GL indirect renderer refuses bad input by name", "[gl][rsm]") {
         }
     };
     gl::indirect_renderer r;
+    SECTION("visibility this backend does not have") {
+        indirect_options o;
+        o.visibility = indirect_visibility::rays;
+        throws_naming([&] { gl::indirect_renderer bad(o); }, "visibility");
+    }
     SECTION("output of another size") {
         gl::texture small(gl::texel_format::rgba32f, 15, 12);
         throws_naming([&] { r.render(gb.textures(), s.cam, maps, small); }, "irradiance");

@@ -341,8 +341,14 @@ struct indirect_renderer::passes {
 
 indirect_renderer::indirect_renderer(const indirect_options& options, bool time_stages)
     : options_(options), time_stages_(time_stages) {
-    options_.validate();
+    validate_options(options_);
     passes_ = std::make_unique<passes>();
+}
+
+void indirect_renderer::validate_options(const indirect_options& options) {
+    options.validate();
+    require(options.visibility == indirect_visibility::none, "visibility",
+            "the GL renderer has none yet (rays: cpu::indirect_renderer with embree::occlusion_rays)");
 }
 
 indirect_renderer::~indirect_renderer() = default;

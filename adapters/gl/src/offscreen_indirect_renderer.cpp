@@ -44,7 +44,7 @@ offscreen_indirect_renderer::~offscreen_indirect_renderer() {
 indirect_timings offscreen_indirect_renderer::render(const indirect_options& options, const gbuffer_view<float>& gb,
                                                      const camera& cam, std::span<const rsm_view> maps,
                                                      image_view<glm::vec3> irradiance) {
-    options.validate();
+    indirect_renderer::validate_options(options);
     cam.validate();
     require(!gb.depth.empty(), "gb", "is empty");
     require(irradiance.width() == gb.width() && irradiance.height() == gb.height(), "irradiance",

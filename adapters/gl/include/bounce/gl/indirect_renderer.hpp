@@ -63,10 +63,15 @@ namespace bounce::gl {
 class indirect_renderer {
 public:
     /// Compiles the passes' programs (a context must be current; it must outlive the
-    /// renderer). Throws parameter_error for bad options. With `time_stages`, glFinish
+    /// renderer). Throws parameter_error for bad options (validate_options). With `time_stages`, glFinish
     /// after every stage, so the stage times are the GPU's (wall clock between finishes);
     /// without, the times measure only the issuing of commands.
     explicit indirect_renderer(const indirect_options& options = {}, bool time_stages = false);
+
+    /// options.validate(), and what this backend cannot do: receiver-sender visibility
+    /// (indirect_visibility::rays runs on the CPU, cpu::indirect_renderer with
+    /// embree::occlusion_rays). Throws parameter_error naming the field.
+    static void validate_options(const indirect_options& options);
     ~indirect_renderer();
     indirect_renderer(const indirect_renderer&) = delete;
     indirect_renderer& operator=(const indirect_renderer&) = delete;
