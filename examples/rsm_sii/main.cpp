@@ -14,6 +14,7 @@
 // 2012 section 5.1 times it); medians of --repeat renders.
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/occlusion_rays.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/io/image_io.hpp>
@@ -64,6 +65,9 @@ json parameters_json(const options& o, float clamp_distance, std::size_t maps) {
 /// reason the command line already showed.
 void check_arguments(const options& o) {
     check_backend_built(o.backend);
+    if (o.backend == backend::gl)
+        require(o.visibility == indirect_visibility::none, "--visibility",
+                "'rays' runs on the CPU backend only (the GL renderer has no receiver-sender visibility yet)");
     if (o.study) require(!o.json.empty(), "--study", "needs --json for the study's report");
     if (o.study)
         require(o.out.empty() && o.indirect_out.empty(), "--out/--indirect-out",
@@ -101,7 +105,8 @@ int run(const options& o) {
                rsm_timer.median_ms("rsm"));
 
     // The backend: both renderers take the same call.
-    cpu::indirect_renderer cpu_renderer;
+    const embree::occlusion_rays rays(bvh);
+    cpu::indirect_renderer cpu_renderer({}, &rays);
     study::indirect_frame frame = [&](const indirect_options& opts, image_view<glm::vec3> out) {
         return cpu_renderer.render(opts, g.view(), cam, caster.views(), out);
     };
@@ -159,7 +164,9 @@ int run(const options& o) {
         single = study::measure_indirect(bench, chosen, plain ? &*plain : nullptr);
         fmt::print("{}\n", single->summary());
         report.set_timings(single->timer);
-        report.error = single->vs_unoccluded;
+        // The error against the reference of what the frame computes: with visibility the
+        // occluded one-bounce light, without it the unoccluded one (the other beside it).
+        report.error = o.visibility == indirect_visibility::rays ? single->vs_occluded : single->vs_unoccluded;
         report.set_count("vpls", single->last.vpls);
         report.set_count("maps", caster.maps().size());
         const json r = single->to_json();

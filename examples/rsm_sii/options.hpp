@@ -24,6 +24,9 @@ inline const choices<light_assignment> assignment_names{{"interleaved", light_as
                                                         {"similar", light_assignment::similarity}};
 inline const choices<vpl_selection> selection_names{{"warping", vpl_selection::flux_warping},
                                                     {"grid", vpl_selection::grid}};
+inline const choices<indirect_visibility> visibility_names{
+    {std::string(visibility_name(indirect_visibility::none)), indirect_visibility::none},
+    {std::string(visibility_name(indirect_visibility::rays)), indirect_visibility::rays}};
 
 struct options {
     indirect_technique technique = indirect_technique::sii;  // rsm (the gather, DS05) | sii (splatting, DS06)
@@ -31,6 +34,7 @@ struct options {
     std::string pattern = "4x4";       // N x M interleave pattern; 1x1: none
     light_assignment assign = light_assignment::interleaved;
     examples::backend backend = backend::cpu;
+    indirect_visibility visibility = indirect_visibility::none;  // none (DS05/DS06: leaks) | rays (exact, CPU)
     std::string scene = "cornell";
     std::size_t width = 512, height = 384;
     std::size_t rsm_resolution = 256;  // texels per side of each map (cube face)
@@ -81,6 +85,7 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
     c.light.offset = o.offset;
     c.light.min_distance2 = clamp_distance * clamp_distance;
     c.seed = o.seed;
+    c.visibility = o.visibility;
     try {
         c.validate();
     } catch (const parameter_error& e) {
@@ -120,6 +125,10 @@ inline void add_options(CLI::App& app, options& o) {
     add_choice(app, "--assign", o.assign, assignment_names, "VPLs to sub-buffers: interleaved | blocked | similar")
         ->capture_default_str();
     add_choice(app, "--backend", o.backend, backend_names, "cpu | gl")->capture_default_str();
+    add_choice(app, "--visibility", o.visibility, visibility_names,
+               "receiver-sender visibility: none (as published: light leaks through walls) | rays (an Embree "
+               "occlusion ray per pair the frame sums; CPU backend)")
+        ->capture_default_str();
     app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();

@@ -232,7 +232,7 @@ void main() {
     vec3 centre = (view * vec4(record_position_inv_r.xyz, 1.0)).xyz;
     float box[4];
     sphere_ndc_bounds(centre, influence_radius(record_radius, a), near_depth, tan_half_fov_y, aspect, box);
-    // One pixel of margin on each side (cpu::splat_rect needs only 1/8), so that no pixel
+    // One pixel of margin on each side (sphere_pixel_rect needs only 1/8), so that no pixel
     // centre on the box edge is lost to rounding (outside the sphere every weight is 0), then
     // clipped to the screen: the invisible sphere's zero-area box at x = y = 2 stays empty.
     vec2 lo = clamp(vec2(box[0], box[1]) - pixel_ndc, vec2(-1.0), vec2(1.0));
