@@ -54,6 +54,30 @@ void add_square_z(Scene& s, float z0, float h, bool faces_up, std::uint32_t mate
     else add_quad(s, a, d, c, b, {0, 0, -1}, material);
 }
 
+// Irradiance at height h above the centre of a Lambertian square of half-side a and exitance
+// M, facing it: M square_factor(a / h), with
+// F(X) = 4/pi X / sqrt(1 + X^2) atan(X / sqrt(1 + X^2)) (four corner rectangles of the
+// parallel differential-area-to-rectangle factor).
+inline double square_factor(double x) {
+    const double s = x / std::sqrt(1 + x * x);
+    return 4 / std::numbers::pi * s * std::atan(s);
+}
+
+// A lit floor (half-side 1, z = 0, albedo rho) under a lit occluder (half-side 0.3, z = 0.5,
+// which shadows the floor's centre), a directional light of irradiance e0 straight down.
+// Seen from (0, 0, 1) facing down, the receiver the RSM tests use: without visibility it
+// sees the floor less its shadow plus the occluder, M (F(1) - F(0.3) + F(0.6)); with it the
+// occluder hides exactly the floor's |x|, |y| <= 0.6 and replaces it with the same radiance,
+// M F(1) (M = rho e0, F = square_factor).
+inline scene lit_floor_under_occluder(float rho, float e0) {
+    scene s;
+    const auto mat = add_material(s, glm::vec3(rho));
+    add_square_z(s, 0.f, 1.f, true, mat);
+    add_square_z(s, 0.5f, 0.3f, true, mat);
+    s.lights.push_back(bounce::directional_light{{0, 0, -1}, glm::vec3(e0)});
+    return s;
+}
+
 // An icosahedron subdivided `levels` times and projected onto the sphere of radius r around
 // `centre`: shared vertices (watertight), unit radial vertex normals, 20 * 4^levels triangles.
 template <class Scene>

@@ -45,15 +45,6 @@ hand_built::scene closed_box(float rho) {
     return s;
 }
 
-// Point-to-square factor: irradiance at height h above the centre of a Lambertian square of
-// half-side a and exitance M, facing it, is M F(a / h) with
-// F(X) = 4/pi X / sqrt(1 + X^2) atan(X / sqrt(1 + X^2)) (four corner rectangles of the
-// parallel differential-area-to-rectangle factor).
-double square_factor(double x) {
-    const double s = x / std::sqrt(1 + x * x);
-    return 4 / pi * s * std::atan(s);
-}
-
 }  // namespace
 
 TEST_CASE("the six cube faces of a point light in a closed box reflect rho I 4 pi", "[rsm][embree]") {
@@ -174,8 +165,8 @@ TEST_CASE("the unoccluded reference counts senders hidden from the receiver, the
     const embree::accel bvh(s.view());
     const glm::vec3 p(0.f, 0.f, 1.f), n(0.f, 0.f, -1.f);
     const double m = rho * e0;
-    const double unoccluded = m * (square_factor(1.0) - square_factor(0.3) + square_factor(0.6));
-    const double occluded = m * square_factor(1.0);
+    const double unoccluded = m * (hand_built::square_factor(1.0) - hand_built::square_factor(0.3) + hand_built::square_factor(0.6));
+    const double occluded = m * hand_built::square_factor(1.0);
     REQUIRE(unoccluded - occluded > 0.3 * occluded);  // the test can tell them apart
 
     // Monte Carlo bound: each ray brings pi L k with L <= M / pi and k <= 2 surfaces, so a

@@ -24,13 +24,6 @@ namespace {
 
 constexpr double pi = std::numbers::pi;
 
-// Irradiance at height h above the centre of a Lambertian square of half-side a and exitance
-// M, facing it: M F(a / h) (test_rsm_embree.cpp derives it).
-double square_factor(double x) {
-    const double s = x / std::sqrt(1 + x * x);
-    return 4 / pi * s * std::atan(s);
-}
-
 // Every lit texel of `maps` as a VPL (its own flux): the splat then sums the map's texels.
 std::vector<vpl> every_texel(const std::vector<embree::reflective_shadow_map>& maps) {
     std::vector<vpl> out;
@@ -94,17 +87,12 @@ double floor_mean(gbuffer<float>& g, const image<glm::vec3>& e, float x0, float 
 
 TEST_CASE("with occlusion rays the texels an occluder hides from a receiver stop lighting it",
           "[rsm][embree][visibility]") {
-    // A lit floor (half-side 1, z = 0) under a lit occluder (half-side 0.3, z = 0.5), light
-    // straight down, receiver at height 1 facing down (test_rsm_embree.cpp's set-up). Every
+    // hand_built::lit_floor_under_occluder, the receiver at height 1 facing down. Every
     // texel splatted as a VPL sums the RSM: without visibility that approaches
     // M (F(1) - F(0.3) + F(0.6)), the floor seen through the occluder; with it the occluder
     // hides the floor's |x|, |y| <= 0.6 and replaces it by its own top: M F(1).
     const float rho = 0.8f, e0 = 2.f;
-    hand_built::scene s;
-    const auto mat = hand_built::add_material(s, glm::vec3(rho));
-    hand_built::add_square_z(s, 0.f, 1.f, true, mat);
-    hand_built::add_square_z(s, 0.5f, 0.3f, true, mat);
-    s.lights.push_back(directional_light{{0, 0, -1}, glm::vec3(e0)});
+    const hand_built::scene s = hand_built::lit_floor_under_occluder(rho, e0);
     const embree::accel bvh(s.view());
     embree::rsm_ray_caster caster(bvh, s.view(), {1024, 60.f});
     caster.render();
@@ -118,8 +106,8 @@ TEST_CASE("with occlusion rays the texels an occluder hides from a receiver stop
     cpu::splat_vpls(g.view(), cam, vpls, {}, visible.view(), &rays);
 
     const double m = rho * e0;
-    const double unoccluded = m * (square_factor(1.0) - square_factor(0.3) + square_factor(0.6));
-    const double occluded = m * square_factor(1.0);
+    const double unoccluded = m * (hand_built::square_factor(1.0) - hand_built::square_factor(0.3) + hand_built::square_factor(0.6));
+    const double occluded = m * hand_built::square_factor(1.0);
     // The texel sum's bound of test_rsm_embree.cpp (midpoint rule, and each texel an outline
     // crosses off by at most M t^2 / (pi h^2), h >= 0.5), the outlines now 17.6 long: the
     // floor's 8, the occluder's and its shadow's 2.4 each, and the 4.8 of the floor's part
