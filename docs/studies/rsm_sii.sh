@@ -4,7 +4,7 @@
 # technique on the Cornell box and Sponza, and adds each run's report (with its commit and
 # machine) to the study's one results file, docs/results/rsm_sii.json; then redraws the
 # figures and tables (docs/studies/rsm_sii_figures.py).
-# Usage: docs/studies/rsm_sii.sh [study|pictures|all]  (BIN=DIR/bin, RUNS=DIR for another build folder)
+# Usage: docs/studies/rsm_sii.sh [study|pictures|visibility|all]  (BIN=DIR/bin, RUNS=DIR for another build folder)
 # Takes about 30 minutes on 2 shared cores; the references (4096 rays per pixel, with and
 # without indirect visibility) are computed once and cached in build/cache.
 set -euo pipefail
@@ -36,6 +36,19 @@ if [[ "$which" == pictures || "$which" == all ]]; then
         --ref-spp "$spp" --json "$runs/$name.json" --indirect-out "docs/figures/rsm_sii_${scene}_${technique}.png"
       add "$name"
     done
+  done
+fi
+
+if [[ "$which" == visibility || "$which" == all ]]; then
+  # The leak and its fix (issue 29): SII 1024 VPLs at 4x4 without visibility, with occlusion
+  # rays, and the one-bounce reference with visibility, one exposure, on the Cornell box and
+  # on the conference room (its chairs and tables hide most of the lit floor from each other).
+  for spec in "cornell 320 240 1024" "conference 256 192 1024"; do
+    read -r scene width height spp <<< "$spec"
+    name="$scene-sii-1024-4x4-rays"
+    "$bin" --scene "$scene" --technique sii --vpls 1024 --pattern 4x4 --visibility rays --width "$width" \
+      --height "$height" --ref-spp "$spp" --json "$runs/$name.json" --indirect-out "docs/figures/rsm_sii_${scene}_visibility.png"
+    add "$name"
   done
 fi
 

@@ -36,6 +36,7 @@
 #include <nlohmann/json.hpp>
 
 #include <optional>
+#include <vector>
 #include <string>
 
 using namespace bounce;
@@ -76,6 +77,33 @@ void check_arguments(const options& o) {
     if (!o.out.empty()) io::check_image_output("--out", o.out);
     if (!o.indirect_out.empty()) io::check_image_output("--indirect-out", o.indirect_out);
     study::check_indirect_reference_spp(o.ref_spp, "--ref-spp");
+}
+
+/// --indirect-out: the run's indirect light beside the reference of what it computes, one
+/// exposure (the reference's). With visibility the same frame without it stands between
+/// them: [no visibility | rays | occluded reference], the leak and its fix side by side.
+void write_indirect_pictures(const options& o, const study::indirect_frame& frame, const indirect_options& chosen,
+                             const image<glm::vec3>& radiance, const study::indirect_references& refs,
+                             const gbuffer_view<float>& g, image_view<const float> mask) {
+    std::vector<image_view<const glm::vec3>> panels;
+    image<glm::vec3> leaking;
+    const bool rays = o.visibility == indirect_visibility::rays;
+    if (rays) {
+        indirect_options none = chosen;
+        none.visibility = indirect_visibility::none;
+        image<glm::vec3> e(o.width, o.height);
+        frame(none, e.view());
+        leaking = study::radiance_image(g, e.view());
+        panels.push_back(leaking.view());
+    }
+    panels.push_back(radiance.view());
+    const image_view<const glm::vec3> reference = rays ? refs.occluded.indirect.view() : refs.unoccluded.view();
+    panels.push_back(reference);
+    image<glm::vec3> row(panels.size() * o.width, o.height);
+    for (std::size_t k = 0; k < panels.size(); ++k)
+        for (std::size_t y = 0; y < o.height; ++y)
+            for (std::size_t x = 0; x < o.width; ++x) row(k * o.width + x, y) = panels[k](x, y);
+    io::write_png(o.indirect_out, row.view(), io::auto_exposure(reference, mask));
 }
 
 int run(const options& o) {
@@ -179,16 +207,8 @@ int run(const options& o) {
             for (std::size_t x = 0; x < o.width; ++x) combined(x, y) = refs.occluded.direct(x, y) + single->radiance(x, y);
         io::write_png(o.out, combined.view(), io::auto_exposure(combined.view(), mask.view()));
     }
-    if (single && !o.indirect_out.empty()) {
-        // The technique's indirect light beside the unoccluded reference, one exposure.
-        image<glm::vec3> pair(2 * o.width, o.height);
-        for (std::size_t y = 0; y < o.height; ++y)
-            for (std::size_t x = 0; x < o.width; ++x) {
-                pair(x, y) = single->radiance(x, y);
-                pair(o.width + x, y) = refs.unoccluded(x, y);
-            }
-        io::write_png(o.indirect_out, pair.view(), io::auto_exposure(refs.unoccluded.view(), mask.view()));
-    }
+    if (single && !o.indirect_out.empty())
+        write_indirect_pictures(o, frame, chosen, single->radiance, refs, g.view(), mask.view());
 
     if (!o.json.empty()) {
         json j = report.to_json();

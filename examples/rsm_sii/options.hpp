@@ -161,7 +161,8 @@ inline void add_options(CLI::App& app, options& o) {
                  "into the --json file");
     app.add_option("--json", o.json, "write the run report (or the study's) here");
     app.add_option("--out", o.out, "write direct + indirect radiance as PNG");
-    app.add_option("--indirect-out", o.indirect_out, "write the indirect radiance beside the unoccluded reference's as PNG");
+    app.add_option("--indirect-out", o.indirect_out, "write the indirect radiance beside the reference of what it computes as PNG (with "
+                   "--visibility rays: the frame without visibility, this one, the occluded reference)");
 }
 
 }  // namespace bounce::examples
