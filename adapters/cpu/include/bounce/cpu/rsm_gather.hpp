@@ -82,18 +82,20 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
         for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
         return e;
     }
-    scratch->segments.clear();
-    scratch->terms.clear();
-    for_each_gather_term(x, n, maps, pattern, scale, lp,
-                         [&](const glm::vec3& t, const glm::vec3& xp, const glm::vec3& np) {
-                             if (t.x == 0.f && t.y == 0.f && t.z == 0.f) return;
-                             scratch->segments.push_back({x, n, xp, np});
-                             scratch->terms.push_back(t);
-                         });
-    scratch->blocked.resize(scratch->terms.size());
-    occlusion->occluded(scratch->segments, scratch->blocked);
-    for (std::size_t k = 0; k < scratch->terms.size(); ++k)
-        if (!scratch->blocked[k]) e += scratch->terms[k];
+    visible_gather_scratch own;  // for a caller without scratch of its own
+    visible_gather_scratch& sc = scratch ? *scratch : own;
+    sc.segments.clear();
+    sc.terms.clear();
+    const auto collect = [&](const glm::vec3& t, const glm::vec3& xp, const glm::vec3& np) {
+        if (t.x == 0.f && t.y == 0.f && t.z == 0.f) return;
+        sc.segments.push_back({x, n, xp, np});
+        sc.terms.push_back(t);
+    };
+    for_each_gather_term(x, n, maps, pattern, scale, lp, collect);
+    sc.blocked.resize(sc.terms.size());
+    occlusion->occluded(sc.segments, sc.blocked);
+    for (std::size_t k = 0; k < sc.terms.size(); ++k)
+        if (!sc.blocked[k]) e += sc.terms[k];
     return e;
 }
 }  // namespace detail
