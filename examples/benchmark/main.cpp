@@ -30,6 +30,7 @@ struct options {
     std::string scenes;      // comma-separated; empty: the defaults
     std::string techniques;  // comma-separated; empty: all
     std::string visibility;  // comma-separated; empty: none,rays
+    std::size_t vpls = 1024;  // RSM techniques' lights a frame
     std::size_t width = 0, height = 0;  // 0: 256 (64 with --quick)
     bool quick = false;
     std::filesystem::path json;
@@ -92,6 +93,7 @@ int run(const options& o, const std::string& command) {
         study::benchmark_settings::defaults(o.quick, o.width ? o.width : side, o.height ? o.height : side);
     if (!o.techniques.empty()) s.techniques = study::parse_techniques(o.techniques);
     if (!o.visibility.empty()) s.visibility = study::parse_visibilities(o.visibility);
+    s.rsm_lights = o.vpls;
     s.progress = print_progress;
     s.validate();
     const std::vector<std::string> scenes =
@@ -130,6 +132,8 @@ int main(int argc, char** argv) {
     app.add_option("--visibility", o.visibility,
                    "comma-separated receiver-sender visibility of the RSM techniques, each a run: none (as "
                    "published), rays (exact, Embree occlusion rays) (default: none,rays)");
+    app.add_option("--vpls", o.vpls, "lights a frame of the RSM techniques: SII's VPLs, the gather's disc samples")
+        ->capture_default_str();
     app.add_option("--width", o.width, "image width (default 256; 64 with --quick)")->check(CLI::Range(1, 16384));
     app.add_option("--height", o.height, "image height (default 256; 64 with --quick)")->check(CLI::Range(1, 16384));
     app.add_flag("--quick", o.quick, "a few minutes: small reference sample counts, 64x64, the built-in Cornell box");

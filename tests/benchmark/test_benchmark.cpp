@@ -112,6 +112,9 @@ TEST_CASE("benchmark settings refuse what cannot run", "[benchmark]") {
     s = benchmark_settings::defaults(false, 256, 256);
     s.visibility.clear();
     CHECK_THROWS_WITH(s.validate(), Catch::Contains("--visibility"));
+    s = benchmark_settings::defaults(false, 256, 256);
+    s.rsm_lights = 15;  // fewer than SII's 4x4 sub-buffers
+    CHECK_THROWS_WITH(s.validate(), Catch::Contains("--vpls"));
 }
 
 TEST_CASE("a scene argument that names nothing is refused with the path tried", "[benchmark]") {

@@ -151,6 +151,8 @@ void benchmark_settings::validate() const {
     require(height >= 1 && height <= 16384, "--height", "must lie in [1, 16384]");
     require(!techniques.empty(), "--techniques", "names no technique");
     require(!visibility.empty(), "--visibility", "names no visibility");
+    require(rsm_lights >= 16 && rsm_lights <= (std::size_t(1) << 24), "--vpls",
+            "must lie in [16, 2^24] (at least one light for each of SII's 4x4 sub-buffers)");
     for (const bench_quantity q : all_bench_quantities) {
         const quantity_samples& n = samples_of(q);
         const std::string what = "reference samples of " + std::string(quantity_name(q));
@@ -182,6 +184,7 @@ nlohmann::ordered_json benchmark_settings::to_json() const {
             {"mc_max_spp", mc},
             {"techniques", names},
             {"visibility", visibilities},
+            {"rsm_lights", rsm_lights},
             {"volume_offset", volume_offset},
             {"radiosity_max_seconds", radiosity_max_seconds},
             {"repeat", repeat}};

@@ -16,17 +16,17 @@ namespace bounce::study::bench {
 
 namespace {
 
-// rsm_sii's defaults (examples/rsm_sii/options.hpp): 1,024 lights (SII: VPLs by flux
-// warping; the gather: disc samples per pixel and map over a disc of radius 1.5 map units),
-// 256^2 texels per map, d^2 clamped at scene_clamp_distance (1% of the scene's diagonal), the
+// rsm_sii's defaults (examples/rsm_sii/options.hpp): the settings' lights a frame (1,024 by
+// default; SII: VPLs by flux warping; the gather: disc samples per pixel and map over a disc
+// of radius 1.5 map units), 256^2 texels per map, d^2 clamped at scene_clamp_distance (1% of the scene's diagonal), the
 // geometry-aware blur after interleaving, energy-correct weights, seed 1.
-constexpr std::size_t lights_per_frame = 1024;
 constexpr std::size_t map_resolution = 256;
 
-indirect_options options_for(bench_technique t, float clamp_distance, indirect_visibility visibility) {
+indirect_options options_for(bench_technique t, std::size_t lights, float clamp_distance,
+                             indirect_visibility visibility) {
     indirect_options o;
     o.technique = t == bench_technique::rsm_gather ? indirect_technique::rsm_gather : indirect_technique::sii;
-    o.count = lights_per_frame;
+    o.count = lights;
     o.pattern = t == bench_technique::sii_interleaved ? interleave_pattern{4, 4} : interleave_pattern{1, 1};
     o.light.min_distance2 = clamp_distance * clamp_distance;
     o.visibility = visibility;
@@ -42,7 +42,7 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
     require(!s.scene.lights.empty(), "scene", "has no point, spot or directional light: reflective shadow maps need one");
     const std::string name = std::string(technique_name(t)) + (visibility == indirect_visibility::none ? "" : "+rays");
     const float clamp_distance = scene_clamp_distance(s.scene);
-    const indirect_options options = options_for(t, clamp_distance, visibility);
+    const indirect_options options = options_for(t, s.settings.rsm_lights, clamp_distance, visibility);
 
     // The maps are part of every frame's cost (the lights may move); cast once timed.
     s.clock.report(name, "maps");
@@ -81,7 +81,7 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
     r.radiance = std::move(e);
     apply_output(output_quantity::radiance, image_view<const glm::vec3>(s.g.view().albedo), r.radiance.view());
     r.counts = {{"vpls", last.vpls}, {"maps", caster.maps().size()}};
-    r.parameters = {{"count", lights_per_frame},
+    r.parameters = {{"count", s.settings.rsm_lights},
                     {"pattern", t == bench_technique::sii_interleaved ? "4x4" : "1x1"},
                     {"rsm_resolution", map_resolution},
                     {"clamp", clamp_distance},

@@ -104,6 +104,9 @@ struct benchmark_settings {
     std::size_t width = 256, height = 256;
     bool quick = false;  ///< the settings of quick_settings (recorded in the results)
     std::vector<bench_technique> techniques{all_bench_techniques.begin(), all_bench_techniques.end()};
+    /// Lights a frame of the RSM techniques (SII: VPLs; the gather: disc samples per pixel and
+    /// map), rsm_sii's default 1,024 (`--vpls`); at least the 16 sub-buffers of SII's 4x4.
+    std::size_t rsm_lights = 1024;
     /// The RSM techniques' visibility policies, each a run of its own (`--visibility`).
     std::vector<indirect_visibility> visibility{indirect_visibilities.begin(), indirect_visibilities.end()};
     quantity_samples one_bounce{1024, 512}, unoccluded{512, 256}, all_bounces{256, 128}, volume_points{512, 256};
