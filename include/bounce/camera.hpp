@@ -10,7 +10,10 @@
 
 #include <bounce/errors.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -67,5 +70,22 @@ struct camera {
         return glm::perspective(glm::radians(fov_y_deg), float(width) / float(height), near_plane, far_plane);
     }
 };
+
+/// Sets the camera's far plane to twice the distance from the eye to the farthest corner of
+/// `bounds` and the near plane to 1e-4 of that, so that a raster depth buffer keeps its
+/// precision for the scene at hand whatever its units. Keeps the camera's planes where the
+/// scene's scale leaves float's normal range.
+inline void fit_clip_planes(camera& cam, const std::pair<glm::vec3, glm::vec3>& bounds) {
+    float farthest = 0.f;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 corner((i & 1) ? bounds.second.x : bounds.first.x, (i & 2) ? bounds.second.y : bounds.first.y,
+                               (i & 4) ? bounds.second.z : bounds.first.z);
+        farthest = std::max(farthest, glm::length(corner - cam.position));
+    }
+    const float far_plane = 2.f * farthest, near_plane = 1e-4f * far_plane;
+    if (!std::isfinite(far_plane) || !(near_plane >= std::numeric_limits<float>::min())) return;
+    cam.far_plane = far_plane;
+    cam.near_plane = near_plane;
+}
 
 }  // namespace bounce
