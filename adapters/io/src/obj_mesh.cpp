@@ -365,13 +365,9 @@ private:
                 throw scene_error(file_, 0, "tinyobjloader returned an index out of range");
         const glm::dvec3 p0 = position(c[0].vertex_index), p1 = position(c[1].vertex_index),
                          p2 = position(c[2].vertex_index);
-        // Zero area up to float resolution: the third vertex lies within one float
-        // epsilon (relative to the longest edge) of the line through the other two,
-        // i.e. |e1 x e2| <= eps * max |e|^2; its face normal would be noise.
         const glm::dvec3 cross = glm::cross(p1 - p0, p2 - p0);
-        const double longest2 = std::max({glm::dot(p1 - p0, p1 - p0), glm::dot(p2 - p1, p2 - p1), glm::dot(p0 - p2, p0 - p2)});
         const double area2 = glm::length(cross);
-        if (!(area2 > double(std::numeric_limits<float>::epsilon()) * longest2)) {
+        if (zero_area(p0, p1, p2)) {
             ++degenerate_;
             return;
         }

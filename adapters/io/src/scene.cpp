@@ -44,14 +44,10 @@ void fit_clip_planes(bounce::camera& camera, const std::pair<glm::vec3, glm::vec
 }
 }  // namespace detail
 
-scene load_obj(const fs::path& obj, const bounce::material& default_material) {
-    scene s;
-    s.name = obj.stem().string();
-    s.source = obj;
-    detail::load_obj_mesh(obj, default_material, s);
-
-    // Frame the bounding sphere in a 45 degree view from +z: distance r / sin(22.5 deg),
-    // with 5% to spare. In double: a mesh near the float range would overflow.
+namespace {
+// Frames the bounding sphere in a 45 degree view from +z: distance r / sin(22.5 deg), with
+// 5% to spare; returns that distance. In double: a mesh near the float range would overflow.
+double frame_from_z(const fs::path& file, scene& s) {
     const auto [lo, hi] = s.bounds();
     const glm::dvec3 centre = 0.5 * (glm::dvec3(lo) + glm::dvec3(hi));
     const double radius = 0.5 * glm::length(glm::dvec3(hi) - glm::dvec3(lo));
@@ -59,8 +55,8 @@ scene load_obj(const fs::path& obj, const bounce::material& default_material) {
     const glm::dvec3 eye = centre + glm::dvec3(0.0, 0.0, distance);
     const double limit = double(std::numeric_limits<float>::max());
     if (!(std::abs(eye.z) < limit && distance * distance < limit))
-        throw scene_error(obj, 0, "the mesh is too large (extent " + std::to_string(2 * radius) +
-                                      ") to place a camera and a light around it in float");
+        throw scene_error(file, 0, "the mesh is too large (extent " + std::to_string(2 * radius) +
+                                       ") to place a camera and a light around it in float");
     s.camera.position = glm::vec3(eye);
     s.camera.look_at = glm::vec3(centre);
     s.camera.up = {0.f, 1.f, 0.f};
@@ -70,16 +66,38 @@ scene load_obj(const fs::path& obj, const bounce::material& default_material) {
         s.camera.validate();
     } catch (const parameter_error&) {
         // The eye rounds onto the centre: a mesh far smaller than float's resolution at its position.
-        throw scene_error(obj, 0, "the mesh is too small (extent " + std::to_string(2 * radius) +
-                                      ") for float to place a camera around it");
+        throw scene_error(file, 0, "the mesh is too small (extent " + std::to_string(2 * radius) +
+                                       ") for float to place a camera around it");
     }
+    return distance;
+}
+}  // namespace
 
-    s.use_emission = true;
-    if (s.emissive_triangles().empty()) {
-        s.use_emission = false;
-        // A head light: E = I / d^2 = 1 W/m^2 at the centre.
-        s.lights.emplace_back(point_light{s.camera.position, glm::vec3(float(distance * distance))});
+namespace detail {
+void place_camera_and_light(const fs::path& file, scene& s, const std::optional<bounce::camera>& given) {
+    double distance = 0.0;
+    if (given) {
+        s.camera = *given;
+        detail::fit_clip_planes(s.camera, s.bounds());
+        const auto [lo, hi] = s.bounds();
+        distance = glm::length(0.5 * (glm::dvec3(lo) + glm::dvec3(hi)) - glm::dvec3(s.camera.position));
+    } else {
+        distance = frame_from_z(file, s);
     }
+    // A head light: E = I / d^2 = 1 W/m^2 at the centre.
+    if (s.lights.empty() && s.emissive_triangles().empty())
+        s.lights.emplace_back(point_light{s.camera.position, glm::vec3(float(std::min(distance * distance, double(max_light_value))))});
+}
+}  // namespace detail
+
+scene load_obj(const fs::path& obj, const bounce::material& default_material) {
+    scene s;
+    s.name = obj.stem().string();
+    s.source = obj;
+    detail::load_obj_mesh(obj, default_material, s);
+    s.use_emission = true;
+    s.use_emission = !s.emissive_triangles().empty();
+    detail::place_camera_and_light(obj, s, std::nullopt);
     return s;
 }
 
@@ -104,6 +122,7 @@ scene load_scene_arg(std::string_view arg) {
     std::string ext = p.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".obj") return load_obj(p);
+    if (ext == ".gltf" || ext == ".glb") return load_gltf(p);
     return load_scene(p);
 }
 

@@ -11,7 +11,11 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -113,12 +117,11 @@ private:
     fs::path file_;
 };
 
-json parse_json(const fs::path& file, const std::string& text) {
+json parse_json(const fs::path& file, std::string_view text, int max_depth = max_json_depth) {
     // nlohmann's parser keeps its own stack, but the depth callback bounds the work and
     // the tree we would have to destroy for an adversarial file.
     const json::parser_callback_t depth_limit = [&](int depth, json::parse_event_t, json&) {
-        if (depth > max_json_depth)
-            throw scene_error(file, 0, "nested deeper than " + std::to_string(max_json_depth) + " levels");
+        if (depth > max_depth) throw scene_error(file, 0, "nested deeper than " + std::to_string(max_depth) + " levels");
         return true;
     };
     try {
@@ -167,22 +170,52 @@ light read_light(const field_reader& r, const json& j, const std::string& field)
     r.fail(f("type"), "unknown light type '" + type.substr(0, 40) + "' (expected point, spot or directional)");
 }
 
+bounce::camera read_camera(const field_reader& r, const json& cam) {
+    r.expect_object(cam, "camera");
+    r.only_keys(cam, {"position", "look_at", "up", "fov_y_deg"}, "camera");
+    bounce::camera c;
+    c.position = r.vec3(r.member(cam, "position", "camera"), "camera.position", field_reader::range::position);
+    c.look_at = r.vec3(r.member(cam, "look_at", "camera"), "camera.look_at", field_reader::range::position);
+    c.up = r.vec3(r.member(cam, "up", "camera"), "camera.up");
+    c.fov_y_deg = r.number(r.member(cam, "fov_y_deg", "camera"), "camera.fov_y_deg");
+    try {
+        c.validate();
+    } catch (const parameter_error& e) {
+        const std::string what = e.what();
+        r.fail("camera." + e.parameter(), what.substr(what.rfind("': ") == std::string::npos ? 0 : what.rfind("': ") + 3));
+    }
+    return c;
+}
+
+// The mesh file: exactly one of "obj" and "gltf".
+std::pair<std::string, bool> mesh_file(const field_reader& r, const json& root) {
+    const bool obj = root.contains("obj"), gltf = root.contains("gltf");
+    if (obj == gltf) r.fail(obj ? "gltf" : "obj", obj ? "given with obj: name one mesh file" : "missing (or gltf)");
+    const char* key = obj ? "obj" : "gltf";
+    const std::string name = r.string(root.at(key), key);
+    if (name.empty()) r.fail(key, "empty file name");
+    if (obj && root.contains("gltf_lights")) r.fail("gltf_lights", "only with gltf");
+    return {name, gltf};
+}
+
 }  // namespace
+
+namespace detail {
+void check_json_text(const fs::path& file, std::string_view text, int max_depth) { parse_json(file, text, max_depth); }
+}  // namespace detail
 
 scene load_scene(const fs::path& file) {
     const std::string text = detail::read_text_file(file, max_json_bytes);
     const json root = parse_json(file, text);
     const field_reader r(file);
     if (!root.is_object()) throw scene_error(file, 0, "expected a JSON object {...} at the top");
-    r.only_keys(root, {"obj", "default_material", "camera", "lights", "use_emission"}, "");
+    r.only_keys(root, {"obj", "gltf", "gltf_lights", "default_material", "camera", "lights", "use_emission"}, "");
 
     scene s;
     s.source = file;
     s.name = file.parent_path().filename().string();
     if (s.name.empty() || s.name == "." || s.name == "..") s.name = file.stem().string();
-
-    const std::string obj = r.string(r.member(root, "obj", ""), "obj");
-    if (obj.empty()) r.fail("obj", "empty file name");
+    const auto [mesh, gltf] = mesh_file(r, root);
 
     bounce::material default_material;
     if (const auto it = root.find("default_material"); it != root.end()) {
@@ -190,33 +223,34 @@ scene load_scene(const fs::path& file) {
         r.only_keys(*it, {"kd"}, "default_material");
         default_material.albedo = r.vec3(r.member(*it, "kd", "default_material"), "default_material.kd", field_reader::range::unit);
     }
-
-    const json& cam = r.member(root, "camera", "");
-    r.expect_object(cam, "camera");
-    r.only_keys(cam, {"position", "look_at", "up", "fov_y_deg"}, "camera");
-    s.camera.position = r.vec3(r.member(cam, "position", "camera"), "camera.position", field_reader::range::position);
-    s.camera.look_at = r.vec3(r.member(cam, "look_at", "camera"), "camera.look_at", field_reader::range::position);
-    s.camera.up = r.vec3(r.member(cam, "up", "camera"), "camera.up");
-    s.camera.fov_y_deg = r.number(r.member(cam, "fov_y_deg", "camera"), "camera.fov_y_deg");
-    try {
-        s.camera.validate();
-    } catch (const parameter_error& e) {
-        const std::string what = e.what();
-        r.fail("camera." + e.parameter(), what.substr(what.rfind("': ") == std::string::npos ? 0 : what.rfind("': ") + 3));
+    // With a glTF file, camera and lights are optional: the file's own, overridden or added to.
+    std::optional<bounce::camera> camera;
+    if (!gltf || root.contains("camera")) camera = read_camera(r, r.member(root, "camera", ""));
+    std::vector<light> lights;
+    if (!gltf || root.contains("lights")) {
+        const json& list = r.member(root, "lights", "");
+        if (!list.is_array()) r.fail("lights", "expected an array [...]");
+        for (std::size_t i = 0; i < list.size(); ++i) lights.push_back(read_light(r, list[i], "lights[" + std::to_string(i) + "]"));
     }
+    std::optional<bool> use_emission;
+    if (const auto it = root.find("use_emission"); it != root.end()) use_emission = r.boolean(*it, "use_emission");
+    const bool gltf_lights = !root.contains("gltf_lights") || r.boolean(root.at("gltf_lights"), "gltf_lights");
 
-    const json& lights = r.member(root, "lights", "");
-    if (!lights.is_array()) r.fail("lights", "expected an array [...]");
-    for (std::size_t i = 0; i < lights.size(); ++i)
-        s.lights.push_back(read_light(r, lights[i], "lights[" + std::to_string(i) + "]"));
-
-    if (const auto it = root.find("use_emission"); it != root.end()) s.use_emission = r.boolean(*it, "use_emission");
-
-    detail::load_obj_mesh(file.parent_path() / obj, default_material, s);
-    detail::fit_clip_planes(s.camera, s.bounds());
+    if (gltf) {
+        detail::gltf_extras extras = detail::load_gltf_mesh(file.parent_path() / mesh, default_material, s);
+        if (gltf_lights) s.lights = std::move(extras.lights);
+        if (!camera) camera = extras.camera;
+        s.use_emission = true;
+        s.use_emission = use_emission.value_or(!s.emissive_triangles().empty());
+    } else {
+        detail::load_obj_mesh(file.parent_path() / mesh, default_material, s);
+        s.use_emission = use_emission.value_or(false);
+    }
+    s.lights.insert(s.lights.end(), lights.begin(), lights.end());
     if (s.lights.empty() && s.emissive_triangles().empty())
-        r.fail("lights", s.use_emission ? "empty, and no face of the OBJ emits (Ke): the scene has no light"
+        r.fail("lights", s.use_emission ? std::string("empty, and no face of the ") + (gltf ? "glTF emits (emissiveFactor)" : "OBJ emits (Ke)") + ": the scene has no light"
                                         : "empty and use_emission is false: the scene has no light");
+    detail::place_camera_and_light(file, s, camera);
     return s;
 }
 

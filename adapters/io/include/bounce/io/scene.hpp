@@ -1,8 +1,9 @@
 #pragma once
 /// \file scene.hpp
 /// `io::scene`: triangles, per-vertex normals, per-triangle materials, lights and a camera,
-/// loaded from OBJ+MTL (tinyobjloader) and the `scene.json` beside it, or built in
-/// (`cornell_box()`). The scene.json format is specified in docs/scenes.md.
+/// loaded from OBJ+MTL (tinyobjloader) or glTF 2.0 (tinygltf) and the `scene.json` beside
+/// it, or built in (`cornell_box()`). The scene.json format is specified in docs/scenes.md,
+/// what bounce takes from a glTF file in docs/gltf.md.
 
 #include <bounce/camera.hpp>
 #include <bounce/errors.hpp>
@@ -37,7 +38,7 @@ private:
 /// `view()` hands the adapters the non-owning `scene_view` they take.
 struct scene {
     std::string name;                        ///< "cornell" or the scene folder's name
-    std::filesystem::path source;            ///< the scene.json or OBJ it came from (empty if built in)
+    std::filesystem::path source;            ///< the scene.json, OBJ or glTF it came from (empty if built in)
     std::vector<glm::vec3> positions;        ///< vertex positions
     std::vector<glm::vec3> normals;          ///< unit vertex normals, one per position
     std::vector<glm::uvec3> triangles;       ///< indices into positions/normals
@@ -65,8 +66,8 @@ struct scene {
     std::pair<glm::vec3, glm::vec3> bounds() const noexcept { return view().bounds(); }
 };
 
-/// Loads a scene.json (and the OBJ+MTL it names), as docs/scenes.md specifies.
-/// \param scene_json path of the JSON file; the OBJ path inside it is relative to its folder.
+/// Loads a scene.json (and the OBJ+MTL or glTF it names), as docs/scenes.md specifies.
+/// \param scene_json path of the JSON file; the mesh path inside it is relative to its folder.
 /// \throws scene_error naming the file and the line (OBJ, MTL, JSON syntax) or the field
 ///         (e.g. "lights[0].intensity: expected 3 numbers").
 scene load_scene(const std::filesystem::path& scene_json);
@@ -76,13 +77,22 @@ scene load_scene(const std::filesystem::path& scene_json);
 /// \param default_material the material of faces without `usemtl`.
 /// \throws scene_error naming the file and line.
 scene load_obj(const std::filesystem::path& obj, const bounce::material& default_material = {});
+/// Loads a glTF 2.0 file (.gltf with its buffers, or .glb) alone, as docs/gltf.md specifies:
+/// the meshes of the scene's nodes in world space, base colour as albedo, emission (and
+/// use_emission set when a used material emits), KHR_lights_punctual lights and the first
+/// perspective camera. Without a camera it is placed as load_obj places it; without lights
+/// and emission a head light is added as load_obj adds it.
+/// \param default_material the material of primitives without one.
+/// \throws scene_error naming the file and the glTF object at fault ("accessors[3]: ...").
+scene load_gltf(const std::filesystem::path& file, const bounce::material& default_material = {});
 /// The Cornell box from its published dimensions (Cornell University Program of Computer
 /// Graphics, "Cornell Box Data"), in metres, with the published camera, the light quad as
 /// an emissive material (Ke = (17, 12, 4), use_emission false) and a cosine spot of the same
 /// power just below it. 38 triangles, all facing into the box (see docs/scenes.md).
 scene cornell_box();
 /// What every program's `--scene` accepts: `cornell` for the built-in box, a path to a
-/// scene.json, a folder holding a scene.json, an .obj (loaded with load_obj), or the name
+/// scene.json, a folder holding a scene.json, an .obj (loaded with load_obj), a .gltf or
+/// .glb (load_gltf), or the name
 /// of a scene folder under scenes_dir() (`sponza`) when no file or folder here has it.
 /// \throws scene_error
 scene load_scene_arg(std::string_view arg);
