@@ -174,10 +174,18 @@ using kernel_arguments = typename detail::argument_lanes<typename glsl::detail::
 template <class F>
 using kernel_result = typename detail::result_lanes<typename glsl::detail::signature_of<F>::result>::host;
 
+/// Which API a compute shader of `map_kernel_source` is written for. Both are GLSL 4.50 with
+/// the same body; they differ in how the range reaches the shader and how buffers are named:
+/// - opengl: `first` and `count` are uniforms at locations 0 and 1; buffers at bindings 0, 1;
+/// - vulkan: `first` and `count` are push constants (two uints at offsets 0 and 4); buffers
+///   at set 0, bindings 0 (inputs) and 1 (outputs). glslang compiles it to SPIR-V
+///   (`--target-env vulkan1.2`); tests/spirv validates every kernel's with spirv-val.
+enum class compute_target { opengl, vulkan };
+
 /// The compute shader `map_kernel` runs for `fn`: plumbing only (loads, one call of the
 /// emitted function, stores) around `glsl::emit("bounce_kernel", fn, ...)`.
 template <class F>
-std::string map_kernel_source(F&& fn) {
+std::string map_kernel_source(F&& fn, compute_target target = compute_target::opengl) {
     using sig = glsl::detail::signature_of<F>;
     using args = typename sig::arguments;
     using results = detail::result_lanes<typename sig::result>;
@@ -209,12 +217,15 @@ std::string map_kernel_source(F&& fn) {
         for (const auto& o : outs) call_args += (call_args.empty() ? "" : ", ") + o;
         call = results::declarations() + "    bounce_kernel(" + call_args + ");\n";
     }
+    const bool vulkan = target == compute_target::vulkan;
+    const std::string set = vulkan ? "set = 0, " : "";
     return "#version 450 core\n"
            "layout(local_size_x = 64) in;\n"
-           "layout(std430, binding = 0) readonly buffer bounce_inputs { float in_data[]; };\n"
-           "layout(std430, binding = 1) writeonly buffer bounce_outputs { float out_data[]; };\n"
-           "layout(location = 0) uniform uint first;\n"
-           "layout(location = 1) uniform uint count;\n\n" +
+           "layout(std430, " + set + "binding = 0) readonly buffer bounce_inputs { float in_data[]; };\n"
+           "layout(std430, " + set + "binding = 1) writeonly buffer bounce_outputs { float out_data[]; };\n" +
+           (vulkan ? "layout(push_constant) uniform bounce_range { uint first; uint count; };\n\n"
+                   : "layout(location = 0) uniform uint first;\n"
+                     "layout(location = 1) uniform uint count;\n\n") +
            function +
            "\nvoid main() {\n"
            "    uint i = first + gl_GlobalInvocationID.x;\n"
