@@ -76,6 +76,7 @@ const std::vector<bad_case>& bad_cases() {
         {"missing light", [](gltf_writer& w) { w.doc["nodes"][0]["extensions"]["KHR_lights_punctual"]["light"] = 0; }, "light 0 does not exist"},
         {"inverted spot cones", [](gltf_writer& w) { w.use_lights({{{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.4}}}}}); w.doc["nodes"][0]["extensions"]["KHR_lights_punctual"]["light"] = 0; }, "lights[0].spot: expected 0 <= innerConeAngle < outerConeAngle"},
         {"missing scene", [](gltf_writer& w) { w.doc["scene"] = 3; }, "scene: 3 does not exist"},
+        {"required extension", [](gltf_writer& w) { w.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }, "extensionsRequired: 'KHR_draco_mesh_compression' is not supported"},
         {"version 1", [](gltf_writer& w) { w.doc["asset"]["version"] = "1.0"; }, "asset.version '1.0'"},
         {"no triangles", [](gltf_writer& w) { w.doc["meshes"][0]["primitives"][0]["mode"] = 0; }, "no triangles"},
         {"missing texture", [](gltf_writer& w) { w.doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 4}}; }, "baseColorTexture: texture 4 does not exist"},

@@ -12,7 +12,9 @@
 
 #include <bounce/io/scene.hpp>
 
+#include <algorithm>
 #include <array>
+#include <initializer_list>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -121,6 +123,12 @@ gltf_document read_gltf(const fs::path& file) {
     if (access.fault) throw *access.fault;
     if (!ok || !err.empty()) doc.fail("tinygltf: " + first_line(err));
     if (doc.model.asset.version.rfind("2.", 0) != 0) doc.fail("asset.version '" + doc.model.asset.version.substr(0, 20) + "' (expected 2.x)");
+    // A file that requires an extension bounce does not read cannot be shown as meant (the
+    // spec asks loaders to refuse it). A texture transform changes no texture's mean.
+    for (const std::string& ext : doc.model.extensionsRequired)
+        if (ext != "KHR_lights_punctual" && ext != "KHR_materials_emissive_strength" && ext != "KHR_texture_transform")
+            doc.fail("extensionsRequired: '" + ext.substr(0, 60) +
+                     "' is not supported (bounce reads KHR_lights_punctual and KHR_materials_emissive_strength)");
     return doc;
 }
 

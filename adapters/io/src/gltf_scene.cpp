@@ -342,7 +342,7 @@ bool read_camera(const gltf_document& doc, const node_instance& at_node, bounce:
     const tinygltf::Camera& c = doc.model.cameras[std::size_t(index)];
     const std::string field = at("cameras", std::size_t(index));
     if (c.type != "perspective") {
-        warnings.push_back(field + ": a " + c.type.substr(0, 20) + " camera, skipped (bounce's camera is a pinhole)");
+        warnings.push_back(field + ": type " + c.type.substr(0, 20) + ", skipped (bounce's camera is a perspective pinhole)");
         return false;
     }
     const double fov = c.perspective.yfov * 180.0 / std::numbers::pi;
