@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
     gl::direct_light_options shadows;  // its resolution comes from shadow_resolution
 #endif
     fs::path json_path, points_csv;
-    app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
+    app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, a .gltf or .glb, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--resolution", resolution, "plane resolution N (N x N pixels)")
         ->check(CLI::Range(1u, 1024u))

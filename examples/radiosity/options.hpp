@@ -63,7 +63,7 @@ inline void add_options(CLI::App& app, options& o) {
             ->check(CLI::IsMember({"on", "off"}))
             ->default_str(flag ? "on" : "off");
     };
-    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, a .gltf or .glb, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--elements", o.elements, "target number of elements (lightmap texels)")
         ->check(CLI::Range(std::size_t(16), std::size_t(50000000)))->capture_default_str();

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
     float exposure = 0.f;
     int repeat = 1;
     bool no_cache = false, quiet = false;
-    app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")->capture_default_str();
+    app.add_option("--scene", scene_arg, "cornell, a scene.json, its folder, an .obj, a .gltf or .glb, or a name under the scenes folder")->capture_default_str();
     app.add_option("--width", width, "image width in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", height, "image height in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--spp", spp, "hemisphere samples per pixel for indirect light (an M x N grid, N ~ pi M)")

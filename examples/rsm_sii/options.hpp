@@ -129,7 +129,7 @@ inline void add_options(CLI::App& app, options& o) {
                "receiver-sender visibility: none (as published: light leaks through walls) | rays (an Embree "
                "occlusion ray per pair the frame sums; CPU backend)")
         ->capture_default_str();
-    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, a .gltf or .glb, or a name under the scenes folder")
         ->capture_default_str();
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
