@@ -3,6 +3,7 @@
 // The shaders are plumbing (buffer and texture fetches, the view transform of the record
 // centre, placing the quad corners, discarding, writing); the weighting, the box, the
 // extrapolation and the normalization are the kernels of include/bounce/, emitted.
+#include <bounce/cache/record_std430.hpp>
 #include <bounce/gl/splat_pass.hpp>
 #include <bounce/glsl/emit.hpp>
 #include <bounce/splat_bounds.hpp>
@@ -26,14 +27,7 @@ namespace bounce::gl {
 namespace {
 
 // One record as the shaders read it (std430: an array of vec4 rows, 144 bytes).
-struct gpu_record {
-    glm::vec4 position_inv_r;  // p_k, 1 / R_k (computed once here, as the CPU path does)
-    glm::vec4 normal_radius;   // n_k, R_k
-    glm::vec4 irradiance;      // E_k
-    glm::vec4 rotation[3];     // grad_r per channel
-    glm::vec4 translation[3];  // grad_t per channel
-};
-static_assert(sizeof(gpu_record) == 9 * sizeof(glm::vec4));
+using gpu_record = std430_record;
 
 constexpr const char* record_block = R"(struct bounce_record {
     vec4 position_inv_r;
@@ -58,26 +52,7 @@ enum location : int {
     loc_front_tolerance = 8,
 };
 
-bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-gpu_record pack(const irradiance_record& r, std::size_t index) {
-    const auto fail = [&](const char* what) {
-        throw parameter_error("records[" + std::to_string(index) + "]", what);
-    };
-    if (!finite3(r.position) || !finite3(r.normal) || !finite3(r.irradiance)) fail("position, normal or irradiance is not finite");
-    for (int c = 0; c < 3; ++c)
-        if (!finite3(r.rotation[std::size_t(c)]) || !finite3(r.translation[std::size_t(c)])) fail("a gradient is not finite");
-    if (!(std::isfinite(r.radius) && r.radius > 0.f)) fail("radius must be a positive finite number");
-    gpu_record g;
-    g.position_inv_r = glm::vec4(r.position, 1.f / r.radius);
-    g.normal_radius = glm::vec4(r.normal, r.radius);
-    g.irradiance = glm::vec4(r.irradiance, 0.f);
-    for (int c = 0; c < 3; ++c) {
-        g.rotation[c] = glm::vec4(r.rotation[std::size_t(c)], 0.f);
-        g.translation[c] = glm::vec4(r.translation[std::size_t(c)], 0.f);
-    }
-    return g;
-}
+gpu_record pack(const irradiance_record& r, std::size_t index) { return pack_std430(r, index); }
 
 void require_rgba32f(const texture_ref& t, const char* name) {
     require(t.format == texel_format::rgba32f, name, "must be an RGBA32F texture");
