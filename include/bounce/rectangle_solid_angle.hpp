@@ -35,6 +35,24 @@ T rectangle_solid_angle(T u0, T v0, T u1, T v1) {
            rectangle_solid_angle_corner<T>(u1, v0) + rectangle_solid_angle_corner<T>(u0, v0);
 }
 
+/// The same solid angle as `rectangle_solid_angle`, as its two spherical triangles
+/// (corners a, b, c of one and a, c, d of the other on the plane z = 1), each by Van Oosterom
+/// and Strackee's formula (1983): tan(Omega / 2) = a . (b x c) / (|a||b||c| + (a.b)|c| +
+/// (a.c)|b| + (b.c)|a|). The triple product is (u1 - u0)(v1 - v0) for both and every term
+/// of the denominators is positive, so no digits cancel: in float a small rectangle (a cube
+/// map's texel) keeps a few ulps, where the corner differences lose the most significant
+/// digits of the corner angles (relative error ~1e-7 / size^-2). The cube-map SH projection
+/// on the GPU (vk::sh_projector) takes its texel solid angles from it.
+template <real T, vec3_of<T> V>
+T rectangle_solid_angle_triangles(T u0, T v0, T u1, T v1) {
+    const V a(u0, v0, T(1)), b(u1, v0, T(1)), c(u1, v1, T(1)), d(u0, v1, T(1));
+    const T la = length(a), lb = length(b), lc = length(c), ld = length(d);
+    const T area = (u1 - u0) * (v1 - v0);
+    const T abc = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+    const T acd = la * lc * ld + dot(a, c) * ld + dot(a, d) * lc + dot(c, d) * la;
+    return T(2) * (atan(area, abc) + atan(area, acd));
+}
+
 /// Corner function of the first moment int omega d omega of a rectangle on the plane at
 /// unit distance (Eqs. H2, H3), as (u component, v component, normal component).
 template <real T, vec3_of<T> V>
