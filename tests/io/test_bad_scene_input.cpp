@@ -2,6 +2,7 @@
 // MTL, JSON syntax) or field (JSON content); random damage to good files never gets
 // anything else out of the loader.
 #include "mesh_invariants.hpp"
+#include "random_damage.hpp"
 #include "scratch_folder.hpp"
 
 #include <bounce/io/scene.hpp>
@@ -266,18 +267,7 @@ std::string damage(std::string text, pcg32& rng) {
     static const std::vector<std::string> tokens = {"-",   "0",  "/",    "//",   "\r",   std::string(1, '\0'),
                                                     "1e39", "nan", "f ",   "v ",   "vn ",  "usemtl x\n",
                                                     "\n",  "-99", "999999999999", "mtllib m.mtl\n", "{", "]", "\"", ","};
-    const int edits = 1 + int(rng.next_u32() % 4);
-    for (int e = 0; e < edits && !text.empty(); ++e) {
-        const std::size_t pos = rng.next_u32() % text.size();
-        switch (rng.next_u32() % 5) {
-            case 0: text[pos] = char(rng.next_u32() & 0xff); break;
-            case 1: text.erase(pos, 1 + rng.next_u32() % 8); break;
-            case 2: text.insert(pos, tokens[rng.next_u32() % tokens.size()]); break;
-            case 3: text.resize(pos); break;
-            default: text.insert(pos, text.substr(pos, 1 + rng.next_u32() % 16)); break;
-        }
-    }
-    return text;
+    return bounce::test::damage(std::move(text), rng, tokens);
 }
 
 const char* cornell_like_obj =

@@ -3,6 +3,7 @@
 // damaged .gltf and .glb files get nothing else out of the loader.
 #include "gltf_writer.hpp"
 #include "mesh_invariants.hpp"
+#include "random_damage.hpp"
 #include "scratch_folder.hpp"
 
 #include <bounce/io/scene.hpp>
@@ -145,21 +146,7 @@ TEST_CASE("bad glTF containers and JSON: GLB header and chunks, syntax with its 
 }
 
 namespace {
-std::string damage(std::string bytes, pcg32& rng) {
-    static const std::vector<std::string> tokens = {"-1", "0", "1e39", "99999", "\"", "{", "]", ",", std::string(1, '\0'), "nan", "5126", "\"mode\":5,"};
-    const int edits = 1 + int(rng.next_u32() % 4);
-    for (int e = 0; e < edits && !bytes.empty(); ++e) {
-        const std::size_t pos = rng.next_u32() % bytes.size();
-        switch (rng.next_u32() % 5) {
-            case 0: bytes[pos] = char(rng.next_u32() & 0xff); break;
-            case 1: bytes.erase(pos, 1 + rng.next_u32() % 8); break;
-            case 2: bytes.insert(pos, tokens[rng.next_u32() % tokens.size()]); break;
-            case 3: bytes.resize(pos); break;
-            default: bytes[pos] = char('0' + rng.next_u32() % 10); break;
-        }
-    }
-    return bytes;
-}
+const std::vector<std::string> damage_tokens = {"-1", "0", "1e39", "99999", "\"", "{", "]", ",", std::string(1, '\0'), "nan", "5126", "\"mode\":5,"};
 }  // namespace
 
 TEST_CASE("randomly damaged .gltf and .glb files load or raise scene_error, nothing else", "[io][gltf][bad-input]") {
@@ -168,7 +155,7 @@ TEST_CASE("randomly damaged .gltf and .glb files load or raise scene_error, noth
     scratch_folder dir;
     const bool binary = seed % 2 == 1;
     const gltf_writer w = good();
-    const auto file = dir.write(binary ? "d.glb" : "d.gltf", damage(binary ? w.glb_bytes() : w.gltf_text(), rng));
+    const auto file = dir.write(binary ? "d.glb" : "d.gltf", test::damage(binary ? w.glb_bytes() : w.gltf_text(), rng, damage_tokens));
     try {
         const io::scene s = io::load_gltf(file);
         bounce::test::check_mesh_invariants(s);
