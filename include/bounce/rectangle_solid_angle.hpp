@@ -35,14 +35,25 @@ T rectangle_solid_angle(T u0, T v0, T u1, T v1) {
            rectangle_solid_angle_corner<T>(u1, v0) + rectangle_solid_angle_corner<T>(u0, v0);
 }
 
+/// atan(y / x) for y >= 0, x > 0, as the series t - t^3/3 + ... - t^11/11 below t = 1/8
+/// (truncation under 1e-12 relative) and atan(y, x) above: GPU atan built-ins may be far
+/// less accurate on small angles (Vulkan allows 4096 ulps; lavapipe's was off by ~2e-5
+/// relative on cube-map texels).
+template <real T>
+T small_angle_atan(T y, T x) {
+    const T t = y / x, t2 = t * t;
+    const T series = t * (T(1) + t2 * (T(-1.0 / 3) + t2 * (T(0.2) + t2 * (T(-1.0 / 7) + t2 * (T(1.0 / 9) + t2 * T(-1.0 / 11))))));
+    return select(t < T(0.125), series, atan(y, x));
+}
+
 /// The same solid angle as `rectangle_solid_angle`, as its two spherical triangles
 /// (corners a, b, c of one and a, c, d of the other on the plane z = 1), each by Van Oosterom
 /// and Strackee's formula (1983): tan(Omega / 2) = a . (b x c) / (|a||b||c| + (a.b)|c| +
 /// (a.c)|b| + (b.c)|a|). The triple product is (u1 - u0)(v1 - v0) for both and every term
 /// of the denominators is positive, so no digits cancel: in float a small rectangle (a cube
 /// map's texel) keeps a few ulps, where the corner differences lose the most significant
-/// digits of the corner angles (relative error ~1e-7 / size^-2). The cube-map SH projection
-/// on the GPU (vk::sh_projector) takes its texel solid angles from it.
+/// digits of the corner angles (tests/vk: over 1e-2 relative at 4096 texels a side). The
+/// cube-map SH projection on the GPU (vk::sh_projector) takes its texel solid angles from it.
 template <real T, vec3_of<T> V>
 T rectangle_solid_angle_triangles(T u0, T v0, T u1, T v1) {
     const V a(u0, v0, T(1)), b(u1, v0, T(1)), c(u1, v1, T(1)), d(u0, v1, T(1));
@@ -50,7 +61,7 @@ T rectangle_solid_angle_triangles(T u0, T v0, T u1, T v1) {
     const T area = (u1 - u0) * (v1 - v0);
     const T abc = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
     const T acd = la * lc * ld + dot(a, c) * ld + dot(a, d) * lc + dot(c, d) * la;
-    return T(2) * (atan(area, abc) + atan(area, acd));
+    return T(2) * (small_angle_atan<T>(area, abc) + small_angle_atan<T>(area, acd));
 }
 
 /// Corner function of the first moment int omega d omega of a rectangle on the plane at

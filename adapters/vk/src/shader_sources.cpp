@@ -162,15 +162,20 @@ void main() {
         vec3 f = vec3(texels[at], texels[at + 1u], texels[at + 2u]) * texel_solid_angle(u0, v0, u1, v1);
         for (int i = 0; i < )" + N + R"(; ++i) sum[i] += f * y_d[i];
     }
-    // Tree reduction of the workgroup's partial sums, one coefficient at a time.
+    // Tree reduction of the workgroup's partial sums, one coefficient at a time. Each
+    // barrier() comes with memoryBarrierShared(): without it lavapipe let some reads see
+    // stale partial sums (c_00 off by 2e-5 relative).
     for (int i = 0; i < )" + N + R"(; ++i) {
         partial[lid] = sum[i];
+        memoryBarrierShared();
         barrier();
         for (uint stride = )" + std::to_string(sh_group / 2) + R"(u; stride > 0u; stride >>= 1u) {
             if (lid < stride) partial[lid] += partial[lid + stride];
+            memoryBarrierShared();
             barrier();
         }
         if (lid == 0u) coefficients[map * )" + N + R"(u + uint(i)] = vec4(partial[0], 0.0);
+        memoryBarrierShared();
         barrier();
     }
 }
