@@ -36,9 +36,8 @@ T rectangle_solid_angle(T u0, T v0, T u1, T v1) {
 }
 
 /// atan(y / x) for y >= 0, x > 0, as the series t - t^3/3 + ... - t^11/11 below t = 1/8
-/// (truncation under 1e-12 relative) and atan(y, x) above: GPU atan built-ins may be far
-/// less accurate on small angles (Vulkan allows 4096 ulps; lavapipe's was off by ~2e-5
-/// relative on cube-map texels).
+/// (truncation under 1e-12 relative) and atan(y, x) above: the Vulkan environment allows a
+/// GPU's atan 4096 ulps, where a cube map's texels need a few.
 template <real T>
 T small_angle_atan(T y, T x) {
     const T t = y / x, t2 = t * t;
