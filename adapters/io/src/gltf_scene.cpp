@@ -194,8 +194,10 @@ public:
         if (counts_.triangles > max_gltf_triangles)
             doc_.fail("more than " + std::to_string(max_gltf_triangles) + " triangles once the nodes' instances are counted");
         world_.resize(p.size());
+        // Without a transform the values pass through bit for bit (1 * -0 + 0 would be +0).
+        const bool identity = at_node.world == glm::dmat4(1.0);
         for (std::size_t k = 0; k < p.size(); ++k) {
-            world_[k] = glm::dvec3(at_node.world * glm::dvec4(p[k], 1.0));
+            world_[k] = identity ? p[k] : glm::dvec3(at_node.world * glm::dvec4(p[k], 1.0));
             if (!(glm::all(glm::lessThanEqual(glm::abs(world_[k]), glm::dvec3(double(max_world_coordinate))))))
                 doc_.fail(at("nodes", at_node.node) + ": vertex " + std::to_string(k) + " of " + field +
                           " lies beyond +-1e18 in world space (what float32 rays carry)");
@@ -258,7 +260,7 @@ private:
                 if (vertex_of[v] == none) {
                     vertex_of[v] = std::uint32_t(out_.positions.size());
                     out_.positions.emplace_back(world_[v]);
-                    const glm::dvec3 w = normal_matrix * n[v];
+                    const glm::dvec3 w = at_node.world == glm::dmat4(1.0) ? n[v] : normal_matrix * n[v];
                     const double len = glm::length(w);
                     // A unit normal under a rigid transform is kept as it is (no rounding
                     // from a division by 1 +- 1e-7).
