@@ -2,7 +2,7 @@
 // compile), wrapped in a Vulkan compute shader, compiles to SPIR-V with glslang (as
 // `glslangValidator -V --target-env vulkan1.2`) and passes SPIRV-Tools' validator (as
 // `spirv-val --target-env vulkan1.2`); the same kernels in their OpenGL compute shaders, and
-// the splat and compose passes' full shaders, compile as OpenGL GLSL 4.50 with glslang.
+// the splat pass's full vertex and fragment shaders, compile as OpenGL GLSL 4.50 with glslang.
 // The catalog is checked against the sources: every name a GL pass adds to its function set
 // (`.add("name", ...)` in adapters/gl/src) must be in it, so a new kernel cannot be missed.
 // The compile cases skip when glslang or SPIRV-Tools was not found at configure time.
@@ -83,7 +83,7 @@ TEST_CASE("every emitted kernel compiles to SPIR-V for Vulkan 1.2 and passes spi
     }
 }
 
-TEST_CASE("the emitted kernels and the splat and compose shaders compile as OpenGL GLSL 4.50", "[spirv]") {
+TEST_CASE("the emitted kernels and the splat pass's shaders compile as OpenGL GLSL 4.50", "[spirv]") {
     const auto compile = [](const std::string& what, const std::string& source, spirv_test::stage s) {
         const auto c = spirv_test::compile_for_opengl(source, s);
         INFO(what << "\n" << c.log << "\n" << source);
