@@ -30,17 +30,7 @@ scene_error::scene_error(fs::path file, std::size_t line, const std::string& wha
 
 namespace detail {
 void fit_clip_planes(bounce::camera& camera, const std::pair<glm::vec3, glm::vec3>& bounds) {
-    float farthest = 0.f;
-    for (int i = 0; i < 8; ++i) {
-        const glm::vec3 corner((i & 1) ? bounds.second.x : bounds.first.x, (i & 2) ? bounds.second.y : bounds.first.y,
-                               (i & 4) ? bounds.second.z : bounds.first.z);
-        farthest = std::max(farthest, glm::length(corner - camera.position));
-    }
-    const float far_plane = 2.f * farthest, near_plane = 1e-4f * far_plane;
-    // Keep the defaults where the scene's scale leaves float's normal range.
-    if (!std::isfinite(far_plane) || !(near_plane >= std::numeric_limits<float>::min())) return;
-    camera.far_plane = far_plane;
-    camera.near_plane = near_plane;
+    bounce::fit_clip_planes(camera, bounds);
 }
 }  // namespace detail
 
