@@ -2,9 +2,10 @@
 """Checks a gpu_timings results file (docs/gpu-timings.md): the GL strings and provenance are
 there, and every pass of the fixed set is present, once, with positive times.
 
-    scripts/check_gpu_timings.py RESULTS.json [--sizes 1920x1080,512x512]
+    scripts/check_gpu_timings.py RESULTS.json [--sizes 1920x1080,512x512] [--markdown]
 
-Prints one line per problem and exits 1 when there is any, 0 otherwise."""
+Prints one line per problem and exits 1 when there is any, 0 otherwise. --markdown prints,
+for a well-formed file, the table docs/gpu-timings.md shows (median, min-max, host clock)."""
 import argparse
 import json
 import math
@@ -80,10 +81,30 @@ def check(results, sizes):
     return problems
 
 
+def markdown(results):
+    """The results as a Markdown table: one row per pass and size."""
+    def ms(x):
+        return f"{x:.3g}" if x < 100 else f"{x:.0f}"
+    rows = ["| pass | size | median ms | min-max ms | host clock ms |", "|---|---|---:|---:|---:|"]
+    def add(p, size):
+        wall = ms(p["wall_median_ms"]) if "wall_median_ms" in p else "(is one)"
+        extra = f" ({p['planes_per_second']:.3g} planes/s)" if "planes_per_second" in p else ""
+        rows.append(f"| {p['name']}{extra} | {size} | {ms(p['median_ms'])} | {ms(p['min_ms'])}-{ms(p['max_ms'])} | {wall} |")
+    for p in results["scene_passes"]:
+        add(p, "-")
+    for name in IMAGE_PASSES:
+        for s in results["sizes"]:
+            for p in s["passes"]:
+                if p["name"] == name:
+                    add(p, f"{s['width']}x{s['height']}")
+    return "\n".join(rows)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("results")
     parser.add_argument("--sizes", help="the sizes the run was asked for, WxH,WxH")
+    parser.add_argument("--markdown", action="store_true", help="print the results as a Markdown table")
     args = parser.parse_args()
     sizes = None
     if args.sizes:
@@ -100,6 +121,8 @@ def main():
     if not problems:
         gl = results["gl"]
         print(f"check_gpu_timings: {args.results}: well formed ({gl['renderer']}, {len(results['sizes'])} sizes)")
+        if args.markdown:
+            print(markdown(results))
     return 1 if problems else 0
 
 
