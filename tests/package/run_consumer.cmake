@@ -7,10 +7,13 @@ function(run)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BOUNCE_BUILD_DIR} --prefix ${SCRATCH}/prefix)
 run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE_DIR} -B ${SCRATCH}/build -G Ninja -DCMAKE_BUILD_TYPE=Release
-    -DCMAKE_PREFIX_PATH=${SCRATCH}/prefix -DCONSUMER_WITH_VIEWS=${WITH_VIEWS}
+    -DCMAKE_PREFIX_PATH=${SCRATCH}/prefix -DCONSUMER_WITH_VIEWS=${WITH_VIEWS} -DCONSUMER_WITH_VK=${WITH_VK}
     "-DCMAKE_CXX_FLAGS=${CONSUMER_CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_LINKER_FLAGS}")
 run(${CMAKE_COMMAND} --build ${SCRATCH}/build)
 run(${SCRATCH}/build/consumer)
+if(WITH_VK)
+  run(${SCRATCH}/build/consumer_vk)
+endif()
 # The core alone: no component named, or only `core`; its configure step fails when any
 # adapter's dependency was loaded.
 run(${CMAKE_COMMAND} -S ${CORE_CONSUMER_SOURCE_DIR} -B ${SCRATCH}/core_build -G Ninja -DCMAKE_BUILD_TYPE=Release
