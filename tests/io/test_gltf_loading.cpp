@@ -150,6 +150,15 @@ TEST_CASE("glTF materials: base colour, its texture's mean, emission with its st
     CHECK(s.use_emission);  // a used material emits, so the file alone lights itself
     CHECK(s.lights.empty());
     CHECK(s.emissive_triangles().size() == 2);
+
+    // A texture that does not decode, or whose file is missing, is a fault naming it.
+    dir.write("junk.png", "not a PNG at all");
+    w.doc["images"][0]["uri"] = "junk.png";
+    w.write(dir.path() / "junk.gltf");
+    CHECK_THROWS_WITH(io::load_gltf(dir.path() / "junk.gltf"), Catch::Matchers::Contains("images[0]: cannot decode"));
+    w.doc["images"][0]["uri"] = "gone.png";
+    w.write(dir.path() / "gone.gltf");
+    CHECK_THROWS_WITH(io::load_gltf(dir.path() / "gone.gltf"), Catch::Matchers::Contains("gone.png: no such file"));
 }
 
 TEST_CASE("KHR_lights_punctual: point, spot and directional placed by their nodes", "[io][gltf]") {
