@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 #include <epoxy/gl.h>
+#include <fmt/chrono.h>
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
@@ -75,14 +76,7 @@ std::string gl_string(GLenum name) {
     return s ? s : "";
 }
 
-std::string utc_now() {
-    const std::time_t t = std::time(nullptr);
-    std::tm tm{};
-    gmtime_r(&t, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-    return buf;
-}
+std::string utc_now() { return fmt::format("{:%Y-%m-%dT%H:%M:%SZ}", fmt::gmtime(std::time(nullptr))); }
 
 json pass_json(const gpu_timings::pass_timing& p) {
     const gpu_timings::summary s = gpu_timings::summarize(p.ms);
