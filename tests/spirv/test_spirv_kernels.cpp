@@ -2,12 +2,14 @@
 // compile), wrapped in a Vulkan compute shader, compiles to SPIR-V with glslang (as
 // `glslangValidator -V --target-env vulkan1.2`) and passes SPIRV-Tools' validator (as
 // `spirv-val --target-env vulkan1.2`); the same kernels in their OpenGL compute shaders, and
-// the splat pass's full vertex and fragment shaders, compile as OpenGL GLSL 4.50 with glslang.
+// the full shaders the GL adapter shows (the splat pass's, the volume lookup's), compile as
+// OpenGL GLSL 4.50 with glslang.
 // The catalog is checked against the sources: every name a GL pass adds to its function set
 // (`.add("name", ...)` in adapters/gl/src) must be in it, so a new kernel cannot be missed.
 // The compile cases skip when glslang or SPIRV-Tools was not found at configure time.
 #include "../skip.hpp"
 
+#include <bounce/gl/irradiance_volume.hpp>
 #include <bounce/gl/kernel_catalog.hpp>
 #include <bounce/gl/splat_pass.hpp>
 
@@ -83,13 +85,14 @@ TEST_CASE("every emitted kernel compiles to SPIR-V for Vulkan 1.2 and passes spi
     }
 }
 
-TEST_CASE("the emitted kernels and the splat pass's shaders compile as OpenGL GLSL 4.50", "[spirv]") {
+TEST_CASE("the emitted kernels and the splat and volume passes' shaders compile as OpenGL GLSL 4.50", "[spirv]") {
     const auto compile = [](const std::string& what, const std::string& source, spirv_test::stage s) {
         const auto c = spirv_test::compile_for_opengl(source, s);
         INFO(what << "\n" << c.log << "\n" << source);
         CHECK(c.ok);
     };
     for (const auto& k : gl::emitted_kernels(gl::compute_target::opengl)) compile(k.name, k.compute_source, spirv_test::stage::compute);
+    compile("irradiance_volume_lookup", gl::irradiance_volume_lookup::shader_source(), spirv_test::stage::compute);
     for (const weighting_kind w : weighting_kinds) {
         compile("splat_pass vertex", gl::splat_pass::vertex_source(w), spirv_test::stage::vertex);
         for (const bool gradients : {false, true})
