@@ -55,6 +55,7 @@ json parameters_json(const options& o, float clamp_distance, std::size_t maps) {
             {"maps", maps},
             {"r_max", o.r_max},
             {"clamp", clamp_distance},
+            {"footprint_clamp", o.footprint_clamp},
             {"offset", o.offset},
             {"blur", o.blur},
             {"energy_correct", !o.thesis_weights},
@@ -191,6 +192,9 @@ int run(const options& o) {
         }
         single = study::measure_indirect(bench, chosen, plain ? &*plain : nullptr);
         fmt::print("{}\n", single->summary());
+        const double removed = study::clamp_removed_fraction(bench, chosen);
+        fmt::print("the 1/d^2 clamp removes {:.2f}% of the frame's light\n", 100.0 * removed);
+        extra["clamp_removed_fraction"] = removed;
         report.set_timings(single->timer);
         // The error against the reference of what the frame computes: with visibility the
         // occluded one-bounce light, without it the unoccluded one (the other beside it).

@@ -41,6 +41,7 @@ struct options {
     vpl_selection selection = vpl_selection::flux_warping;  // SII VPLs: warping (DS06 section 3.3) | grid
     float r_max = 1.5f;                // RSM gather disc radius, map units
     float clamp = -1.f;                // d^2 clamped at clamp^2 (scene units); unset (< 0): scene_clamp_distance
+    float footprint_clamp = 1.f;       // SII: d^2 clamped at the disc of each VPL's area times this^2; 0: --clamp
     float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
     bool blur = true;
     bool thesis_weights = false;       // interleaved lights at weight 1 (Hahn 2012), not N M
@@ -84,6 +85,7 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
     c.r_max = o.r_max;
     c.light.offset = o.offset;
     c.light.min_distance2 = clamp_distance * clamp_distance;
+    c.light.footprint_scale = o.footprint_clamp;
     c.seed = o.seed;
     c.visibility = o.visibility;
     try {
@@ -94,6 +96,7 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
                                  : f.rfind("pattern", 0) == 0      ? "--pattern"
                                  : f == "r_max"                    ? "--r-max"
                                  : f == "min_distance2"            ? "--clamp"
+                                 : f == "footprint_scale"          ? "--footprint-clamp"
                                  : f == "offset"                   ? "--offset"
                                                                    : f;
         const std::string what = e.what();
@@ -143,8 +146,14 @@ inline void add_options(CLI::App& app, options& o) {
         ->capture_default_str();
     app.add_option("--clamp", o.clamp,
                    "sender-receiver distance below which 1/d^2 is clamped (scene units, >= 0; 0: no clamp); "
-                   "default 1% of the scene's bounding-box diagonal (scene_clamp_distance)")
+                   "default 1% of the scene's bounding-box diagonal (scene_clamp_distance); SII uses it only "
+                   "with --footprint-clamp 0")
         ->check(examples::finite_non_negative);
+    app.add_option("--footprint-clamp", o.footprint_clamp,
+                   "SII: 1/d^2 clamped inside the disc of the area each VPL stands for, its radius scaled by this "
+                   "(>= 0; 0: the fixed --clamp instead)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
     app.add_option("--offset", o.offset, "senders moved this far along -n_p (scene units; DS05's remedy)")
         ->check(examples::finite_non_negative)
         ->capture_default_str();

@@ -186,6 +186,18 @@ TEST_CASE("GL SII equals the CPU's, plain and interleaved with blur, with and wi
         const comparison c = compare(s, cut.gl_img, whole.gl_img);
         CHECK(c.worst_relative > 1e-2);
     }
+    SECTION("each VPL clamped at its own footprint (position.w on GL), and the clamp acts") {
+        o.sii_cutoff = 0.f;
+        o.light.footprint_scale = 1.f;
+        for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{2, 2}}) {
+            o.pattern = p;
+            check_agreement(s, o);
+        }
+        const frame footprint = render_both(s, o);
+        o.light.footprint_scale = 0.f;
+        const frame fixed = render_both(s, o);
+        CHECK(compare(s, footprint.gl_img, fixed.gl_img).worst_relative > 1e-2);
+    }
     SECTION("grid VPLs, similarity assignment, weight 1 (the thesis's)") {
         o.pattern = {2, 2};
         o.selection = vpl_selection::grid;

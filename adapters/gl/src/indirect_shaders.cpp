@@ -223,6 +223,7 @@ std::string splat_fragment() {
     glsl::function_set k;
     k.add("pixel_light_irradiance", pixel_light_irradiance<glsl::f32, glsl::vec3>, "x", "n", "xp", "np", "flux",
           "offset", "min_distance2");
+    // position.w: the VPL's own d^2 clamp (pixel_light_params::min_distance2_for).
     return std::string("#version 450 core\n") + R"(struct bounce_vpl {
     vec4 position;
     vec4 normal;
@@ -230,7 +231,6 @@ std::string splat_fragment() {
 };
 layout(std430, binding = 0) readonly buffer bounce_vpls { bounce_vpl vpls[]; };
 )" + detail::gbuffer_position_normal_samplers() + R"(layout(location = 5) uniform float offset;
-layout(location = 6) uniform float min_distance2;
 flat in int vpl_index;
 layout(location = 0) out vec4 irradiance;
 
@@ -241,7 +241,7 @@ void main() {
     if (!covered(position_depth.w)) discard;
     bounce_vpl l = vpls[vpl_index];
     irradiance = vec4(pixel_light_irradiance(position_depth.xyz, texelFetch(gbuffer_normal, g, 0).xyz, l.position.xyz,
-                                             l.normal.xyz, l.flux.xyz, offset, min_distance2), 0.0);
+                                             l.normal.xyz, l.flux.xyz, offset, l.position.w), 0.0);
 }
 )";
 }

@@ -9,6 +9,7 @@
 #include <bounce/study/stage_timer.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -18,17 +19,17 @@ namespace {
 
 // rsm_sii's defaults (examples/rsm_sii/options.hpp): the settings' lights a frame (1,024 by
 // default; SII: VPLs by flux warping; the gather: disc samples per pixel and map over a disc
-// of radius 1.5 map units), 256^2 texels per map, d^2 clamped at scene_clamp_distance (1% of the scene's diagonal), the
-// geometry-aware blur after interleaving, energy-correct weights, seed 1.
+// of radius 1.5 map units), 256^2 texels per map, d^2 clamped at each VPL's footprint (SII) or at
+// scene_clamp_distance (the gather; default_pixel_light), the geometry-aware blur after interleaving, energy-correct weights, seed 1.
 constexpr std::size_t map_resolution = 256;
 
-indirect_options options_for(bench_technique t, std::size_t lights, float clamp_distance,
+indirect_options options_for(bench_technique t, std::size_t lights, const pixel_light_params& light,
                              indirect_visibility visibility) {
     indirect_options o;
     o.technique = t == bench_technique::rsm_gather ? indirect_technique::rsm_gather : indirect_technique::sii;
     o.count = lights;
     o.pattern = t == bench_technique::sii_interleaved ? interleave_pattern{4, 4} : interleave_pattern{1, 1};
-    o.light.min_distance2 = clamp_distance * clamp_distance;
+    o.light = light;
     o.visibility = visibility;
     o.validate();
     return o;
@@ -41,8 +42,8 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
             "technique", "is not an RSM technique");
     require(!s.scene.lights.empty(), "scene", "has no point, spot or directional light: reflective shadow maps need one");
     const std::string name = std::string(technique_name(t)) + (visibility == indirect_visibility::none ? "" : "+rays");
-    const float clamp_distance = scene_clamp_distance(s.scene);
-    const indirect_options options = options_for(t, s.settings.rsm_lights, clamp_distance, visibility);
+    const pixel_light_params light = default_pixel_light(s.scene);
+    const indirect_options options = options_for(t, s.settings.rsm_lights, light, visibility);
 
     // The maps are part of every frame's cost (the lights may move); cast once timed.
     s.clock.report(name, "maps");
@@ -84,7 +85,8 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
     r.parameters = {{"count", s.settings.rsm_lights},
                     {"pattern", t == bench_technique::sii_interleaved ? "4x4" : "1x1"},
                     {"rsm_resolution", map_resolution},
-                    {"clamp", clamp_distance},
+                    {"clamp", std::sqrt(light.min_distance2)},
+                    {"footprint_clamp", light.footprint_scale},
                     {"r_max", options.r_max},
                     {"blur", options.blur},
                     {"visibility", visibility_name(visibility)},

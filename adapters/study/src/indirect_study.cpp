@@ -3,6 +3,7 @@
 #include <bounce/embree/rsm_unoccluded_reference.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
+#include <bounce/luminance.hpp>
 #include <bounce/output.hpp>
 
 #include <fmt/core.h>
@@ -164,6 +165,25 @@ indirect_run measure_indirect(const indirect_bench& bench, const indirect_option
         r.plain_total_ms = plain->total_ms();
     }
     return r;
+}
+
+double clamp_removed_fraction(const indirect_bench& bench, indirect_options options) {
+    require(bool(bench.frame), "bench.frame", "is empty");
+    options.visibility = indirect_visibility::none;
+    image<glm::vec3> e(bench.g.width(), bench.g.height());
+    const auto light = [&] {
+        bench.frame(options, e.view());
+        double sum = 0;
+        for (std::size_t y = 0; y < e.height(); ++y)
+            for (std::size_t x = 0; x < e.width(); ++x)
+                if (bench.mask(x, y) > 0.f) sum += double(rec709_luminance<float, glm::vec3>(e(x, y)));
+        return sum;
+    };
+    const double clamped = light();
+    options.light.min_distance2 = 0.f;
+    options.light.footprint_scale = 0.f;
+    const double whole = light();
+    return whole > 0 ? 1.0 - clamped / whole : 0.0;
 }
 
 json interleaving_study(const indirect_bench& bench, const indirect_options& base,

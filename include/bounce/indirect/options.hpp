@@ -13,6 +13,7 @@
 #include <bounce/scene_view.hpp>
 
 #include <cmath>
+#include <numbers>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -43,12 +44,27 @@ enum class disc_weighting {
 struct pixel_light_params {
     float offset = 0.f;         ///< sender moved along -n_p (m, >= 0; typical: half a texel footprint)
     float min_distance2 = 0.f;  ///< d^2 clamped below at this (m^2, >= 0; typical: texel footprint^2)
+    /// SII's clamp that follows the VPLs' density (>= 0; typical 1; 0: off): when > 0, SII
+    /// clamps d^2 below at footprint_scale^2 area / pi instead of min_distance2, the squared
+    /// radius of the disc of the area the VPL stands for (vpl::area), so a VPL is never
+    /// brighter than that disc would be, and the clamp shrinks as VPLs are added (docs,
+    /// section 16). The RSM gather's disc samples carry no area: it keeps min_distance2.
+    float footprint_scale = 0.f;
 
     bool operator==(const pixel_light_params&) const = default;
+
+    /// The d^2 below which SII clamps a VPL standing for `vpl_area` (m^2).
+    float min_distance2_for(float vpl_area) const noexcept {
+        if (!(footprint_scale > 0.f)) return min_distance2;
+        const float footprint = footprint_scale * footprint_scale * vpl_area * float(1.0 / std::numbers::pi);
+        return std::isfinite(footprint) ? footprint : 0.f;
+    }
 
     void validate() const {
         require(std::isfinite(offset) && offset >= 0.f, "offset", "must be finite and >= 0");
         require(std::isfinite(min_distance2) && min_distance2 >= 0.f, "min_distance2", "must be finite and >= 0");
+        require(std::isfinite(footprint_scale) && footprint_scale >= 0.f, "footprint_scale",
+                "must be finite and >= 0");
     }
 };
 
@@ -150,6 +166,17 @@ inline float scene_clamp_distance(const scene_view& scene) {
     if (scene.positions.empty()) return 0.f;
     const auto [lo, hi] = scene.bounds();
     return 0.01f * float(glm::length(glm::dvec3(hi) - glm::dvec3(lo)));
+}
+
+/// The singularity remedies rsm_sii and the benchmark use on `scene` unless told otherwise:
+/// SII clamps each VPL at the disc of its own area (footprint_scale 1), the RSM gather at
+/// scene_clamp_distance.
+inline pixel_light_params default_pixel_light(const scene_view& scene) {
+    pixel_light_params p;
+    const float d = scene_clamp_distance(scene);
+    p.min_distance2 = d * d;
+    p.footprint_scale = 1.f;
+    return p;
 }
 
 /// Per-stage wall-clock times of one frame (milliseconds) and its counts. On GL the times

@@ -21,6 +21,8 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -56,7 +58,37 @@ struct vpl {
     glm::vec3 position{0.f};          ///< world position of the texel's surface point
     glm::vec3 normal{0.f, 0.f, 1.f};  ///< its unit normal
     glm::vec3 flux{0.f};              ///< W per channel, already divided by the sampling probability
+    /// World area (m^2) it stands for: its texel's (texel_world_area) divided like its flux
+    /// by count x probability, so the VPLs' areas sum to the lit area the map sees. The
+    /// footprint clamp (indirect/rsm.hpp's vpl_min_distance2) makes it a disc of this area.
+    float area = 0.f;
 };
+
+/// The world area of texel (x, y) of `map`: the texel's square of the map's image plane
+/// carried onto the tangent plane of its surface point (position, normal) through
+/// `inverse_view_projection` = inverse(map.light_view_projection), so it holds for the
+/// perspective maps of point and spot lights and the orthographic maps of directional ones.
+/// A plane seen edge-on is taken at a grazing cosine of 1e-3 (the area 1000 times the
+/// face-on one at most), which keeps it finite.
+inline double texel_world_area(const rsm_view& map, const glm::dmat4& inverse_view_projection, std::size_t x,
+                               std::size_t y) {
+    const glm::dvec3 p(map.position(x, y)), n(map.normal(x, y));
+    const double cx = 2.0 * (double(x) + 0.5) / double(map.width()) - 1.0;
+    const double cy = 1.0 - 2.0 * (double(y) + 0.5) / double(map.height());
+    const auto on_plane = [&](double ndc_x, double ndc_y) {
+        const glm::dvec4 a = inverse_view_projection * glm::dvec4(ndc_x, ndc_y, -1.0, 1.0);
+        const glm::dvec4 b = inverse_view_projection * glm::dvec4(ndc_x, ndc_y, 1.0, 1.0);
+        const glm::dvec3 from = glm::dvec3(a) / a.w, dir = glm::dvec3(b) / b.w - from;
+        const double grazing = 1e-3 * glm::length(dir), along = glm::dot(dir, n);
+        const double den = std::abs(along) >= grazing ? along : std::copysign(grazing, along);
+        return from + dir * (glm::dot(p - from, n) / den);
+    };
+    const double hx = 1.0 / double(map.width()), hy = 1.0 / double(map.height());
+    const glm::dvec3 across = on_plane(cx + hx, cy) - on_plane(cx - hx, cy);
+    const glm::dvec3 down = on_plane(cx, cy + hy) - on_plane(cx, cy - hy);
+    const double area = glm::length(glm::cross(across, down));
+    return std::isfinite(area) ? area : 0.0;
+}
 
 /// The importance of a texel's flux: its Rec. 709 luminance (W, luminance-weighted).
 inline float flux_importance(const glm::vec3& flux) noexcept { return rec709_luminance<float, glm::vec3>(flux); }
@@ -69,6 +101,7 @@ inline std::vector<vpl> vpls_on_grid(const rsm_view& map, std::size_t grid_x, st
     map.validate();
     require(grid_x > 0 && grid_y > 0, "grid_x/grid_y", "must be positive");
     const double scale = double(map.width()) * double(map.height()) / (double(grid_x) * double(grid_y));
+    const glm::dmat4 inverse = glm::inverse(glm::dmat4(map.light_view_projection));
     std::vector<vpl> out;
     out.reserve(grid_x * grid_y);
     for (std::size_t j = 0; j < grid_y; ++j)
@@ -77,7 +110,8 @@ inline std::vector<vpl> vpls_on_grid(const rsm_view& map, std::size_t grid_x, st
             const auto y = std::size_t((double(j) + 0.5) * double(map.height()) / double(grid_y));
             const glm::vec3 f = map.flux(x, y);
             if (!(f.x > 0.f || f.y > 0.f || f.z > 0.f)) continue;
-            out.push_back({map.position(x, y), map.normal(x, y), glm::vec3(glm::dvec3(f) * scale)});
+            out.push_back({map.position(x, y), map.normal(x, y), glm::vec3(glm::dvec3(f) * scale),
+                           float(texel_world_area(map, inverse, x, y) * scale)});
         }
     return out;
 }
@@ -172,13 +206,14 @@ inline std::vector<vpl> vpls_by_flux_warping(const rsm_view& map, std::size_t co
     if (!(warping.total() > 0)) return {};
     pcg32 rng(seed);
     const glm::dvec2 shift(rng.next_double(), rng.next_double());
+    const glm::dmat4 inverse = glm::inverse(glm::dmat4(map.light_view_projection));
     std::vector<vpl> out;
     out.reserve(count);
     for (std::size_t k = 0; k < count; ++k) {
         const auto c = warping.warp(halton2(k, shift));
         const double scale = 1.0 / (double(count) * c.probability);
-        out.push_back(
-            {map.position(c.x, c.y), map.normal(c.x, c.y), glm::vec3(glm::dvec3(map.flux(c.x, c.y)) * scale)});
+        out.push_back({map.position(c.x, c.y), map.normal(c.x, c.y), glm::vec3(glm::dvec3(map.flux(c.x, c.y)) * scale),
+                       float(texel_world_area(map, inverse, c.x, c.y) * scale)});
     }
     for (std::size_t k = count; k > 1; --k) std::swap(out[k - 1], out[rng.next_u32() % k]);
     return out;

@@ -70,6 +70,7 @@ void splat(const gbuffer_view<float>& gb, const vpl& l, float scale, const pixel
            const bounce::pixel_rect& rect, const bounce::pixel_rect& tile, Add&& add) {
     const glm::vec3 flux = l.flux * scale;
     const glm::vec3 sender = l.position - l.normal * lp.offset;
+    const float min_distance2 = lp.min_distance2_for(l.area);
     for (int v = std::max(rect.y0, tile.y0); v <= std::min(rect.y1, tile.y1); ++v)
         for (int u = std::max(rect.x0, tile.x0); u <= std::min(rect.x1, tile.x1); ++u) {
             const std::size_t uu = std::size_t(u), vv = std::size_t(v);
@@ -79,7 +80,7 @@ void splat(const gbuffer_view<float>& gb, const vpl& l, float scale, const pixel
             if (!(glm::dot(l.normal, gb.position(uu, vv) - sender) > 0.f)) continue;
             add(uu, vv,
                 pixel_light_irradiance<float, glm::vec3>(gb.position(uu, vv), gb.normal(uu, vv), l.position, l.normal,
-                                                         flux, lp.offset, lp.min_distance2));
+                                                         flux, lp.offset, min_distance2));
         }
 }
 

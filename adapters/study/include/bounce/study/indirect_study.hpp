@@ -104,6 +104,11 @@ std::string pattern_name(interleave_pattern p);
 indirect_run measure_indirect(const indirect_bench& bench, const indirect_options& options,
                               const indirect_run* plain = nullptr, std::optional<int> repeat = {});
 
+/// The share of a frame's light that its singularity clamps (options.light) remove: 1 minus
+/// the luminance it sums over bench.mask against the same frame with no clamp at all, both
+/// without visibility (the pairs a clamp acts on are close neighbours that see each other).
+double clamp_removed_fraction(const indirect_bench& bench, indirect_options options);
+
 /// Hahn 2012's grid (section 5: 64 ... 1024 VPLs by patterns none, 2x2, 2x4, 4x4, 8x8, both
 /// techniques) from `base` (its other fields kept), plus plain runs at 16, 32 and 4096 and SII
 /// with the thesis's weight 1 at 128 and 1024 (4x4); then the targets of the issue that
