@@ -4,8 +4,9 @@
 // `spirv-val --target-env vulkan1.2`); the same kernels in their OpenGL compute shaders, and
 // the full shaders the GL adapter shows (the splat pass's, the volume lookup's), compile as
 // OpenGL GLSL 4.50 with glslang.
-// The catalog is checked against the sources: every name a GL pass adds to its function set
-// (`.add("name", ...)` in adapters/gl/src) must be in it, so a new kernel cannot be missed.
+// The catalog is checked against the sources: every kernel a GL pass adds to its function set
+// (`.add("name", kernel<...>, ...)` in adapters/gl/src) must be in it under the same name and
+// kernel function, so a new or replaced kernel cannot be missed.
 // The compile cases skip when glslang or SPIRV-Tools was not found at configure time.
 #include "../skip.hpp"
 
@@ -23,6 +24,7 @@
 #include <fstream>
 #include <regex>
 #include <set>
+#include <utility>
 #include <sstream>
 #include <string>
 
@@ -40,21 +42,35 @@ std::string read_all(const fs::path& p) {
 
 }  // namespace
 
-TEST_CASE("every kernel the GL passes emit is in the kernel catalog", "[spirv]") {
-    std::set<std::string> catalogued;
-    for (const auto& k : gl::emitted_kernels()) catalogued.insert(k.name);
-    const std::regex added(R"(\.add\(\s*"([A-Za-z_][A-Za-z_0-9]*)\")");
+// The kernel function an `.add(` call names, from the text of its expression:
+// "&W::template influence_radius<glsl::f32>" and "influence_radius<f32>" are both
+// "influence_radius".
+std::string kernel_function(std::string expr) {
+    expr = expr.substr(0, expr.find_first_of("<("));
+    const auto space = expr.find_last_of(" \t\n&");
+    if (space != std::string::npos) expr = expr.substr(space + 1);
+    const auto scope = expr.rfind("::");
+    return scope == std::string::npos ? expr : expr.substr(scope + 2);
+}
+
+TEST_CASE("every kernel the GL passes emit is in the kernel catalog, under its name", "[spirv]") {
+    std::set<std::pair<std::string, std::string>> catalogued;  // (name, kernel function)
+    for (const auto& k : gl::emitted_kernels()) catalogued.insert({k.name, kernel_function(k.kernel)});
+    const std::regex added(R"(\.add\(\s*"([A-Za-z_][A-Za-z_0-9]*)\"\s*,\s*([^,<(]+))");
     std::size_t found = 0;
     for (const auto& entry : fs::directory_iterator(fs::path(BOUNCE_SOURCE_DIR) / "adapters" / "gl" / "src")) {
         if (entry.path().extension() != ".cpp" || entry.path().filename() == "kernel_catalog.cpp") continue;
         const std::string text = read_all(entry.path());
         for (std::sregex_iterator it(text.begin(), text.end(), added), end; it != end; ++it) {
             ++found;
-            INFO(entry.path().filename().string() << " emits " << (*it)[1].str());
-            CHECK(catalogued.count((*it)[1].str()) == 1);
+            const std::pair<std::string, std::string> kernel{(*it)[1].str(), kernel_function((*it)[2].str())};
+            INFO(entry.path().filename().string() << " emits " << kernel.second << " as " << kernel.first);
+            CHECK(catalogued.count(kernel) == 1);
         }
     }
     CHECK(found >= 60);  // the pattern still matches the passes' calls
+    CHECK(kernel_function("&W::template influence_radius<glsl::f32>") == "influence_radius");
+    CHECK(kernel_function("glsl::f32") == "f32");
 }
 
 #if BOUNCE_HAS_GLSLANG

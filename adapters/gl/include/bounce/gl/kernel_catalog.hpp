@@ -6,7 +6,8 @@
 /// a storage buffer, calls it and stores its results (gl::map_kernel_source). For Vulkan
 /// the shader is written with `compute_target::vulkan` (set 0, push constants), which
 /// glslang compiles to SPIR-V; tests/spirv compiles and validates every entry, and checks
-/// that every kernel name the GL passes add (`.add("name", ...)` in adapters/gl/src) is here.
+/// that every kernel the GL passes add (`.add("name", kernel<...>, ...)` in adapters/gl/src)
+/// is here under the same name and the same kernel function.
 ///
 /// A pass that emits a new kernel adds it to `emitted_kernels` (kernel_catalog.cpp).
 
@@ -17,12 +18,14 @@
 
 namespace bounce::gl {
 
-/// One emitted kernel: the pass (or shader) that emits it, the name it has there, what
-/// variant it is (e.g. "ward_smooth, gradients, front test"; empty when there is one), and
-/// the compute shader that calls it.
+/// One emitted kernel: the pass (or shader) that emits it, the name it has there, the C++
+/// kernel as written in the catalog (e.g. "disc_form_factor<f32, vec3>"), what variant it is
+/// (e.g. "ward-smooth, gradients, front test"; empty when there is one), and the compute
+/// shader that calls it.
 struct emitted_kernel {
     std::string pass;
     std::string name;
+    std::string kernel;
     std::string variant;
     std::string compute_source;
 };
