@@ -111,7 +111,8 @@ int run_with(const options& o) {
     integrator_settings.hemisphere_samples = 64;
     integrator_settings.seed = 1;
     const embree::reference_integrator integrator(bvh, scene, integrator_settings);
-    const radius_limits limits = radius_limits_for(o);
+    const auto [lo, hi] = scene.bounds();
+    const radius_limits limits = radius_limits_for(o, lo, hi);
     const adaptive_rays adaptive = adaptive_settings(o, bvh, scene, integrator, limits, setup);
     const embree::record_sampler embree_sampler =
         o.adaptive_rays ? embree::record_sampler(integrator, adaptive, limits)
@@ -121,7 +122,6 @@ int run_with(const options& o) {
                        std::span<std::optional<irradiance_record>>)>
         sampler = std::cref(embree_sampler);
     cpu::irradiance_cache_options cache_options = cache_options_for(o, o.a);
-    const auto [lo, hi] = scene.bounds();
     cpu::irradiance_cache<W> cache(lo, hi, cache_options);
     std::function<cache_frame(const camera&)> frame = [&](const camera& cam) {
         const auto ray_cast = [&](const camera& c) { return embree::ray_cast_gbuffer(bvh, scene, c, o.width, o.height); };
@@ -157,7 +157,7 @@ int run_with(const options& o) {
         };
 #endif
 
-    const nlohmann::json cache_params = cache_parameters(o, scene.name);
+    const nlohmann::json cache_params = cache_parameters(o, scene.name, limits);
     if (!o.cache_in.empty()) cache.assign(study::load_records(o.cache_in, cache_params));
     const std::size_t loaded = cache.records().size();
 

@@ -13,8 +13,10 @@
 #include "../common/cli_number_checks.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -65,6 +67,10 @@ struct options {
     std::vector<float> a_sweep;
     std::uint32_t record_samples = 1024, ref_spp = 1024;
     float min_pixels = 1.5f, max_pixels = 64.f;
+    float ambient_resolution = 0.f;  // world limits: R in [size / this, max_world_ratio * size / this] (0: none)
+    float max_world_ratio = 64.f;
+    float min_mean_distance = 0.f;   // R >= this * the record's mean hit distance (0: none)
+    float hessian_zone_cap = std::numeric_limits<float>::infinity();  // --radius hessian: a R <= this * harmonic mean
     radius_policy radius = radius_policy::split_sphere;
     bool adaptive_rays = false;              // records from min_record_samples up to record_samples rays
     std::uint32_t min_record_samples = 256;  // adaptive: the first round's rays
@@ -121,10 +127,10 @@ inline cpu::irradiance_cache_options cache_options_for(const options& o, float a
 // The parameters records depend on (not a: records are valid for every a). falloff_kappa
 // and the plane's turn keep their defaults unless the raster sampler takes them (run()
 // refuses them with the Embree sampler).
-inline nlohmann::json cache_parameters(const options& o, const std::string& scene) {
+inline nlohmann::json cache_parameters(const options& o, const std::string& scene, const radius_limits& limits) {
     const bool hessian = o.radius == radius_policy::hessian;
     const bool raster = o.sampler == record_source::raster;  // the raster's records see the shadow maps
-    return {{"scene", scene},         {"sampler", name_of(sampler_names, o.sampler)}, {"record_samples", o.record_samples},
+    nlohmann::json p = {{"scene", scene},         {"sampler", name_of(sampler_names, o.sampler)}, {"record_samples", o.record_samples},
             {"falloff_kappa", o.falloff_kappa}, {"plane_turn", o.plane_turn}, {"hashed_turn", o.hashed_turn},
             {"shadow_resolution", raster ? o.shadow_resolution : 0},
             {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels}, {"neighbour_clamp", o.neighbour_clamp},
@@ -136,18 +142,26 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
             {"min_record_samples", o.adaptive_rays ? o.min_record_samples : 0u},
             {"record_error", o.adaptive_rays ? o.record_error * o.a : 0.f},
             {"record_error_floor", o.adaptive_rays ? o.record_error_floor : 0.f}};
+    // The world limits, keyed only where set, so caches saved before them still load.
+    if (limits.min_world > 0.f || std::isfinite(limits.max_world))
+        p["world_limits"] = {limits.min_world, limits.max_world};
+    if (limits.min_mean_distance > 0.f) p["min_mean_distance"] = limits.min_mean_distance;
+    if (hessian && std::isfinite(limits.hessian_zone_cap)) p["hessian_zone_cap"] = limits.hessian_zone_cap;
+    return p;
 }
 
-/// The record radius limits the options ask for.
-inline radius_limits radius_limits_for(const options& o) {
-    radius_limits limits;
+/// The record radius limits the options ask for, in a scene of bounds [lo, hi].
+inline radius_limits radius_limits_for(const options& o, const glm::vec3& lo, const glm::vec3& hi) {
+    radius_limits limits = scene_radius_limits({}, lo, hi, o.ambient_resolution, o.max_world_ratio);
     limits.min_pixels = o.min_pixels;
     limits.max_pixels = o.max_pixels;
+    limits.min_mean_distance = o.min_mean_distance;
     limits.gradient_limit = o.gradient_limit;
     if (o.radius == radius_policy::hessian) {
         limits.policy = radius_policy::hessian;
         limits.hessian_a = o.a;
         limits.hessian_gradients = o.gradients;  // the error model follows the interpolation in use
+        limits.hessian_zone_cap = o.hessian_zone_cap;
     }
     return limits;
 }
@@ -172,6 +186,10 @@ inline void check_combinations(const options& o, bool with_gl) {
         throw parameter_error("--ref-spp", "must be even: the reference is two independent halves of N/2 samples");
     if (hessian && raster)
         throw parameter_error("--radius", "'hessian' needs the Embree sampler (the raster's reduction has no Hessian)");
+    if (o.min_mean_distance > 0.f && raster)
+        throw parameter_error("--min-mean-distance", "needs the Embree sampler (the raster's reduction has no mean distance)");
+    if (std::isfinite(o.hessian_zone_cap) && !hessian)
+        throw parameter_error("--hessian-zone-cap", "applies to --radius hessian only");
     if (hessian && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
     if (o.adaptive_rays && raster) throw parameter_error("--adaptive-rays", "needs the Embree sampler");
@@ -196,6 +214,9 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
             {"shadow_resolution", o.shadow_resolution},
             {"interp", name_of(interp_names, o.interp)}, {"record_samples", o.record_samples},
             {"reference_spp", o.ref_spp}, {"min_pixels", o.min_pixels}, {"max_pixels", o.max_pixels},
+            {"ambient_resolution", o.ambient_resolution}, {"max_world_ratio", o.max_world_ratio},
+            {"min_mean_distance", o.min_mean_distance},
+            {"hessian_zone_cap", std::isfinite(o.hessian_zone_cap) ? nlohmann::ordered_json(o.hessian_zone_cap) : nullptr},
             {"radius", name_of(radius_names, o.radius)},
             {"adaptive_rays", o.adaptive_rays}, {"min_record_samples", o.min_record_samples},
             {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
@@ -276,6 +297,23 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
         ->capture_default_str();
     app.add_option("--min-pixels", o.min_pixels, "record radius at least this many pixel footprints (--walkthrough: 0 unless given)")->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--max-pixels", o.max_pixels, "record radius at most this many pixel footprints")->check(examples::finite_positive)->capture_default_str();
+    app.add_option("--ambient-resolution", o.ambient_resolution,
+                   "record radius at least the scene's largest extent over this, and at most --max-world-ratio times "
+                   "that (Radiance's -ar; 0: no world limits)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
+    app.add_option("--max-world-ratio", o.max_world_ratio, "largest record radius over the smallest (--ambient-resolution)")
+        ->check(examples::finite_positive)
+        ->check(CLI::Range(1.f, 1e6f))
+        ->capture_default_str();
+    app.add_option("--min-mean-distance", o.min_mean_distance,
+                   "record radius at least this times the record's mean hit distance (0: no floor)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
+    app.add_option("--hessian-zone-cap", o.hessian_zone_cap,
+                   "--radius hessian: the zone a R at most this times the record's harmonic mean distance (the split "
+                   "sphere's R; default: no cap)")
+        ->check(examples::finite_positive);
     add_choice(app, "--scan", o.scan, scan_names,
                "batched: measure records ahead in parallel (same result); sequential: one at a time")
         ->capture_default_str();

@@ -52,9 +52,16 @@ endforeach()
 # NaN in every number option (CLI11's own Range and PositiveNumber let it through).
 foreach(option a falloff-kappa plane-turn fill-holes record-error record-error-floor min-pixels max-pixels
                max-extrapolation front-tolerance min-weight a-sweep frames record-samples ref-spp width repeat
-               scan-batch shadow-resolution min-record-samples mc-max-spp)
+               scan-batch shadow-resolution min-record-samples mc-max-spp ambient-resolution max-world-ratio
+               min-mean-distance hessian-zone-cap)
   bounce_cli_refusal(${option}-nan PROGRAM ic_splatting MATCH "--${option}.*nan" ARGS --${option} nan)
 endforeach()
+
+# World limits: the ratio of the largest radius to the smallest is at least 1, and the
+# Hessian's zone cap means nothing to the split sphere.
+bounce_cli_refusal(max-world-ratio-below-one PROGRAM ic_splatting MATCH "--max-world-ratio" ARGS --max-world-ratio 0.5)
+bounce_cli_refusal(hessian-zone-cap-split-sphere PROGRAM ic_splatting
+  MATCH "--hessian-zone-cap.*applies to --radius hessian only" ARGS --hessian-zone-cap 1)
 
 # Named choices are read into enums at parse time: an unknown name (or an enum's number) is
 # refused there, listing the names (examples/common/cli_choices.hpp).

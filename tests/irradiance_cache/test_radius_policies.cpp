@@ -335,3 +335,73 @@ TEST_CASE("the Hessian policy's radius on hard hemispheres", "[irradiance_record
         CHECK(make_record(p, n, t, b, est, lim, 0.0).radius == Approx(0.5f));
     }
 }
+
+TEST_CASE("world limits from the scene's size and the record's mean hit distance", "[irradiance_record][world]") {
+    const glm::dvec3 e(1.0);
+    const std::array<glm::dvec3, 3> flat{};
+    SECTION("scene_radius_limits: size over the resolution, capped by the ratio and the size") {
+        const radius_limits lim = scene_radius_limits({}, glm::vec3(-1.f, 0.f, 0.f), glm::vec3(3.f, 1.f, 2.f), 64.f, 8.f);
+        CHECK(lim.min_world == Approx(4.f / 64.f));  // the largest extent, 4, over 64
+        CHECK(lim.max_world == Approx(8.f * 4.f / 64.f));
+        CHECK(scene_radius_limits({}, glm::vec3(0.f), glm::vec3(1.f), 2.f, 64.f).max_world == Approx(1.f));  // at most the size
+        const radius_limits none = scene_radius_limits({}, glm::vec3(0.f), glm::vec3(1.f), 0.f);
+        CHECK(none.min_world == 0.f);
+        CHECK(std::isinf(none.max_world));
+        CHECK_THROWS(scene_radius_limits({}, glm::vec3(0.f), glm::vec3(1.f), -1.f));
+        CHECK_THROWS(scene_radius_limits({}, glm::vec3(0.f), glm::vec3(1.f), 8.f, 0.5f));
+        // The clamp follows: a corner's R = 0.001 rises to the floor, an open sky's to the cap.
+        CHECK(limit_radius(0.001, e, flat, lim, 0.0) == Approx(lim.min_world));
+        CHECK(limit_radius(std::numeric_limits<double>::infinity(), e, flat, lim, 0.0) == Approx(lim.max_world));
+    }
+    SECTION("the mean-distance floor: a corner's harmonic mean against the room's mean distance") {
+        radius_limits lim;
+        lim.min_mean_distance = 1.f / 32.f;
+        CHECK(limit_radius(0.01, e, flat, lim, 0.0, 4.0) == Approx(4.0 / 32.0));  // raised to 1/32 of 4
+        CHECK(limit_radius(0.5, e, flat, lim, 0.0, 4.0) == Approx(0.5));          // above the floor: unchanged
+        CHECK(limit_radius(0.01, e, flat, lim, 0.0) == Approx(0.01));             // no length: no floor
+        // The pixel guard still applies after it, and the floor scales with the scene.
+        lim.min_pixels = 2.f;
+        CHECK(limit_radius(0.01, e, flat, lim, 0.1, 4.0) == Approx(0.2));
+        lim.min_pixels = 0.f;
+        CHECK(limit_radius(0.01 * 1000, e, flat, lim, 0.0, 4.0 * 1000) == Approx(1000 * limit_radius(0.01, e, flat, lim, 0.0, 4.0)));
+    }
+    SECTION("make_record floors the split sphere with the estimate's mean distance") {
+        // A point 1 above the floor of a box of size 100: the floor's hits are near, the walls far.
+        const auto s = hemisphere_of(8, 25, [](glm::vec3) { return glm::vec3(1.f); },
+                                     [](glm::vec3 d) { return d.z > 0.9f ? 0.001f : 50.f; });
+        const hemisphere_strata strata(8, 25);
+        const auto est = estimate_hemisphere(s, strata, translation_gradient_kind::krivanek_2005, true);
+        radius_limits lim;
+        lim.gradient_limit = false;
+        const float plain = make_record(glm::vec3(0.f), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), est, lim, 0.0).radius;
+        lim.min_mean_distance = 1.f / 16.f;
+        const float floored = make_record(glm::vec3(0.f), glm::vec3(0, 0, 1), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), est, lim, 0.0).radius;
+        CHECK(plain < est.mean_distance / 16.0);
+        CHECK(floored == Approx(est.mean_distance / 16.0));
+    }
+}
+
+TEST_CASE("the Hessian zone capped by the split sphere's radius", "[irradiance_record][hessian]") {
+    radius_limits lim;
+    lim.policy = radius_policy::hessian;
+    lim.hessian_a = 0.25f;
+    lim.gradient_limit = false;
+    hemisphere_estimate est;
+    est.irradiance = glm::dvec3(2.0);
+    est.hessian = {glm::dmat2(1e-6), glm::dmat2(1e-6), glm::dmat2(1e-6)};  // nearly flat light
+    est.harmonic_mean_distance = 0.1;  // near geometry
+    est.mean_distance = 5.0;
+    const glm::vec3 p(0.f), n(0, 0, 1), t(1, 0, 0), b(0, 1, 0);
+    const float free = make_record(p, n, t, b, est, lim, 0.0).radius;
+    CHECK(free * lim.hessian_a > 1.f);  // the Hessian alone: a zone of the room's size
+    lim.hessian_zone_cap = 1.f;
+    CHECK(make_record(p, n, t, b, est, lim, 0.0).radius * lim.hessian_a == Approx(0.1f));  // the zone at R_split
+    lim.hessian_zone_cap = 2.f;
+    CHECK(make_record(p, n, t, b, est, lim, 0.0).radius * lim.hessian_a == Approx(0.2f));
+    // Where the light curves, the Hessian's own zone is the smaller and the cap does nothing.
+    est.hessian = {glm::dmat2(1e6), glm::dmat2(1e6), glm::dmat2(1e6)};
+    const float curved = make_record(p, n, t, b, est, lim, 0.0).radius;
+    lim.hessian_zone_cap = std::numeric_limits<float>::infinity();
+    CHECK(make_record(p, n, t, b, est, lim, 0.0).radius == curved);
+    CHECK(curved * lim.hessian_a < 0.2f);
+}

@@ -164,8 +164,13 @@ enum class radius_policy {
 struct radius_limits {
     radius_policy policy = radius_policy::split_sphere;  ///< where R comes from
     float hessian_a = 0.15f;  ///< radius_policy::hessian: the cache's accuracy a the radius is made for
-    float min_world = 0.f;  ///< R >= this (world units)
+    float min_world = 0.f;  ///< R >= this (world units); see scene_radius_limits
     float max_world = std::numeric_limits<float>::infinity();  ///< R <= this (world units)
+    /// R >= this times the record's mean hit distance (hemisphere_estimate::mean_distance):
+    /// a floor in world space that follows the size of the space around the record, where
+    /// the harmonic mean goes to 0 in a corner or a crack while the mean stays the room's
+    /// size. View-independent, scale-free. Typical 1/64; 0 disables.
+    float min_mean_distance = 0.f;
     /// R >= min_pixels * footprint: stops records piling up where geometry is close.
     /// Typical: 1-3 pixels (0 disables).
     float min_pixels = 0.f;
@@ -183,24 +188,50 @@ struct radius_limits {
     /// would cut the zone to a E / |grad E|, where the extrapolation is still exact to first
     /// order.
     bool hessian_gradients = true;
+    /// radius_policy::hessian: the zone a R at most this times the record's harmonic mean
+    /// distance, the split sphere's own R, where Ward's first-order bound on the error of
+    /// moving the record reaches 100% (near occluders the irradiance may change by as much
+    /// as itself, however flat its Hessian looked from the record). 1: the Hessian zone may
+    /// grow up to 1/a times the split sphere's zone where the light is smooth, never past
+    /// where the split sphere's error test says the record is no longer valid. Infinity: off.
+    float hessian_zone_cap = std::numeric_limits<float>::infinity();
 };
 
 /// R from a hemisphere's harmonic mean distance and translation gradient, with the limits
-/// applied in order: gradient limit, world clamp, pixel-footprint clamp (the footprint is
-/// the world size of one pixel at the record, see camera::pixel_footprint). A hemisphere
-/// that saw nothing (R = infinity) gets the largest radius the limits allow.
+/// applied in order: gradient limit, mean-distance floor (given a finite `mean_distance`),
+/// world clamp, pixel-footprint clamp (the footprint is the world size of one pixel at the
+/// record, see camera::pixel_footprint). A hemisphere that saw nothing (R = infinity) gets
+/// the largest radius the limits allow.
 inline float limit_radius(double harmonic_mean, const glm::dvec3& e, const std::array<glm::dvec3, 3>& translation,
-                          const radius_limits& lim, double pixel_footprint) {
+                          const radius_limits& lim, double pixel_footprint,
+                          double mean_distance = std::numeric_limits<double>::infinity()) {
     double r = harmonic_mean;
     if (lim.gradient_limit)
         for (int c = 0; c < 3; ++c) {
             const double g = glm::length(translation[c]);
             if (g > 0 && e[c] > 0) r = std::min(r, e[c] / g);
         }
+    if (std::isfinite(mean_distance)) r = std::max(r, lim.min_mean_distance * mean_distance);
     r = std::clamp(r, double(lim.min_world), double(lim.max_world));
     if (pixel_footprint > 0 && std::isfinite(pixel_footprint))
         r = std::clamp(r, lim.min_pixels * pixel_footprint, std::max(lim.min_pixels * pixel_footprint, lim.max_pixels * pixel_footprint));
     return float(r);
+}
+
+/// World limits from the scene's size, as Radiance's ambient resolution `-ar` sets them
+/// (`src/rt/ambient.c`): min_world = size / resolution and max_world = max_ratio *
+/// min_world, at most the size, where size is the largest extent of the bounds [lo, hi].
+/// resolution 0 leaves both unlimited (the scene then has no scale of its own in R).
+inline radius_limits scene_radius_limits(radius_limits lim, const glm::vec3& lo, const glm::vec3& hi, float resolution,
+                                         float max_ratio = 64.f) {
+    require(std::isfinite(resolution) && resolution >= 0.f, "resolution", "must be a non-negative number");
+    require(std::isfinite(max_ratio) && max_ratio >= 1.f, "max_ratio", "must be at least 1");
+    const glm::vec3 extent = hi - lo;
+    const float size = std::max({extent.x, extent.y, extent.z});
+    if (!(resolution > 0.f) || !(size > 0.f) || !std::isfinite(size)) return lim;
+    lim.min_world = size / resolution;
+    lim.max_world = std::min(size, max_ratio * lim.min_world);
+    return lim;
 }
 
 /// The largest |eigenvalue| of a symmetric 2x2 matrix: |mid| + sqrt(((h00 - h11) / 2)^2 + h01^2).
@@ -270,12 +301,16 @@ inline irradiance_record make_record(const glm::vec3& p, const glm::vec3& n, con
     require(lim.policy != radius_policy::hessian || (std::isfinite(lim.hessian_a) && lim.hessian_a > 0.f), "hessian_a",
             "must be a positive number");
     if (lim.policy != radius_policy::hessian) {
-        r.radius = limit_radius(est.harmonic_mean_distance, est.irradiance, translation_world, lim, pixel_footprint);
+        r.radius = limit_radius(est.harmonic_mean_distance, est.irradiance, translation_world, lim, pixel_footprint,
+                                est.mean_distance);
         return r;
     }
     const double a = lim.hessian_a;
     double unlimited = hessian_radius(est.irradiance, est.hessian, a, lim.hessian_gradients ? nullptr : &est.translation,
                                       est.mean_distance);
+    // The split sphere's bound on the zone where its error test needs it (hessian_zone_cap).
+    if (std::isfinite(lim.hessian_zone_cap))
+        unlimited = std::min(unlimited, double(lim.hessian_zone_cap) * est.harmonic_mean_distance / a);
     radius_limits rest = lim;
     if (lim.gradient_limit && lim.hessian_gradients) {
         // The gradient limit on the zone: a R <= E / |grad E| (see radius_limits::hessian_gradients).
@@ -285,7 +320,7 @@ inline irradiance_record make_record(const glm::vec3& p, const glm::vec3& n, con
         }
         rest.gradient_limit = false;
     }
-    r.radius = limit_radius(unlimited, est.irradiance, translation_world, rest, pixel_footprint);
+    r.radius = limit_radius(unlimited, est.irradiance, translation_world, rest, pixel_footprint, est.mean_distance);
     return r;
 }
 

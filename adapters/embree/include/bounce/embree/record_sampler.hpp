@@ -271,8 +271,10 @@ private:
     };
     mutable tally tally_;
 
-    // Only the Hessian radius reads the estimate's Hessian and mean distance.
-    bool needs_hessian() const noexcept { return limits_.policy == radius_policy::hessian; }
+    // Only the Hessian radius and the mean-distance floor read the estimate's Hessian and mean distance.
+    bool needs_hessian() const noexcept {
+        return limits_.policy == radius_policy::hessian || limits_.min_mean_distance > 0.f;
+    }
 
     static hemisphere_grid checked(hemisphere_grid grid) {
         require(grid.m > 0 && grid.n > 0, "grid", "need at least one stratum in each direction");
