@@ -108,6 +108,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     timer.add_sample("total", setup_ms + r.report.solve_ms);
     const lightmap_atlas& a = solver.atlas();
     r.shots = solver.progress().shots;
+    r.clamped_shots = solver.clamped_shots();
     r.shooters = solver.shooters();
     r.elements = a.size();
     r.charts = a.charts.size();
@@ -255,6 +256,9 @@ int run(const options& o) {
                timer.median_ms("visibility"), timer.median_ms("reconstruction"), timer.median_ms("shooter_choice"),
                report.error ? fmt::format("{:.4f}", report.error->rel_rms) : std::string("-"));
     if (versus) fmt::print("  versus {}: rel_rms {:.4f}\n", o.versus.string(), j["versus"]["rel_rms"].get<double>());
+    if (r.report.stop == radiosity_stop::time_limit)
+        fmt::print(stderr, "radiosity: stopped unconverged by --max-seconds {}: {:.1f}% of the emitted power shot, {:.1f}% asked\n",
+                   o.max_seconds, 100.0 * (1.0 - r.report.unshot_fraction), 100.0 * o.converge);
     return 0;
 }
 

@@ -25,6 +25,7 @@ struct solve_result {
     std::vector<checkpoint> curve;
     double setup_ms = 0;  // atlas and solver construction (lights shot), before the solve
     std::size_t shots = 0, shooters = 0, elements = 0, charts = 0;
+    std::size_t clamped_shots = 0;  // shots scaled down to their power (shot_scale)
     std::size_t base_elements = 0;  // the atlas's, before adaptive subdivision
     glm::dvec3 emitted{0}, absorbed{0}, escaped{0};
     image<glm::vec3> lightmap, unshot, view;
@@ -35,6 +36,7 @@ struct solve_result {
 inline void add_solve_json(nlohmann::ordered_json& j, const solve_result& r) {
     j["unshot_fraction"] = r.report.unshot_fraction;
     j["stopped"] = to_string(r.report.stop);
+    j["clamped_shots"] = r.clamped_shots;
     const auto sum = [](const glm::dvec3& v) { return v.x + v.y + v.z; };
     j["energy"] = {{"emitted_w", sum(r.emitted)},
                    {"absorbed_fraction", sum(r.absorbed) / sum(r.emitted)},

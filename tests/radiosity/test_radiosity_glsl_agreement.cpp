@@ -39,7 +39,7 @@ constexpr int random_count = 5000;
 const auto unit_scale = [](std::size_t) { return 1.0; };
 }  // namespace
 
-TEST_CASE("disc_form_factor and shot_radiosity agree on the GPU and the CPU, hard cases included",
+TEST_CASE("disc_form_factor, element_form_factor and shot_radiosity agree on the GPU and the CPU, hard cases included",
           "[glsl][radiosity]") {
     gl_test::shared_context();
     pcg32 rng(31);
@@ -87,6 +87,23 @@ TEST_CASE("disc_form_factor and shot_radiosity agree on the GPU and the CPU, har
     });
     INFO("worst scaled shot difference " << worst_shot);
     CHECK(worst_shot <= tolerance);
+
+    // element_form_factor, the solvers' factor: the receiver's area beside the shooter's,
+    // smaller, equal and larger (up to 100 times: a big element next to a sliver).
+    using element_args = std::tuple<glm::vec3, glm::vec3, float, glm::vec3, glm::vec3, float>;
+    std::vector<element_args> elements;
+    for (std::size_t e = 0; e < in.size(); ++e) {
+        const auto& [pr, nr, ps, ns, area] = in[e];
+        const float ratio = e % 3 == 0 ? 0.f : e % 3 == 1 ? 1.f : 100.f * rng.next_float();
+        elements.emplace_back(pr, nr, area * ratio, ps, ns, area);
+    }
+    std::vector<float> cpu_element;
+    for (const auto& a : elements) cpu_element.push_back(std::apply(element_form_factor<float, glm::vec3>, a));
+    const auto gpu_element = gl::map_kernel(element_form_factor<f32, vec3>, elements);
+    const double worst_element = worst_scaled(gpu_element, cpu_element, scale);
+    INFO("worst scaled element factor difference " << worst_element);
+    CHECK(worst_element <= tolerance);
+    for (std::size_t e = 0; e < elements.size(); e += 3) CHECK(cpu_element[e] == cpu[e]);  // no receiver area
 }
 
 TEST_CASE("the stereographic projection, its inverse and its texture coordinates agree on the GPU and the CPU",

@@ -7,6 +7,7 @@
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/radiosity/solve.hpp>
+#include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -131,10 +132,15 @@ TEST_CASE("a solve stops at its time limit, checkpoints not counted", "[radiosit
 }
 
 TEST_CASE("a solve that creates energy is stopped with the step named", "[radiosity][solve][errors]") {
+    // The unshot power may only fall: the first rise (step 2, 0.8 -> 0.9 of the emitted
+    // power) stops it, long before it passes the emitted power (step 3).
     const scripted_solver gains{{0.8, 0.9, 1.5, 3.0}};
     scripted_solver s = gains, t = gains;
     CHECK_THROWS_AS(run(s, {}), radiosity_error);
-    CHECK_THROWS_WITH(run(t, {}), Catch::Contains("step 3"));
+    CHECK_THROWS_WITH(run(t, {}), Catch::Contains("step 2") && Catch::Contains("rose from 0.8 to 0.9"));
+    // A rise within float rounding of the sums (2^-20 of them) is not one.
+    scripted_solver rounding{{0.8, 0.8 * (1 + 1e-7), 0.5}};
+    CHECK_NOTHROW(run(rounding, {}));
     scripted_solver n{{0.8, std::nan("")}};
     CHECK_THROWS_AS(run(n, {}), radiosity_error);
     radiosity_solve_options bad;
@@ -226,4 +232,71 @@ TEST_CASE("a stereographic tolerance below what the buffer resolves is refused w
     for (glm::vec3& p : far.positions) p += glm::vec3(1e5f, 0.f, 0.f);
     const float far_floor = stereographic_tolerance_floor(far.view(), atlas.size(), 128);
     CHECK(far_floor > 0.1f);
+}
+
+namespace {
+
+// A floor 10 m wide of a few large elements under a lamp, with `count` sliver triangles
+// (1 mm wide, half a metre long) a millimetre to a centimetre above it: every other one faces
+// the floor, the rest face the lamp or stand across the floor, each its own chart of one tiny
+// element. A tiny shooter a millimetre from a floor element metres wide is the case where the
+// disc factor at the receiver's centre, times the receiver's area, hands the receiver many
+// times the shot's power (issue 30's conference room).
+owned_scene slivers_over_a_floor(int count) {
+    owned_scene s;
+    const auto floor = s.add_material(glm::vec3(0.8f));
+    const auto sliver = s.add_material(glm::vec3(0.9f, 0.85f, 0.8f));
+    const auto lamp = s.add_material(glm::vec3(0.5f), glm::vec3(5.f));
+    s.add_quad({-5, 0, -5}, {-5, 0, 5}, {5, 0, 5}, {5, 0, -5}, floor);  // faces +y
+    s.add_quad({-1, 4, -1}, {1, 4, -1}, {1, 4, 1}, {-1, 4, 1}, lamp);   // faces -y
+    pcg32 rng(30);
+    for (int k = 0; k < count; ++k) {
+        const glm::vec3 at(8 * rng.next_float() - 4, 0.001f + 0.009f * rng.next_float(), 8 * rng.next_float() - 4);
+        const glm::vec3 along(0.5f, 0.f, 0.f), across(0.f, 0.f, 0.001f), up(0.f, 0.001f, 0.f);
+        const auto base = std::uint32_t(s.positions.size());
+        switch (k % 4) {
+            case 0:  // faces the floor
+            case 1: s.positions.insert(s.positions.end(), {at, at + along, at + across}); break;
+            case 2: s.positions.insert(s.positions.end(), {at, at + across, at + along}); break;  // faces the lamp
+            default: s.positions.insert(s.positions.end(), {at, at + along, at + up}); break;  // stands across
+        }
+        s.triangles.emplace_back(base, base + 1, base + 2);
+        s.material_of.push_back(sliver);
+    }
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("slivers and near-touching elements: no shot delivers more than its power, the unshot power only falls",
+          "[radiosity][solve][energy]") {
+    const auto scene = slivers_over_a_floor(200);
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 40});
+    REQUIRE(atlas.size() > 200);  // a chart per sliver, floor elements much larger
+    cpu::progressive_radiosity solver(scene.view(), atlas, cpu::all_visible{});
+    glm::dvec3 escaped = solver.escaped_power();
+    double unshot = solver.unshot_fraction();
+    radiosity_solve_options o;
+    o.converge = 1;  // 400 steps: the slivers shoot too
+    o.progress = [&](const radiosity_progress& p) {
+        // Each shot hands out at most its power: what escapes never falls (to float rounding).
+        const glm::dvec3 e = solver.escaped_power(), emitted = solver.emitted_power();
+        for (int c = 0; c < 3; ++c) CHECK(e[c] >= escaped[c] - 1e-6 * emitted[c]);
+        escaped = e;
+        CHECK(p.unshot_fraction <= unshot * (1 + 1e-6));
+        CHECK(p.unshot_fraction >= 0);
+        unshot = p.unshot_fraction;
+        // No receiver takes more than the shot.
+        CHECK(solver.last_shot().top_share <= 1 + 1e-6);
+        return p.steps < 400;
+    };
+    radiosity_solve_report r;
+    REQUIRE_NOTHROW(r = solver.solve(o));
+    CHECK(r.stop == radiosity_stop::callback);
+    CHECK(solver.unshot_fraction() < 1e-3);
+    // Either bound alone keeps this scene's energy (element_form_factor leaves no shot to
+    // scale here; with the receiver's point factor instead, shot_scale scales most of them);
+    // with neither, the first floor shot hands a sliver-covered floor element 1.8 times its
+    // power and the solve stops at step 1 naming shooter and element (checked by hand).
+    CHECK(solver.clamped_shots() == 0);
 }

@@ -90,6 +90,7 @@ std::uint32_t progressive_radiosity::next_shooter() const noexcept { return s_->
 double progressive_radiosity::next_shooter_power() const noexcept { return s_->next_power; }
 std::size_t progressive_radiosity::shooters() const noexcept { return s_->first.size() - 1; }
 std::uint32_t progressive_radiosity::shooter_first(std::size_t k) const { return s_->first.at(k); }
+std::size_t progressive_radiosity::clamped_shots() const noexcept { return s_->clamped_shots; }
 glm::dvec3 progressive_radiosity::emitted_power() const noexcept { return s_->emitted; }
 glm::dvec3 progressive_radiosity::absorbed_power() const noexcept { return s_->absorbed; }
 glm::dvec3 progressive_radiosity::escaped_power() const noexcept { return s_->escaped; }

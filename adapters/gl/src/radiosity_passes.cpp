@@ -111,6 +111,7 @@ void progressive_radiosity::state::compile() {
     light_program = std::make_unique<program>(program::compute(light_compute()));
     reduce_program = std::make_unique<program>(program::compute(reduce_compute()));
     finish_program = std::make_unique<program>(program::compute(finish_compute()));
+    rescale_program = std::make_unique<program>(program::compute(rescale_compute()));
 }
 
 }  // namespace bounce::gl

@@ -233,10 +233,8 @@ std::string parallel_fragment() {
 // (disc form factors), times its visibility.
 std::string distribute_compute(int max_nodes, int stack_size) {
     glsl::function_set fs;
-    fs.add("radiosity_form_factor", disc_form_factor<f32, vec3>, "receiver_position", "receiver_normal",
-           "shooter_position", "shooter_normal", "shooter_area");
-    fs.add("radiosity_shot", shot_radiosity<f32, vec3>, "receiver_position", "receiver_normal", "receiver_albedo",
-           "shooter_position", "shooter_normal", "shooter_area", "shooter_unshot", "visibility");
+    fs.add("radiosity_form_factor", element_form_factor<f32, vec3>, "receiver_position", "receiver_normal",
+           "receiver_area", "shooter_position", "shooter_normal", "shooter_area");
     fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
     return version_line + "layout(local_size_x = 64) in;\n" + shot_uniforms() +
            uniforms({{distribute_uniform::node_count, "int node_count"}, {distribute_uniform::near2, "float near2"}}) +
@@ -253,7 +251,10 @@ void main() {
     if (!(a.position_area.w > 0.0)) return;
     if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
     vec3 pr = a.position_area.xyz, nr = a.normal_chart.xyz, rho = a.albedo.rgb;
-    vec3 gain = vec3(0.0), incident = vec3(0.0);
+    float ar = a.position_area.w;
+    // precise: no fused multiply-add in the sum, so it rounds as the CPU's does (a shooter's
+    // power decides the next shot, and equal powers in a symmetric scene must stay equal).
+    precise vec3 incident = vec3(0.0);
     // The block as one disc where the receiver is farther than near_field times its side,
     // else as its four quadrants, recursively, down to elements: the CPU solver's traversal
     // (a stack, children pushed in order, so terms are summed in its order). Each node is
@@ -261,11 +262,8 @@ void main() {
     // Most receivers are far from the whole block: one disc, no stack.
     near_node root = node[node_count - 1];
     if (root.meta.y == 0 || !(radiosity_near_field(pr, root.position_area.xyz, root.position_area.w, near2) > 0.5)) {
-        float f = radiosity_form_factor(pr, nr, root.position_area.xyz, shot_n, root.position_area.w);
-        if (f > 0.0) {
-            incident = root.unshot.xyz * f;
-            gain = radiosity_shot(pr, nr, rho, root.position_area.xyz, shot_n, root.position_area.w, root.unshot.xyz, 1.0);
-        }
+        float f = radiosity_form_factor(pr, nr, ar, root.position_area.xyz, shot_n, root.position_area.w);
+        if (f > 0.0) incident = root.unshot.xyz * f;
     } else {
         int stack[stack_size];
         int top = 0;
@@ -274,11 +272,8 @@ void main() {
             near_node nd = node[stack[--top]];
             bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
             if (nd.meta.y == 0 || !near_node_) {
-                float f = radiosity_form_factor(pr, nr, nd.position_area.xyz, shot_n, nd.position_area.w);
-                if (f > 0.0) {
-                    incident += nd.unshot.xyz * f;
-                    gain += radiosity_shot(pr, nr, rho, nd.position_area.xyz, shot_n, nd.position_area.w, nd.unshot.xyz, 1.0);
-                }
+                float f = radiosity_form_factor(pr, nr, ar, nd.position_area.xyz, shot_n, nd.position_area.w);
+                if (f > 0.0) incident += nd.unshot.xyz * f;
             } else {
                 for (int c = 0; c < nd.meta.y && top < stack_size; ++c) stack[top++] = nd.meta.x + c;
             }
@@ -287,7 +282,36 @@ void main() {
     if (!(incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
     float v = shot_visibility(pr, a.normal_chart.w);
     if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
-    receive(xy, gain * v, incident * (v * a.position_area.w));
+    vec3 received = incident * v;
+    receive(xy, rho * received, received * ar);
+}
+)";
+}
+
+// A shot that would deliver more than its power, scaled down after its distribution
+// (shot_scale, radiosity/shooters.hpp): each element's received radiosity, its intercepted
+// power over its area, times (scale - 1) is taken back from its radiosity and unshot
+// radiosity (times rho), and its intercepted power scaled, for the reduction that follows.
+std::string rescale_compute() {
+    using namespace rescale_uniform;
+    return version_line + "layout(local_size_x = 64) in;\n" +
+           uniforms({{atlas_width, "int atlas_width"}, {element_count, "uint element_count"}, {scale, "vec3 scale"}}) +
+           "\n" + texel_attributes_struct +
+           storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
+           storage_block(element_binding, "readonly buffer element_block { uint element_texel[]; }") +
+           image(radiosity_unit, "image2D radiosity_image") + image(unshot_unit, "image2D unshot_image") +
+           image(intercepted_unit, "image2D intercepted_image") + R"(
+void main() {
+    if (gl_GlobalInvocationID.x >= element_count) return;
+    uint code = element_texel[gl_GlobalInvocationID.x];
+    ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
+    texel_attributes a = texel[xy.y * atlas_width + xy.x];
+    vec3 got = imageLoad(intercepted_image, xy).rgb;
+    if (!(a.position_area.w > 0.0) || got == vec3(0.0)) return;
+    vec3 change = a.albedo.rgb * (got / a.position_area.w * (scale - vec3(1.0)));
+    imageStore(radiosity_image, xy, imageLoad(radiosity_image, xy) + vec4(change, 0.0));
+    imageStore(unshot_image, xy, max(imageLoad(unshot_image, xy) + vec4(change, 0.0), vec4(0.0)));
+    imageStore(intercepted_image, xy, vec4(got * scale, 0.0));
 }
 )";
 }

@@ -105,6 +105,11 @@ namespace finish_uniform {
 enum : int { shooter_count = 0 };
 }
 
+// The pass that scales a shot down to its power.
+namespace rescale_uniform {
+enum : int { atlas_width = 0, element_count = 1, scale = 2 };
+}
+
 std::string item_buffer_vertex();
 std::string item_buffer_fragment();
 std::string hemicube_vertex();
@@ -116,6 +121,7 @@ std::string distribute_compute(int max_nodes, int stack_size);
 std::string light_compute();
 std::string reduce_compute();
 std::string finish_compute();
+std::string rescale_compute();
 std::string lightmap_compute();
 
 }  // namespace bounce::gl::radiosity_glsl

@@ -305,11 +305,36 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     }
     if (options.timed_stages) finish();
     timings.distribution_ms += ms_since(start);
-    const reduction got = reduce();
+    reduction got = reduce();
+    // At most its own power (shot_scale, as the CPU solver scales it).
+    const glm::dvec3 scale = shot_scale(power, got.intercepted);
+    if (scale != glm::dvec3(1.0)) {
+        rescale(glm::vec3(scale));
+        got = reduce();
+        ++clamped_shots;
+    }
     absorbed += got.absorbed;
     escaped += power - got.intercepted;
     intercepted_power += got.intercepted;
     ++shots;
+}
+
+void progressive_radiosity::state::rescale(glm::vec3 scale) {
+    const auto start = clock_type::now();
+    {
+        binding_state saved;
+        bind_common();
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+        const program& p = *rescale_program;
+        glUseProgram(p.id());
+        p.set(radiosity_glsl::rescale_uniform::atlas_width, int(width));
+        p.set(radiosity_glsl::rescale_uniform::element_count, unsigned(atlas.size()));
+        p.set(radiosity_glsl::rescale_uniform::scale, scale);
+        glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
+        check_error("progressive_radiosity: scaling a shot to its power");
+    }
+    if (options.timed_stages) finish();
+    timings.distribution_ms += ms_since(start);
 }
 
 void progressive_radiosity::state::set_shot_uniforms(const program& p, float chart, bool hemicube) const {

@@ -165,7 +165,8 @@ struct progressive_radiosity::state {
     std::unique_ptr<texture> lightmap_texture;
     std::unique_ptr<buffer> source_texel;
     std::unique_ptr<program> lightmap_program;
-    std::unique_ptr<program> item_program, cube_program, parallel_program, distribute_program, light_program, reduce_program, finish_program;
+    std::unique_ptr<program> item_program, cube_program, parallel_program, distribute_program, light_program, reduce_program, finish_program,
+        rescale_program;
 
     // Per shot, CPU side.
     glm::vec3 shot_position{0.f}, shot_axis{0.f, 0.f, 1.f}, t{1, 0, 0}, b{0, 1, 0};
@@ -181,6 +182,7 @@ struct progressive_radiosity::state {
     std::uint32_t next = 0;
     double next_power = 0;
     std::size_t steps = 0, shots = 0;
+    std::size_t clamped_shots = 0;  // shots scaled down to their power (shot_scale)
     radiosity_timings timings;
 
     state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o);
@@ -196,6 +198,8 @@ struct progressive_radiosity::state {
     void draw_visibility();
     void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
     void shoot(std::uint32_t k);
+    // The last distribution's deliveries times `scale` (per channel, each at most 1).
+    void rescale(glm::vec3 scale);
     void shoot_light(const packed_light& l);
     // The light pass for the current shot of light l (the uniforms of set_light_uniforms),
     // then the reduction, whose intercepted power the light emitted.

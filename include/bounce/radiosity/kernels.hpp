@@ -42,16 +42,22 @@ namespace bounce::inline radiosity {
 // ---------------------------------------------------------------------------------------
 // Form factor and shot
 
-/// Oriented-disc form factor F_{r->s} (dimensionless, in [0, 1)) from a receiving point at
-/// `receiver_position` with unit normal `receiver_normal` to a shooting disc centred at
-/// `shooter_position` with unit normal `shooter_normal` and area `shooter_area` (m^2, > 0;
-/// typical: one texel, 1e-4 to 1e-2): Wallace et al. 1989 Eq. 4, as in Coombe and Harris
-/// Listing 39-4 with each cosine clamped separately. Visibility is not included.
-/// The + A_s in the denominator keeps F below 1 as d -> 0 (the exact disc-to-point factor
-/// on the axis is A_s / (pi d^2 + A_s)); coincident points give 0.
+/// Form factor F_{r->s} (dimensionless) from a receiving element of area `receiver_area`
+/// (m^2, >= 0), taken at its centre `receiver_position` with unit normal `receiver_normal`, to
+/// a shooting disc centred at `shooter_position` with unit normal `shooter_normal` and area
+/// `shooter_area` (m^2, > 0): Wallace et al. 1989 Eq. 4 with the larger of the two areas in
+/// the denominator,
+///   F_{r->s} = A_s max(cos_r, 0) max(cos_s, 0) / (pi d^2 + max(A_s, A_r)),
+/// so that both directions stay below 1: F_{r->s} < 1, and by reciprocity the fraction of the
+/// shooter's power the receiver takes, F_{s->r} = A_r F_{r->s} / A_s, is the disc factor with
+/// the two swapped (exact on the axis of a receiving disc seen from a small shooter). The
+/// receiver's point alone (receiver_area 0, disc_form_factor) hands a receiver much larger
+/// than its distance to a small shooter A_r / A_s times the shooter's power: on the conference
+/// room a 4.2 m^2 element half a metre from a 0.13 m^2 one took 4.75 times the shot (issue 30's
+/// divergence). Each cosine is clamped separately; coincident points give 0.
 template <real T, vec3_of<T> V>
-T disc_form_factor(const V& receiver_position, const V& receiver_normal, const V& shooter_position,
-                   const V& shooter_normal, T shooter_area) {
+T element_form_factor(const V& receiver_position, const V& receiver_normal, T receiver_area, const V& shooter_position,
+                      const V& shooter_normal, T shooter_area) {
     const V r = shooter_position - receiver_position;
     const T d2 = dot(r, r);
     const auto apart = d2 > T(0);
@@ -59,8 +65,23 @@ T disc_form_factor(const V& receiver_position, const V& receiver_normal, const V
     const T inv_d = inversesqrt(safe_d2);
     const T cos_r = max(T(0), dot(receiver_normal, r) * inv_d);
     const T cos_s = max(T(0), -dot(shooter_normal, r) * inv_d);
-    const T f = shooter_area * cos_r * cos_s / (T(std::numbers::pi) * safe_d2 + shooter_area);
+    const T f = shooter_area * cos_r * cos_s / (T(std::numbers::pi) * safe_d2 + max(shooter_area, receiver_area));
     return select(apart, f, T(0));
+}
+
+/// Oriented-disc form factor F_{r->s} (dimensionless, in [0, 1)) from a receiving point at
+/// `receiver_position` with unit normal `receiver_normal` to a shooting disc centred at
+/// `shooter_position` with unit normal `shooter_normal` and area `shooter_area` (m^2, > 0;
+/// typical: one texel, 1e-4 to 1e-2): Wallace et al. 1989 Eq. 4, as in Coombe and Harris
+/// Listing 39-4 with each cosine clamped separately. Visibility is not included.
+/// The + A_s in the denominator keeps F below 1 as d -> 0 (the exact disc-to-point factor
+/// on the axis is A_s / (pi d^2 + A_s)); coincident points give 0. element_form_factor with a
+/// receiver of no area; the solvers use element_form_factor.
+template <real T, vec3_of<T> V>
+T disc_form_factor(const V& receiver_position, const V& receiver_normal, const V& shooter_position,
+                   const V& shooter_normal, T shooter_area) {
+    return element_form_factor<T, V>(receiver_position, receiver_normal, T(0), shooter_position, shooter_normal,
+                                     shooter_area);
 }
 
 /// Radiosity (W/m^2 per channel) one shot adds to a receiver: rho_r dB_s F_{r->s} V

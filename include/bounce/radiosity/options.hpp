@@ -13,10 +13,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
 #include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 namespace bounce::inline radiosity {
 
@@ -50,6 +52,18 @@ struct radiosity_timings {
     double choice_ms = 0;        ///< choosing shooters (reduction; GL: it also sums the powers)
     double distribution_ms = 0;  ///< form factors and updates over the elements
     double subdivision_ms = 0;   ///< adaptive subdivision: the test and the refined atlas (CPU only)
+};
+
+/// What the last shot of a solver did, for the energy check of radiosity/solve.hpp and its
+/// error message.
+struct radiosity_shot_record {
+    std::size_t shot = 0;              ///< the shot's number (0: the first)
+    std::size_t shooter = 0;           ///< the shooter (block or element) that shot
+    std::uint32_t first_element = 0;   ///< the shooter's first element
+    std::uint32_t top_receiver = 0;    ///< the element that intercepted the most of it
+    double top_share = 0;              ///< that element's intercepted power / the shot's power
+    glm::dvec3 scale{1.0};             ///< per channel, the factor that kept the shot's delivered
+                                       ///< power within its own (shot_scale; 1 when it was)
 };
 
 /// Where a solve stands after a step.

@@ -50,6 +50,20 @@ inline shooter_disc shooter_disc_of(const lightmap_atlas& atlas, std::uint32_t i
     return {glm::vec3(moment / area), area};
 }
 
+/// The factor, per channel, by which a shot's deliveries are scaled so that it hands out at
+/// most the power it shoots: min(1, power / intercepted), `power` the shooter's unshot power
+/// and `intercepted` what its form factors (times visibility) would deliver, both in W per
+/// channel. A shooter's form factors to everything it sees sum to at most 1 (they tile its
+/// hemisphere); the disc approximation, evaluated at receivers' centres, can sum above it
+/// where receivers lie close to a shooter (slivers, near-touching elements), and a shot that
+/// delivered more than it shot would create energy. Both solvers apply it. It is 1 unless
+/// receivers lie close to the shooter: in a closed box the near field's discs over-deliver
+/// into the corners and many block shots are scaled.
+inline glm::dvec3 shot_scale(const glm::dvec3& power, const glm::dvec3& intercepted) {
+    const auto one = [](double p, double got) { return got > p && got > 0 ? std::max(0.0, p) / got : 1.0; };
+    return {one(power.x, intercepted.x), one(power.y, intercepted.y), one(power.z, intercepted.z)};
+}
+
 /// Builds the near-field tree of the shooter made of the elements [i0, i1) of `atlas` (one
 /// chart's): with `block` (the shooter is atlas block `block_index`, shot as one) its cells
 /// are the block's grid cells, else the shooter is one element, a tree of one node.

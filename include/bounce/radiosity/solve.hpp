@@ -108,6 +108,43 @@ inline double channel_total(const glm::dvec3& v) { return v.x + v.y + v.z; }
 /// The solve loop of every backend. `Solver` has step(), unshot_fraction(), progress(),
 /// emitted_power(), unshot_power() and intercepted_power(); `after_step(step_index)` runs after each step inside the
 /// solve's clock and returns the leaves it split (adaptive subdivision; 0 otherwise).
+/// The unshot and the emitted power of a solver, channels summed (W).
+struct energy_sums {
+    double unshot = 0, emitted = 0;
+};
+template <class Solver>
+energy_sums energy_of(const Solver& solver) {
+    const double emitted = channel_total(solver.emitted_power());
+    return {solver.unshot_fraction() * emitted, emitted};
+}
+
+/// Throws radiosity_error when a step raised the unshot power by more than the power the
+/// lights added (adaptive subdivision re-gathers them), beyond float rounding: each element's
+/// unshot radiosity is a float (2^-24 relative), so the sum may drift by 2^-20 of what it held
+/// and was added. A shot hands out at most its power (shot_scale) times albedos at most 1,
+/// so the unshot power can only fall; a rise, or a non-finite sum, means energy was created.
+/// The message names the step, the shot's shooter and the element that took the most.
+template <class Solver>
+void check_energy(const Solver& solver, const energy_sums& before, const energy_sums& after) {
+    const double added = after.emitted - before.emitted;
+    const double rise = after.unshot - before.unshot - added;
+    const double tolerance = std::ldexp(before.unshot + std::abs(added), -20);
+    if (std::isfinite(after.unshot) && std::isfinite(after.emitted) && rise <= tolerance &&
+        after.unshot <= after.emitted * (1.0 + 1e-6))
+        return;
+    std::string where;
+    if constexpr (requires { solver.last_shot(); }) {
+        const radiosity_shot_record& s = solver.last_shot();
+        where = " (shot " + std::to_string(s.shot) + " from shooter " + std::to_string(s.shooter) + ", element " +
+                std::to_string(s.first_element) + "; element " + std::to_string(s.top_receiver) + " took " +
+                radiosity_number(s.top_share) + " of its power)";
+    }
+    throw radiosity_error("bounce: radiosity: the solve created energy at step " + std::to_string(solver.progress().steps) +
+                          where + ": the unshot power rose from " + radiosity_number(before.unshot) + " to " +
+                          radiosity_number(after.unshot) + " W (" + radiosity_number(after.unshot / after.emitted) +
+                          " of the emitted power); it can only fall");
+}
+
 template <class Solver, class AfterStep>
 radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve_options& o, AfterStep&& after_step) {
     o.validate();
@@ -143,6 +180,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
         checked_here = true;
     };
     r.stop = radiosity_stop::converged;
+    energy_sums before = energy_of(solver);
     while (solver.unshot_fraction() > target) {
         if (o.max_seconds > 0 && elapsed() > o.max_seconds * 1e3) {
             r.stop = radiosity_stop::time_limit;
@@ -156,11 +194,9 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
         checked_here = false;
         r.splits += after_step(r.steps);
         const double f = solver.unshot_fraction();
-        if (!std::isfinite(f) || f > 1.0 + 1e-6)
-            throw radiosity_error("bounce: radiosity: the solve created energy at step " + std::to_string(solver.progress().steps) +
-                                  ": the unshot power is " + radiosity_number(f) +
-                                  " times the emitted power (it can only fall; the disc form factor summed above 1, "
-                                  "typically between tiny or sliver elements very close to their shooter)");
+        const energy_sums after = energy_of(solver);
+        check_energy(solver, before, after);
+        before = after;
         r.converged.push_back(1.0 - f);
         r.step_ms.push_back(elapsed());
         checkpoint(false);

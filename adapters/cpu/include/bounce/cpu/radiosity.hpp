@@ -28,7 +28,12 @@
 ///
 /// Energy: with the disc form factor a shot hands out dB_s sum_r F_{r->s} V A_r, which need not
 /// equal the shot power dB_s A_s (energy leaves open scenes; and the approximation is not
-/// exactly conservative). The solver keeps, in double per channel, absorbed power (the
+/// exactly conservative). Two bounds keep it from exceeding it (issue 30): the form factor
+/// takes the receiver's area too (element_form_factor: A_r F_{r->s} <= A_s), and a shot whose
+/// deliveries still sum above its power is scaled down to it (shot_scale), so each shot is
+/// two passes, the incident radiosity per element (received_), then the scaled update; the
+/// solve checks after every step that the unshot power fell. The solver keeps, in double per
+/// channel, absorbed power (the
 /// (1 - rho) share of what each element intercepts) and escaped power (shot power less
 /// intercepted power, negative where the disc approximation over-delivers), so that
 /// absorbed + unshot + escaped = emitted after every step, to rounding.
@@ -81,7 +86,7 @@ using bounce::radiosity_timings;
 /// and the triangle count made before anything is allocated, so a caller can refuse a budget
 /// that cannot fit (`--elements 50000000`) instead of dying in std::bad_alloc or the OOM
 /// killer. Per element: the atlas's arrays (64 bytes), twice while the solver copies it, and
-/// the solver's radiosity, unshot, direct and gathered arrays (48); per texel of the atlas (elements
+/// the solver's radiosity, unshot, direct, gathered and received arrays (60); per texel of the atlas (elements
 /// plus each chart's padding ring and the packing's waste, at most one chart per triangle):
 /// element_at, the build's overlap sums and the lightmaps laid out (56); per triangle the
 /// build's adjacency (about 200). Visibility is not included (an item buffer: about 112
@@ -93,7 +98,7 @@ inline double radiosity_memory_estimate(const scene_view& scene, const atlas_opt
     const double p = double(options.padding);
     const double texels = 1.25 * (1.3 * e + 4 * p * std::sqrt(e * n) + 4 * p * p * n);
     const double shooters = e / double(options.block_texels * options.block_texels) + n;
-    return e * (2 * 64 + 48) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
+    return e * (2 * 64 + 60) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
 }
 
 /// The solver. `Real` is the type of the radiosity arrays and of the kernel's arithmetic
@@ -275,6 +280,12 @@ public:
     const radiosity_timings& timings() const noexcept { return timings_; }
     radiosity_progress progress() const noexcept { return {steps_, shots_, unshot_fraction(), 0.0}; }
     std::size_t shooters() const noexcept { return power_.size(); }
+    /// The last shot: its shooter, its first element, the element that took the most of it
+    /// and its share, and the scale that kept its delivered power within its own
+    /// (radiosity/shooters.hpp, shot_scale; 1 unless the form factors summed above 1).
+    const radiosity_shot_record& last_shot() const noexcept { return last_shot_; }
+    /// Shots whose form factors summed above 1 and were scaled down to deliver their power.
+    std::size_t clamped_shots() const noexcept { return clamped_shots_; }
     const lightmap_atlas& atlas() const noexcept { return atlas_; }
     Visibility& visibility() noexcept { return visibility_; }
 
@@ -345,6 +356,8 @@ private:
     struct chunk_sums {
         glm::dvec3 absorbed{0}, intercepted{0};
         double unshot = 0;
+        double top_power = 0;            // the largest power one element intercepted (channels summed)
+        std::uint32_t top_receiver = 0;  // that element
     };
 
     static double channel_sum(const vec& v) { return double(v.x) + double(v.y) + double(v.z); }
@@ -376,9 +389,9 @@ private:
     }
 
     // Runs `receive(i, sums)` for every element, chunk by chunk of shooters in parallel,
-    // refreshing each shooter's power; then adds the chunks' sums in order.
+    // refreshing each shooter's power (with `refresh`); then adds the chunks' sums in order.
     template <class Receive>
-    chunk_sums distribute(const Receive& receive) {
+    chunk_sums for_elements(const Receive& receive, bool refresh = false) {
         const std::size_t shooters = power_.size(), chunks = (shooters + chunk - 1) / chunk;
         sums_.assign(chunks, chunk_sums{});
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -389,8 +402,9 @@ private:
                     double p = 0;
                     for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
                         receive(i, s);
-                        p += channel_sum(unshot_[i]) * double(atlas_.area[i]);
+                        if (refresh) p += channel_sum(unshot_[i]) * double(atlas_.area[i]);
                     }
+                    if (!refresh) continue;
                     power_[k] = p;
                     s.unshot += p;
                 }
@@ -402,39 +416,61 @@ private:
             total.absorbed += s.absorbed;
             total.intercepted += s.intercepted;
             total.unshot += s.unshot;
+            if (s.top_power > total.top_power) total.top_power = s.top_power, total.top_receiver = s.top_receiver;
         }
-        unshot_total_ = total.unshot;
+        if (refresh) unshot_total_ = total.unshot;
         return total;
     }
+    template <class Receive>
+    chunk_sums distribute(const Receive& receive) {
+        return for_elements(receive, true);
+    }
 
+    // A shot in two passes: every element's incident radiosity from the shooter (form factors
+    // and visibility, into received_), then, scaled so that the shot delivers at most its own
+    // power (shot_scale), added to the receivers.
     void shoot(std::uint32_t k) {
         const lightmap_atlas& at = atlas_;
         const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
-        // The shooter's unshot radiosity, area-weighted over its elements; then zeroed, so
-        // its elements' power (refreshed in the distribution) starts from 0. Its elements are
-        // kept for the near field.
+        // The shooter's unshot power, summed over its elements; then zeroed, so its elements'
+        // power (refreshed in the distribution) starts from 0. Its elements are kept for the
+        // near field.
         glm::dvec3 power(0);
         for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot_[i]) * double(at.area[i]);
         build_near_tree(k);
         for (std::uint32_t i = i0; i < i1; ++i) unshot_[i] = vec(0);
-        const glm::vec3 ns_f = at.normal[i0];
-        const vec ns = vec(ns_f);
-        const std::uint32_t chart = at.chart[i0];
-        const std::uint32_t root = std::uint32_t(near_.size() - 1);
-        const Real near2 = Real(options_.near_field) * Real(options_.near_field);
 
         auto start = clock::now();
-        visibility_.begin_shot(shot_frame{centre_[k], ns_f, false, chart});
+        visibility_.begin_shot(shot_frame{centre_[k], at.normal[i0], false, at.chart[i0]});
         timings_.visibility_ms += ms_since(start);
 
         start = clock::now();
+        const glm::dvec3 incident = gather_shot(at.chart[i0], vec(at.normal[i0]));
+        const glm::dvec3 scale = shot_scale(power, incident);
+        const chunk_sums total = apply_shot(Real(scale.x), Real(scale.y), Real(scale.z));
+        timings_.distribution_ms += ms_since(start);
+        absorbed_ += total.absorbed;
+        escaped_ += power - total.intercepted;
+        intercepted_ += total.intercepted;
+        last_shot_ = {shots_, k, i0, total.top_receiver, total.top_power / std::max(bounce::detail::channel_total(power), 1e-300), scale};
+        if (scale != glm::dvec3(1.0)) ++clamped_shots_;
+        ++shots_;
+    }
+
+    // Pass 1 of a shot from the near-field tree near_ (normal `ns`, chart `chart`): each
+    // element's incident radiosity sum_j dB_j F_{r->j} V (element_form_factor, the receiver's
+    // area in it) into received_, and the power they intercept together (W per channel).
+    glm::dvec3 gather_shot(std::uint32_t chart, const vec ns) {
+        const lightmap_atlas& at = atlas_;
+        const std::uint32_t root = std::uint32_t(near_.size() - 1);
+        const Real near2 = Real(options_.near_field) * Real(options_.near_field);
+        received_.assign(at.size(), vec(0));
         const Visibility& vis = visibility_;
-        const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
+        const chunk_sums total = for_elements([&](std::uint32_t i, chunk_sums& s) {
             if (at.chart[i] == chart) return;  // coplanar with the shooter: F = 0
             const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
-            const vec rho = vec(at.albedo[i]);
-            vec gain(0);
-            glm::dvec3 incident(0);  // sum of dB_j F_{r->j} over the discs used, before visibility
+            const Real ar = Real(at.area[i]);
+            vec incident(0);
             // The block as one disc where the receiver is farther than near_field times its
             // side, else as its four quadrants, recursively, down to elements.
             std::array<std::uint32_t, 64> stack;
@@ -443,30 +479,42 @@ private:
             while (top > 0) {
                 const near_node& node = near_[stack[--top]];
                 if (node.child_count == 0 || !(near_field_opens<Real, vec>(pr, node.position, node.area, near2) > Real(0.5))) {
-                    const Real f = disc_form_factor<Real, vec>(pr, nr, node.position, ns, node.area);
-                    if (!(f > Real(0))) continue;
-                    incident += glm::dvec3(node.unshot) * double(f);
-                    gain += shot_radiosity<Real, vec>(pr, nr, rho, node.position, ns, node.area, node.unshot, Real(1));
+                    const Real f = element_form_factor<Real, vec>(pr, nr, ar, node.position, ns, node.area);
+                    if (f > Real(0)) incident += node.unshot * f;
                 } else {
                     for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = node.first_child + c;
                 }
             }
-            if (!(incident.x > 0 || incident.y > 0 || incident.z > 0)) return;
+            if (!(incident.x > Real(0) || incident.y > Real(0) || incident.z > Real(0))) return;
             const Real v = Real(vis.visible(at.position[i], at.chart[i]));
             if (!(v > Real(0))) return;
-            gain *= v;
+            received_[i] = incident * v;
+            s.intercepted += glm::dvec3(received_[i]) * double(at.area[i]);
+        });
+        return total.intercepted;
+    }
+
+    // Pass 2: each element's received_ times the shot's scale (per channel) raises its
+    // radiosity and unshot radiosity by rho times it (shot_radiosity's rho dB_s F V), refreshing
+    // the shooters' powers; the sums of what was intercepted and absorbed, and the receiver
+    // that took the most.
+    chunk_sums apply_shot(Real sx, Real sy, Real sz) {
+        const lightmap_atlas& at = atlas_;
+        const vec scale(sx, sy, sz);
+        return distribute([&](std::uint32_t i, chunk_sums& s) {
+            if (received_[i] == vec(0)) return;
+            const vec incident = received_[i] * scale;
+            const vec rho = vec(at.albedo[i]);
+            const vec gain = rho * incident;
             radiosity_[i] += gain;
             unshot_[i] += gain;
-            gathered_[i] += vec(incident * double(v));
-            const glm::dvec3 intercepted = incident * (double(v) * double(at.area[i]));
+            gathered_[i] += incident;
+            const glm::dvec3 intercepted = glm::dvec3(incident) * double(at.area[i]);
             s.intercepted += intercepted;
             s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
+            const double taken = bounce::detail::channel_total(intercepted);
+            if (taken > s.top_power) s.top_power = taken, s.top_receiver = i;
         });
-        timings_.distribution_ms += ms_since(start);
-        absorbed_ += total.absorbed;
-        escaped_ += power - total.intercepted;
-        intercepted_ += total.intercepted;
-        ++shots_;
     }
 
     // The lights' direct irradiance at every element of the refined atlas, against what the
@@ -553,6 +601,9 @@ private:
     std::vector<Real> shooter_area_;
     std::vector<double> power_;
     std::vector<chunk_sums> sums_;
+    std::vector<vec> received_;  // a shot's incident radiosity per element, before its scale (W/m^2)
+    radiosity_shot_record last_shot_;
+    std::size_t clamped_shots_ = 0;
     // The shooter's near-field tree: its elements, then groups of 2 x 2, 4 x 4 ... cells of
     // its grid (the chapter's mipmap pyramid of the residual texture), the whole block last.
     // A node's unshot radiosity is the area-weighted mean of its elements', so every level

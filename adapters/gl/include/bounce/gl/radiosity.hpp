@@ -130,6 +130,9 @@ public:
     /// elements [shooter_first(k), shooter_first(k + 1)).
     std::size_t shooters() const noexcept;
     std::uint32_t shooter_first(std::size_t k) const;
+    /// Shots whose form factors summed above 1 and were scaled down to deliver their power
+    /// (shot_scale, radiosity/shooters.hpp), as cpu::progressive_radiosity counts them.
+    std::size_t clamped_shots() const noexcept;
 
     /// Power per channel, W, as cpu::progressive_radiosity keeps them: emitted (surfaces and
     /// the direct light that reached elements), absorbed, escaped, and unshot (read back and
