@@ -1,0 +1,53 @@
+#!/usr/bin/env python3
+"""Records and debiased error of ic_splatting per scene and image size (issue 28).
+
+usage: ic_image_size.py TAG SIZES SPP [scenes...] [-- ic_splatting options]
+  SIZES: comma-separated WxH; SPP: the reference's samples per pixel (in halves; 2 for
+  record counts alone). Appends one JSON object per run to $RESULTS
+  (docs/results/ic_image_size.jsonl), with the commit and the machine's load, and prints a
+  line per run. IC_BIN: the ic_splatting binary (build/bin/ic_splatting); BOUNCE_CACHE: the
+  reference cache; BOUNCE_SCENES: the scenes folder (../shared/scenes).
+
+  docs/studies/ic_image_size.py base 256x256,512x512 1024
+  docs/studies/ic_image_size.py hess 1920x1080 2 sponza -- --radius hessian
+"""
+import json, os, subprocess, sys, tempfile, time
+
+root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+args = sys.argv[1:]
+extra = []
+if '--' in args:
+    i = args.index('--')
+    extra, args = args[i + 1:], args[:i]
+if len(args) < 3:
+    sys.exit(__doc__)
+tag, sizes, spp = args[0], args[1].split(','), args[2]
+scenes = args[3:] or ['cornell', 'cornell-box', 'bunny', 'sponza', 'conference', 'living-room', 'modern-hall']
+binary = os.environ.get('IC_BIN', os.path.join(root, 'build/bin/ic_splatting'))
+scenes_dir = os.environ.get('BOUNCE_SCENES', os.path.join(root, '../shared/scenes'))
+results = os.environ.get('RESULTS', os.path.join(root, 'docs/results/ic_image_size.jsonl'))
+commit = subprocess.run(['git', '-C', root, 'rev-parse', '--short', 'HEAD'], capture_output=True, text=True).stdout.strip()
+with open(results, 'a') as out, tempfile.TemporaryDirectory() as tmp:
+    for size in sizes:
+        w, h = size.split('x')
+        for s in scenes:
+            report = os.path.join(tmp, f'{tag}-{s}-{size}.json')
+            scene = s if s == 'cornell' else os.path.join(scenes_dir, s)
+            cmd = [binary, '--scene', scene, '--width', w, '--height', h, '--ref-spp', spp, '--json', report] + extra
+            t0 = time.time()
+            r = subprocess.run(cmd, capture_output=True, text=True)
+            if r.returncode != 0:
+                print(s, size, 'failed:', r.stderr[-500:], flush=True)
+                continue
+            j = json.load(open(report))
+            e = j['error']
+            row = {'tag': tag, 'scene': s, 'size': size, 'reference_spp': int(spp), 'records': j['records'],
+                   'records_per_pixel': j['records'] / (int(w) * int(h)), 'rel_rms': e['rel_rms'],
+                   'rel_rms_debiased': e.get('rel_rms_debiased'), 'reference_noise': e.get('reference_noise_rel_rms'),
+                   'total_ms_loaded_machine': j['timings_ms']['total'], 'options': ' '.join(extra), 'commit': commit,
+                   'load_average': os.getloadavg()[0], 'cores': os.cpu_count()}
+            out.write(json.dumps(row) + '\n')
+            out.flush()
+            deb = row['rel_rms_debiased']
+            print(f"{tag} {s} {size}: {row['records']} records ({row['records_per_pixel']:.3f} per pixel), "
+                  f"debiased rel_rms {deb if deb is None else round(deb, 4)}, {time.time() - t0:.0f} s", flush=True)
