@@ -79,12 +79,14 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     const int level = o.adaptive ? o.max_level : 0;  // 0 on GL, which refuses --adaptive
     radiosity_solve_options s;
     s.converge = o.converge;
+    s.measure = o.converge_on;
     s.max_seconds = o.max_seconds;
     s.checkpoints = with_curve && cmp.reference ? o.curve_points : 0;
     auto last_print = clock_type::now();
     const auto print = [&](const radiosity_progress& p, const char* end) {
-        fmt::print(stderr, "\rradiosity: step {}, {} shots, {:.1f}% converged, {:.2f} s   {}", p.steps, p.shots,
-                   100.0 * (1.0 - p.unshot_fraction), (setup_ms + p.elapsed_ms) / 1e3, end);
+        fmt::print(stderr, "\rradiosity: step {}, {} shots, {:.1f}% converged ({:.1f}% of the emitted power shot), {:.2f} s   {}",
+                   p.steps, p.shots, 100.0 * (1.0 - p.indirect_unshot_fraction), 100.0 * (1.0 - p.unshot_fraction),
+                   (setup_ms + p.elapsed_ms) / 1e3, end);
     };
     s.progress = [&](const radiosity_progress& p) {
         if (!o.quiet && ms_since(last_print) > 250) print(p, ""), last_print = clock_type::now();
@@ -97,7 +99,10 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     if constexpr (cpu) r.report = o.adaptive ? solver.solve(s, scene, subdivision_options_for(o), std::size_t(o.subdivide_steps))
                                              : solver.solve(s);
     else r.report = solver.solve(s);
-    if (!o.quiet) print({r.report.steps, solver.progress().shots, r.report.unshot_fraction, r.report.solve_ms}, "\n");
+    if (!o.quiet)
+        print({r.report.steps, solver.progress().shots, r.report.unshot_fraction, r.report.solve_ms,
+               r.report.indirect_unshot_fraction},
+              "\n");
     const auto& t = solver.timings();
     timer.add_sample("atlas", atlas_ms);
     timer.add_sample("lights", t.lights_ms);
@@ -248,17 +253,20 @@ int run(const options& o) {
         io::write_exr(o.lightmaps / "unshot.exr", r.unshot.view());
     }
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
-    fmt::print("radiosity {} {} {}: {} elements, {} iterations, {:.1f}% converged ({}), total {:.0f} ms (visibility {:.0f}, "
-               "reconstruction {:.0f}, choice {:.1f}), rel_rms {}\n",
+    fmt::print("radiosity {} {} {}: {} elements, {} iterations, {:.1f}% converged ({}; {:.1f}% of the emitted power "
+               "shot), total {:.0f} ms (visibility {:.0f}, reconstruction {:.0f}, choice {:.1f}), rel_rms {}\n",
                scene.name, name_of(visibility_names, o.visibility), o.adaptive ? "adaptive" : "uniform", r.elements,
-               r.report.steps,
-               100.0 * (1.0 - r.report.unshot_fraction), to_string(r.report.stop), timer.median_ms("total"),
+               r.report.steps, 100.0 * (1.0 - r.report.indirect_unshot_fraction), to_string(r.report.stop),
+               100.0 * (1.0 - r.report.unshot_fraction), timer.median_ms("total"),
                timer.median_ms("visibility"), timer.median_ms("reconstruction"), timer.median_ms("shooter_choice"),
                report.error ? fmt::format("{:.4f}", report.error->rel_rms) : std::string("-"));
     if (versus) fmt::print("  versus {}: rel_rms {:.4f}\n", o.versus.string(), j["versus"]["rel_rms"].get<double>());
     if (r.report.stop == radiosity_stop::time_limit)
-        fmt::print(stderr, "radiosity: stopped unconverged by --max-seconds {}: {:.1f}% of the emitted power shot, {:.1f}% asked\n",
-                   o.max_seconds, 100.0 * (1.0 - r.report.unshot_fraction), 100.0 * o.converge);
+        fmt::print(stderr, "radiosity: stopped unconverged by --max-seconds {}: {:.1f}% converged ({}), {:.1f}% asked\n",
+                   o.max_seconds,
+                   100.0 * (1.0 - (o.converge_on == radiosity_measure::indirect ? r.report.indirect_unshot_fraction
+                                                                               : r.report.unshot_fraction)),
+                   name_of(measure_names, o.converge_on), 100.0 * o.converge);
     return 0;
 }
 

@@ -30,6 +30,11 @@ enum class visibility_kind { stereo, hemicube, rays };
 inline const choices<visibility_kind> visibility_names{
     {"stereo", visibility_kind::stereo}, {"hemicube", visibility_kind::hemicube}, {"rays", visibility_kind::rays}};
 
+/// What --converge is a fraction of (radiosity_measure): the power surfaces reflect, bounces
+/// to come included (indirect), or the emitted power, lights' direct light included (emitted).
+inline const choices<radiosity_measure> measure_names{{"indirect", radiosity_measure::indirect},
+                                                      {"emitted", radiosity_measure::emitted}};
+
 struct options {
     std::string scene = "cornell";
     std::size_t elements = 10000;     // target element count of the atlas (before subdivision)
@@ -42,7 +47,8 @@ struct options {
     double threshold = 0.25;          // adaptive: second-difference threshold
     int subdivide_steps = 200;        // adaptive: subdivide after each of the first N steps
     examples::backend backend = backend::cpu;
-    double converge = 0.9;            // stop when this fraction of the emitted power is shot
+    double converge = 0.9;            // stop when this fraction of converge_on's power is shot
+    radiosity_measure converge_on = radiosity_measure::indirect;
     double max_seconds = 0;           // also stop after this much solving (0: no limit)
     int shooters_per_step = 1;
     double near_field = 4;
@@ -82,8 +88,11 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--subdivide-steps", o.subdivide_steps, "adaptive: subdivide after each of the first N steps")
         ->check(CLI::Range(0, 1000000))->capture_default_str();
     add_choice(app, "--backend", o.backend, backend_names, "cpu | gl")->capture_default_str();
-    app.add_option("--converge", o.converge, "stop when this fraction of the emitted power has been shot, in [0, 1)")
+    app.add_option("--converge", o.converge, "stop when this fraction of --converge-on's power has been shot, in [0, 1)")
         ->check(examples::detail::number_in(0, 1, false, "a fraction"))->capture_default_str();
+    add_choice(app, "--converge-on", o.converge_on, measure_names,
+               "indirect (the power surfaces reflect, bounces to come included) | emitted (lights' direct light included)")
+        ->capture_default_str();
     app.add_option("--max-seconds", o.max_seconds, "also stop after this many seconds of shooting (0: no limit)")
         ->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--shooters-per-step", o.shooters_per_step, "shooters taken from one choice")
@@ -183,7 +192,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"resolution", o.resolution}, {"tolerance_px", o.tolerance_px},
             {"adaptive", o.adaptive ? "on" : "off"}, {"max_level", o.max_level},
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
-            {"converge", o.converge}, {"max_seconds", o.max_seconds},
+            {"converge", o.converge}, {"converge_on", name_of(measure_names, o.converge_on)}, {"max_seconds", o.max_seconds},
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
             {"ambient", o.ambient ? "on" : "off"}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }

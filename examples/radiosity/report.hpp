@@ -34,7 +34,8 @@ struct solve_result {
 /// The solve's figures for the report: why it stopped, energy, memory, and the curves (times
 /// from the atlas on, checkpoints excluded).
 inline void add_solve_json(nlohmann::ordered_json& j, const solve_result& r) {
-    j["unshot_fraction"] = r.report.unshot_fraction;
+    j["unshot_fraction"] = r.report.unshot_fraction;  // of the emitted power (the older measure)
+    j["indirect_unshot_fraction"] = r.report.indirect_unshot_fraction;
     j["stopped"] = to_string(r.report.stop);
     j["clamped_shots"] = r.clamped_shots;
     const auto sum = [](const glm::dvec3& v) { return v.x + v.y + v.z; };

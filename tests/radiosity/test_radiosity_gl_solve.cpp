@@ -32,6 +32,13 @@ TEST_CASE("the GL solver's solve(options) stops where the CPU solver's does", "[
     CHECK(rg.unshot_fraction == Approx(rc.unshot_fraction).epsilon(1e-4));
     CHECK(checkpoints >= 2 * 2);  // each solve: after the first step, then at 0.4 and 0.8
     CHECK(g.intercepted_power().x == Approx(c.intercepted_power().x).epsilon(1e-4));
+    // Converging on the power surfaces reflect: the same steps again, the same measure.
+    o.measure = radiosity_measure::indirect;
+    const auto ig = g.solve(o);
+    const auto ic = c.solve(o);
+    CHECK(ig.steps == ic.steps);
+    CHECK(ig.indirect_unshot_fraction <= 0.2);
+    CHECK(ig.indirect_unshot_fraction == Approx(ic.indirect_unshot_fraction).epsilon(1e-4));
 }
 
 TEST_CASE("the GL solver names reversed winding and refuses a tolerance below the floor", "[radiosity][solve][gl][errors]") {

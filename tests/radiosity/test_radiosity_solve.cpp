@@ -300,3 +300,34 @@ TEST_CASE("slivers and near-touching elements: no shot delivers more than its po
     // power and the solve stops at step 1 naming shooter and element (checked by hand).
     CHECK(solver.clamped_shots() == 0);
 }
+
+TEST_CASE("the convergence measure that counts bounced light: a dark room lit by a lamp is not converged before a bounce",
+          "[radiosity][solve]") {
+    // The measure itself: 1 before any shot, 0 once nothing is left, the bounces to come counted.
+    CHECK(indirect_unshot_fraction(5.0, 0.0, 0.5) == 1.0);
+    CHECK(indirect_unshot_fraction(0.0, 5.0, 0.5) == 0.0);
+    CHECK(indirect_unshot_fraction(1.0, 8.0, 0.5) == Approx(0.2));  // r = 2 of 10
+    CHECK(indirect_unshot_fraction(0.0, 0.0, 0.5) == 0.0);
+    // Walls of albedo about 0.07 around a point light: 93% of the emitted power (the lights'
+    // direct light counts as emitted) is absorbed where it lands, so the older measure calls
+    // the room 90% converged before any shot; the new one asks for the bounces.
+    owned_scene s = closed_box(1.f, 0.08f, 0.f);
+    s.triangles.resize(s.triangles.size() - 2);  // the lamp quad
+    s.material_of.resize(s.material_of.size() - 2);
+    s.lights.push_back(point_light{{0.4f, 0.6f, 0.5f}, {1.f, 1.f, 1.f}});
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 600});
+    cpu::progressive_radiosity solver(s.view(), atlas, cpu::all_visible{});
+    CHECK(solver.unshot_fraction() < 0.1);
+    CHECK(solver.indirect_unshot_fraction() == 1.0);
+    radiosity_solve_options o;
+    o.converge = 0.9;
+    o.measure = radiosity_measure::emitted;
+    CHECK(solver.solve(o).steps == 0);
+    o.measure = radiosity_measure::indirect;
+    const auto r = solver.solve(o);
+    CHECK(r.steps > 10);
+    CHECK(r.indirect_unshot_fraction <= 0.1);
+    CHECK(r.converged.back() == Approx(1 - r.indirect_unshot_fraction));
+    // It only falls.
+    for (std::size_t k = 1; k < r.converged.size(); ++k) CHECK(r.converged[k] >= r.converged[k - 1]);
+}

@@ -84,7 +84,11 @@ double progressive_radiosity::unshot_fraction() const noexcept {
     return e > 0 ? s_->unshot_total / e : 0.0;
 }
 radiosity_progress progressive_radiosity::progress() const noexcept {
-    return {s_->steps, s_->shots, unshot_fraction(), 0.0};
+    return {s_->steps, s_->shots, unshot_fraction(), 0.0, indirect_unshot_fraction()};
+}
+double progressive_radiosity::indirect_unshot_fraction() const noexcept {
+    const glm::dvec3 rho = s_->albedo_area / s_->total_area;
+    return bounce::indirect_unshot_fraction(s_->unshot_total, s_->shot_power, (rho.x + rho.y + rho.z) / 3.0);
 }
 std::uint32_t progressive_radiosity::next_shooter() const noexcept { return s_->next; }
 double progressive_radiosity::next_shooter_power() const noexcept { return s_->next_power; }

@@ -183,6 +183,7 @@ struct progressive_radiosity::state {
     double next_power = 0;
     std::size_t steps = 0, shots = 0;
     std::size_t clamped_shots = 0;  // shots scaled down to their power (shot_scale)
+    double shot_power = 0;          // power shot by surfaces so far, channels summed (W)
     radiosity_timings timings;
 
     state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o);

@@ -72,7 +72,24 @@ struct radiosity_progress {
     double unshot_fraction = 1;  ///< unshot power / emitted power (channel sums)
     double elapsed_ms = 0;       ///< time of the running solve(radiosity_solve_options) so far,
                                  ///< its checkpoints excluded (radiosity/solve.hpp); 0 outside one
+    double indirect_unshot_fraction = 1;  ///< of the power surfaces reflect, the share still to
+                                          ///< shoot (indirect_unshot_fraction below)
 };
+
+/// The convergence measure that counts bounced light (issue 30): of the power the surfaces
+/// reflect (the emitters' emission, the reflected part of the lights' direct light and of
+/// every shot), the fraction still to shoot, its own future bounces included:
+///   r / (shot + r),  r = unshot / (1 - rho_avg),
+/// `unshot` the unshot power, `shot` the power shot so far, `rho_avg` the area-weighted mean
+/// albedo (channels averaged, at most 0.999): r is the unshot power with the interreflections
+/// it will cause (Cohen et al. 1988's ambient factor). It starts at 1 and falls to 0 as the
+/// solve converges. unshot / emitted, the older measure, counts the lights' direct light as
+/// emitted power: a scene lit mostly by direct light was "90% converged" before any bounce
+/// (the absorbed part of the direct light counted as done).
+inline double indirect_unshot_fraction(double unshot, double shot, double rho_avg) {
+    const double r = std::max(0.0, unshot) / (1.0 - std::clamp(rho_avg, 0.0, 0.999));
+    return r + shot > 0 ? r / (r + shot) : 0.0;
+}
 
 }  // namespace bounce::radiosity
 

@@ -63,10 +63,17 @@ inline const char* to_string(radiosity_stop s) noexcept {
     return "?";
 }
 
+/// What `converge` is a fraction of (radiosity/options.hpp).
+enum class radiosity_measure {
+    emitted,   ///< the emitted power (lights' direct light included): unshot_fraction
+    indirect   ///< the power surfaces reflect, bounces to come included: indirect_unshot_fraction
+};
+
 /// How far a solve goes and what it reports on the way.
 struct radiosity_solve_options {
-    double converge = 0.9;      ///< stop once this fraction of the emitted power has been shot
-                                ///< (unshot fraction <= 1 - converge), in [0, 1]
+    double converge = 0.9;      ///< stop once this fraction of the `measure` has been shot
+                                ///< (its unshot fraction <= 1 - converge), in [0, 1]
+    radiosity_measure measure = radiosity_measure::emitted;
     double max_seconds = 0;     ///< also stop after this many seconds of solving (checkpoints
                                 ///< excluded), checked before each step; 0: no limit
     int checkpoints = 0;        ///< `checkpoint` after the first step, each time the converged
@@ -94,9 +101,10 @@ struct radiosity_solve_report {
     std::size_t splits = 0;        ///< leaves split by adaptive subdivision during it (CPU)
     double solve_ms = 0;           ///< wall-clock time of the solve less the checkpoints'
     double checkpoint_ms = 0;      ///< time spent in `checkpoint` (not in solve_ms)
-    std::vector<double> converged; ///< 1 - unshot fraction after each step
+    std::vector<double> converged; ///< 1 - the measure's unshot fraction after each step
     std::vector<double> step_ms;   ///< solve time (checkpoints excluded) at the end of each step
-    double unshot_fraction = 1;    ///< at the end
+    double unshot_fraction = 1;    ///< at the end: unshot / emitted power
+    double indirect_unshot_fraction = 1;  ///< at the end: indirect_unshot_fraction
 };
 
 }  // namespace bounce::radiosity
@@ -145,6 +153,15 @@ void check_energy(const Solver& solver, const energy_sums& before, const energy_
                           " of the emitted power); it can only fall");
 }
 
+/// The unshot fraction of `o.measure` (a solver without indirect_unshot_fraction() has only
+/// the emitted measure).
+template <class Solver>
+double measured_unshot(const Solver& solver, const radiosity_solve_options& o) {
+    if constexpr (requires { solver.indirect_unshot_fraction(); })
+        if (o.measure == radiosity_measure::indirect) return solver.indirect_unshot_fraction();
+    return solver.unshot_fraction();
+}
+
 template <class Solver, class AfterStep>
 radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve_options& o, AfterStep&& after_step) {
     o.validate();
@@ -165,7 +182,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
     bool checked_here = false;  // a checkpoint at the current step already
     const auto checkpoint = [&](bool force) {
         if (!o.checkpoint || o.checkpoints <= 0 || checked_here) return;
-        const double converged = 1.0 - solver.unshot_fraction();
+        const double converged = 1.0 - measured_unshot(solver, o);
         bool due = force || r.steps == 1;
         while (next_mark <= std::size_t(o.checkpoints) &&
                converged >= o.converge * double(next_mark) / double(o.checkpoints)) {
@@ -181,7 +198,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
     };
     r.stop = radiosity_stop::converged;
     energy_sums before = energy_of(solver);
-    while (solver.unshot_fraction() > target) {
+    while (measured_unshot(solver, o) > target) {
         if (o.max_seconds > 0 && elapsed() > o.max_seconds * 1e3) {
             r.stop = radiosity_stop::time_limit;
             break;
@@ -193,7 +210,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
         ++r.steps;
         checked_here = false;
         r.splits += after_step(r.steps);
-        const double f = solver.unshot_fraction();
+        const double f = measured_unshot(solver, o);
         const energy_sums after = energy_of(solver);
         check_energy(solver, before, after);
         before = after;
@@ -208,6 +225,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
     checkpoint(true);
     r.solve_ms = elapsed();
     r.unshot_fraction = solver.unshot_fraction();
+    r.indirect_unshot_fraction = solver.progress().indirect_unshot_fraction;
     // Shots were made (in this solve or before) and none of their power, nor any light's,
     // reached the front of a surface.
     const double emitted = channel_total(solver.emitted_power());

@@ -278,7 +278,15 @@ public:
     }
 
     const radiosity_timings& timings() const noexcept { return timings_; }
-    radiosity_progress progress() const noexcept { return {steps_, shots_, unshot_fraction(), 0.0}; }
+    radiosity_progress progress() const noexcept {
+        return {steps_, shots_, unshot_fraction(), 0.0, indirect_unshot_fraction()};
+    }
+    /// Of the power the surfaces reflect, the share still to shoot, its bounces to come
+    /// included (radiosity/options.hpp): the convergence measure that counts bounced light.
+    double indirect_unshot_fraction() const noexcept {
+        const glm::dvec3 rho = albedo_area_ / total_area_;
+        return bounce::indirect_unshot_fraction(unshot_total_, shot_power_, (rho.x + rho.y + rho.z) / 3.0);
+    }
     std::size_t shooters() const noexcept { return power_.size(); }
     /// The last shot: its shooter, its first element, the element that took the most of it
     /// and its share, and the scale that kept its delivered power within its own
@@ -454,6 +462,7 @@ private:
         intercepted_ += total.intercepted;
         last_shot_ = {shots_, k, i0, total.top_receiver, total.top_power / std::max(bounce::detail::channel_total(power), 1e-300), scale};
         if (scale != glm::dvec3(1.0)) ++clamped_shots_;
+        shot_power_ += bounce::detail::channel_total(power);
         ++shots_;
     }
 
@@ -628,6 +637,7 @@ private:
             });
     }
     double unshot_total_ = 0, total_area_ = 0;
+    double shot_power_ = 0;  // power shot by surfaces so far, channels summed (W)
     glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, intercepted_{0}, albedo_area_{0};
     radiosity_timings timings_;
     std::size_t steps_ = 0, shots_ = 0;

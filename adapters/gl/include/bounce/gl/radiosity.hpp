@@ -121,6 +121,9 @@ public:
     /// Unshot power / emitted power, channels summed (from the last reduction); 0 for a
     /// scene that emits nothing.
     double unshot_fraction() const noexcept;
+    /// Of the power the surfaces reflect, the share still to shoot, its bounces to come
+    /// included (radiosity/options.hpp), as cpu::progressive_radiosity gives it.
+    double indirect_unshot_fraction() const noexcept;
     radiosity_progress progress() const noexcept;
     /// The shooter the next step will shoot (the last reduction's choice) and its unshot
     /// power (W, channels summed); power 0 when nothing is left.
