@@ -54,7 +54,7 @@ const examples::choices<cpu::volume_interpolation> interp_names{{"trilinear", cp
 
 struct options {
     volume_mode mode = volume_mode::adaptive;
-    cpu::volume_interpolation interp = cpu::volume_interpolation::weighted;
+    cpu::volume_interpolation interp = cpu::volume_interpolation::trilinear;
     std::string scene = "cornell", gradients = "on", json, out;
     int max_depth = 4, min_depth = -1;  // -1: 1 (adaptive) or max_depth (uniform)
     float b = 2.f, support = 1.5f;
@@ -64,6 +64,7 @@ struct options {
     float margin = -0.01f;   // fraction of the scene's extent added on every side
     std::vector<float> path; // x0 y0 z0 x1 y1 z1 as fractions of the volume's box
     float distance_ratio = 1.f, neighbour_change = 0.25f, gradient_ratio = 0.3f, cull = 0.05f;
+    float prediction_tolerance = 0.05f, noise_sigmas = 4.f, gradient_noise = 1.f;
     float gradient_step = 0.1f;  // fraction of the finest cell's shortest edge
     std::uint64_t seed = 1;
     int threads = 0;
@@ -141,12 +142,15 @@ int run(const options& o) {
     vs.geometry_triangles = o.geometry_triangles;
     vs.gradient_ratio = o.gradient_ratio;
     vs.cull_tolerance = o.cull;
+    vs.prediction_tolerance = o.prediction_tolerance;
+    vs.noise_sigmas = o.noise_sigmas;
     vs.memory_limit_bytes = study::available_memory_bytes();
     const glm::vec3 finest = extent / float(1 << o.max_depth);
     embree::probe_baker_settings bs;
     bs.rays = o.rays;
     bs.seed = o.seed;
     bs.gradient_step = o.gradient_step * std::min({finest.x, finest.y, finest.z});
+    bs.gradient_noise_ratio = o.gradient_noise;
     std::size_t batch = 0;
     bs.progress = [&](std::size_t done, std::size_t total) {
         if (done == total || done % 64 < 4) std::fprintf(stderr, "\rbake: batch %zu, %zu / %zu probes   ", batch, done, total);
@@ -212,7 +216,9 @@ int run(const options& o) {
                          {"volume_lo", {lo.x, lo.y, lo.z}}, {"volume_hi", {hi.x, hi.y, hi.z}},
                          {"distance_ratio", o.distance_ratio}, {"neighbour_change", o.neighbour_change},
                          {"geometry_triangles", o.geometry_triangles}, {"gradient_ratio", o.gradient_ratio},
-                         {"cull_tolerance", o.cull}, {"seed", o.seed}, {"threads", o.threads}};
+                         {"cull_tolerance", o.cull}, {"prediction_tolerance", o.prediction_tolerance},
+                         {"noise_sigmas", o.noise_sigmas}, {"gradient_noise_ratio", o.gradient_noise},
+                         {"seed", o.seed}, {"threads", o.threads}};
     report.timings_ms = {{"bake", bake_ms}, {"reference", sphere.reference_ms()}};
     report.error = best.error;
     report.set_count("probes", volume.probes().size());
@@ -230,7 +236,8 @@ int run(const options& o) {
     j["lookups"] = lookups;
     j["build"] = {{"split_min_depth", stats.split_min_depth}, {"split_distance", stats.split_distance},
                   {"split_neighbour", stats.split_neighbour}, {"split_geometry", stats.split_geometry},
-                  {"split_gradient", stats.split_gradient},   {"culled", stats.culled},
+                  {"split_gradient", stats.split_gradient},   {"split_prediction", stats.split_prediction},
+                  {"culled", stats.culled},
                   {"inside_cells", stats.inside_cells}};
     j["light_transport"] = "one-bounce indirect: probes and reference integrate Kd/pi * direct irradiance at the first hit";
     j["provenance"] = study::collect_provenance().to_json();
@@ -278,6 +285,14 @@ int main(int argc, char** argv) {
     app.add_option("--gradient-ratio", o.gradient_ratio, "split: |grad E| * edge / E (0 off)")->check(finite_non_negative);
     app.add_option("--cull", o.cull, "cull children within this fraction of the parent's interpolation (0 off)")
         ->check(finite_non_negative);
+    app.add_option("--prediction-tolerance", o.prediction_tolerance,
+                   "adaptive: split where a new probe differs from its parent's prediction by more than this fraction "
+                   "and noise-sigmas standard errors (0: Oat's heuristics above)")
+        ->check(finite_non_negative);
+    app.add_option("--noise-sigmas", o.noise_sigmas, "differences within this many standard errors of the probes are noise")
+        ->check(finite_non_negative);
+    app.add_option("--gradient-noise", o.gradient_noise, "keep a probe's gradient only where it exceeds this times its noise "
+                                                         "(0: keep all)")->check(finite_non_negative);
     app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge")
         ->check(finite_positive);
     app.add_option("--seed", o.seed, "seed of the probes' and the reference's light samples, 0 .. 2^64 - 1")

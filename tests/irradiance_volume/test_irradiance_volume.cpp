@@ -102,6 +102,7 @@ struct adaptive_fixture {
         settings.min_depth = 1;
         settings.max_depth = 4;
         settings.distance_ratio = settings.neighbour_change = settings.gradient_ratio = settings.cull_tolerance = 0;
+        settings.prediction_tolerance = 0;  // Oat's heuristics shape this octree
         settings.geometry_triangles = 1;
     }
 };

@@ -38,6 +38,9 @@ TEST_CASE("a probe in a uniform environment sees E = pi L and no gradient", "[ir
         const glm::vec3 e = sh_irradiance<3, float, glm::vec3>(p.radiance, n);
         for (int k = 0; k < 3; ++k) CHECK(e[k] == Approx(std::numbers::pi_v<float> * rs.environment[k]).epsilon(0.01));
     }
+    // Both halves of the rays see the same constant: the noise is the halves' quadrature
+    // error, a few 1/N of E (1% allowed), and no more than that.
+    CHECK(p.noise < 0.01f * std::numbers::pi_v<float> * (0.2126f * 1 + 0.7152f * 2 + 0.0722f * 3));
     // Every displaced probe sees the same constant: the difference quotients are exactly 0.
     for (const auto& g : p.gradient)
         for (const auto& c : g) CHECK(c == glm::vec3(0.f));
@@ -141,6 +144,10 @@ TEST_CASE("a volume whose every probe is inside geometry (reversed winding) is r
     std::size_t inside = 0;
     for (const auto& p : room.probes()) inside += p.inside ? 1 : 0;
     CHECK(inside == 0);
+    // A point light seen off the walls: the halves of the rays differ, so probes report noise.
+    std::size_t noisy = 0;
+    for (const auto& p : room.probes()) noisy += p.noise > 0 ? 1 : 0;
+    CHECK(noisy > 0);
     CHECK(room.trilinear(glm::vec3(0.f), glm::vec3(0, -1, 0)).x > 0.f);
     // Wound the wrong way: every ray of every probe hits the back of a wall.
     try {

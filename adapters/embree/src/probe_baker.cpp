@@ -1,6 +1,6 @@
 #include <bounce/embree/probe_baker.hpp>
 
-#include <bounce/sh/gradients.hpp>
+#include <bounce/luminance.hpp>
 #include <bounce/sh/projection.hpp>
 
 #include <tbb/blocked_range.h>
@@ -41,6 +41,8 @@ probe_baker::probe_baker(const reference_integrator& light, const accel& bvh, co
     require(std::isfinite(settings_.gradient_step) && settings_.gradient_step >= 0, "gradient_step",
             "must be finite and >= 0 (0: no gradients)");
     require(settings_.nearest_fraction > 0 && settings_.nearest_fraction <= 1, "nearest_fraction", "must lie in (0, 1]");
+    require(std::isfinite(settings_.gradient_noise_ratio) && settings_.gradient_noise_ratio >= 0, "gradient_noise_ratio",
+            "must be finite and >= 0 (0: keep every gradient)");
     require(settings_.inside_fraction >= 0 && settings_.inside_fraction <= 1, "inside_fraction", "must lie in [0, 1]");
     require_match(bvh, scene);
     // Spherical Fibonacci points: z uniform in (-1, 1) at cell centres, golden-angle azimuth.
@@ -52,7 +54,7 @@ probe_baker::probe_baker(const reference_integrator& light, const accel& bvh, co
     }
 }
 
-irradiance_probe::coefficients probe_baker::project(glm::vec3 position, std::uint64_t seed, cast* details) const {
+probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t seed, cast* details) const {
     const std::size_t n = directions_.size();
     std::vector<glm::dvec3> radiance(n);
     double inverse_distance_sum = 0;
@@ -81,12 +83,57 @@ irradiance_probe::coefficients probe_baker::project(glm::vec3 position, std::uin
         details->nearest = nearest;
         details->back_fraction = float(double(back) / double(n));
     }
-    const auto c = sh_project_monte_carlo<irradiance_volume_bands, glm::dvec3>(
-        std::span<const glm::dvec3>(directions_), std::span<const glm::dvec3>(radiance), 1 / (4 * std::numbers::pi));
-    irradiance_probe::coefficients out{};
-    for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec3(c[i]);
-    return out;
+    const auto to_float = [](const sh_coefficients<irradiance_volume_bands, glm::dvec3>& c) {
+        irradiance_probe::coefficients out{};
+        for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec3(c[i]);
+        return out;
+    };
+    estimate e;
+    e.all = to_float(sh_project_monte_carlo<irradiance_volume_bands, glm::dvec3>(
+        std::span<const glm::dvec3>(directions_), std::span<const glm::dvec3>(radiance), 1 / (4 * std::numbers::pi)));
+    // The two halves: even and odd rays (each a Fibonacci set of half the density).
+    for (int h = 0; h < 2 && n >= 2; ++h) {
+        std::vector<glm::dvec3> dirs, values;
+        for (std::size_t j = std::size_t(h); j < n; j += 2) dirs.push_back(directions_[j]), values.push_back(radiance[j]);
+        e.half[h] = to_float(sh_project_monte_carlo<irradiance_volume_bands, glm::dvec3>(
+            std::span<const glm::dvec3>(dirs), std::span<const glm::dvec3>(values), 1 / (4 * std::numbers::pi)));
+    }
+    return e;
 }
+
+namespace {
+
+/// Half the largest difference of two estimates' irradiance luminance at the axis normals.
+float probe_noise(const irradiance_probe::coefficients& a, const irradiance_probe::coefficients& b) {
+    const auto ea = bounce::detail::axis_irradiance(a), eb = bounce::detail::axis_irradiance(b);
+    float worst = 0;
+    for (std::size_t k = 0; k < ea.size(); ++k) worst = std::max(worst, 0.5f * std::abs(ea[k] - eb[k]));
+    return worst;
+}
+
+/// Central-difference gradients from the six shifted estimates (+x -x +y -y +z -z), each
+/// axis set to 0 where its signal is at most noise_ratio times its noise (the halves').
+std::array<irradiance_probe::coefficients, 3> gated_gradient(const std::array<probe_baker::estimate, 6>& shifted, float step,
+                                                              float noise_ratio) {
+    std::array<irradiance_probe::coefficients, 3> g{};
+    for (std::size_t a = 0; a < 3; ++a) {
+        const auto& plus = shifted[2 * a];
+        const auto& minus = shifted[2 * a + 1];
+        double signal2 = 0, noise2 = 0;
+        for (std::size_t i = 0; i < g[a].size(); ++i) {
+            g[a][i] = (plus.all[i] - minus.all[i]) / (2 * step);
+            const glm::vec3 h0 = (plus.half[0][i] - minus.half[0][i]) / (2 * step);
+            const glm::vec3 h1 = (plus.half[1][i] - minus.half[1][i]) / (2 * step);
+            const double s = rec709_luminance<float, glm::vec3>(g[a][i]), d = 0.5 * rec709_luminance<float, glm::vec3>(h0 - h1);
+            signal2 += s * s;
+            noise2 += d * d;
+        }
+        if (noise_ratio > 0 && signal2 <= double(noise_ratio) * double(noise_ratio) * noise2) g[a] = {};
+    }
+    return g;
+}
+
+}  // namespace
 
 irradiance_probe probe_baker::bake(glm::vec3 position) const {
     require(std::isfinite(position.x) && std::isfinite(position.y) && std::isfinite(position.z), "position",
@@ -95,23 +142,22 @@ irradiance_probe probe_baker::bake(glm::vec3 position) const {
     irradiance_probe p;
     p.position = position;
     cast details;
-    p.radiance = project(position, seed, &details);
+    const estimate centre = project(position, seed, &details);
+    p.radiance = centre.all;
+    p.noise = probe_noise(centre.half[0], centre.half[1]);
     p.harmonic_mean_distance = details.harmonic_mean_distance;
     p.inside = details.back_fraction > settings_.inside_fraction;
     const float step = std::min(settings_.gradient_step, settings_.nearest_fraction * details.nearest);
     if (!p.inside && settings_.gradient_step > 0 && step > 1e-6f * bvh_.diagonal()) {
-        const auto g = sh_translational_gradient<irradiance_volume_bands, glm::dvec3>(
-            [&](const glm::dvec3& q) {
-                const auto c = project(glm::vec3(q), seed, nullptr);
-                sh_coefficients<irradiance_volume_bands, glm::dvec3> d{};
-                for (std::size_t i = 0; i < d.size(); ++i) d[i] = glm::dvec3(c[i]);
-                return d;
-            },
-            glm::dvec3(position), double(step));
-        const sh_coefficients<irradiance_volume_bands, glm::dvec3>* axes[3] = {&g.x, &g.y, &g.z};
-        for (int a = 0; a < 3; ++a)
-            for (std::size_t i = 0; i < p.gradient[std::size_t(a)].size(); ++i)
-                p.gradient[std::size_t(a)][i] = glm::vec3((*axes[a])[i]);
+        // Central differences (sh_translational_gradient's, +x -x +y -y +z -z), on all rays
+        // and on each half, so that each axis's noise is known.
+        std::array<estimate, 6> shifted;
+        for (int k = 0; k < 6; ++k) {
+            glm::vec3 q = position;
+            q[k / 2] += (k % 2 ? -step : step);
+            shifted[std::size_t(k)] = project(q, seed, nullptr);
+        }
+        p.gradient = gated_gradient(shifted, step, settings_.gradient_noise_ratio);
     }
     return p;
 }

@@ -43,6 +43,11 @@ struct irradiance_probe {
     /// Set by the build: half the diagonal of the largest leaf this probe is a corner of
     /// (world units). The weighted lookup lets the probe reach support * reach.
     float reach = 0.f;
+    /// Standard error of the probe's irradiance luminance (W/m^2) at the worst of the six
+    /// axis normals, e.g. half the difference of two estimates from half the rays each
+    /// (embree::probe_baker); 0 when the source has no noise or does not say. Subdivision
+    /// treats differences within a few of these as noise (irradiance_volume_settings).
+    float noise = 0.f;
 };
 
 /// Something that fills probes at positions: `source(positions, out)` with spans of equal
@@ -78,8 +83,29 @@ struct irradiance_volume_settings {
     float gradient_ratio = 0.3f;
     /// Culling: children are removed again when every new probe's irradiance at the six
     /// axis normals lies within this fraction (plus `absolute_floor`) of what the parent's
-    /// trilinear interpolation predicts there. Typical: 0.02-0.1; 0 keeps every child.
+    /// trilinear interpolation predicts there, or within noise_sigmas standard errors.
+    /// Typical: 0.02-0.1; 0 keeps every child.
     float cull_tolerance = 0.05f;
+    /// Subdivision by prediction error (issue 31), which replaces the four heuristics above
+    /// when > 0: every cell with a corner outside geometry is tried, its children's new
+    /// corners baked, and the split kept only where some new probe's irradiance at an axis
+    /// normal differs from the parent's trilinear prediction by more than this fraction of
+    /// the prediction (plus `absolute_floor`) *and* by more than noise_sigmas standard
+    /// errors of the difference; otherwise the children are culled. Typical: 0.02-0.1;
+    /// 0: Oat's heuristics propose and cull_tolerance culls.
+    float prediction_tolerance = 0.05f;
+    /// Differences within this many standard errors (from the probes' `noise`, pooled over
+    /// the parent's corners and the new probes) are noise: they neither split nor keep a
+    /// cell (at 4, noise alone splits about 1% of cells: 19 new probes each, at most
+    /// 6e-5 of them beyond 4 standard errors). Typical: 3-5; 0 ignores the noise.
+    float noise_sigmas = 4.f;
+    /// Least-squares refit (issue 31): the probes baked for a split that culling undid are
+    /// samples of the light inside the parent cell, which its corners interpolate within
+    /// the noise; with this on, every kept probe becomes the least-squares fit of its own
+    /// value and of those samples' trilinear interpolations (sweeps of Gauss-Seidel), which
+    /// lowers the corners' noise instead of throwing the samples away. Off: the probes keep
+    /// their baked values.
+    bool refit_culled = true;
     /// Absolute floor added to the denominators above, as a fraction of the mean
     /// luminance of the root's probes, so that dark regions do not split on noise.
     /// Typical: 0.02.
@@ -95,6 +121,7 @@ struct irradiance_volume_settings {
 /// Counts of a build: which heuristic split how many cells, how many were culled.
 struct irradiance_volume_build_stats {
     std::size_t split_min_depth = 0, split_distance = 0, split_neighbour = 0, split_geometry = 0, split_gradient = 0;
+    std::size_t split_prediction = 0;  ///< cells tried by prediction error (culled ones included)
     std::size_t culled = 0;          ///< subdivisions undone by culling
     std::size_t inside_cells = 0;    ///< cells not split because every corner is inside geometry
     std::size_t probes_baked = 0;    ///< probes the source computed, culled ones included
@@ -108,6 +135,7 @@ namespace bounce::detail {
 inline bool finite_probe(const irradiance_probe& p) {
     const auto ok = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     if (!ok(p.position) || std::isnan(p.harmonic_mean_distance) || p.harmonic_mean_distance < 0) return false;
+    if (!std::isfinite(p.noise) || p.noise < 0) return false;
     for (const auto& c : p.radiance)
         if (!ok(c)) return false;
     for (const auto& g : p.gradient)
@@ -238,6 +266,7 @@ inline bool cell_splits(const octree_cell& c, const std::array<std::uint32_t, 8>
         ++stats.inside_cells;
         return false;
     }
+    if (s.prediction_tolerance > 0) return fires(stats.split_prediction);
     const float diagonal = glm::length(size), edge = std::max({size.x, size.y, size.z});
     if (s.distance_ratio > 0 && corner_sees_near_surfaces(corners, diagonal, s)) return fires(stats.split_distance);
     if (s.neighbour_change > 0 && corners_differ(corners, floor_level, s)) return fires(stats.split_neighbour);
@@ -246,28 +275,91 @@ inline bool cell_splits(const octree_cell& c, const std::array<std::uint32_t, 8>
     return false;
 }
 
-/// Whether probe p (outside geometry) lies, at the six axis normals, within cull_tolerance
-/// (plus the floor) of the trilinear interpolation of the parent box [lo, lo + size]'s
-/// corners (`corner_e`: their axis irradiance; `corner_valid`: 1 outside geometry).
-inline bool parent_predicts_probe(const irradiance_probe& p, glm::vec3 lo, glm::vec3 size,
-                                  const std::array<std::array<float, 6>, 8>& corner_e,
-                                  const std::array<float, 8>& corner_valid, float floor_level,
-                                  const irradiance_volume_settings& s) {
+/// What a cell's culling test compares: its corners' axis irradiance, which corners are
+/// outside geometry, the relative tolerance, the floor, and the probes' pooled standard
+/// error times noise_sigmas.
+struct parent_prediction {
+    std::array<std::array<float, 6>, 8> corner_e{};
+    std::array<float, 8> corner_valid{};
+    float tolerance = 0, floor_level = 0, noise = 0;
+};
+
+/// Whether probe p (outside geometry) lies, at the six axis normals, within the tolerance
+/// (times the prediction, plus the floor) of the trilinear interpolation of the parent box
+/// [lo, lo + size]'s corners, or within the noise of that difference (the probe's and
+/// the interpolated corners', sqrt(1 + sum of the squared normalized weights) times the
+/// pooled standard error).
+inline bool parent_predicts_probe(const irradiance_probe& p, glm::vec3 lo, glm::vec3 size, const parent_prediction& parent) {
     const auto w = trilinear_weights<float, glm::vec3>(p.position, lo, size);
     std::array<float, 6> predicted{};
-    float wsum = 0;
+    float wsum = 0, w2sum = 0;
     for (int j = 0; j < 8; ++j) {
-        const float wj = w[std::size_t(j)] * corner_valid[std::size_t(j)];
+        const float wj = w[std::size_t(j)] * parent.corner_valid[std::size_t(j)];
         wsum += wj;
-        for (int a = 0; a < 6; ++a) predicted[std::size_t(a)] += wj * corner_e[std::size_t(j)][std::size_t(a)];
+        w2sum += wj * wj;
+        for (int a = 0; a < 6; ++a) predicted[std::size_t(a)] += wj * parent.corner_e[std::size_t(j)][std::size_t(a)];
     }
     if (wsum <= 0) return false;
+    const float noise = parent.noise * std::sqrt(1 + w2sum / (wsum * wsum));
     const auto actual = axis_irradiance(p.radiance);
     for (int a = 0; a < 6; ++a) {
-        const float pred = predicted[std::size_t(a)] / wsum;
-        if (std::abs(actual[std::size_t(a)] - pred) > s.cull_tolerance * (std::abs(pred) + floor_level)) return false;
+        const float pred = predicted[std::size_t(a)] / wsum, diff = std::abs(actual[std::size_t(a)] - pred);
+        if (diff > parent.tolerance * (std::abs(pred) + parent.floor_level) && diff > noise) return false;
     }
     return true;
+}
+
+/// A probe baked for a split that culling undid: its value (`probe`, an index into the
+/// build's probes) and where it lies in the parent cell (the parent's corner probes and
+/// their trilinear weights there, renormalized over the corners outside geometry).
+struct culled_sample {
+    std::uint32_t probe = 0;
+    std::array<std::uint32_t, 8> corner{};
+    std::array<float, 8> weight{};
+};
+
+/// The least-squares fit of the radiance coefficients of every probe (outside geometry)
+/// that a culled sample's corners name: minimizes sum over those probes of |c_p - v_p|^2
+/// plus sum over samples of |sum_k w_k c_k - v_s|^2 (v: the baked values), by `sweeps`
+/// Gauss-Seidel sweeps from the baked values. Gradients and noise are left as they are.
+inline void refit_probes(std::vector<irradiance_probe>& probes, const std::vector<culled_sample>& samples, int sweeps) {
+    using coefficients = irradiance_probe::coefficients;
+    std::vector<coefficients> baked(probes.size());
+    for (std::size_t i = 0; i < probes.size(); ++i) baked[i] = probes[i].radiance;
+    std::vector<std::vector<std::uint32_t>> touching(probes.size());  // samples naming a probe
+    for (std::uint32_t si = 0; si < samples.size(); ++si)
+        for (int k = 0; k < 8; ++k)
+            if (samples[si].weight[std::size_t(k)] > 0) touching[samples[si].corner[std::size_t(k)]].push_back(si);
+    // The residual sum_k w_k c_k - v_s of every sample, kept current as corners change.
+    std::vector<coefficients> residual(samples.size());
+    for (std::size_t si = 0; si < samples.size(); ++si) {
+        const culled_sample& cs = samples[si];
+        for (std::size_t i = 0; i < residual[si].size(); ++i) {
+            glm::vec3 r = -baked[cs.probe][i];
+            for (std::size_t k = 0; k < 8; ++k) r += cs.weight[k] * probes[cs.corner[k]].radiance[i];
+            residual[si][i] = r;
+        }
+    }
+    for (int sweep = 0; sweep < sweeps; ++sweep)
+        for (std::size_t p = 0; p < probes.size(); ++p) {
+            if (touching[p].empty() || probes[p].inside) continue;
+            float diagonal = 1;
+            coefficients g{};
+            for (std::size_t i = 0; i < g.size(); ++i) g[i] = probes[p].radiance[i] - baked[p][i];
+            std::vector<float> wp(touching[p].size());
+            for (std::size_t t = 0; t < touching[p].size(); ++t) {
+                const culled_sample& cs = samples[touching[p][t]];
+                for (std::size_t k = 0; k < 8; ++k)
+                    if (cs.corner[k] == p) wp[t] += cs.weight[k];
+                diagonal += wp[t] * wp[t];
+                for (std::size_t i = 0; i < g.size(); ++i) g[i] += wp[t] * residual[touching[p][t]][i];
+            }
+            for (std::size_t i = 0; i < g.size(); ++i) {
+                const glm::vec3 step = g[i] / diagonal;
+                probes[p].radiance[i] -= step;
+                for (std::size_t t = 0; t < touching[p].size(); ++t) residual[touching[p][t]][i] -= wp[t] * step;
+            }
+        }
 }
 
 }  // namespace bounce::detail

@@ -212,6 +212,8 @@ public:
     }
     std::uint32_t index(std::uint64_t key) const { return at_key_.at(key); }
     const std::vector<irradiance_probe>& probes() const noexcept { return all_; }
+    /// Least-squares refit of the probes to the samples of culled splits (refit_probes).
+    void refit(const std::vector<culled_sample>& samples, int sweeps) { refit_probes(all_, samples, sweeps); }
 
     /// Bakes every corner of `cells` (cells of `depth`) not yet in the lattice, in one batch
     /// from `source`; `nodes` is the node count the volume will have with them, for
@@ -264,22 +266,52 @@ private:
 
 /// Whether the parent box [lo, lo + size] with corner probes `corner` predicts every probe
 /// of its children `family` (cells of `child_depth`, their corners baked) outside
-/// geometry, as parent_predicts_probe says: then culling undoes the split.
+/// geometry, as parent_predicts_probe says, with `tolerance` and noise_sigmas times the
+/// standard error pooled (root mean square of `noise`) over the corners and new probes
+/// outside geometry: then culling undoes the split, and the new probes outside geometry are
+/// appended to `samples` (when given) for the refit.
 inline bool parent_predicts_children(const probe_lattice& lattice, const std::array<std::uint32_t, 8>& corner,
                                      glm::vec3 lo, glm::vec3 size, const std::vector<octree_cell>& family,
-                                     int child_depth, float floor_level, const irradiance_volume_settings& s) {
+                                     int child_depth, float floor_level, float tolerance, const irradiance_volume_settings& s,
+                                     std::vector<culled_sample>* samples) {
     const std::vector<irradiance_probe>& all = lattice.probes();
-    std::array<std::array<float, 6>, 8> corner_e{};
-    std::array<float, 8> corner_valid{};
+    parent_prediction parent;
+    parent.tolerance = tolerance;
+    parent.floor_level = floor_level;
+    double noise2 = 0;
+    std::size_t counted = 0;
+    const auto pool = [&](const irradiance_probe& p) {
+        if (!p.inside) noise2 += double(p.noise) * double(p.noise), ++counted;
+    };
     for (int k = 0; k < 8; ++k) {
         const auto& p = all[corner[std::size_t(k)]];
-        corner_e[std::size_t(k)] = axis_irradiance(p.radiance);
-        corner_valid[std::size_t(k)] = p.inside ? 0.f : 1.f;
+        parent.corner_e[std::size_t(k)] = axis_irradiance(p.radiance);
+        parent.corner_valid[std::size_t(k)] = p.inside ? 0.f : 1.f;
+        pool(p);
     }
+    std::vector<std::uint32_t> fresh;
     for (const auto& ch : family)
         for (const std::uint64_t key : lattice.corner_keys(ch, child_depth)) {
-            const auto& p = all[lattice.index(key)];
-            if (!p.inside && !parent_predicts_probe(p, lo, size, corner_e, corner_valid, floor_level, s)) return false;
+            const std::uint32_t i = lattice.index(key);
+            if (std::find(corner.begin(), corner.end(), i) != corner.end() ||
+                std::find(fresh.begin(), fresh.end(), i) != fresh.end())
+                continue;
+            fresh.push_back(i);
+            pool(all[i]);
+        }
+    parent.noise = counted ? s.noise_sigmas * float(std::sqrt(noise2 / double(counted))) : 0.f;
+    for (const std::uint32_t i : fresh) {
+        const auto& p = all[i];
+        if (!p.inside && !parent_predicts_probe(p, lo, size, parent)) return false;
+    }
+    if (samples)  // the new probes outside geometry, where the parent's corners predict them
+        for (const std::uint32_t i : fresh) {
+            if (all[i].inside) continue;
+            culled_sample cs{i, corner, trilinear_weights<float, glm::vec3>(all[i].position, lo, size)};
+            float wsum = 0;
+            for (std::size_t k = 0; k < 8; ++k) wsum += cs.weight[k] *= parent.corner_valid[k];
+            for (float& w : cs.weight) w /= wsum;
+            samples->push_back(cs);
         }
     return true;
 }
@@ -299,6 +331,8 @@ inline void validate_volume_build(const scene_view& scene, glm::vec3 lo, glm::ve
     threshold(s.neighbour_change, "settings.neighbour_change");
     threshold(s.gradient_ratio, "settings.gradient_ratio");
     threshold(s.cull_tolerance, "settings.cull_tolerance");
+    threshold(s.prediction_tolerance, "settings.prediction_tolerance");
+    threshold(s.noise_sigmas, "settings.noise_sigmas");
     threshold(s.absolute_floor, "settings.absolute_floor");
 }
 
@@ -328,7 +362,7 @@ template <class Source>
 std::vector<octree_cell> grow_level(const scene_view& scene, const std::vector<octree_cell>& level, int depth,
                                     float floor_level, const irradiance_volume_settings& s, Source& source,
                                     probe_lattice& lattice, std::vector<irradiance_volume::node>& nodes,
-                                    irradiance_volume_build_stats& stats) {
+                                    irradiance_volume_build_stats& stats, std::vector<culled_sample>& samples) {
     std::vector<std::size_t> split_cells;
     for (std::size_t ci = 0; ci < level.size(); ++ci)
         if (cell_splits(level[ci], nodes[level[ci].node].corner, nodes[level[ci].node].size, lattice.probes(), depth,
@@ -343,13 +377,16 @@ std::vector<octree_cell> grow_level(const scene_view& scene, const std::vector<o
         for (const auto& ch : families[si]) batch.push_back(octree_cell{0, ch.x, ch.y, ch.z, {}});
     }
     lattice.bake_corners(batch, depth + 1, nodes.size() + batch.size(), s, source, stats);
-    // Culling: undo a split whose new probes the parent already predicts.
+    // Culling: undo a split whose new probes the parent already predicts (within the
+    // prediction tolerance when it drives the splits, else the cull tolerance).
+    const float tolerance = s.prediction_tolerance > 0 ? s.prediction_tolerance : s.cull_tolerance;
     std::vector<octree_cell> children;
     for (std::size_t si = 0; si < split_cells.size(); ++si) {
         const irradiance_volume::node& parent = nodes[level[split_cells[si]].node];
-        const bool keep = depth < s.min_depth || s.cull_tolerance <= 0 ||
+        const bool keep = depth < s.min_depth || tolerance <= 0 ||
                           !parent_predicts_children(lattice, parent.corner, parent.lo, parent.size, families[si],
-                                                    depth + 1, floor_level, s);
+                                                    depth + 1, floor_level, tolerance, s,
+                                                    s.refit_culled ? &samples : nullptr);
         if (!keep) {
             ++stats.culled;
             continue;
@@ -418,6 +455,7 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
     detail::probe_lattice lattice(lo, hi, s.max_depth);
     v.nodes_.push_back(node{lo, hi - lo, 0, -1, {}});
     std::vector<detail::octree_cell> level{detail::root_cell(scene, lo, hi)};
+    std::vector<detail::culled_sample> samples;
     lattice.bake_corners(level, 0, v.nodes_.size() + level.size(), s, source, stats);
     const float floor_level = detail::absolute_floor_level(lattice.probes(), s.absolute_floor);
     for (int depth = 0; depth <= s.max_depth; ++depth) {
@@ -426,9 +464,10 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
             for (int k = 0; k < 8; ++k) v.nodes_[c.node].corner[std::size_t(k)] = lattice.index(keys[std::size_t(k)]);
         }
         if (depth == s.max_depth) break;
-        level = detail::grow_level(scene, level, depth, floor_level, s, source, lattice, v.nodes_, stats);
+        level = detail::grow_level(scene, level, depth, floor_level, s, source, lattice, v.nodes_, stats, samples);
         if (level.empty()) break;
     }
+    if (!samples.empty()) lattice.refit(samples, 16);
     v.probes_ = detail::used_probes(lattice.probes(), v.nodes_);
     for (const auto& p : v.probes_) stats.probes_inside += p.inside ? 1 : 0;
     if (stats.probes_inside == v.probes_.size())

@@ -15,6 +15,9 @@
 /// their own, only the directional discretization, which is the same at p +- h.
 ///
 /// - Harmonic mean distance: rays / sum_j 1 / d_j over the hits (misses add 0).
+/// - Noise: the probe's `noise` is half the largest difference, over the six axis normals,
+///   between the irradiance luminance projected from the even rays and from the odd rays
+///   (the standard error of the whole estimate, from its two halves).
 /// - Inside geometry: a probe whose rays hit the back of triangles (the side opposite
 ///   their counter-clockwise normal) in more than `inside_fraction` of the cases is
 ///   flagged inside; it gets no gradient.
@@ -27,6 +30,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/volume/probe_octree.hpp>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -46,6 +50,11 @@ struct probe_baker_settings {
     /// The step is also at most this fraction of the distance to the nearest hit.
     /// Typical: 0.5.
     float nearest_fraction = 0.5f;
+    /// Gradients only where their signal exceeds their noise: an axis's gradient (the
+    /// luminance of its 9 coefficients, as a vector) is set to 0 when its length is at most
+    /// this ratio times the noise, estimated as half the difference of the gradients from
+    /// the even and the odd rays. Typical: 1-2; 0 keeps every gradient.
+    float gradient_noise_ratio = 1.f;
     /// Fraction of back-facing hits above which a probe is inside geometry. Typical: 0.5.
     float inside_fraction = 0.5f;
     /// Base seed of the area-light samples at the hits (unused without emitters).
@@ -61,7 +70,8 @@ struct probe_baker_settings {
 class probe_baker {
 public:
     /// Throws parameter_error naming the setting: rays = 0, a negative or non-finite
-    /// gradient_step, nearest_fraction outside (0, 1], inside_fraction outside [0, 1].
+    /// gradient_step or gradient_noise_ratio, nearest_fraction outside (0, 1], inside_fraction
+    /// outside [0, 1].
     probe_baker(const reference_integrator& light, const accel& bvh, const scene_view& scene,
                 probe_baker_settings settings = {});
 
@@ -78,9 +88,15 @@ public:
         bake(positions, out);
     }
 
+    /// A projection from every ray, and from the even and the odd rays alone.
+    struct estimate {
+        irradiance_probe::coefficients all{};
+        std::array<irradiance_probe::coefficients, 2> half{};
+    };
+
 private:
     struct cast;
-    irradiance_probe::coefficients project(glm::vec3 position, std::uint64_t seed, cast* details) const;
+    estimate project(glm::vec3 position, std::uint64_t seed, cast* details) const;
 
     const reference_integrator& light_;
     const accel& bvh_;

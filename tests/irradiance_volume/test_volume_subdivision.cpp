@@ -1,0 +1,146 @@
+// Subdivision by prediction error (irradiance_volume_settings::prediction_tolerance,
+// issue 31): noise alone does not split a cell, a real change of the light does, and the
+// noise each probe reports (two half-estimates) is what tells them apart.
+#include "../owned_scene.hpp"
+
+#include <bounce/sampling.hpp>
+#include <bounce/volume/probe_octree.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <numbers>
+#include <vector>
+
+using namespace bounce;
+
+namespace {
+
+// One triangle far outside the volume: a scene the build accepts and nothing in it.
+test::owned_scene far_triangle() {
+    test::owned_scene s;
+    s.positions = {{100, 100, 100}, {101, 100, 100}, {100, 101, 100}};
+    s.triangles = {{0, 1, 2}};
+    s.material_of = {0};
+    s.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
+    return s;
+}
+
+// Probes of a uniform radiance L(p) (band 0 only, grey) estimated as a source with rays
+// would: two half-estimates, each L(p) plus Gaussian noise of relative standard deviation
+// `half_sigma`, averaged; the probe's noise is half their irradiance difference, as
+// embree::probe_baker reports it. Deterministic per position.
+struct noisy_field {
+    std::function<float(glm::vec3)> radiance;
+    float half_sigma = 0;
+    void operator()(std::span<const glm::vec3> p, std::span<irradiance_probe> out) const {
+        constexpr float y00 = 0.28209479177387814f, pi = std::numbers::pi_v<float>;
+        for (std::size_t j = 0; j < p.size(); ++j) {
+            pcg32 rng(hash_floats({p[j].x, p[j].y, p[j].z}));
+            const auto gaussian = [&] {
+                const float u = std::max(rng.next_float(), 1e-7f), v = rng.next_float();
+                return std::sqrt(-2 * std::log(u)) * std::cos(2 * pi * v);
+            };
+            const float l = radiance(p[j]);
+            const float a = l * (1 + half_sigma * gaussian()), b = l * (1 + half_sigma * gaussian());
+            out[j] = {};
+            out[j].position = p[j];
+            // c_00 of a uniform radiance L is L / Y_00; its irradiance is pi L at every normal.
+            out[j].radiance[0] = glm::vec3(0.5f * (a + b) / y00);
+            out[j].noise = 0.5f * pi * std::abs(a - b);
+            out[j].harmonic_mean_distance = 1;
+        }
+    }
+};
+
+irradiance_volume_settings prediction_settings() {
+    irradiance_volume_settings s;  // the defaults: prediction_tolerance 0.05, noise_sigmas 4
+    s.min_depth = 1;
+    s.max_depth = 4;
+    return s;
+}
+
+std::map<int, int> leaf_depths(const irradiance_volume& v) {
+    std::map<int, int> depths;
+    for (const auto& n : v.nodes())
+        if (n.leaf()) ++depths[n.depth];
+    return depths;
+}
+
+}  // namespace
+
+TEST_CASE("noise alone does not split a cell", "[irradiance_volume]") {
+    const auto scene = far_triangle();
+    // Constant light; each probe off by 8% (standard deviation of the whole estimate:
+    // 0.08 / sqrt 2 of a half), above the 5% tolerance, so a test without the noise splits.
+    const noisy_field field{[](glm::vec3) { return 1.f; }, 0.08f};
+    auto s = prediction_settings();
+    irradiance_volume_build_stats stats;
+    const auto v = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, field, &stats);
+    CHECK(v.depth() == 1);
+    CHECK(v.probes().size() == 27);
+    CHECK(stats.split_prediction == 8);
+    CHECK(stats.culled == 8);
+    // Without the noise term the same probes split: the test above can fail.
+    s.noise_sigmas = 0;
+    const auto naive = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, field);
+    CHECK(naive.depth() == 4);
+    CHECK(naive.probes().size() > 200);
+}
+
+TEST_CASE("a change of the light splits the cells it crosses, to the deepest level", "[irradiance_volume]") {
+    const auto scene = far_triangle();
+    // A step from 1 to 4 across x = 0.3 (width 0.05), half the noise above.
+    const noisy_field field{[](glm::vec3 p) { return 1 + 3 / (1 + std::exp(-(p.x - 0.3f) / 0.05f)); }, 0.04f};
+    irradiance_volume_build_stats stats;
+    const auto v = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), prediction_settings(), field, &stats);
+    REQUIRE(v.depth() == 4);
+    for (const float y : {-0.9f, -0.3f, 0.4f})
+        for (const float z : {-0.7f, 0.1f, 0.8f}) {
+            INFO("y " << y << " z " << z);
+            CHECK(v.nodes()[v.find_leaf({0.3f, y, z})].depth == 4);   // on the step
+            CHECK(v.nodes()[v.find_leaf({-0.7f, y, z})].depth == 1);  // far from it: flat light
+        }
+    CHECK(stats.culled > 0);
+    // The adaptive octree keeps far fewer probes than the uniform grid of depth 4 (4913).
+    CHECK(v.probes().size() < 4913 / 2);
+    const auto depths = leaf_depths(v);
+    CHECK(depths.size() >= 3);
+    // Trilinear lookups follow the step where it is resolved: within 15% of the light.
+    constexpr float pi = std::numbers::pi_v<float>;
+    for (const float x : {-0.8f, -0.2f, 0.26f, 0.34f, 0.8f}) {
+        const float exact = pi * field.radiance({x, 0.1f, 0.1f});
+        CHECK(std::abs(v.trilinear({x, 0.1f, 0.1f}, {0, 0, 1}).x - exact) < 0.15f * exact);
+    }
+}
+
+TEST_CASE("prediction settings out of range are refused by name", "[irradiance_volume]") {
+    const auto scene = far_triangle();
+    const noisy_field field{[](glm::vec3) { return 1.f; }, 0.f};
+    const auto name_of = [&](irradiance_volume_settings s) -> std::string {
+        try {
+            (void)irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, field);
+        } catch (const parameter_error& e) {
+            return e.parameter();
+        }
+        return "";
+    };
+    auto s = prediction_settings();
+    s.prediction_tolerance = -1;
+    CHECK(name_of(s) == "settings.prediction_tolerance");
+    s = prediction_settings();
+    s.noise_sigmas = std::nanf("");
+    CHECK(name_of(s) == "settings.noise_sigmas");
+    // A source that reports negative noise is refused like any non-finite probe.
+    const auto bad = [](std::span<const glm::vec3> p, std::span<irradiance_probe> out) {
+        for (std::size_t j = 0; j < p.size(); ++j) out[j] = {}, out[j].position = p[j], out[j].noise = -1;
+    };
+    try {
+        (void)irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), prediction_settings(), bad);
+        FAIL("a negative noise was accepted");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "probes");
+    }
+}
