@@ -69,6 +69,7 @@ struct options {
     std::uint64_t seed = 1;
     int threads = 0;
     bool sh_study = false;
+    std::string refit = "on";
 };
 
 // Refuses a depth whose worst case (the uniform grid) would not fit in memory.
@@ -144,6 +145,7 @@ int run(const options& o) {
     vs.cull_tolerance = o.cull;
     vs.prediction_tolerance = o.prediction_tolerance;
     vs.noise_sigmas = o.noise_sigmas;
+    vs.refit_culled = o.refit == "on";
     vs.memory_limit_bytes = study::available_memory_bytes();
     const glm::vec3 finest = extent / float(1 << o.max_depth);
     embree::probe_baker_settings bs;
@@ -217,7 +219,7 @@ int run(const options& o) {
                          {"distance_ratio", o.distance_ratio}, {"neighbour_change", o.neighbour_change},
                          {"geometry_triangles", o.geometry_triangles}, {"gradient_ratio", o.gradient_ratio},
                          {"cull_tolerance", o.cull}, {"prediction_tolerance", o.prediction_tolerance},
-                         {"noise_sigmas", o.noise_sigmas}, {"gradient_noise_ratio", o.gradient_noise},
+                         {"noise_sigmas", o.noise_sigmas}, {"refit", o.refit}, {"gradient_noise_ratio", o.gradient_noise},
                          {"seed", o.seed}, {"threads", o.threads}};
     report.timings_ms = {{"bake", bake_ms}, {"reference", sphere.reference_ms()}};
     report.error = best.error;
@@ -291,6 +293,8 @@ int main(int argc, char** argv) {
         ->check(finite_non_negative);
     app.add_option("--noise-sigmas", o.noise_sigmas, "differences within this many standard errors of the probes are noise")
         ->check(finite_non_negative);
+    app.add_option("--refit", o.refit, "on: the samples of culled splits refit the kept probes (least squares)")
+        ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--gradient-noise", o.gradient_noise, "keep a probe's gradient only where it exceeds this times its noise "
                                                          "(0: keep all)")->check(finite_non_negative);
     app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge")
