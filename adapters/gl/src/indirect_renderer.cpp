@@ -96,13 +96,13 @@ vpl_splats place_vpl_splats(std::span<const rsm_textures> maps, const camera& ca
         const sub_buffer_rect sub = sub_buffer_of(pattern, i, j, w, h);
         for (std::uint32_t k = groups.begin[std::size_t(s)]; k < groups.begin[std::size_t(s) + 1]; ++k) {
             const vpl& l = all[groups.order[k]];
-            const vpl scaled{l.position, l.normal, l.flux * scale, l.area};
+            const vpl scaled{l.position, l.normal, l.flux * scale, l.area * scale};
             splatted.push_back(scaled);
             const pixel_rect q = split_buffer_rect(
                 vpl_splat_rect(cam, view, l, all.size(), o.sii_cutoff, o.light.offset, w, h), pattern, i, j, sub);
             if (q.empty()) continue;
             out.packed.push_back(
-                {glm::vec4(scaled.position, o.light.min_distance2_for(l.area)), glm::vec4(scaled.normal, 0.f),
+                {glm::vec4(scaled.position, o.light.min_distance2_for(scaled.area)), glm::vec4(scaled.normal, 0.f),
                  glm::vec4(scaled.flux, 0.f)});
             out.rects.emplace_back(float(q.x0), float(q.y0), float(q.x1), float(q.y1));
         }

@@ -70,7 +70,8 @@ void splat(const gbuffer_view<float>& gb, const vpl& l, float scale, const pixel
            const bounce::pixel_rect& rect, const bounce::pixel_rect& tile, Add&& add) {
     const glm::vec3 flux = l.flux * scale;
     const glm::vec3 sender = l.position - l.normal * lp.offset;
-    const float min_distance2 = lp.min_distance2_for(l.area);
+    // An interleaved VPL stands for `scale` times its area within its sub-buffer, as for its flux.
+    const float min_distance2 = lp.min_distance2_for(l.area * scale);
     for (int v = std::max(rect.y0, tile.y0); v <= std::min(rect.y1, tile.y1); ++v)
         for (int u = std::max(rect.x0, tile.x0); u <= std::min(rect.x1, tile.x1); ++u) {
             const std::size_t uu = std::size_t(u), vv = std::size_t(v);
