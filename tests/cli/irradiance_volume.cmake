@@ -12,7 +12,7 @@ bounce_cli_refusal("a depth whose grid exceeds memory" PROGRAM irradiance_volume
                    ARGS --max-depth 10)
 bounce_cli_refusal("a --seed of -1" PROGRAM irradiance_volume MATCH "--seed.*'-1' is not a whole number"
                    ARGS ${iv_big} --seed -1)
-foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull)
+foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull --prediction-tolerance --noise-sigmas --gradient-noise)
   bounce_cli_refusal("${option} nan" PROGRAM irradiance_volume MATCH "${option}.*'nan' is not" ARGS ${iv_big} ${option} nan)
 endforeach()
 # --support must exceed 1; the refusal prints the open bound as such, "(1, 16]", not 1.000001
@@ -35,3 +35,5 @@ bounce_cli_refusal("a scene whose triangles all face away" PROGRAM irradiance_vo
                    ARGS --max-depth 2 --rays 64 --ref-samples 4096 --scene ${iv_fx}/reversed/scene.json)
 bounce_cli_refusal("an unknown --interp" PROGRAM irradiance_volume MATCH "--interp: nearest not in .trilinear,weighted."
                    ARGS --interp nearest)
+bounce_cli_refusal("an unknown --refit" PROGRAM irradiance_volume MATCH "--refit: maybe not in .on,off."
+                   ARGS ${iv_big} --refit maybe)

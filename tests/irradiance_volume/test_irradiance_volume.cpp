@@ -2,7 +2,7 @@
 // triangle-box test against a brute-force clipper, trilinear and gradient-extrapolated
 // lookups on linear fields (exact up to float rounding), continuity of the weighted lookup
 // across a subdivision boundary, skipped inside probes and bad input.
-#include "../owned_scene.hpp"
+#include "far_triangle.hpp"
 
 #include <bounce/volume/probe_octree.hpp>
 #include <bounce/sampling.hpp>
@@ -19,17 +19,6 @@
 using namespace bounce;
 
 namespace {
-
-// One triangle far outside the volumes below: a scene the build accepts but whose
-// geometry heuristic never fires.
-test::owned_scene far_triangle() {
-    test::owned_scene s;
-    s.positions = {{100, 100, 100}, {101, 100, 100}, {100, 101, 100}};
-    s.triangles = {{0, 1, 2}};
-    s.material_of = {0};
-    s.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
-    return s;
-}
 
 irradiance_volume_settings uniform_settings(int depth) {
     irradiance_volume_settings s;
@@ -230,7 +219,7 @@ TEST_CASE("every point finds exactly one leaf and corner probes are shared", "[i
 }
 
 TEST_CASE("trilinear lookup reproduces a linear field exactly on a uniform grid", "[irradiance_volume]") {
-    const auto scene = far_triangle();
+    const auto scene = test::far_triangle();
     const linear_field field(11);
     const auto v = irradiance_volume::build(scene, glm::vec3(-1, -2, 0), glm::vec3(1, 2, 3), uniform_settings(2), field);
     CHECK(v.probes().size() == 125);
@@ -310,7 +299,7 @@ TEST_CASE("the weighted lookup does not pop across a subdivision boundary", "[ir
 }
 
 TEST_CASE("probes inside geometry are skipped by every lookup", "[irradiance_volume]") {
-    const auto scene = far_triangle();
+    const auto scene = test::far_triangle();
     // Probes with x > 0.3 are "inside" and carry absurd values that would show at once.
     const auto source = [](std::span<const glm::vec3> p, std::span<irradiance_probe> out) {
         for (std::size_t j = 0; j < p.size(); ++j) {
@@ -343,7 +332,7 @@ TEST_CASE("probes inside geometry are skipped by every lookup", "[irradiance_vol
 }
 
 TEST_CASE("bad input throws parameter_error naming the parameter", "[irradiance_volume]") {
-    const auto scene = far_triangle();
+    const auto scene = test::far_triangle();
     const linear_field field(5);
     const auto name_of = [&](auto&& f) -> std::string {
         try {

@@ -1,7 +1,7 @@
 // Subdivision by prediction error (irradiance_volume_settings::prediction_tolerance,
 // issue 31): noise alone does not split a cell, a real change of the light does, and the
 // noise each probe reports (two half-estimates) is what tells them apart.
-#include "../owned_scene.hpp"
+#include "far_triangle.hpp"
 
 #include <bounce/sampling.hpp>
 #include <bounce/volume/probe_octree.hpp>
@@ -17,16 +17,6 @@
 using namespace bounce;
 
 namespace {
-
-// One triangle far outside the volume: a scene the build accepts and nothing in it.
-test::owned_scene far_triangle() {
-    test::owned_scene s;
-    s.positions = {{100, 100, 100}, {101, 100, 100}, {100, 101, 100}};
-    s.triangles = {{0, 1, 2}};
-    s.material_of = {0};
-    s.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
-    return s;
-}
 
 // Probes of a uniform radiance L(p) (band 0 only, grey) estimated as a source with rays
 // would: two half-estimates, each L(p) plus Gaussian noise of relative standard deviation
@@ -72,7 +62,7 @@ std::map<int, int> leaf_depths(const irradiance_volume& v) {
 }  // namespace
 
 TEST_CASE("noise alone does not split a cell", "[irradiance_volume]") {
-    const auto scene = far_triangle();
+    const auto scene = test::far_triangle();
     // Constant light; each probe off by 8% (standard deviation of the whole estimate:
     // 0.08 / sqrt 2 of a half), above the 5% tolerance, so a test without the noise splits.
     const noisy_field field{[](glm::vec3) { return 1.f; }, 0.08f};
@@ -91,7 +81,7 @@ TEST_CASE("noise alone does not split a cell", "[irradiance_volume]") {
 }
 
 TEST_CASE("a change of the light splits the cells it crosses, to the deepest level", "[irradiance_volume]") {
-    const auto scene = far_triangle();
+    const auto scene = test::far_triangle();
     // A step from 1 to 4 across x = 0.3 (width 0.05), half the noise above.
     const noisy_field field{[](glm::vec3 p) { return 1 + 3 / (1 + std::exp(-(p.x - 0.3f) / 0.05f)); }, 0.04f};
     irradiance_volume_build_stats stats;
@@ -117,7 +107,7 @@ TEST_CASE("a change of the light splits the cells it crosses, to the deepest lev
 }
 
 TEST_CASE("prediction settings out of range are refused by name", "[irradiance_volume]") {
-    const auto scene = far_triangle();
+    const auto scene = test::far_triangle();
     const noisy_field field{[](glm::vec3) { return 1.f; }, 0.f};
     const auto name_of = [&](irradiance_volume_settings s) -> std::string {
         try {
