@@ -197,7 +197,7 @@ std::string map_kernel_source(F&& fn, compute_target target = compute_target::op
     [&]<std::size_t... I>(std::index_sequence<I...>) {
         ((loads += detail::lane<std::tuple_element_t<I, args>>::load_statements(std::string("a") + std::to_string(I), at),
           at += detail::lane<std::tuple_element_t<I, args>>::floats,
-          call_args += (I ? ", a" : "a") + std::to_string(I)),
+          call_args.append(I ? ", a" : "a").append(std::to_string(I))),
          ...);
     }(std::make_index_sequence<arity>{});
 
