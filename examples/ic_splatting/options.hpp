@@ -234,7 +234,7 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
 
 /// Declares every option on `app`, writing into `o` (and `gradients`: "on" or "off").
 inline void add_options(CLI::App& app, options& o, std::string& gradients) {
-    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, or a name under the scenes folder")->capture_default_str();
+    app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, a .gltf or .glb, or a name under the scenes folder")->capture_default_str();
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
     app.add_option("--a", o.a, "accuracy a (Eq. 8.3); smaller means more records")->check(examples::finite_positive)->capture_default_str();
