@@ -20,12 +20,11 @@ technique_run run_irradiance_volume(const scene_setup& s, const gbuffer_view<flo
     // irradiance_volume's defaults (examples/irradiance_volume/main.cpp): an adaptive octree
     // of depth 1 to 4 with Oat's heuristics as irradiance_volume_settings has them, over the
     // scene's bounds shrunk by 1% of their extent per side, 512 rays per probe, gradients by
-    // central differences a tenth of the finest cell's shortest edge apart, looked up by the
-    // weighted average (b = 2, support 1.5) with gradients.
+    // central differences a tenth of the finest cell's shortest edge apart (kept where they
+    // stand out of their noise), looked up trilinearly.
     constexpr int max_depth = 4;
     constexpr float margin = -0.01f, gradient_step = 0.1f;
     constexpr std::uint32_t rays = 512;
-    const weighted_lookup lookup{2.f, true, 1.5f};
     const std::string name(technique_name(bench_technique::irradiance_volume));
 
     auto [lo, hi] = s.scene.bounds();
@@ -69,7 +68,7 @@ technique_run run_irradiance_volume(const scene_setup& s, const gbuffer_view<flo
             }
     e.resize(p.size());
     const auto t1 = std::chrono::steady_clock::now();
-    cpu::light_points(volume, p, n, e, cpu::volume_lookup{cpu::volume_interpolation::weighted, lookup});
+    cpu::light_points(volume, p, n, e, cpu::volume_lookup{cpu::volume_interpolation::trilinear, {}});
     const double lookup_ms = ms_since(t1);
 
     technique_run r;
@@ -96,10 +95,7 @@ technique_run run_irradiance_volume(const scene_setup& s, const gbuffer_view<flo
                     {"rays", rays},
                     {"gradient_step", bs.gradient_step},
                     {"margin", margin},
-                    {"interp", "weighted"},
-                    {"b", lookup.b},
-                    {"gradients", lookup.gradients},
-                    {"support", lookup.support},
+                    {"interp", "trilinear"},
                     {"volume_offset", s.settings.volume_offset}};
     return r;
 }

@@ -25,7 +25,9 @@ enum class volume_interpolation {
 
 /// A lookup's choice of interpolation and, for `weighted`, its exponent and gradients.
 struct volume_lookup {
-    volume_interpolation interpolation = volume_interpolation::weighted;
+    /// Trilinear by default: the weighted lookups lose to it on every shared scene
+    /// (docs/sh-and-irradiance-volumes.md, issue 31).
+    volume_interpolation interpolation = volume_interpolation::trilinear;
     weighted_lookup weighted{};
 };
 
