@@ -55,7 +55,6 @@ json parameters_json(const options& o, float clamp_distance, std::size_t maps) {
             {"maps", maps},
             {"r_max", o.r_max},
             {"clamp", clamp_distance},
-            {"footprint_clamp", o.footprint_clamp},
             {"offset", o.offset},
             {"blur", o.blur},
             {"energy_correct", !o.thesis_weights},
@@ -168,6 +167,7 @@ int run(const options& o) {
     report.backend = name_of(backend_names, o.backend);
     report.gl_renderer = gl_name;
     report.parameters = parameters_json(o, clamp_distance, caster.maps().size());
+    report.parameters["footprint_clamp"] = chosen.light.footprint_scale;
     report.parameters["embree_config"] = bvh.owner().config();
     json extra = json::object();
     extra["references"] = {

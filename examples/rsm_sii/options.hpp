@@ -41,7 +41,8 @@ struct options {
     vpl_selection selection = vpl_selection::flux_warping;  // SII VPLs: warping (DS06 section 3.3) | grid
     float r_max = 1.5f;                // RSM gather disc radius, map units
     float clamp = -1.f;                // d^2 clamped at clamp^2 (scene units); unset (< 0): scene_clamp_distance
-    float footprint_clamp = 1.f;       // SII: d^2 clamped at the disc of each VPL's area times this^2; 0: --clamp
+    float footprint_clamp = -1.f;      // SII: d^2 clamped at the disc of each VPL's area times this^2; 0: --clamp;
+                                       // unset (< 0): default_pixel_light's (1 plain, 0 interleaved)
     float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
     bool blur = true;
     bool thesis_weights = false;       // interleaved lights at weight 1 (Hahn 2012), not N M
@@ -85,7 +86,7 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
     c.r_max = o.r_max;
     c.light.offset = o.offset;
     c.light.min_distance2 = clamp_distance * clamp_distance;
-    c.light.footprint_scale = o.footprint_clamp;
+    c.light.footprint_scale = o.footprint_clamp >= 0.f ? o.footprint_clamp : (pattern.cells() == 1 ? 1.f : 0.f);
     c.seed = o.seed;
     c.visibility = o.visibility;
     try {
@@ -151,9 +152,8 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(examples::finite_non_negative);
     app.add_option("--footprint-clamp", o.footprint_clamp,
                    "SII: 1/d^2 clamped inside the disc of the area each VPL stands for, its radius scaled by this "
-                   "(>= 0; 0: the fixed --clamp instead)")
-        ->check(examples::finite_non_negative)
-        ->capture_default_str();
+                   "(>= 0; 0: the fixed --clamp instead); default 1 without interleaving, 0 with it")
+        ->check(examples::finite_non_negative);
     app.add_option("--offset", o.offset, "senders moved this far along -n_p (scene units; DS05's remedy)")
         ->check(examples::finite_non_negative)
         ->capture_default_str();

@@ -19,8 +19,8 @@ namespace {
 
 // rsm_sii's defaults (examples/rsm_sii/options.hpp): the settings' lights a frame (1,024 by
 // default; SII: VPLs by flux warping; the gather: disc samples per pixel and map over a disc
-// of radius 1.5 map units), 256^2 texels per map, d^2 clamped at each VPL's footprint (SII) or at
-// scene_clamp_distance (the gather; default_pixel_light), the geometry-aware blur after interleaving, energy-correct weights, seed 1.
+// of radius 1.5 map units), 256^2 texels per map, d^2 clamped at each VPL's footprint (plain SII) or at
+// scene_clamp_distance (interleaved SII, the gather; default_pixel_light), the geometry-aware blur after interleaving, energy-correct weights, seed 1.
 constexpr std::size_t map_resolution = 256;
 
 indirect_options options_for(bench_technique t, std::size_t lights, const pixel_light_params& light,
@@ -42,7 +42,8 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
             "technique", "is not an RSM technique");
     require(!s.scene.lights.empty(), "scene", "has no point, spot or directional light: reflective shadow maps need one");
     const std::string name = std::string(technique_name(t)) + (visibility == indirect_visibility::none ? "" : "+rays");
-    const pixel_light_params light = default_pixel_light(s.scene);
+    const pixel_light_params light = default_pixel_light(
+        s.scene, t == bench_technique::sii_interleaved ? interleave_pattern{4, 4} : interleave_pattern{1, 1});
     const indirect_options options = options_for(t, s.settings.rsm_lights, light, visibility);
 
     // The maps are part of every frame's cost (the lights may move); cast once timed.

@@ -168,14 +168,16 @@ inline float scene_clamp_distance(const scene_view& scene) {
     return 0.01f * float(glm::length(glm::dvec3(hi) - glm::dvec3(lo)));
 }
 
-/// The singularity remedies rsm_sii and the benchmark use on `scene` unless told otherwise:
-/// SII clamps each VPL at the disc of its own area (footprint_scale 1), the RSM gather at
-/// scene_clamp_distance.
-inline pixel_light_params default_pixel_light(const scene_view& scene) {
+/// The singularity remedies rsm_sii and the benchmark use on `scene` for `pattern` unless
+/// told otherwise: plain SII clamps each VPL at the disc of its own area (footprint_scale
+/// 1); interleaved SII and the RSM gather at scene_clamp_distance. Interleaved, neither
+/// footprint is right everywhere: a pixel whose blur covers the pattern sees all the VPLs'
+/// density, one at an edge only its sub-buffer's (docs, section 16).
+inline pixel_light_params default_pixel_light(const scene_view& scene, const interleave_pattern& pattern) {
     pixel_light_params p;
     const float d = scene_clamp_distance(scene);
     p.min_distance2 = d * d;
-    p.footprint_scale = 1.f;
+    p.footprint_scale = pattern.cells() == 1 ? 1.f : 0.f;
     return p;
 }
 
