@@ -19,7 +19,7 @@
 ///     radiosity/kernels.hpp) into an item buffer holding chart id, triangle id and the exact depth at
 ///     each pixel centre (item_plane_depth), depth tested on a separate depth attachment;
 ///  3. a compute pass, one invocation per element at its texel, evaluates the shot from
-///     the shooter's near-field nodes (disc_form_factor and shot_radiosity, emitted), looks
+///     the shooter's near-field nodes (element_form_factor, emitted), looks
 ///     its pixel up with item_buffer_sees (the CPU's concave-corner rule) and adds the result
 ///     to the radiosity and unshot textures, writing the power it intercepted;
 ///  4. a compute reduction (one invocation per shooter, then one group of 64) finds the next
