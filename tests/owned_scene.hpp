@@ -1,35 +1,11 @@
 #pragma once
-// A scene the tests build by hand and own, as a renderer owns its arrays: vectors behind a
-// bounce::scene_view, with no loader and no bounce::io, so the GL and Embree tests need
+// A scene the tests build by hand and own, as a renderer owns its arrays (the core's
+// bounce::owned_scene), with no loader and no bounce::io, so the GL and Embree tests need
 // neither OpenImageIO nor tinyobjloader.
-#include <bounce/camera.hpp>
-#include <bounce/light.hpp>
-#include <bounce/scene_view.hpp>
-
-#include <cstdint>
-#include <string>
-#include <utility>
-#include <vector>
-
-#include <glm/vec3.hpp>
+#include <bounce/owned_scene.hpp>
 
 namespace bounce::test {
 
-struct owned_scene {
-    std::string name;
-    std::vector<glm::vec3> positions, normals;
-    std::vector<glm::uvec3> triangles;
-    std::vector<std::uint32_t> material_of;
-    std::vector<material> materials;
-    std::vector<light> lights;
-    bool use_emission = false;
-    bounce::camera camera;
-
-    scene_view view() const& noexcept {
-        return {positions, normals, triangles, material_of, materials, lights, use_emission};
-    }
-    operator scene_view() const& noexcept { return view(); }
-    std::pair<glm::vec3, glm::vec3> bounds() const noexcept { return view().bounds(); }
-};
+using owned_scene = bounce::owned_scene;
 
 }  // namespace bounce::test

@@ -8,8 +8,7 @@
 
 #include <bounce/camera.hpp>
 #include <bounce/cache/record.hpp>
-#include <bounce/light.hpp>
-#include <bounce/scene_view.hpp>
+#include <bounce/owned_scene.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -33,19 +32,6 @@ struct settings {
     int volume_depth = 4;             ///< uniform irradiance-volume octree depth
     std::size_t gather_samples = 400; ///< RSM gather disc samples per pixel and map
     std::size_t sii_vpls = 1024;      ///< SII VPLs per frame
-};
-
-/// The Cornell box as a renderer would own it.
-struct owned_scene {
-    std::vector<glm::vec3> positions, normals;
-    std::vector<glm::uvec3> triangles;
-    std::vector<std::uint32_t> material_of;
-    std::vector<material> materials;
-    std::vector<light> lights;
-    bool use_emission = false;
-    bounce::camera camera;
-
-    scene_view view() const { return {positions, normals, triangles, material_of, materials, lights, use_emission}; }
 };
 
 /// The Cornell box, each triangle split `subdivide` times into four (midpoints; the face's
