@@ -20,8 +20,8 @@
 #include <utility>
 #include <vector>
 
-#include <glm/mat4x4.hpp>
 #include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -60,7 +60,8 @@ struct vpl {
     glm::vec3 flux{0.f};              ///< W per channel, already divided by the sampling probability
     /// World area (m^2) it stands for: its texel's (texel_world_area) divided like its flux
     /// by count x probability, so the VPLs' areas sum to the lit area the map sees. The
-    /// footprint clamp (indirect/rsm.hpp's vpl_min_distance2) makes it a disc of this area.
+    /// footprint clamp (pixel_light_params::min_distance2_for, indirect/options.hpp) makes it
+    /// a disc of this area.
     float area = 0.f;
 };
 
