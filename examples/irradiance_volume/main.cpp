@@ -118,13 +118,7 @@ int run(const options& o) {
         std::vector<glm::vec3> points;
         for (std::size_t s = 0; s < 4; ++s) points.push_back(path.centre(s, 4));
         const ojson environments = study::sh_environment_study(light, points);
-        for (const auto& e : environments) {
-            std::printf("environment at (%.3f, %.3f, %.3f)\n  order  radiance L2  irradiance max/peak  mean/peak\n",
-                        e["position"][0].get<double>(), e["position"][1].get<double>(), e["position"][2].get<double>());
-            for (const auto& r : e["orders"])
-                std::printf("  %5d  %11.4f  %19.4f  %9.4f\n", r["order"].get<int>(), r["radiance_rel_l2"].get<double>(),
-                            r["irradiance_max_rel_peak"].get<double>(), r["irradiance_mean_rel_peak"].get<double>());
-        }
+        study::print_sh_environments(environments);
         if (!o.json.empty())
             io::write_text_file(o.json, ojson{{"technique", "irradiance_volume_sh_study"}, {"scene", scene.name},
                                               {"environments", environments},
@@ -132,8 +126,7 @@ int run(const options& o) {
         return 0;
     }
 
-    // Bake.
-    irradiance_volume_settings vs;
+    irradiance_volume_settings vs;  // the bake
     vs.max_depth = o.max_depth;
     vs.min_depth = o.mode == volume_mode::uniform ? o.max_depth
                    : o.min_depth >= 0            ? o.min_depth
@@ -183,16 +176,14 @@ int run(const options& o) {
     cpu::volume_lookup chosen_how;
     for (const auto& [name, how] : variants) {
         auto f = sphere.measure(volume, name, how);
-        lookups[name] = {{"rel_rms", f.error.rel_rms},       {"max_abs", f.error.max_abs},   {"popping", f.popping},
-                         {"popping_excess", f.popping_excess}, {"lookup_ns", f.lookup_ns}, {"popping_series", f.popping_series}};
+        lookups[name] = f.to_json();
         std::printf("%-20s rel_rms %.4f  popping %.4f (excess %.4f)  lookup %.0f ns\n", name.c_str(), f.error.rel_rms, f.popping,
                     f.popping_excess, f.lookup_ns);
         if (name == chosen) best = std::move(f), chosen_how = how;
     }
     std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms; reference popping %.4f\n",
                 scene.name.c_str(), examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(),
-                stats.probes_inside,
-                volume.leaf_count(), bake_ms, sphere.reference_popping());
+                stats.probes_inside, volume.leaf_count(), bake_ms, sphere.reference_popping());
 
     std::size_t strip_w = 0, strip_h = 0;
     if (!o.out.empty()) {
@@ -236,11 +227,7 @@ int run(const options& o) {
     j["popping_reference"] = sphere.reference_popping();
     j["popping_reference_series"] = sphere.reference_popping_series();
     j["lookups"] = lookups;
-    j["build"] = {{"split_min_depth", stats.split_min_depth}, {"split_distance", stats.split_distance},
-                  {"split_neighbour", stats.split_neighbour}, {"split_geometry", stats.split_geometry},
-                  {"split_gradient", stats.split_gradient},   {"split_prediction", stats.split_prediction},
-                  {"culled", stats.culled},
-                  {"inside_cells", stats.inside_cells}};
+    j["build"] = study::build_stats_json(stats);
     j["light_transport"] = "one-bounce indirect: probes and reference integrate Kd/pi * direct irradiance at the first hit";
     j["provenance"] = study::collect_provenance().to_json();
     io::write_text_file(o.json, j.dump(2, ' ', false, ojson::error_handler_t::replace) + "\n");

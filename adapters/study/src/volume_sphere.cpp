@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <span>
@@ -355,6 +356,28 @@ nlohmann::ordered_json sh_environment_study(const embree::reference_integrator& 
         all.push_back({{"position", {p.x, p.y, p.z}}, {"orders", rows}});
     }
     return all;
+}
+
+nlohmann::ordered_json volume_lookup_figures::to_json() const {
+    return {{"rel_rms", error.rel_rms}, {"max_abs", error.max_abs},       {"popping", popping},
+            {"popping_excess", popping_excess}, {"lookup_ns", lookup_ns}, {"popping_series", popping_series}};
+}
+
+nlohmann::ordered_json build_stats_json(const irradiance_volume_build_stats& stats) {
+    return {{"split_min_depth", stats.split_min_depth}, {"split_distance", stats.split_distance},
+            {"split_neighbour", stats.split_neighbour}, {"split_geometry", stats.split_geometry},
+            {"split_gradient", stats.split_gradient},   {"split_prediction", stats.split_prediction},
+            {"culled", stats.culled},                   {"inside_cells", stats.inside_cells}};
+}
+
+void print_sh_environments(const nlohmann::ordered_json& environments) {
+    for (const auto& e : environments) {
+        std::printf("environment at (%.3f, %.3f, %.3f)\n  order  radiance L2  irradiance max/peak  mean/peak\n",
+                    e["position"][0].get<double>(), e["position"][1].get<double>(), e["position"][2].get<double>());
+        for (const auto& r : e["orders"])
+            std::printf("  %5d  %11.4f  %19.4f  %9.4f\n", r["order"].get<int>(), r["radiance_rel_l2"].get<double>(),
+                        r["irradiance_max_rel_peak"].get<double>(), r["irradiance_mean_rel_peak"].get<double>());
+    }
 }
 
 }  // namespace bounce::study

@@ -78,7 +78,14 @@ struct volume_lookup_figures {
     double popping_excess = 0;  ///< largest change of (lookup - reference) / the reference's mean
     double lookup_ns = 0;       ///< per point, median of the repeats
     std::vector<double> popping_series;  ///< luminance at the popping point, per step
+
+    /// {"rel_rms", "max_abs", "popping", "popping_excess", "lookup_ns", "popping_series"}.
+    nlohmann::ordered_json to_json() const;
 };
+
+/// How an octree was built: {"split_min_depth", "split_distance", "split_neighbour",
+/// "split_geometry", "split_gradient", "split_prediction", "culled", "inside_cells"}.
+nlohmann::ordered_json build_stats_json(const irradiance_volume_build_stats& stats);
 
 /// The sphere's points and the reference on them (computed by the constructor, in parallel).
 class volume_sphere_study {
@@ -122,5 +129,8 @@ image<glm::vec3> render_sphere_strip(const embree::accel& bvh, const scene_view&
 /// samples, relative to its peak. Rows {"position", "orders": [{"order",
 /// "radiance_rel_l2", "irradiance_max_rel_peak", "irradiance_mean_rel_peak"}]}.
 nlohmann::ordered_json sh_environment_study(const embree::reference_integrator& light, const std::vector<glm::vec3>& points);
+
+/// sh_environment_study's rows as a table on stdout, one block per environment.
+void print_sh_environments(const nlohmann::ordered_json& environments);
 
 }  // namespace bounce::study
