@@ -228,3 +228,43 @@ TEST_CASE("visibility by rays without an occlusion query is refused by its optio
     CHECK_THROWS_WITH(embree::occlusion_rays(bvh, -1.f), Catch::Contains("offset"));
     CHECK_THROWS_WITH(embree::occlusion_rays(bvh, std::nanf("")), Catch::Contains("offset"));
 }
+
+TEST_CASE("imperfect shadow maps darken the floor behind the partition as the rays do",
+          "[rsm][embree][visibility][ism]") {
+    // The partition room above, SII with 1024 VPLs, 4 x 4 and blur: with imperfect shadow
+    // maps (indirect/imperfect_shadow_maps.hpp) the floor behind the partition must be
+    // darker than the open floor, and its ratio near the one the exact rays give.
+    const hand_built::scene s = partition_room();
+    const embree::accel bvh(s.view());
+    camera cam;
+    cam.position = {0.f, 2.45f, 0.f};
+    cam.look_at = {0.f, 0.f, 0.f};
+    cam.up = {0.f, 0.f, -1.f};
+    cam.fov_y_deg = 90.f;
+    const std::size_t size = 96;
+    gbuffer<float> g = embree::ray_cast_gbuffer(bvh, s.view(), cam, size, size);
+    embree::rsm_ray_caster caster(bvh, s.view(), {128, 60.f});
+    caster.render();
+    const embree::occlusion_rays rays(bvh);
+    const ism_point_sampler points(s.view());
+    const float clamp = scene_clamp_distance(s.view());
+    indirect_options o;
+    o.count = 1024;
+    o.pattern = {4, 4};
+    o.light.min_distance2 = clamp * clamp;
+    image<glm::vec3> none(size, size), exact(size, size), ism(size, size);
+    cpu::indirect_renderer(o).render(g.view(), cam, caster.views(), none.view());
+    o.visibility = indirect_visibility::rays;
+    cpu::indirect_renderer(o, &rays).render(g.view(), cam, caster.views(), exact.view());
+    o.visibility = indirect_visibility::ism;
+    cpu::indirect_renderer(o, nullptr, &points).render(g.view(), cam, caster.views(), ism.view());
+    const auto ratio = [&](const image<glm::vec3>& e) {
+        return floor_mean(g, e, -1.6f, -0.7f) / floor_mean(g, e, 0.7f, 1.6f);
+    };
+    const double r_none = ratio(none), r_rays = ratio(exact), r_ism = ratio(ism);
+    INFO("behind / open floor: none " << r_none << ", rays " << r_rays << ", ism " << r_ism);
+    CHECK(r_ism < 0.6 * r_none);
+    CHECK(std::abs(r_ism / r_rays - 1) <= 0.15);
+    // The open floor sees most VPLs: ISM's false shadows there stay small.
+    CHECK(floor_mean(g, ism, 0.7f, 1.6f) >= 0.85 * floor_mean(g, exact, 0.7f, 1.6f));
+}

@@ -8,6 +8,7 @@
 /// rectangles) are in indirect/rsm_sampling.hpp.
 
 #include <bounce/errors.hpp>
+#include <bounce/indirect/imperfect_shadow_maps.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/visibility.hpp>
 #include <bounce/scene_view.hpp>
@@ -121,6 +122,9 @@ struct indirect_options {
     /// as DS05/DS06 do; rays tests every pair the frame sums (the renderer needs an
     /// occlusion_query, CPU only).
     indirect_visibility visibility = indirect_visibility::none;
+    /// Imperfect shadow maps' parameters (visibility ism; SII only, the renderer needs an
+    /// ism_point_sampler of the scene).
+    ism_params ism;
     /// SII splat cutoff, W/m^2 per pixel over all VPLs (each VPL is splatted over the sphere
     /// outside which it gives less than cutoff / VPLs); 0: whole screen.
     float sii_cutoff = 0.f;
@@ -155,6 +159,11 @@ struct indirect_options {
         require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
                 "applies to the RSM gather only");
         upsample.validate();
+        if (visibility == indirect_visibility::ism) {
+            require(technique == indirect_technique::sii, "visibility",
+                    "ism applies to SII only (the RSM gather's disc samples have no maps of their own)");
+            ism.validate(count);
+        }
     }
 };
 

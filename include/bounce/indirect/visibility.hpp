@@ -26,13 +26,19 @@ namespace bounce::inline indirect {
 enum class indirect_visibility {
     none,  ///< none, as published (DS05, DS06): light leaks through walls and partitions
     rays,  ///< every pair the frame sums, by an occlusion ray (exact; needs an occlusion_query)
+    /// imperfect shadow maps (Ritschel et al. 2008, indirect/imperfect_shadow_maps.hpp): each
+    /// VPL's paraboloid depth map splatted from a point sampling of the scene (approximate;
+    /// SII only; needs an ism_point_sampler)
+    ism,
 };
 
-inline constexpr std::array<indirect_visibility, 2> indirect_visibilities = {indirect_visibility::none,
-                                                                           indirect_visibility::rays};
+inline constexpr std::array<indirect_visibility, 3> indirect_visibilities = {
+    indirect_visibility::none, indirect_visibility::rays, indirect_visibility::ism};
 
-/// "none", "rays": the spelling of programs' --visibility and of results files.
-constexpr std::string_view visibility_name(indirect_visibility v) { return v == indirect_visibility::rays ? "rays" : "none"; }
+/// "none", "rays", "ism": the spelling of programs' --visibility and of results files.
+constexpr std::string_view visibility_name(indirect_visibility v) {
+    return v == indirect_visibility::rays ? "rays" : v == indirect_visibility::ism ? "ism" : "none";
+}
 
 /// The policy spelled `name` (visibility_name's inverse); nullopt for a name none has.
 constexpr std::optional<indirect_visibility> parse_visibility(std::string_view name) {

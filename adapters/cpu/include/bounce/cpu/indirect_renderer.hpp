@@ -18,6 +18,7 @@
 /// rectangles in indirect/rsm_sampling.hpp) are the core's, shared with gl::indirect_renderer.
 
 #include <bounce/camera.hpp>
+#include <bounce/cpu/imperfect_shadow_maps.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/cpu/sii_splat.hpp>
@@ -39,11 +40,22 @@ namespace bounce::cpu {
 class indirect_renderer {
 public:
     /// `occlusion` answers the visibility queries of options.visibility == rays
-    /// (embree::occlusion_query); it must outlive the frames that use it.
-    explicit indirect_renderer(const indirect_options& options = {}, const occlusion_query* occlusion = nullptr)
-        : options_(options), occlusion_(occlusion) {
+    /// (embree::occlusion_query); `points` samples the scene for visibility ism. Both must
+    /// outlive the frames that use them.
+    explicit indirect_renderer(const indirect_options& options = {}, const occlusion_query* occlusion = nullptr,
+                               const ism_point_sampler* points = nullptr)
+        : options_(options), occlusion_(occlusion), points_(points) {
         options_.validate();
         require_occlusion(options_, occlusion_);
+        require_points(options_, points_);
+    }
+
+    /// The scene's point sampler of the next frames (visibility ism); nullptr allowed only
+    /// while options().visibility is not ism. Throws parameter_error otherwise.
+    void set_point_sampler(const ism_point_sampler* points) {
+        require_points(options_, points);
+        if (points != points_) ism_points_.clear();
+        points_ = points;
     }
 
     const indirect_options& options() const noexcept { return options_; }
@@ -61,6 +73,7 @@ public:
     void set_options(const indirect_options& options) {
         options.validate();
         require_occlusion(options, occlusion_);
+        require_points(options, points_);
         if (options == options_) return;
         options_ = options;
         full_pattern_.clear();
@@ -80,7 +93,8 @@ public:
     /// per spot or directional light, six per point light) reflect onto the G-buffer's
     /// pixels, as `quantity` (output.hpp): irradiance (W/m^2, the default) or radiance with
     /// the G-buffer's albedo; 0 where the G-buffer sees nothing. Unoccluded (light passes
-    /// through walls, as DS05/DS06 publish it) unless options().visibility asks for rays.
+    /// through walls, as DS05/DS06 publish it) unless options().visibility asks for rays or
+    /// imperfect shadow maps (ism).
     indirect_timings render(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
                             image_view<glm::vec3> out, output_quantity quantity = output_quantity::irradiance) {
         const indirect_timings t = render_irradiance(gb, cam, maps, out);
@@ -210,7 +224,24 @@ private:
         sp.light = options_.light;
         sp.cutoff = options_.sii_cutoff;
         sp.energy_correct = options_.energy_correct;
-        splat_vpls(gb, imaps, cam, vpls_, g, sp, out, occlusion());
+        const imperfect_shadow_maps* ism = nullptr;
+        if (options_.visibility == indirect_visibility::ism) {
+            build_ism();
+            ism = &ism_;
+        }
+        splat_vpls(gb, imaps, cam, vpls_, g, sp, out, occlusion(), ism);
+    }
+
+    /// The frame's imperfect shadow maps: the point set (count x points_per_vpl points,
+    /// kept while neither changes), then the maps of vpls_.
+    void build_ism() {
+        const ism_params& p = options_.ism;
+        const std::size_t total = options_.count * std::size_t(p.points_per_vpl);
+        if (ism_points_.size() != total || ism_seed_ != p.seed) {
+            ism_points_ = points_->points(total, p.seed);
+            ism_seed_ = p.seed;
+        }
+        ism_.build(vpls_, ism_points_, p, ism_point_spacing(points_->area(), p.points_per_vpl));
     }
 
     /// The groups of a pattern already reordered by grouped_pattern: run s is
@@ -227,6 +258,11 @@ private:
         if (o.visibility == indirect_visibility::rays && !q)
             throw parameter_error("visibility", "rays needs an occlusion query (embree::occlusion_query) given to the "
                                                 "renderer");
+    }
+
+    static void require_points(const indirect_options& o, const ism_point_sampler* p) {
+        if (o.visibility == indirect_visibility::ism && !p)
+            throw parameter_error("visibility", "ism needs the scene's ism_point_sampler given to the renderer");
     }
 
     /// The query the frame asks: none unless the options ask for rays.
@@ -247,6 +283,10 @@ private:
     std::vector<glm::vec3> full_pattern_;
     std::size_t pattern_texels_ = 0;
     std::vector<vpl> vpls_;
+    const ism_point_sampler* points_ = nullptr;
+    std::vector<glm::vec3> ism_points_;
+    std::uint64_t ism_seed_ = 0;
+    imperfect_shadow_maps ism_;
 };
 
 }  // namespace bounce::cpu

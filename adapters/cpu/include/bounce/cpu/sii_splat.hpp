@@ -12,6 +12,7 @@
 /// sums the same terms in the same order whatever the thread count (bitwise reproducible).
 
 #include <bounce/camera.hpp>
+#include <bounce/cpu/imperfect_shadow_maps.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/gbuffer.hpp>
@@ -118,10 +119,12 @@ inline void splat_visible(const gbuffer_view<float>& gb, const vpl& l, float sca
 /// itself for a 1 x 1 pattern): sub-buffer s receives `groups.group(s)`. `gb` is the split
 /// G-buffer; `cam` the camera of the full image (maps.width x maps.height). With
 /// `occlusion`, a VPL lights only the pixels that see it (indirect/visibility.hpp; the
-/// pixels of one VPL and tile asked in one batch).
+/// pixels of one VPL and tile asked in one batch); with `ism` instead (built for `vpls`),
+/// each term is multiplied by imperfect_shadow_maps::visible.
 inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& maps, const camera& cam,
                        std::span<const vpl> vpls, const light_groups& groups, const sii_params& params,
-                       image_view<glm::vec3> out, const occlusion_query* occlusion = nullptr) {
+                       image_view<glm::vec3> out, const occlusion_query* occlusion = nullptr,
+                       const imperfect_shadow_maps* ism = nullptr) {
     params.validate();
     detail::require_size(gb.width(), gb.height(), maps, "gb");
     detail::require_size(out.width(), out.height(), maps, "out");
@@ -165,6 +168,11 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
             if (occlusion)
                 detail::splat_visible(gb, l, scale, params.light, rects[k], tile_rect, *occlusion, scratches.local(),
                                       out);
+            else if (ism)
+                detail::splat(gb, l, scale, params.light, rects[k], tile_rect,
+                              [&](std::size_t u, std::size_t v, const glm::vec3& e) {
+                                  out(u, v) += e * ism->visible(groups.order[k], gb.position(u, v), gb.normal(u, v), l);
+                              });
             else
                 detail::splat(gb, l, scale, params.light, rects[k], tile_rect,
                               [&](std::size_t u, std::size_t v, const glm::vec3& e) { out(u, v) += e; });
