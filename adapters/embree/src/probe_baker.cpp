@@ -1,4 +1,5 @@
 #include <bounce/embree/probe_baker.hpp>
+#include <bounce/embree/probe_visibility_baker.hpp>
 
 #include <bounce/luminance.hpp>
 #include <bounce/sh/projection.hpp>
@@ -45,13 +46,7 @@ probe_baker::probe_baker(const reference_integrator& light, const accel& bvh, co
             "must be finite and >= 0 (0: keep every gradient)");
     require(settings_.inside_fraction >= 0 && settings_.inside_fraction <= 1, "inside_fraction", "must lie in [0, 1]");
     require_match(bvh, scene);
-    // Spherical Fibonacci points: z uniform in (-1, 1) at cell centres, golden-angle azimuth.
-    const double n = settings_.rays, golden = std::numbers::pi * (3 - std::sqrt(5.0));
-    directions_.reserve(settings_.rays);
-    for (std::uint32_t j = 0; j < settings_.rays; ++j) {
-        const double z = 1 - (2 * j + 1) / n, r = std::sqrt(std::max(0.0, 1 - z * z)), phi = golden * j;
-        directions_.push_back(glm::normalize(glm::dvec3(r * std::cos(phi), r * std::sin(phi), z)));
-    }
+    directions_ = spherical_fibonacci_directions(settings_.rays);
 }
 
 probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t seed, cast* details) const {
