@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -68,6 +69,7 @@ struct vpl_splats {
     std::size_t selected = 0;
     std::vector<gpu_vpl> packed;
     std::vector<glm::vec4> rects;
+    std::vector<glm::vec4> frames;  // every selected VPL's position and normal, selection order
 };
 
 // VPLs from the read-back maps, selected and grouped as the CPU renderer does, each with its
@@ -90,6 +92,10 @@ vpl_splats place_vpl_splats(std::span<const rsm_textures> maps, const camera& ca
     const glm::mat4 view = cam.view_matrix();
     vpl_splats out;
     out.selected = all.size();
+    for (const auto& l : all) {
+        out.frames.emplace_back(l.position, 0.f);
+        out.frames.emplace_back(l.normal, 0.f);
+    }
     splatted.clear();
     for (int s = 0; s < pattern.cells(); ++s) {
         const int i = s % pattern.n, j = s / pattern.n;
@@ -102,7 +108,8 @@ vpl_splats place_vpl_splats(std::span<const rsm_textures> maps, const camera& ca
                 vpl_splat_rect(cam, view, l, all.size(), o.sii_cutoff, o.light.offset, w, h), pattern, i, j, sub);
             if (q.empty()) continue;
             out.packed.push_back(
-                {glm::vec4(scaled.position, o.light.min_distance2_for(scaled.area)), glm::vec4(scaled.normal, 0.f),
+                {glm::vec4(scaled.position, o.light.min_distance2_for(scaled.area)),
+                 glm::vec4(scaled.normal, float(groups.order[k])),
                  glm::vec4(scaled.flux, 0.f)});
             out.rects.emplace_back(float(q.x0), float(q.y0), float(q.x1), float(q.y1));
         }
@@ -135,6 +142,16 @@ struct indirect_renderer::passes {
     std::optional<buffer> whole_disc, whole_group;
     std::size_t disc_count = 0, disc_texels = 0;
     std::optional<buffer> vpls, rects;
+    // Imperfect shadow maps: the programs (made on the first ism frame), the point set as
+    // uploaded (kept while its sampler, size and seed stay), the frame's VPLs and the depth
+    // pyramid (every level, finest first).
+    std::optional<program> ism_splat, ism_pull, ism_push;
+    std::optional<buffer> ism_points, ism_vpls, ism_depth;
+    const ism_point_sampler* ism_sampler = nullptr;
+    std::size_t ism_point_count = 0;
+    std::uint64_t ism_seed = 0;
+    ism_atlas_layout ism_layout;
+    float ism_spacing = 0.f;
     // Low-resolution G-buffer and result, the fallback mask, and the query that counts the
     // fallback's pixels.
     std::optional<texture> low_position_depth, low_normal, low_irradiance, fallback_mask;
@@ -306,11 +323,82 @@ struct indirect_renderer::passes {
         const program& prog = splat;
         prog.set(loc_size, glm::vec2(float(w), float(h)));
         prog.set(loc_offset, o.light.offset);
+        const bool ism = o.visibility == indirect_visibility::ism;
+        prog.set(6, ism ? 1 : 0);
+        if (ism) {
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ism_depth->id());
+            prog.set(7, float(ism_layout.map_size));
+            prog.set(8, int(ism_layout.columns));
+            prog.set(9, int(ism_layout.width()));
+            prog.set(10, ism_spacing);
+            prog.set(11, o.ism.bias_scale);
+        }
         glUseProgram(prog.id());
         glVertexArrayVertexBuffer(rect_vao.id(), 0, rects->id(), 0, sizeof(glm::vec4));
         glBindVertexArray(rect_vao.id());
         glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, GLsizei(packed.size()));
         glDisable(GL_BLEND);
+    }
+
+    // The frame's imperfect shadow maps of the VPLs `frames` (selection order) in ism_depth:
+    // the point set (made and uploaded when it changes), cleared atlas, splat, pull-push.
+    void build_ism(const ism_point_sampler& sampler, const indirect_options& o, const std::vector<glm::vec4>& frames) {
+        const ism_params& ip = o.ism;
+        if (!ism_splat) {
+            ism_splat.emplace(program::compute(ism_splat_compute()));
+            ism_pull.emplace(program::compute(ism_pull_compute()));
+            ism_push.emplace(program::compute(ism_push_compute()));
+        }
+        const std::size_t total = o.count * std::size_t(ip.points_per_vpl);
+        if (!ism_points || ism_sampler != &sampler || ism_point_count != total || ism_seed != ip.seed) {
+            const std::vector<glm::vec3> pts = sampler.points(total, ip.seed);
+            std::vector<glm::vec4> packed(std::max<std::size_t>(pts.size(), 1), glm::vec4(0.f));
+            for (std::size_t i = 0; i < pts.size(); ++i) packed[i] = glm::vec4(pts[i], 0.f);
+            ism_points.emplace(std::span<const glm::vec4>(packed));
+            ism_sampler = &sampler;
+            ism_point_count = pts.size();
+            ism_seed = ip.seed;
+        }
+        const std::size_t v = frames.size() / 2;
+        ism_layout = ism_atlas_layout(ip.map_size, v);
+        ism_spacing = ism_point_spacing(sampler.area(), ip.points_per_vpl);
+        std::size_t texels = 0;
+        for (int l = 0; l <= ism_layout.levels(); ++l) texels += (ism_layout.width() >> l) * (ism_layout.height() >> l);
+        if (!ism_depth || ism_depth->size() != texels * sizeof(float)) ism_depth.emplace(texels * sizeof(float));
+        const std::uint32_t empty_bits = std::bit_cast<std::uint32_t>(ism_empty);
+        glClearNamedBufferData(ism_depth->id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &empty_bits);
+        if (v == 0) return;
+        ism_vpls.emplace(std::span<const glm::vec4>(frames));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ism_points->id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ism_vpls->id());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, ism_depth->id());
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        const program& sp = *ism_splat;
+        sp.set(0, unsigned(ism_point_count));
+        sp.set(1, unsigned(v));
+        sp.set(2, float(ip.map_size));
+        sp.set(3, unsigned(ism_layout.columns));
+        sp.set(4, unsigned(ism_layout.width()));
+        glUseProgram(sp.id());
+        const std::size_t groups = (ism_point_count + 255) / 256, gx = std::min<std::size_t>(groups, 4096);
+        if (groups > 0) glDispatchCompute(GLuint(gx), GLuint((groups + gx - 1) / gx), 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        if (!ip.pull_push) return;
+        std::vector<std::size_t> offset(1, 0);
+        for (int l = 1; l <= ism_layout.levels(); ++l)
+            offset.push_back(offset.back() + (ism_layout.width() >> (l - 1)) * (ism_layout.height() >> (l - 1)));
+        const auto level_pass = [&](const program& p, int coarse, std::size_t dispatch_w, std::size_t dispatch_h) {
+            p.set(0, unsigned(offset[std::size_t(coarse - 1)]));
+            p.set(1, unsigned(offset[std::size_t(coarse)]));
+            glProgramUniform2ui(p.id(), 2, GLuint(ism_layout.width() >> coarse), GLuint(ism_layout.height() >> coarse));
+            glUseProgram(p.id());
+            glDispatchCompute(GLuint((dispatch_w + 7) / 8), GLuint((dispatch_h + 7) / 8), 1);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        };
+        for (int l = 1; l <= ism_layout.levels(); ++l)
+            level_pass(*ism_pull, l, ism_layout.width() >> l, ism_layout.height() >> l);
+        for (int l = ism_layout.levels(); l >= 1; --l)
+            level_pass(*ism_push, l, ism_layout.width() >> (l - 1), ism_layout.height() >> (l - 1));
     }
 
     // The geometry-aware blur of `gathered` into `out`: the discontinuity buffer of g, then
@@ -347,8 +435,8 @@ indirect_renderer::indirect_renderer(const indirect_options& options, bool time_
 
 void indirect_renderer::validate_options(const indirect_options& options) {
     options.validate();
-    require(options.visibility == indirect_visibility::none, "visibility",
-            "the GL renderer has none yet (rays: cpu::indirect_renderer with embree::occlusion_rays)");
+    require(options.visibility != indirect_visibility::rays, "visibility",
+            "rays run on the CPU only (cpu::indirect_renderer with embree::occlusion_rays); GL offers ism");
 }
 
 indirect_renderer::~indirect_renderer() = default;
@@ -380,7 +468,9 @@ indirect_timings indirect_renderer::render(const gbuffer_textures& g, const came
     indirect_timings t;
     const detail::raster_state raster;
     const detail::blend_offset_state blend;
-    const detail::program_and_storage_state bindings({0u, 1u});
+    require(options_.visibility != indirect_visibility::ism || points_, "visibility",
+            "ism needs the scene's ism_point_sampler (set_point_sampler)");
+    const detail::program_and_storage_state bindings({0u, 1u, 2u});
     const detail::texture_unit_state units(0, 6);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
@@ -475,6 +565,7 @@ void indirect_renderer::frame(const gbuffer_textures& g, std::size_t w, std::siz
     } else {
         const vpl_splats splats = place_vpl_splats(maps, cam, w, h, options_, scale, splatted_);
         t.vpls = splats.selected;
+        if (options_.visibility == indirect_visibility::ism) p.build_ism(*points_, options_, splats.frames);
         if (!splats.packed.empty()) p.draw_splats(shaded, shaded_out, w, h, splats.packed, splats.rects, options_);
     }
     check_error("indirect_renderer shade");

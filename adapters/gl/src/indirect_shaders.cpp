@@ -5,6 +5,7 @@
 #include "gbuffer_samplers.hpp"
 
 #include <bounce/glsl/emit.hpp>
+#include <bounce/indirect/imperfect_shadow_maps.hpp>
 #include <bounce/indirect/rsm.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
 
@@ -223,14 +224,25 @@ std::string splat_fragment() {
     glsl::function_set k;
     k.add("pixel_light_irradiance", pixel_light_irradiance<glsl::f32, glsl::vec3>, "x", "n", "xp", "np", "flux",
           "offset", "min_distance2");
-    // position.w: the VPL's own d^2 clamp (pixel_light_params::min_distance2_for).
+    k.add("ism_map_texel", ism_map_texel<glsl::f32, glsl::vec3, glsl::vec2>, "p", "origin", "n", "res");
+    k.add("ism_visible", ism_visible<glsl::f32, glsl::vec3>, "receiver", "receiver_normal", "origin", "stored_depth",
+          "res", "spacing", "scale");
+    // position.w: the VPL's own d^2 clamp (pixel_light_params::min_distance2_for); normal.w:
+    // its index in the frame's selection, its map in the imperfect shadow maps' atlas.
     return std::string("#version 450 core\n") + R"(struct bounce_vpl {
     vec4 position;
     vec4 normal;
     vec4 flux;
 };
 layout(std430, binding = 0) readonly buffer bounce_vpls { bounce_vpl vpls[]; };
+layout(std430, binding = 2) readonly buffer bounce_ism_depth { float ism_depth[]; };
 )" + detail::gbuffer_position_normal_samplers() + R"(layout(location = 5) uniform float offset;
+layout(location = 6) uniform int ism_on;
+layout(location = 7) uniform float ism_map_size;
+layout(location = 8) uniform int ism_columns;
+layout(location = 9) uniform int ism_atlas_width;
+layout(location = 10) uniform float ism_spacing;
+layout(location = 11) uniform float ism_bias_scale;
 flat in int vpl_index;
 layout(location = 0) out vec4 irradiance;
 
@@ -240,8 +252,89 @@ void main() {
     vec4 position_depth = texelFetch(gbuffer_position_depth, g, 0);
     if (!covered(position_depth.w)) discard;
     bounce_vpl l = vpls[vpl_index];
-    irradiance = vec4(pixel_light_irradiance(position_depth.xyz, texelFetch(gbuffer_normal, g, 0).xyz, l.position.xyz,
-                                             l.normal.xyz, l.flux.xyz, offset, l.position.w), 0.0);
+    vec3 x = position_depth.xyz;
+    vec3 n = texelFetch(gbuffer_normal, g, 0).xyz;
+    vec3 e = pixel_light_irradiance(x, n, l.position.xyz, l.normal.xyz, l.flux.xyz, offset, l.position.w);
+    if (ism_on != 0) {
+        // The texel of the VPL's map in the atlas (ism_atlas_layout::index), its depth test.
+        int j = int(l.normal.w), s = int(ism_map_size);
+        vec3 t = ism_map_texel(x, l.position.xyz, l.normal.xyz, ism_map_size);
+        int at = ((j / ism_columns) * s + int(t.y)) * ism_atlas_width + (j % ism_columns) * s + int(t.x);
+        e = e * ism_visible(x, n, l.position.xyz, ism_depth[at], ism_map_size, ism_spacing, ism_bias_scale);
+    }
+    irradiance = vec4(e, 0.0);
+}
+)";
+}
+
+// Imperfect shadow maps, 1: point i of the set (VPL i % V's subset) into its VPL's map in
+// the atlas, the nearest depth kept by atomicMin on the float's bits (non-negative floats
+// order as their bits). 2D dispatch: i = y * (groups in x) * 256 + x.
+std::string ism_splat_compute() {
+    glsl::function_set k;
+    k.add("ism_splat_texel", ism_splat_texel<glsl::f32, glsl::vec3, glsl::vec2>, "p", "origin", "n", "res");
+    return std::string("#version 450 core\nlayout(local_size_x = 256) in;\n") +
+           R"(layout(std430, binding = 0) readonly buffer bounce_ism_points { vec4 points[]; };
+layout(std430, binding = 1) readonly buffer bounce_ism_vpls { vec4 vpl_frames[]; };
+layout(std430, binding = 2) buffer bounce_ism_depth { uint depth_bits[]; };
+layout(location = 0) uniform uint point_count;
+layout(location = 1) uniform uint vpl_count;
+layout(location = 2) uniform float map_size;
+layout(location = 3) uniform uint columns;
+layout(location = 4) uniform uint atlas_width;
+
+)" + k.source() + R"(
+void main() {
+    uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u + gl_GlobalInvocationID.x;
+    if (i >= point_count) return;
+    uint j = i % vpl_count;
+    vec3 t = ism_splat_texel(points[i].xyz, vpl_frames[2u * j].xyz, vpl_frames[2u * j + 1u].xyz, map_size);
+    if (!(t.z < )" + glsl::float_literal(ism_empty) + R"()) return;
+    uint s = uint(map_size);
+    uint at = ((j / columns) * s + uint(t.y)) * atlas_width + (j % columns) * s + uint(t.x);
+    atomicMin(depth_bits[at], floatBitsToUint(t.z));
+}
+)";
+}
+
+// 2: the pull, one coarse texel of 2 x 2 finer ones (levels stored one after another).
+std::string ism_pull_compute() {
+    glsl::function_set k;
+    k.add("ism_pull", ism_pull<glsl::f32>, "a", "b", "c", "d");
+    return std::string("#version 450 core\nlayout(local_size_x = 8, local_size_y = 8) in;\n") +
+           R"(layout(std430, binding = 2) buffer bounce_ism_depth { float depth[]; };
+layout(location = 0) uniform uint fine_offset;
+layout(location = 1) uniform uint coarse_offset;
+layout(location = 2) uniform uvec2 coarse_size;
+
+)" + k.source() + R"(
+void main() {
+    uvec2 c = gl_GlobalInvocationID.xy;
+    if (c.x >= coarse_size.x || c.y >= coarse_size.y) return;
+    uint fw = 2u * coarse_size.x;
+    uint f = fine_offset + 2u * c.y * fw + 2u * c.x;
+    depth[coarse_offset + c.y * coarse_size.x + c.x] = ism_pull(depth[f], depth[f + 1u], depth[f + fw], depth[f + fw + 1u]);
+}
+)";
+}
+
+// 3: the push, one finer texel from its (already pushed) parent.
+std::string ism_push_compute() {
+    glsl::function_set k;
+    k.add("ism_push", ism_push<glsl::f32>, "fine", "coarse");
+    return std::string("#version 450 core\nlayout(local_size_x = 8, local_size_y = 8) in;\n") +
+           R"(layout(std430, binding = 2) buffer bounce_ism_depth { float depth[]; };
+layout(location = 0) uniform uint fine_offset;
+layout(location = 1) uniform uint coarse_offset;
+layout(location = 2) uniform uvec2 coarse_size;
+
+)" + k.source() + R"(
+void main() {
+    uvec2 f = gl_GlobalInvocationID.xy;
+    uint fw = 2u * coarse_size.x;
+    if (f.x >= fw || f.y >= 2u * coarse_size.y) return;
+    uint at = fine_offset + f.y * fw + f.x;
+    depth[at] = ism_push(depth[at], depth[coarse_offset + (f.y / 2u) * coarse_size.x + f.x / 2u]);
 }
 )";
 }

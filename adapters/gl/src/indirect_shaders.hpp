@@ -16,5 +16,8 @@ std::string upsample_fragment();
 std::string splat_fragment();
 std::string discontinuity_fragment();
 std::string tent_fragment(int radius, bool vertical);
+std::string ism_splat_compute();
+std::string ism_pull_compute();
+std::string ism_push_compute();
 
 }  // namespace bounce::gl::indirect_glsl

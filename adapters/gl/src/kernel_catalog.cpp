@@ -7,6 +7,7 @@
 #include <bounce/cache/weighting.hpp>
 #include <bounce/direct_light.hpp>
 #include <bounce/gl/irradiance_volume.hpp>
+#include <bounce/indirect/imperfect_shadow_maps.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/rsm.hpp>
 #include <bounce/indirect/rsm_layout.hpp>
@@ -105,7 +106,12 @@ void indirect(catalog& c) {
         .add("indirect tent", "geometry_aware_tent", BOUNCE_KERNEL(geometry_aware_tent<7, f32, vec3>), "R = 7")
         .add("indirect tent", "geometry_aware_tent", BOUNCE_KERNEL(geometry_aware_tent<15, f32, vec3>), "R = 15")
         .add("indirect tent", "geometry_aware_tent", BOUNCE_KERNEL(geometry_aware_tent<31, f32, vec3>), "R = 31")
-        .add("indirect tent", "geometry_aware_tent", BOUNCE_KERNEL(geometry_aware_tent<63, f32, vec3>), "R = 63");
+        .add("indirect tent", "geometry_aware_tent", BOUNCE_KERNEL(geometry_aware_tent<63, f32, vec3>), "R = 63")
+        .add("indirect splat", "ism_map_texel", BOUNCE_KERNEL(ism_map_texel<f32, vec3, vec2>))
+        .add("indirect splat", "ism_visible", BOUNCE_KERNEL(ism_visible<f32, vec3>))
+        .add("indirect ism splat", "ism_splat_texel", BOUNCE_KERNEL(ism_splat_texel<f32, vec3, vec2>))
+        .add("indirect ism pull", "ism_pull", BOUNCE_KERNEL(ism_pull<f32>))
+        .add("indirect ism push", "ism_push", BOUNCE_KERNEL(ism_push<f32>));
 }
 
 void volume(catalog& c) {

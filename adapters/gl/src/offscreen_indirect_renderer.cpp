@@ -68,6 +68,7 @@ indirect_timings offscreen_indirect_renderer::render(const indirect_options& opt
         renderer_.reset();
         renderer_.emplace(options, /*time_stages=*/true);
     }
+    renderer_->set_point_sampler(points_);
     const indirect_timings t = renderer_->render(u.gbuffer.textures(), cam, refs, *u.out);
     read_texture(*u.out, irradiance);
     return t;

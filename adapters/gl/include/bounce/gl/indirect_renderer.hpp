@@ -27,7 +27,7 @@
 /// Textures are in GL row order (row 0 at the bottom); the index maps are applied to the
 /// rows counted from the top, as on the CPU, so both backends put a pixel in the same
 /// sub-buffer. The renderer restores the GL state it changes (framebuffers, viewport,
-/// program, vertex array, storage bindings 0-1, texture units 0-5 and their samplers,
+/// program, vertex array, storage bindings 0-2, texture units 0-5 and their samplers,
 /// blend, depth and dither state).
 
 #include <bounce/camera.hpp>
@@ -37,6 +37,7 @@
 #include <bounce/gl/output_pass.hpp>
 #include <bounce/gl/rsm_textures.hpp>
 #include <bounce/gl/splat_pass.hpp>
+#include <bounce/indirect/imperfect_shadow_maps.hpp>
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
@@ -68,9 +69,9 @@ public:
     /// without, the times measure only the issuing of commands.
     explicit indirect_renderer(const indirect_options& options = {}, bool time_stages = false);
 
-    /// options.validate(), and what this backend cannot do: receiver-sender visibility
-    /// (indirect_visibility::rays runs on the CPU, cpu::indirect_renderer with
-    /// embree::occlusion_rays). Throws parameter_error naming the field.
+    /// options.validate(), and what this backend cannot do: receiver-sender visibility by
+    /// rays (indirect_visibility::rays runs on the CPU, cpu::indirect_renderer with
+    /// embree::occlusion_rays; ism runs here). Throws parameter_error naming the field.
     static void validate_options(const indirect_options& options);
     ~indirect_renderer();
     indirect_renderer(const indirect_renderer&) = delete;
@@ -78,6 +79,13 @@ public:
 
     const indirect_options& options() const noexcept { return options_; }
     bool time_stages() const noexcept { return time_stages_; }
+
+    /// The scene's point sampler for visibility ism (indirect/imperfect_shadow_maps.hpp): its
+    /// points are uploaded on the first ism frame (again when it, the VPL count or the
+    /// points per VPL change) and each SII frame splats them into the VPLs' maps (compute
+    /// passes, in the shade stage). It must outlive the frames; render throws
+    /// parameter_error when the options ask for ism and none was given.
+    void set_point_sampler(const ism_point_sampler* points) noexcept { points_ = points; }
 
     /// Writes into `irradiance` (RGBA32F, the G-buffer's size; rgb = W/m^2, a = 0) the
     /// one-bounce indirect irradiance `maps` (one per spot or directional light, six per
@@ -116,6 +124,7 @@ private:
     std::unique_ptr<passes> passes_;
     std::vector<vpl> splatted_;
     std::optional<output_pass> output_;
+    const ism_point_sampler* points_ = nullptr;
 };
 
 /// `gl::indirect_renderer` in an EGL context of its own, on a G-buffer and maps held in host
@@ -148,6 +157,9 @@ public:
         return t;
     }
 
+    /// The scene's point sampler for visibility ism (indirect_renderer::set_point_sampler).
+    void set_point_sampler(const ism_point_sampler* points) noexcept { points_ = points; }
+
     /// GL_RENDERER of the context ("llvmpipe (LLVM 15.0.6, 256 bits)" ...).
     std::string gl_renderer() const { return context_.renderer(); }
 
@@ -156,6 +168,7 @@ private:
     context context_;  // first: everything below needs it current
     std::unique_ptr<uploads> uploads_;
     std::optional<indirect_renderer> renderer_;
+    const ism_point_sampler* points_ = nullptr;
 };
 
 }  // namespace bounce::gl
