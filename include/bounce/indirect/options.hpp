@@ -10,6 +10,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/indirect/imperfect_shadow_maps.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
+#include <bounce/indirect/view_selection.hpp>
 #include <bounce/indirect/visibility.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -122,6 +123,10 @@ struct indirect_options {
     /// as DS05/DS06 do; rays tests every pair the frame sums (the renderer needs an
     /// occlusion_query, CPU only).
     indirect_visibility visibility = indirect_visibility::none;
+    /// With visibility rays (CPU): SII's VPLs drawn again from a larger pool by their
+    /// visible contribution to a sparse grid of pixels (indirect/view_selection.hpp; docs
+    /// section 15). candidates 1 turns it off.
+    view_selection_params view_selection;
     /// Imperfect shadow maps' parameters (visibility ism; SII only, the renderer needs an
     /// ism_point_sampler of the scene).
     ism_params ism;
@@ -159,6 +164,7 @@ struct indirect_options {
         require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
                 "applies to the RSM gather only");
         upsample.validate();
+        view_selection.validate();
         if (visibility == indirect_visibility::ism) {
             require(technique == indirect_technique::sii, "visibility",
                     "ism applies to SII only (the RSM gather's disc samples have no maps of their own)");

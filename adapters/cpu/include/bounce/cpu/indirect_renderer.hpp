@@ -22,6 +22,7 @@
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/cpu/sii_splat.hpp>
+#include <bounce/cpu/view_selection.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
@@ -212,7 +213,10 @@ private:
 
     void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
                      const interleave_maps& imaps, image_view<glm::vec3> out, indirect_timings& t) {
-        vpls_ = select_vpls(maps, options_);
+        // With rays, VPLs chosen by their visible contribution to the view (view_selection.hpp).
+        vpls_ = occlusion() && options_.view_selection.enabled()
+                    ? select_vpls_for_view(maps, options_, gb, occlusion(), imaps.pattern.cells())
+                    : select_vpls(maps, options_);
         t.vpls = vpls_.size();
         fill_zero(out);
         std::vector<glm::vec3> positions;
