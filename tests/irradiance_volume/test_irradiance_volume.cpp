@@ -267,7 +267,10 @@ TEST_CASE("the weighted lookup does not pop across a subdivision boundary", "[ir
             out[j].harmonic_mean_distance = 1;
         }
     };
+    f.settings.conforming_corners = false;  // the T-junction probes keep their baked values
     const auto v = irradiance_volume::build(f.scene, glm::vec3(-1), glm::vec3(1), f.settings, source);
+    f.settings.conforming_corners = true;   // they take the coarse side's interpolation
+    const auto conforming = irradiance_volume::build(f.scene, glm::vec3(-1), glm::vec3(1), f.settings, source);
     // The boundary between the depth-2 cells of x < 0 and the depth-4 cells of x > 0.
     REQUIRE(v.nodes()[v.find_leaf({-0.01f, 0.3f, 0.3f})].depth < v.nodes()[v.find_leaf({0.01f, 0.3f, 0.3f})].depth);
     const glm::vec3 n(0, 1, 0);
@@ -279,13 +282,14 @@ TEST_CASE("the weighted lookup does not pop across a subdivision boundary", "[ir
     }
     const float range = hi - lo;
     pcg32 rng(31);
-    float worst_weighted = 0, worst_trilinear = 0;
+    float worst_weighted = 0, worst_trilinear = 0, worst_conforming = 0;
     const float eps = 1e-4f;
     for (int trial = 0; trial < 400; ++trial) {
         const float y = 1.8f * rng.next_float() - 0.9f, z = 1.8f * rng.next_float() - 0.9f;
         const glm::vec3 left(-eps, y, z), right(eps, y, z);
         worst_weighted = std::max(worst_weighted, std::abs(v.weighted(left, n, {}).x - v.weighted(right, n, {}).x));
         worst_trilinear = std::max(worst_trilinear, std::abs(v.trilinear(left, n).x - v.trilinear(right, n).x));
+        worst_conforming = std::max(worst_conforming, std::abs(conforming.trilinear(left, n).x - conforming.trilinear(right, n).x));
     }
     // Budget: the weighted lookup is continuous (every probe enters and leaves the average
     // with weight 0), so over 2 eps it changes by at most its slope times 2 eps. The field's
@@ -296,6 +300,9 @@ TEST_CASE("the weighted lookup does not pop across a subdivision boundary", "[ir
     // corners' interpolation, ~ 2 * 0.5^2 / 4 * pi Y00), far above it.
     CHECK(worst_weighted < 0.01f * range);
     CHECK(worst_trilinear > 0.01f * range);  // the budget is tight enough to see trilinear pop
+    // With conforming corners trilinear is continuous too: over 2 eps it changes by at most
+    // its slope (below 4, times 3 / 2 for the coarse cell's bilinear face) times 2 eps.
+    CHECK(worst_conforming < 0.01f * range);
 }
 
 TEST_CASE("probes inside geometry are skipped by every lookup", "[irradiance_volume]") {

@@ -57,6 +57,18 @@ concept probe_source = requires(S& s, std::span<const glm::vec3> positions, std:
     s(positions, out);
 };
 
+/// How an adaptive irradiance volume finds its shape (irradiance_volume_settings::refinement).
+enum class volume_refinement {
+    /// Bake the finest uniform grid, then merge 8 leaves into their parent, from the finest
+    /// level up, where the parent's trilinear interpolation predicts every baked probe in
+    /// its box (prediction_tolerance, noise_sigmas): the decision sees every fine probe.
+    merge,
+    /// From the root down, try each cell's split and keep it where one of its 19 new probes
+    /// is not predicted (prediction_tolerance, noise_sigmas); with prediction_tolerance 0,
+    /// Oat's heuristics split and cull_tolerance culls.
+    split,
+};
+
 /// The octree's shape and Oat's subdivision heuristics. A heuristic is off when its
 /// threshold is 0. A cell at or above min_depth and below max_depth is split when any
 /// fires, unless all its corners are inside geometry (nothing there to light).
@@ -86,6 +98,9 @@ struct irradiance_volume_settings {
     /// trilinear interpolation predicts there, or within noise_sigmas standard errors.
     /// Typical: 0.02-0.1; 0 keeps every child.
     float cull_tolerance = 0.05f;
+    /// Merging from the finest grid (the default) or splitting from the root; merging needs
+    /// prediction_tolerance > 0 (with 0, Oat's heuristics split whatever this says).
+    volume_refinement refinement = volume_refinement::merge;
     /// Subdivision by prediction error (issue 31), which replaces the four heuristics above
     /// when > 0: every cell with a corner outside geometry is tried, its children's new
     /// corners baked, and the split kept only where some new probe's irradiance at an axis
@@ -106,6 +121,19 @@ struct irradiance_volume_settings {
     /// lowers the corners' noise instead of throwing the samples away. Off: the probes keep
     /// their baked values.
     bool refit_culled = true;
+    /// Conforming corners (issue 31): a leaf corner on a face or edge of a coarser leaf (a
+    /// T-junction) takes that leaf's interpolation there, so trilinear lookups are
+    /// continuous across level boundaries; its baked value joins the refit's samples. Off:
+    /// such corners keep their baked values and trilinear lookups jump at the boundary.
+    bool conforming_corners = true;
+    /// Merging (refinement merge) by a bias budget instead of the per-probe test, when > 0:
+    /// a cell merges while the bias its interpolation adds (mean squared miss less the
+    /// expected noise) stays below this fraction of the noise variance merging removes
+    /// (cell_bias_within_budget). 1: break-even with the refit's noise reduction.
+    float bias_budget = 0.f;
+    /// With bias_budget: scale the probes' reported noise to what the finest grid's second
+    /// differences support (noise_scale2).
+    bool calibrate_noise = true;
     /// Absolute floor added to the denominators above, as a fraction of the mean
     /// luminance of the root's probes, so that dark regions do not split on noise.
     /// Typical: 0.02.
@@ -123,6 +151,9 @@ struct irradiance_volume_build_stats {
     std::size_t split_min_depth = 0, split_distance = 0, split_neighbour = 0, split_geometry = 0, split_gradient = 0;
     std::size_t split_prediction = 0;  ///< cells tried by prediction error (culled ones included)
     std::size_t culled = 0;          ///< subdivisions undone by culling
+    std::size_t merged = 0;          ///< cells merged from their children (refinement merge)
+    std::size_t hanging_corners = 0; ///< leaf corners set from a coarser leaf (conforming_corners)
+    float noise_scale = 1;           ///< scale applied to the probes' noise (calibrate_noise)
     std::size_t inside_cells = 0;    ///< cells not split because every corner is inside geometry
     std::size_t probes_baked = 0;    ///< probes the source computed, culled ones included
     std::size_t probes_inside = 0;   ///< probes of the final volume flagged inside

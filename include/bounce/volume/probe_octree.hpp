@@ -26,6 +26,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/scene_view.hpp>
 #include <bounce/volume/kernels.hpp>
+#include <bounce/volume/octree_merging.hpp>
 #include <bounce/volume/octree_subdivision.hpp>
 
 #include <algorithm>
@@ -214,6 +215,14 @@ public:
     const std::vector<irradiance_probe>& probes() const noexcept { return all_; }
     /// Least-squares refit of the probes to the samples of culled splits (refit_probes).
     void refit(const std::vector<culled_sample>& samples, int sweeps) { refit_probes(all_, samples, sweeps); }
+    /// Sets the hanging corners from their coarser leaves (set_hanging_corners).
+    void set_hanging(const std::vector<culled_sample>& hanging) { set_hanging_corners(all_, hanging); }
+    /// f(index, lattice coordinates) for every baked probe.
+    template <class F>
+    void for_each_point(F&& f) const {
+        for (const auto& [key, idx] : at_key_)
+            f(idx, std::array<std::uint64_t, 3>{key % (res_ + 1), key / (res_ + 1) % (res_ + 1), key / ((res_ + 1) * (res_ + 1))});
+    }
 
     /// Bakes every corner of `cells` (cells of `depth`) not yet in the lattice, in one batch
     /// from `source`; `nodes` is the node count the volume will have with them, for
@@ -458,7 +467,17 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
     std::vector<detail::culled_sample> samples;
     lattice.bake_corners(level, 0, v.nodes_.size() + level.size(), s, source, stats);
     const float floor_level = detail::absolute_floor_level(lattice.probes(), s.absolute_floor);
-    for (int depth = 0; depth <= s.max_depth; ++depth) {
+    const bool merge = s.refinement == volume_refinement::merge && s.prediction_tolerance > 0 && s.min_depth < s.max_depth;
+    if (merge) {  // the finest grid, then merged from the finest level up
+        std::vector<detail::octree_cell> finest;
+        const std::uint64_t n = std::uint64_t(1) << s.max_depth;
+        for (std::uint64_t z = 0; z < n; ++z)
+            for (std::uint64_t y = 0; y < n; ++y)
+                for (std::uint64_t x = 0; x < n; ++x) finest.push_back({0, x, y, z, {}});
+        lattice.bake_corners(finest, s.max_depth, std::size_t((8 * n * n * n - 1) / 7), s, source, stats);
+        detail::merged_nodes(lattice, detail::merge_from_finest(lattice, floor_level, s, stats), s, v.nodes_);
+    }
+    for (int depth = 0; depth <= s.max_depth && !merge; ++depth) {
         for (const auto& c : level) {
             const auto keys = lattice.corner_keys(c, depth);
             for (int k = 0; k < 8; ++k) v.nodes_[c.node].corner[std::size_t(k)] = lattice.index(keys[std::size_t(k)]);
@@ -467,7 +486,13 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
         level = detail::grow_level(scene, level, depth, floor_level, s, source, lattice, v.nodes_, stats, samples);
         if (level.empty()) break;
     }
-    if (!samples.empty()) lattice.refit(samples, 16);
+    detail::lattice_constraints constraints;
+    if (merge || s.conforming_corners) {
+        constraints = detail::conforming_constraints(lattice, v.nodes_, s.max_depth);
+        samples = std::move(constraints.samples);  // the culled splits' probes are among them
+    }
+    if (s.refit_culled && !samples.empty()) lattice.refit(samples, 16);
+    if (s.conforming_corners) lattice.set_hanging(constraints.hanging), stats.hanging_corners = constraints.hanging.size();
     v.probes_ = detail::used_probes(lattice.probes(), v.nodes_);
     for (const auto& p : v.probes_) stats.probes_inside += p.inside ? 1 : 0;
     if (stats.probes_inside == v.probes_.size())
