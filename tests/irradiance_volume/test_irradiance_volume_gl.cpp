@@ -15,6 +15,7 @@
 
 #include <bounce/gl/irradiance_volume.hpp>
 #include <bounce/volume/probe_octree.hpp>
+#include <bounce/volume/probe_visibility.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -102,4 +103,40 @@ TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_vo
     CHECK_THROWS_AS(lookup.light_points(buffers, points, normals, gl::volume_interpolation::weighted, {},
                                         output_quantity::radiance),
                     parameter_error);
+
+    // Visibility (DDGI, volume/probe_visibility.hpp): random distance moments in 8 x 8 maps,
+    // points at probes too (distance 0), the eye inside the volume; the same tolerance.
+    std::vector<float> moments;
+    for (std::size_t j = 0; j < volume.probes().size() * 64; ++j) {
+        const float mean = 1.2f * rng.next_float(), variance = 0.05f * rng.next_float() * rng.next_float();
+        moments.push_back(mean);
+        moments.push_back(mean * mean + variance);
+    }
+    const probe_visibility vis(8, moments);
+    for (std::size_t j = 0; j < volume.probes().size(); j += 17) points[j] = volume.probes()[j].position;
+    const glm::vec3 eye(0.1f, 0.2f, -0.3f);
+    const gl::irradiance_volume_buffers with_moments(volume, &vis);
+    CHECK_THROWS_AS(lookup.light_points(buffers, points, normals, eye, visibility_lookup{}), parameter_error);
+    for (const float bias : {0.f, 0.3f, 1.f}) {
+        const visibility_lookup how{volume_visibility::chebyshev, bias};
+        const auto gpu = lookup.light_points(with_moments, points, normals, eye, how);
+        float largest = 0;
+        std::vector<glm::vec3> cpu(points.size());
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            cpu[i] = trilinear_visible(volume, vis, points[i], normals[i],
+                                       view_direction<float, glm::vec3>(points[i], normals[i], eye), how);
+            for (int k = 0; k < 3; ++k) largest = std::max(largest, std::abs(cpu[i][k]));
+        }
+        REQUIRE(largest > 0.1f);
+        for (std::size_t i = 0; i < points.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                INFO("visibility: point " << i << " channel " << k << " bias " << bias);
+                REQUIRE(std::isfinite(gpu[i][k]));
+                REQUIRE(gpu[i][k] == Approx(cpu[i][k]).margin(1e-5 * largest));
+            }
+    }
+    // Mode none is the plain trilinear lookup.
+    const auto none = lookup.light_points(with_moments, points, normals, eye, visibility_lookup{volume_visibility::none, 0.3f});
+    for (std::size_t i = 0; i < points.size(); ++i)
+        for (int k = 0; k < 3; ++k) REQUIRE(none[i][k] == Approx(volume.trilinear(points[i], normals[i])[k]).margin(1e-5));
 }

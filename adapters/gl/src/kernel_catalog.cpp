@@ -20,6 +20,7 @@
 #include <bounce/splat_bounds.hpp>
 #include <bounce/surface.hpp>
 #include <bounce/volume/kernels.hpp>
+#include <bounce/volume/visibility_kernels.hpp>
 
 #include <string>
 #include <utility>
@@ -122,7 +123,16 @@ void volume(catalog& c) {
         .add("irradiance_volume_lookup", "iv_trilinear_weights", BOUNCE_KERNEL(trilinear_weights<f32, vec3>))
         .add("irradiance_volume_lookup", "iv_trilinear_add", BOUNCE_KERNEL(trilinear_probe_accumulate<L, f32, vec3>))
         .add("irradiance_volume_lookup", "iv_weighted_add", BOUNCE_KERNEL(weighted_probe_accumulate<L, f32, vec3>))
-        .add("irradiance_volume_lookup", "iv_average", BOUNCE_KERNEL(probe_average<f32, vec3>));
+        .add("irradiance_volume_lookup", "iv_average", BOUNCE_KERNEL(probe_average<f32, vec3>))
+        .add("irradiance_volume_lookup", "iv_oct_encode", BOUNCE_KERNEL(octahedral_encode<f32, vec3>))
+        .add("irradiance_volume_lookup", "iv_oct_bilinear", BOUNCE_KERNEL(octahedral_bilinear<f32>))
+        .add("irradiance_volume_lookup", "iv_oct_texel", BOUNCE_KERNEL(octahedral_texel_index<f32>))
+        .add("irradiance_volume_lookup", "iv_bilinear_moments", BOUNCE_KERNEL(bilinear_moments<f32>))
+        .add("irradiance_volume_lookup", "iv_view", BOUNCE_KERNEL(view_direction<f32, vec3>))
+        .add("irradiance_volume_lookup", "iv_spacing", BOUNCE_KERNEL(cell_spacing<f32, vec3>))
+        .add("irradiance_volume_lookup", "iv_bias", BOUNCE_KERNEL(self_shadow_biased<f32, vec3>))
+        .add("irradiance_volume_lookup", "iv_probe_to_point", BOUNCE_KERNEL(probe_to_point<f32, vec3>))
+        .add("irradiance_volume_lookup", "iv_visibility_weight", BOUNCE_KERNEL(visibility_probe_weight<f32, vec3>));
 }
 
 void radiosity(catalog& c) {

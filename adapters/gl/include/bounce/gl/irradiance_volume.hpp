@@ -4,11 +4,14 @@
 /// (irradiance_volume::flatten, std430) in storage buffers, and a compute pass that lights
 /// points with the same kernels as the CPU (volume/kernels.hpp, printed as GLSL
 /// by glsl::emit). The pass's own GLSL is plumbing only: buffer reads, the descent loop,
-/// the traversal stack and the loops over corners.
+/// the traversal stack and the loops over corners. With the probes' distance moments
+/// (volume/probe_visibility.hpp) the trilinear lookup tests each corner's visibility with
+/// the kernels of volume/visibility_kernels.hpp (DDGI), as cpu::light_points does.
 
 #include <bounce/gl/objects.hpp>
 #include <bounce/output.hpp>
 #include <bounce/volume/probe_octree.hpp>
+#include <bounce/volume/probe_visibility.hpp>
 
 #include <cstdint>
 #include <span>
@@ -19,21 +22,27 @@
 
 namespace bounce::gl {
 
-/// A volume's nodes, probes and probe owners in three storage buffers (created in the
-/// current context; destroy before it).
+/// A volume's nodes, probes and probe owners in three storage buffers, and optionally its
+/// probes' distance moments in a fourth (created in the current context; destroy before it).
 class irradiance_volume_buffers {
 public:
-    /// Uploads `volume`. Throws gl_error when a buffer exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE.
-    explicit irradiance_volume_buffers(const irradiance_volume& volume);
+    /// Uploads `volume` and, when not null, `visibility` (one map per probe of `volume`).
+    /// Throws gl_error when a buffer exceeds GL_MAX_SHADER_STORAGE_BLOCK_SIZE,
+    /// parameter_error naming "visibility" for moments of another volume.
+    explicit irradiance_volume_buffers(const irradiance_volume& volume, const probe_visibility* visibility = nullptr);
 
     const buffer& nodes() const noexcept { return nodes_; }    ///< irradiance_volume_gpu_node[]
     const buffer& probes() const noexcept { return probes_; }  ///< irradiance_volume_gpu_probe[]
     const buffer& owners() const noexcept { return owners_; }  ///< uint[]: probe_owners()
     float reference_reach() const noexcept { return reference_reach_; }
+    const buffer& moments() const noexcept { return moments_; }  ///< float[]: probe_visibility::moments()
+    /// The moments' map resolution N; 0 when none were uploaded.
+    std::uint32_t visibility_resolution() const noexcept { return visibility_resolution_; }
 
 private:
-    buffer nodes_, probes_, owners_;
+    buffer nodes_, probes_, owners_, moments_;
     float reference_reach_;
+    std::uint32_t visibility_resolution_ = 0;
 };
 
 /// Which interpolation the GPU lookup runs.
@@ -60,7 +69,21 @@ public:
                                         output_quantity quantity = output_quantity::irradiance,
                                         std::span<const glm::vec3> albedo = {}) const;
 
+    /// The trilinear lookup with each corner probe's visibility tested from the point (its
+    /// view direction towards `eye`), as cpu::light_points with a probe_visibility computes
+    /// it; `how.mode = none` is the plain trilinear lookup. Throws parameter_error naming
+    /// "visibility" when `volume` holds no moments and the test is asked, and as above.
+    std::vector<glm::vec3> light_points(const irradiance_volume_buffers& volume, std::span<const glm::vec3> points,
+                                        std::span<const glm::vec3> normals, glm::vec3 eye, const visibility_lookup& how,
+                                        output_quantity quantity = output_quantity::irradiance,
+                                        std::span<const glm::vec3> albedo = {}) const;
+
 private:
+    struct dispatch;
+    std::vector<glm::vec3> run(const irradiance_volume_buffers& volume, std::span<const glm::vec3> points,
+                               std::span<const glm::vec3> normals, const dispatch& d, output_quantity quantity,
+                               std::span<const glm::vec3> albedo) const;
+
     program program_;
 };
 
