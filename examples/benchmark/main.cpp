@@ -131,7 +131,8 @@ int main(int argc, char** argv) {
                    "irradiance_volume (default: all)");
     app.add_option("--visibility", o.visibility,
                    "comma-separated receiver-sender visibility of the RSM techniques, each a run: none (as "
-                   "published), rays (exact, Embree occlusion rays) (default: none,rays)");
+                   "published), rays (exact, Embree occlusion rays), ism (imperfect shadow maps; SII only) "
+                   "(default: none,rays)");
     app.add_option("--vpls", o.vpls, "lights a frame of the RSM techniques: SII's VPLs, the gather's disc samples")
         ->capture_default_str();
     app.add_option("--width", o.width, "image width (default 256; 64 with --quick)")->check(CLI::Range(1, 16384));

@@ -67,7 +67,7 @@ json parameters_json(const options& o, float clamp_distance, std::size_t maps) {
 void check_arguments(const options& o) {
     check_backend_built(o.backend);
     if (o.backend == backend::gl)
-        require(o.visibility == indirect_visibility::none, "--visibility",
+        require(o.visibility != indirect_visibility::rays, "--visibility",
                 "'rays' runs on the CPU backend only (the GL renderer has no receiver-sender visibility yet)");
     if (o.study) require(!o.json.empty(), "--study", "needs --json for the study's report");
     if (o.study)
@@ -81,14 +81,14 @@ void check_arguments(const options& o) {
 
 /// --indirect-out: the run's indirect light beside the reference of what it computes, one
 /// exposure (the reference's). With visibility the same frame without it stands between
-/// them: [no visibility | rays | occluded reference], the leak and its fix side by side.
+/// them: [no visibility | rays or ism | occluded reference], the leak and its fix side by side.
 void write_indirect_pictures(const options& o, const study::indirect_frame& frame, const indirect_options& chosen,
                              const image<glm::vec3>& radiance, const study::indirect_references& refs,
                              const gbuffer_view<float>& g, image_view<const float> mask) {
     std::vector<image_view<const glm::vec3>> panels;
     image<glm::vec3> leaking;
-    const bool rays = o.visibility == indirect_visibility::rays;
-    if (rays) {
+    const bool visible = o.visibility != indirect_visibility::none;
+    if (visible) {
         indirect_options none = chosen;
         none.visibility = indirect_visibility::none;
         image<glm::vec3> e(o.width, o.height);
@@ -97,7 +97,7 @@ void write_indirect_pictures(const options& o, const study::indirect_frame& fram
         panels.push_back(leaking.view());
     }
     panels.push_back(radiance.view());
-    const image_view<const glm::vec3> reference = rays ? refs.occluded.indirect.view() : refs.unoccluded.view();
+    const image_view<const glm::vec3> reference = visible ? refs.occluded.indirect.view() : refs.unoccluded.view();
     panels.push_back(reference);
     image<glm::vec3> row(panels.size() * o.width, o.height);
     for (std::size_t k = 0; k < panels.size(); ++k)
@@ -134,7 +134,9 @@ int run(const options& o) {
 
     // The backend: both renderers take the same call.
     const embree::occlusion_rays rays(bvh);
-    cpu::indirect_renderer cpu_renderer({}, &rays);
+    std::optional<ism_point_sampler> points;
+    if (o.visibility == indirect_visibility::ism) points.emplace(scene.view());
+    cpu::indirect_renderer cpu_renderer({}, &rays, points ? &*points : nullptr);
     study::indirect_frame frame = [&](const indirect_options& opts, image_view<glm::vec3> out) {
         return cpu_renderer.render(opts, g.view(), cam, caster.views(), out);
     };
@@ -143,6 +145,7 @@ int run(const options& o) {
     std::optional<gl::offscreen_indirect_renderer> gl_renderer;
     if (o.backend == backend::gl) {
         gl_renderer.emplace();
+        gl_renderer->set_point_sampler(points ? &*points : nullptr);
         gl_name = gl_renderer->gl_renderer();
         frame = [&](const indirect_options& opts, image_view<glm::vec3> out) {
             return gl_renderer->render(opts, g.view(), cam, caster.views(), out);
@@ -198,7 +201,7 @@ int run(const options& o) {
         report.set_timings(single->timer);
         // The error against the reference of what the frame computes: with visibility the
         // occluded one-bounce light, without it the unoccluded one (the other beside it).
-        report.error = o.visibility == indirect_visibility::rays ? single->vs_occluded : single->vs_unoccluded;
+        report.error = o.visibility != indirect_visibility::none ? single->vs_occluded : single->vs_unoccluded;
         report.set_count("vpls", single->last.vpls);
         report.set_count("maps", caster.maps().size());
         const json r = single->to_json();

@@ -26,7 +26,8 @@ inline const choices<vpl_selection> selection_names{{"warping", vpl_selection::f
                                                     {"grid", vpl_selection::grid}};
 inline const choices<indirect_visibility> visibility_names{
     {std::string(visibility_name(indirect_visibility::none)), indirect_visibility::none},
-    {std::string(visibility_name(indirect_visibility::rays)), indirect_visibility::rays}};
+    {std::string(visibility_name(indirect_visibility::rays)), indirect_visibility::rays},
+    {std::string(visibility_name(indirect_visibility::ism)), indirect_visibility::ism}};
 
 struct options {
     indirect_technique technique = indirect_technique::sii;  // rsm (the gather, DS05) | sii (splatting, DS06)
@@ -34,7 +35,8 @@ struct options {
     std::string pattern = "4x4";       // N x M interleave pattern; 1x1: none
     light_assignment assign = light_assignment::interleaved;
     examples::backend backend = backend::cpu;
-    indirect_visibility visibility = indirect_visibility::none;  // none (DS05/DS06: leaks) | rays (exact, CPU)
+    indirect_visibility visibility = indirect_visibility::none;  // none (DS05/DS06: leaks) | rays (exact, CPU) | ism
+    ism_params ism;  // imperfect shadow maps (--visibility ism): --ism-map-size, --ism-points, --ism-bias
     std::string scene = "cornell";
     std::size_t width = 512, height = 384;
     std::size_t rsm_resolution = 256;  // texels per side of each map (cube face)
@@ -89,6 +91,7 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
     c.light.footprint_scale = o.footprint_clamp >= 0.f ? o.footprint_clamp : (pattern.cells() == 1 ? 1.f : 0.f);
     c.seed = o.seed;
     c.visibility = o.visibility;
+    c.ism = o.ism;
     try {
         c.validate();
     } catch (const parameter_error& e) {
@@ -99,6 +102,10 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
                                  : f == "min_distance2"            ? "--clamp"
                                  : f == "footprint_scale"          ? "--footprint-clamp"
                                  : f == "offset"                   ? "--offset"
+                                 : f == "visibility"               ? "--visibility"
+                                 : f == "ism.map_size"             ? "--ism-map-size"
+                                 : f == "ism.points_per_vpl"       ? "--ism-points"
+                                 : f == "ism.bias_scale"           ? "--ism-bias"
                                                                    : f;
         const std::string what = e.what();
         const auto at = what.find("': ");
@@ -131,7 +138,14 @@ inline void add_options(CLI::App& app, options& o) {
     add_choice(app, "--backend", o.backend, backend_names, "cpu | gl")->capture_default_str();
     add_choice(app, "--visibility", o.visibility, visibility_names,
                "receiver-sender visibility: none (as published: light leaks through walls) | rays (an Embree "
-               "occlusion ray per pair the frame sums; CPU backend)")
+               "occlusion ray per pair the frame sums; CPU backend) | ism (imperfect shadow maps, SII only; CPU or GL)")
+        ->capture_default_str();
+    app.add_option("--ism-map-size", o.ism.map_size, "--visibility ism: texels per side of each VPL's paraboloid map "
+                                                     "(a power of two in [4, 256])")
+        ->capture_default_str();
+    app.add_option("--ism-points", o.ism.points_per_vpl, "--visibility ism: points splatted into each VPL's map")
+        ->capture_default_str();
+    app.add_option("--ism-bias", o.ism.bias_scale, "--visibility ism: scale of the depth test's bias")
         ->capture_default_str();
     app.add_option("--scene", o.scene, "cornell, a scene.json, its folder, an .obj, a .gltf or .glb, or a name under the scenes folder")
         ->capture_default_str();

@@ -108,7 +108,7 @@ struct benchmark_settings {
     /// map), rsm_sii's default 1,024 (`--vpls`); at least the 16 sub-buffers of SII's 4x4.
     std::size_t rsm_lights = 1024;
     /// The RSM techniques' visibility policies, each a run of its own (`--visibility`).
-    std::vector<indirect_visibility> visibility{indirect_visibilities.begin(), indirect_visibilities.end()};
+    std::vector<indirect_visibility> visibility{indirect_visibility::none, indirect_visibility::rays};
     quantity_samples one_bounce{1024, 512}, unoccluded{512, 256}, all_bounces{256, 128}, volume_points{512, 256};
     /// The volume's points: each surface point moved this fraction of the scene's bounding
     /// diagonal along its normal (at most half the free distance along it).
