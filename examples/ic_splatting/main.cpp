@@ -225,6 +225,10 @@ int run_with(const options& o) {
             report.set_count("records_measured", last.frame.measured);
             report.set_count("records_wasted", last.frame.wasted);
         }
+        if (o.filter_k > 0.f) {
+            report.set_count("records_filter_merged", last.frame.filter_merged);
+            report.set_count("records_filter_refused", last.frame.filter_refused);
+        }
         if (o.mc_compare) extra.update(study::monte_carlo_report(measure, last, timer.median_ms("total")));
         if (o.ray_rates) extra["ray_rates"] = study::ray_rates(embree_sampler, cache.records());
         if (!o.out.empty() || !o.exr.empty()) {

@@ -77,6 +77,9 @@ struct options {
     float record_error = 0.2f;               // adaptive: target relative standard error of E, times a
     float record_error_floor = 1.f;          // adaptive: irradiance floor, times the scene's mean irradiance
     bool neighbour_clamp = true;
+    float filter_k = 0.f;      // neighbour filter: merge within this many standard errors (0: off)
+    float filter_reach = 2.f;  // neighbour filter: neighbours' weights at this times a
+    bool filter_soft = true;   // neighbour filter: count the prediction's bias estimated from the difference
     cpu::scan_kind scan = cpu::scan_kind::batched;
     cpu::scan_order scan_order = cpu::scan_order::linear;  // unless given: coarse-to-fine when progressive
     std::size_t scan_batch = 0;
@@ -121,6 +124,9 @@ inline cpu::irradiance_cache_options cache_options_for(const options& o, float a
     if (o.progressive > 0) c.max_new_records = o.progressive;
     c.fill_holes = c.interpolation == cpu::cache_interpolation::splat ? o.fill_holes : 0.f;
     c.neighbour_clamp = o.neighbour_clamp;
+    c.filter.k = o.filter_k;
+    c.filter.reach = o.filter_reach;
+    c.filter.soft = o.filter_soft;
     return c;
 }
 
@@ -147,6 +153,8 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
         p["world_limits"] = {limits.min_world, limits.max_world};
     if (limits.min_mean_distance > 0.f) p["min_mean_distance"] = limits.min_mean_distance;
     if (hessian && std::isfinite(limits.hessian_zone_cap)) p["hessian_zone_cap"] = limits.hessian_zone_cap;
+    // Filtered records depend on the filter and on a; keyed only where on.
+    if (o.filter_k > 0.f) p["record_filter"] = {o.filter_k, o.filter_reach, o.a, o.filter_soft};
     return p;
 }
 
@@ -193,6 +201,10 @@ inline void check_combinations(const options& o, bool with_gl) {
     if (hessian && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
     if (o.adaptive_rays && raster) throw parameter_error("--adaptive-rays", "needs the Embree sampler");
+    if (o.filter_k > 0.f && raster)
+        throw parameter_error("--record-filter", "needs the Embree sampler (the raster's records carry no variance)");
+    if (o.filter_k > 0.f && !o.a_sweep.empty())
+        throw parameter_error("--a-sweep", "the neighbour filter weighs neighbours at a: sweep a over separate runs");
     if (o.adaptive_rays && o.ray_rates)
         throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --adaptive-rays");
     if (o.adaptive_rays && !o.a_sweep.empty())
@@ -221,6 +233,7 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
             {"adaptive_rays", o.adaptive_rays}, {"min_record_samples", o.min_record_samples},
             {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
             {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
+            {"record_filter", o.filter_k}, {"filter_reach", o.filter_reach}, {"filter_soft", o.filter_soft},
             {"max_extrapolation", o.max_extrapolation},
             {"front_tolerance", o.front_tolerance},
             {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
@@ -322,6 +335,16 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--scan-batch", o.scan_batch, "records measured together by the batched scan (0: one per thread; 16 planes per atlas for --sampler raster)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
+    app.add_option("--record-filter", o.filter_k,
+                   "shrink each new record toward its neighbours' prediction, weighted by both variances, unless they "
+                   "differ by more than this many standard errors (0: off; docs/irradiance-splatting.md)")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
+    app.add_option("--filter-reach", o.filter_reach, "--record-filter: neighbours' weights at this times a")
+        ->check(examples::finite_positive)
+        ->capture_default_str();
+    app.add_flag("--filter-soft,!--no-filter-soft", o.filter_soft,
+                 "--record-filter: also weigh the prediction's bias, estimated from the difference (default on)");
     app.add_flag("--neighbour-clamp,!--no-neighbour-clamp", o.neighbour_clamp,
                  "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|), new records and, each frame, older ones (default on)");
     app.add_option("--walkthrough", o.walkthrough,

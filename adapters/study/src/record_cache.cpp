@@ -43,12 +43,14 @@ void save_records(const std::filesystem::path& file, const std::vector<irradianc
     for (const auto& r : records) {
         if (!std::isfinite(r.radius) || r.radius <= 0.f)
             throw cache_error(file, "refusing to save a record with radius " + std::to_string(r.radius));
-        arr.push_back({{"p", vec(r.position)},
-                       {"n", vec(r.normal)},
-                       {"e", vec(r.irradiance)},
-                       {"rot", {vec(r.rotation[0]), vec(r.rotation[1]), vec(r.rotation[2])}},
-                       {"tr", {vec(r.translation[0]), vec(r.translation[1]), vec(r.translation[2])}},
-                       {"r", r.radius}});
+        nlohmann::json o = {{"p", vec(r.position)},
+                            {"n", vec(r.normal)},
+                            {"e", vec(r.irradiance)},
+                            {"rot", {vec(r.rotation[0]), vec(r.rotation[1]), vec(r.rotation[2])}},
+                            {"tr", {vec(r.translation[0]), vec(r.translation[1]), vec(r.translation[2])}},
+                            {"r", r.radius}};
+        if (std::isfinite(r.variance) && r.variance > 0.f) o["v"] = r.variance;  // absent: unknown (0)
+        arr.push_back(std::move(o));
     }
     std::ofstream out(file);
     if (!out) throw cache_error(file, "cannot open for writing");
@@ -89,6 +91,10 @@ std::vector<irradiance_record> load_records(const std::filesystem::path& file, c
         r.radius = o["r"].get<float>();
         if (!std::isfinite(r.radius) || r.radius <= 0.f)
             throw cache_error(file, "records[" + std::to_string(i) + "].r: radius must be positive");
+        if (o.contains("v")) {
+            if (!o["v"].is_number()) throw cache_error(file, "records[" + std::to_string(i) + "].v: expected a number");
+            r.variance = o["v"].get<float>();
+        }
         recs.push_back(r);
     }
     return recs;

@@ -28,6 +28,8 @@ struct cache_frame {
     std::size_t new_records = 0;  ///< records the scan added
     std::size_t measured = 0;     ///< records the batched scan measured (new + wasted + refused)
     std::size_t wasted = 0;       ///< guesses dropped because covered by the time the scan got there
+    std::size_t filter_merged = 0;   ///< new records the neighbour filter merged (cache/record_filter.hpp)
+    std::size_t filter_refused = 0;  ///< new records it left alone, beyond k standard errors
     /// The frame's stages in the order they ran, in milliseconds of wall time: "gbuffer",
     /// ("direct",) "splat_existing", ("readback",) "scan", "compute_records", "interpolate",
     /// "normalize" (the names in parentheses: the GL frame only).

@@ -29,6 +29,9 @@ struct irradiance_record {
     std::array<glm::vec3, 3> rotation{};        ///< grad_r per channel R, G, B (W/m^2 per radian)
     std::array<glm::vec3, 3> translation{};     ///< grad_t per channel (W/m^2 per world unit)
     float radius = 1.f;                         ///< R_k, world units, after every clamp
+    /// Estimated variance of the luminance of E_k from the record's own rays ((W/m^2)^2;
+    /// cache/record_filter.hpp); 0: unknown (samplers that do not estimate it).
+    float variance = 0.f;
 };
 
 /// E_k(p) = E_k + (n_k x n) . grad_r + (p - p_k) . grad_t per channel (Gautron 2008, Algorithm 4),

@@ -54,6 +54,8 @@ cache_frame render_frame(irradiance_cache<Weight>& cache, const camera& cam, GBu
     f.new_records = s.new_records;
     f.measured = s.measured;
     f.wasted = s.wasted;
+    f.filter_merged = s.filter_merged;
+    f.filter_refused = s.filter_refused;
     f.stages_ms.emplace_back("splat_existing", s.splat_existing_ms);
     f.stages_ms.emplace_back("scan", s.scan_ms);
     f.stages_ms.emplace_back("compute_records", s.records_ms);

@@ -31,6 +31,7 @@
 #include <bounce/output.hpp>
 #include <bounce/splat_bounds.hpp>
 #include <bounce/cache/record.hpp>
+#include <bounce/cache/record_filter.hpp>
 #include <bounce/cache/record_sampler.hpp>
 
 #include <algorithm>
@@ -84,6 +85,11 @@ struct irradiance_cache_options {
     /// (Krivanek et al. 2006's neighbour clamping), and at the start of each frame the
     /// records of earlier frames to the later ones (clamp_to_neighbours).
     bool neighbour_clamp = false;
+    /// Each new record's irradiance shrunk toward its neighbours' prediction, weighted by
+    /// both variances, unless they differ beyond filter.k standard errors
+    /// (cache/record_filter.hpp); off by default (k = 0). Needs records with a variance
+    /// (embree::record_sampler's); others pass unchanged.
+    record_filter filter{};
 
     /// The weight-sum threshold the scan uses.
     float miss_threshold() const noexcept { return min_weight > 0.f ? min_weight : splat.a; }
@@ -97,6 +103,7 @@ struct irradiance_cache_options {
         require(std::isfinite(min_weight) && min_weight >= 0.f, "min_weight", "must be a non-negative number (0: a)");
         require(std::isfinite(fill_holes) && fill_holes >= 0.f, "fill_holes", "must be a non-negative number (0: off)");
         require(max_new_records > 0, "max_new_records", "must be positive");
+        filter.validate();
         require(interpolation == cache_interpolation::splat || !fills_holes(), "fill_holes",
                 "applies to splatting only (set 0 for the octree)");
     }
@@ -108,6 +115,8 @@ struct cache_frame_stats {
     std::size_t measured = 0;     ///< records the batched scan measured (new + wasted + refused)
     std::size_t wasted = 0;       ///< guesses dropped because covered by the time the scan got there
     std::size_t reclamped = 0;    ///< older records whose radius clamp_to_neighbours shrank (render only)
+    std::size_t filter_merged = 0;   ///< new records the neighbour filter shrank toward their prediction
+    std::size_t filter_refused = 0;  ///< new records it left alone: beyond k standard errors of it
     double splat_existing_ms = 0; ///< step 1: the records held before the frame (octree: inserting them)
     double scan_ms = 0;           ///< step 2 without record computation
     double records_ms = 0;        ///< step 2's record computation (the sampler)
@@ -286,13 +295,31 @@ private:
         };
     }
 
-    // What a new record owes to the records before it, in scan order: neighbour clamping.
-    auto committer() {
-        return [this](irradiance_record& rec) {
-            if (!options_.neighbour_clamp) return;
+    // What a new record owes to the records before it, in scan order: neighbour clamping
+    // and the neighbour filter (counted in `stats`).
+    auto committer(cache_frame_stats& stats) {
+        return [this, &stats](irradiance_record& rec) {
+            if (!options_.neighbour_clamp && !options_.filter.enabled()) return;
             clamp_.sync(records_);
-            rec.radius = clamp_.clamped_radius(rec);
+            if (options_.filter.enabled()) {
+                const filter_outcome f = filter_record(rec);
+                stats.filter_merged += f.what == filter_outcome::merged;
+                stats.filter_refused += f.what == filter_outcome::refused;
+            }
+            if (options_.neighbour_clamp) rec.radius = clamp_.clamped_radius(rec);
         };
+    }
+
+    // The neighbour filter: the prediction of the records whose zones at reach * a cover
+    // rec's point, as the splat would weigh and extrapolate them there.
+    filter_outcome filter_record(irradiance_record& rec) const {
+        const splat_params& sp = options_.splat;
+        const float a = options_.filter.reach * sp.a;
+        neighbour_prediction p;
+        clamp_.for_each_covering(rec.position, Weight::template influence_radius<float>(1.f, a), [&](std::size_t j) {
+            add_neighbour<Weight>(p, rec, records_[j], a, sp.gradients, sp.max_extrapolation);
+        });
+        return shrink_to_prediction(rec, p, options_.filter.k, options_.filter.soft);
     }
 
     template <class Sampler>
@@ -307,7 +334,7 @@ private:
         auto measure = batch_measurer(where, cam, sampler);
         if (options_.scan == scan_kind::batched) {
             const scan_stats s = scan_cache_misses_batched<Weight>(g, cam, options_.splat, min_weight, measure,
-                                                                   committer(), records_, splat, options_.batch, order,
+                                                                   committer(stats), records_, splat, options_.batch, order,
                                                                    options_.max_new_records);
             stats.new_records += s.created;
             stats.measured += s.measured;
@@ -316,7 +343,7 @@ private:
             stats.scan_ms += ms_since(t0) - s.measure_ms;
         } else {
             double record_ms = 0;
-            auto commit = committer();
+            auto commit = committer(stats);
             const auto create = [&](std::size_t x, std::size_t y) {
                 std::optional<irradiance_record> rec;
                 const pixel_xy px{x, y};
@@ -353,7 +380,7 @@ private:
             [&](std::size_t x, std::size_t y) {
                 return g.covered(x, y) && tree.lookup(g.position(x, y), g.normal(x, y), g.albedo(x, y)).w < min_weight;
             },
-            batch_measurer(where, cam, sampler), committer(), [&](const irradiance_record& rec) {
+            batch_measurer(where, cam, sampler), committer(stats), [&](const irradiance_record& rec) {
                 records_.push_back(rec);
                 tree.insert(rec);
                 const float zone = Weight::template influence_radius<float>(rec.radius, sp.a);

@@ -48,8 +48,7 @@ public:
         const glm::vec3 p = r.position;
         require(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "record.position", "must be finite");
         require(std::isfinite(r.radius) && r.radius >= 0.f, "record.radius", "must be a finite radius >= 0");
-        ++count_;
-        const entry e{p, r.radius};
+        const entry e{p, r.radius, count_++};
         if (!inside(nodes_[0], p)) {
             outside_.push_back(e);
             return;
@@ -57,6 +56,7 @@ public:
         std::size_t n = 0;
         for (int depth = 0;; ++depth) {
             nodes_[n].min_radius = std::min(nodes_[n].min_radius, e.radius);
+            nodes_[n].max_radius = std::max(nodes_[n].max_radius, e.radius);
             if (nodes_[n].first_child == 0) {
                 nodes_[n].entries.push_back(e);
                 if (nodes_[n].entries.size() > leaf_size && depth < max_depth) split(n);
@@ -106,14 +106,39 @@ public:
         return best;
     }
 
+    /// Calls f(j) for every record j inserted so far (j: its insertion order, the index into
+    /// the vector sync mirrors) with |p - p_j| < scale * R_j: the records whose zones of
+    /// radius scale * R_j contain p (the neighbours that interpolation at p may ask).
+    template <class F>
+    void for_each_covering(const glm::vec3& p, float scale, F&& f) const {
+        const double s = scale;
+        auto covers = [&](const entry& e) { return double(glm::length(p - e.p)) < s * double(e.radius); };
+        for (const entry& e : outside_)
+            if (covers(e)) f(e.index);
+        std::vector<std::size_t> stack{0};
+        while (!stack.empty()) {
+            const node& nd = nodes_[stack.back()];
+            stack.pop_back();
+            if (!(box_distance(nd, p) < s * double(nd.max_radius))) continue;
+            if (nd.first_child == 0) {
+                for (const entry& e : nd.entries)
+                    if (covers(e)) f(e.index);
+                continue;
+            }
+            for (std::size_t c = 0; c < 8; ++c) stack.push_back(nd.first_child + c);
+        }
+    }
+
 private:
     struct entry {
         glm::vec3 p;
         float radius;
+        std::size_t index;  // insertion order
     };
     struct node {
         glm::vec3 lo, hi;
         float min_radius = std::numeric_limits<float>::infinity();  // +inf: no record below
+        float max_radius = 0.f;                                     // 0: no record below
         std::size_t first_child = 0;                                // 0: a leaf (the root is never a child)
         std::vector<entry> entries;
     };
@@ -151,6 +176,7 @@ private:
             node& child = nodes_[first + octant(nodes_[n], e.p)];
             child.entries.push_back(e);
             child.min_radius = std::min(child.min_radius, e.radius);
+            child.max_radius = std::max(child.max_radius, e.radius);
         }
     }
 

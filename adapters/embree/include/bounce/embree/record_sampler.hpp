@@ -11,7 +11,9 @@
 /// With adaptive rays (bounce/cache/adaptive_hemisphere.hpp) a record starts from a grid of about
 /// min_rays strata and adds rays to the strata next to uncertain ones until the estimated
 /// relative standard error of its irradiance is below the target or max_rays are cast.
-/// rays_cast() counts the rays and records of every call, adaptive or not.
+/// rays_cast() counts the rays and records of every call, adaptive or not. Each record
+/// carries the variance of its irradiance's luminance from its own rays (collapsed strata,
+/// cache/record_filter.hpp), for the cache's neighbour filter.
 ///
 /// What a record costs beyond its rays is kept small: the grid's trigonometry
 /// (hemisphere_strata) is computed once per grid size, the per-record buffers are reused from
@@ -22,6 +24,7 @@
 #include <bounce/embree/reference.hpp>
 #include <bounce/cache/gradients.hpp>
 #include <bounce/cache/record.hpp>
+#include <bounce/cache/record_filter.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/cache/record_sampler.hpp>
 #include <bounce/sampling.hpp>
@@ -33,6 +36,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -115,10 +119,10 @@ public:
         const std::uint64_t key = point_key(p, n);
         integrator_.sample_hemisphere(p, n, grid_, derive_seed(seed_, 0x1c, key), samples);
         if (adaptive_.enabled) {
-            const auto [est, cast] = adaptive_estimate(samples, key, w);
+            const auto [est, cast, variance] = adaptive_estimate(samples, key, w);
             tally_.add(cast);
             if (rays) *rays = cast;
-            return finish(p, samples, est, pixel_footprint);
+            return finish(p, samples, est, variance, pixel_footprint);
         }
         tally_.add(grid_.count());
         if (rays) *rays = grid_.count();
@@ -138,7 +142,8 @@ public:
         // p (a corner); no surface is nearer than the offset itself, so floor them there.
         const float eps = integrator_.ray_epsilon();
         for (float& d : local.distance) d = std::max(d, eps);
-        return finish(p, samples, estimate_hemisphere(local, *strata_, kind_, needs_hessian()), pixel_footprint);
+        return finish(p, samples, estimate_hemisphere(local, *strata_, kind_, needs_hessian()),
+                      stratified_luminance_variance(local.radiance, grid_.m, grid_.n), pixel_footprint);
     }
 
     /// Records for points[k], normals[k], footprints[k] into out[k], the points on every
@@ -288,10 +293,12 @@ private:
         return {g.rings, g.wedges};
     }
 
+    // `variance`: of E's luminance, from the record's own rays (NaN: unknown, stored as 0).
     std::optional<irradiance_record> finish(glm::vec3 p, const embree::hemisphere_samples& samples,
-                                     const hemisphere_estimate& est, double pixel_footprint) const {
+                                     const hemisphere_estimate& est, double variance, double pixel_footprint) const {
         irradiance_record rec = make_record(p, samples.normal, samples.tangent, samples.bitangent, est, limits_,
                                             pixel_footprint);
+        rec.variance = std::isfinite(variance) ? float(variance) : 0.f;
         if (!std::isfinite(rec.radius) || !(rec.radius > 0.f)) return std::nullopt;
         return rec;
     }
@@ -301,8 +308,9 @@ private:
     // cast so far (at least an eighth of them), splits the chosen cells' sub-strata with
     // jitters from a stream keyed by the point and the round, and shades the new rays as
     // sample_hemisphere does, in one batched query (bitwise the single-ray incoming_radiance).
-    std::pair<hemisphere_estimate, std::uint32_t> adaptive_estimate(const embree::hemisphere_samples& samples,
-                                                                    std::uint64_t key, scratch& w) const {
+    // Returns the estimate, the rays cast and the variance of E's luminance (collapsed strata).
+    std::tuple<hemisphere_estimate, std::uint32_t, double> adaptive_estimate(const embree::hemisphere_samples& samples,
+                                                                             std::uint64_t key, scratch& w) const {
         adaptive_hemisphere h(grid_.m, grid_.n);
         const float eps = integrator_.ray_epsilon();
         auto local_of = [&](const glm::vec3& d) {
@@ -360,7 +368,8 @@ private:
             used += count;
         }
         const bounce::hemisphere_samples fine = h.fine_samples();
-        return {estimate_hemisphere(fine, w.strata_for(fine.rings, fine.wedges), kind_, needs_hessian()), std::uint32_t(used)};
+        return {estimate_hemisphere(fine, w.strata_for(fine.rings, fine.wedges), kind_, needs_hessian()), std::uint32_t(used),
+                h.variance()};
     }
 
     // Distinct points get independent streams, the same point the same stream.

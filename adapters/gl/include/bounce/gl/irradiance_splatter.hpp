@@ -154,6 +154,8 @@ public:
                     records_ms += s.records_ms;
                     f.measured = s.measured;
                     f.wasted = s.wasted;
+                    f.filter_merged = s.filter_merged;
+                    f.filter_refused = s.filter_refused;
                 };
                 if constexpr (std::is_same_v<std::remove_cvref_t<RecordPoints>, raster_record_points>) {
                     took(cache.scan(g, cam, sampler, splat));
