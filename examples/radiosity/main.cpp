@@ -59,13 +59,25 @@ struct comparison {
     const io::scene& scene;
     std::optional<embree::multi_bounce_image> reference;
     image<float> mask;
-    image<glm::vec3> view(const lightmap_atlas& atlas, const image<glm::vec3>& lightmap, int level, const options& o) const {
-        return embree::lightmap_view(bvh, scene, atlas, lightmap.view(), level, scene.camera, o.width, o.height);
+    // The view from the front's lightmap and, for two-sided solves, the back's (else empty).
+    image<glm::vec3> view(const lightmap_atlas& atlas, const image<glm::vec3>& front, const image<glm::vec3>& back,
+                          int level, const options& o) const {
+        return embree::lightmap_view(bvh, scene, atlas, front.view(), back.width() ? back.view() : front.view(), level,
+                                     scene.camera, o.width, o.height);
     }
     double rel_rms(const image<glm::vec3>& v) const {
         return study::compare_luminance(v.view(), reference->radiance.view(), mask.view()).rel_rms;
     }
+    std::size_t black_pixels(const image<glm::vec3>& v) const { return examples::black_pixels(v, reference->radiance, mask); }
 };
+
+// The back sides' radiosity lightmap of a two-sided solver, else an empty image.
+template <class Solver>
+image<glm::vec3> back_lightmap(const Solver& solver, int level) {
+    if constexpr (requires { solver.sides(); })
+        if (solver.sides() == 2) return solver.radiosity_lightmap(level, 1);
+    return {};
+}
 
 // Solves with `solver` (built after `setup_ms` of atlas and lights) as the options ask, through
 // the library's solve; with `cmp` holding a reference, the view's error at checkpoints.
@@ -93,7 +105,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
         return true;
     };
     s.checkpoint = [&](const radiosity_progress& p) {
-        const auto v = cmp.view(solver.atlas(), solver.radiosity_lightmap(level), level, o);
+        const auto v = cmp.view(solver.atlas(), solver.radiosity_lightmap(level), back_lightmap(solver, level), level, o);
         r.curve.push_back({p.steps, p.shots, solver.atlas().size(), setup_ms + p.elapsed_ms, p.unshot_fraction, cmp.rel_rms(v)});
     };
     if constexpr (cpu) r.report = o.adaptive ? solver.solve(s, scene, subdivision_options_for(o), std::size_t(o.subdivide_steps))
@@ -120,10 +132,12 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     r.base_elements = base_elements;
     std::tie(r.emitted, r.absorbed, r.escaped) = std::tuple(solver.emitted_power(), solver.absorbed_power(), solver.escaped_power());
     r.lightmap = solver.radiosity_lightmap(level);
+    r.lightmap_back = back_lightmap(solver, level);
     const auto u = solver.unshot();
     const std::vector<glm::vec3> unshot(u.begin(), u.end());
     r.unshot = a.to_fine_texels(std::span<const glm::vec3>(unshot), level);
-    timer.time("lightmap_view", [&] { r.view = cmp.view(a, r.lightmap, level, o); });
+    timer.time("lightmap_view", [&] { r.view = cmp.view(a, r.lightmap, r.lightmap_back, level, o); });
+    if (cmp.reference) r.black_pixels = cmp.black_pixels(r.view);
     return r;
 }
 
@@ -173,7 +187,7 @@ std::optional<image<glm::vec3>> check_before_work(const options& o, const io::sc
                                                                 "positions at this scene's scale) it only tessellates deeper",
                                                                 o.tolerance_px, o.resolution, scene.name, finest));
     }
-    check_lights_face_surfaces(scene);  // reversed winding, before the reference
+    if (o.one_sided) check_lights_face_surfaces(scene);  // reversed winding, before the reference
     if (o.reference) study::check_cache_dir();
     check_memory(o, scene);
     if (o.versus.empty()) return std::nullopt;
@@ -237,10 +251,13 @@ int run(const options& o) {
         report.set_count(name, n);
     nlohmann::ordered_json j = report.to_json();
     add_solve_json(j, r);
+    if (cmp.reference) j["black_pixels"] = r.black_pixels;
     if (cmp.reference) j["reference"] = reference_json(o, *cmp.reference);
     if (versus) {
         const auto e = study::compare_luminance(r.view.view(), versus->view(), cmp.mask.view());
         j["versus"] = {{"file", o.versus.filename().string()}, {"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}};
+        // Against another seed's reference, this is that reference's noise (times sqrt 2).
+        if (cmp.reference) j["versus"]["reference_rel_rms"] = cmp.rel_rms(*versus);
     }
     const auto write_view = [](const std::filesystem::path& f, const image<glm::vec3>& v) {
         if (f.extension() == ".exr") io::write_exr(f, v.view());
@@ -251,15 +268,18 @@ int run(const options& o) {
     if (!o.lightmaps.empty()) {
         io::write_exr(o.lightmaps / "radiosity.exr", r.lightmap.view());
         io::write_exr(o.lightmaps / "unshot.exr", r.unshot.view());
+        if (r.lightmap_back.width()) io::write_exr(o.lightmaps / "radiosity_back.exr", r.lightmap_back.view());
     }
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
     fmt::print("radiosity {} {} {}: {} elements, {} iterations, {:.1f}% converged ({}; {:.1f}% of the emitted power "
-               "shot), total {:.0f} ms (visibility {:.0f}, reconstruction {:.0f}, choice {:.1f}), rel_rms {}\n",
+               "shot), total {:.0f} ms (visibility {:.0f}, reconstruction {:.0f}, choice {:.1f}), rel_rms {}, "
+               "{} black pixels where the reference is lit\n",
                scene.name, name_of(visibility_names, o.visibility), o.adaptive ? "adaptive" : "uniform", r.elements,
                r.report.steps, 100.0 * (1.0 - r.report.indirect_unshot_fraction), to_string(r.report.stop),
                100.0 * (1.0 - r.report.unshot_fraction), timer.median_ms("total"),
                timer.median_ms("visibility"), timer.median_ms("reconstruction"), timer.median_ms("shooter_choice"),
-               report.error ? fmt::format("{:.4f}", report.error->rel_rms) : std::string("-"));
+               report.error ? fmt::format("{:.4f}", report.error->rel_rms) : std::string("-"),
+               cmp.reference ? std::to_string(r.black_pixels) : std::string("-"));
     if (versus) fmt::print("  versus {}: rel_rms {:.4f}\n", o.versus.string(), j["versus"]["rel_rms"].get<double>());
     if (r.report.stop == radiosity_stop::time_limit)
         fmt::print(stderr, "radiosity: stopped unconverged by --max-seconds {}: {:.1f}% converged ({}), {:.1f}% asked\n",

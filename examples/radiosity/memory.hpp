@@ -17,7 +17,7 @@ namespace bounce::examples {
 /// Throws parameter_error naming --elements when the run's estimated peak exceeds what the
 /// machine can give it, with both figures.
 inline void check_memory(const options& o, const io::scene& scene) {
-    double need = cpu::radiosity_memory_estimate(scene, atlas_options_for(o));
+    double need = cpu::radiosity_memory_estimate(scene, atlas_options_for(o), !o.one_sided);
     if (o.visibility != visibility_kind::rays) {
         const double faces = o.visibility == visibility_kind::hemicube ? 3 : 1;  // five faces of res x res/2 or res
         need += 112.0 * double(scene.triangles.size()) + faces * 12.0 * double(o.resolution) * double(o.resolution);

@@ -53,6 +53,7 @@ struct options {
     int shooters_per_step = 1;
     double near_field = 4;
     bool ambient = false;
+    bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
     int repeat = 1;                   // solves timed (medians reported)
     std::size_t width = 256, height = 256;
     bool reference = true;
@@ -100,6 +101,9 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--near-field", o.near_field, "a block shoots as its quadrants within this many sides (0: one disc)")
         ->check(examples::finite_non_negative)->capture_default_str();
     on_off("--ambient", o.ambient, "show the ambient term (Cohen et al. 1988): on | off");
+    app.add_flag("--one-sided", o.one_sided,
+                 "only the front (counter-clockwise) side of a surface receives and shoots (default: both sides, "
+                 "as the reference; the GL backend needs it)");
     app.add_option("--repeat", o.repeat, "solve N times; timings are medians")->check(CLI::Range(1, 100))
         ->capture_default_str();
     app.add_option("--width", o.width, "view width")->check(CLI::Range(1, 16384))->capture_default_str();
@@ -135,6 +139,7 @@ inline radiosity_options solver_options_for(const options& o) {
     r.shooters_per_step = o.shooters_per_step;
     r.ambient = o.ambient;
     r.near_field = o.near_field;
+    r.two_sided = !o.one_sided;
     return r;
 }
 
@@ -163,6 +168,9 @@ inline void check_options(const options& o) {
         throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
     if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
     if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
+    if (!o.one_sided)
+        throw parameter_error("--one-sided", "the GL backend solves one-sided surfaces only: add --one-sided "
+                                             "(two-sided surfaces, the default, run on the CPU backend)");
 }
 
 inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
@@ -194,7 +202,8 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
             {"converge", o.converge}, {"converge_on", name_of(measure_names, o.converge_on)}, {"max_seconds", o.max_seconds},
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
-            {"ambient", o.ambient ? "on" : "off"}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
+            {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2},
+            {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 
 /// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),

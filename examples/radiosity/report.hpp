@@ -1,11 +1,13 @@
 #pragma once
 // What one radiosity solve gives the report, and its JSON beside study::run_report's fields.
 #include <bounce/image.hpp>
+#include <bounce/luminance.hpp>
 #include <bounce/radiosity/solve.hpp>
 
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -29,7 +31,25 @@ struct solve_result {
     std::size_t base_elements = 0;  // the atlas's, before adaptive subdivision
     glm::dvec3 emitted{0}, absorbed{0}, escaped{0};
     image<glm::vec3> lightmap, unshot, view;
+    image<glm::vec3> lightmap_back;  // two-sided solves: the back sides' radiosity, laid out as lightmap
+    std::size_t black_pixels = 0;    // view pixels black where the reference is lit (comparison::black_pixels)
 };
+
+/// Pixels of `view` that are black (luminance below 1e-3 of the reference's mean over `mask`)
+/// where the reference is lit (above 1% of that mean): holes in the lightmap (issue 30).
+inline std::size_t black_pixels(const image<glm::vec3>& view, const image<glm::vec3>& reference, const image<float>& mask) {
+    const auto lum = [](const glm::vec3& c) { return rec709_luminance<float, glm::vec3>(c); };
+    double mean = 0, n = 0;
+    for (std::size_t y = 0; y < view.height(); ++y)
+        for (std::size_t x = 0; x < view.width(); ++x)
+            if (mask(x, y) > 0.f) mean += lum(reference(x, y)), n += 1;
+    mean /= std::max(n, 1.0);
+    std::size_t black = 0;
+    for (std::size_t y = 0; y < view.height(); ++y)
+        for (std::size_t x = 0; x < view.width(); ++x)
+            black += mask(x, y) > 0.f && lum(reference(x, y)) > 0.01 * mean && lum(view(x, y)) < 1e-3 * mean ? 1 : 0;
+    return black;
+}
 
 /// The solve's figures for the report: why it stopped, energy, memory, and the curves (times
 /// from the atlas on, checkpoints excluded).

@@ -34,8 +34,8 @@ bounce_cli_refusal("an --out of an unknown image type" PROGRAM radiosity
 bounce_cli_refusal("an --out that is a folder" PROGRAM radiosity
   MATCH "--out" SECONDS 10 ARGS ${quick} --out ${CMAKE_CURRENT_BINARY_DIR}/radiosity_fixtures.exr/)
 bounce_cli_refusal("a --json under /proc" PROGRAM radiosity MATCH "--json" SECONDS 10 ARGS ${quick} --json /proc/r.json)
-bounce_cli_refusal("a scene whose triangles all face away from its light (reversed winding)" PROGRAM radiosity
-  MATCH "reversed winding" SECONDS 10 ARGS ${quick} --scene ${radiosity_fixtures}/reversed/scene.json)
+bounce_cli_refusal("a scene whose triangles all face away from its light (reversed winding), one-sided" PROGRAM radiosity
+  MATCH "reversed winding" SECONDS 10 ARGS ${quick} --one-sided --scene ${radiosity_fixtures}/reversed/scene.json)
 
 # 50 million elements under a 4 GB address-space limit (prlimit): refused with the estimate
 # before anything is allocated, not std::bad_alloc or the OOM killer. Not under
@@ -57,5 +57,10 @@ endif()
 # the names (examples/common/cli_choices.hpp).
 bounce_cli_refusal("an unknown --backend" PROGRAM radiosity MATCH "--backend: vulkan not in .cpu,gl."
   SECONDS 10 ARGS ${quick} --backend vulkan)
+# The GL solver is one-sided (issue 30): two-sided surfaces, the default, are refused there by name.
+if(BOUNCE_WITH_GL)
+  bounce_cli_refusal("two-sided surfaces on the GL backend" PROGRAM radiosity MATCH "--one-sided" SECONDS 10
+    ARGS ${quick} --backend gl)
+endif()
 bounce_cli_refusal("an unknown --visibility" PROGRAM radiosity MATCH "--visibility: raster not in .stereo,hemicube,rays."
   SECONDS 10 ARGS ${quick} --visibility raster)

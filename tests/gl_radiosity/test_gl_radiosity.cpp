@@ -55,7 +55,7 @@ TEST_CASE("without occlusion, GL and CPU shoot the same shooters and agree to fl
     for (std::size_t v = scene.positions.size() - 4; v < scene.positions.size(); ++v)
         scene.positions[v] += glm::vec3(0.13f, 0.f, 0.05f);
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400});
-    cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{});
+    cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.two_sided = false});  // as the GL
     gl::progressive_radiosity gl_solver(scene.view(), atlas, {.visibility = gl::radiosity_visibility::none});
     REQUIRE(gl_solver.shooters() == cpu_solver.shooters());
     CHECK(gl_solver.emitted_power().x == Approx(cpu_solver.emitted_power().x).epsilon(1e-12));
@@ -95,9 +95,9 @@ TEST_CASE("the GL solver's outputs are the CPU solver's: irradiance or radiance,
     scene.lights.push_back(point_light{{0.6f, 1.2f, 0.8f}, glm::vec3(2.f, 1.5f, 1.f)});
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
     for (const bool ambient : {false, true}) {
-        cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.ambient = ambient});
+        cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.ambient = ambient, .two_sided = false});
         gl::progressive_radiosity gl_solver(scene.view(), atlas,
-                                            {.shooting = {.ambient = ambient}, .visibility = gl::radiosity_visibility::none});
+                                            {.shooting = {.ambient = ambient, .two_sided = false}, .visibility = gl::radiosity_visibility::none});
         for (int s = 0; s < 20; ++s) {
             REQUIRE(gl_solver.step());
             REQUIRE(cpu_solver.step());
@@ -158,7 +158,7 @@ TEST_CASE("absorbed + unshot + escaped power equals emitted power on GL after ev
         const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
         gl::progressive_radiosity solver(
             scene.view(), atlas,
-            {.shooting = {.shoot_blocks = false}, .visibility = gl::radiosity_visibility::hemicube, .resolution = 64});
+            {.shooting = {.shoot_blocks = false, .two_sided = false}, .visibility = gl::radiosity_visibility::hemicube, .resolution = 64});
         CHECK(solver.emitted_power().x > 0);
         check_balance(solver, 40);
     }
@@ -175,7 +175,8 @@ cpu::progressive_radiosity<cpu::item_buffer_visibility> cpu_item_buffer_solver(c
         scene.view(), atlas,
         cpu::item_buffer_visibility(scene.view(), atlas,
                                     {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
-                                     .resolution = res}));
+                                     .resolution = res}),
+        {.two_sided = false});  // the GL solver is one-sided
 }
 gl::radiosity_options gl_item_buffer_options(bool hemicube, int res) {
     return {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
@@ -313,7 +314,8 @@ TEST_CASE("a directional light shot first gives the CPU's direct radiosity, shad
     scene.lights.push_back(sun);
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
     cpu::progressive_radiosity cpu_solver(
-        scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 64, .parallel_resolution = 256}));
+        scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 64, .parallel_resolution = 256}),
+        {.two_sided = false});
     gl::progressive_radiosity gl_solver(scene.view(), atlas, {.resolution = 64, .parallel_resolution = 256});
     const auto bc = cpu_solver.radiosity();
     const auto bg = gl_solver.radiosity();
@@ -341,7 +343,7 @@ TEST_CASE("the GL lightmap texture is the solver's radiosity lightmap, padding f
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300, .padding = 2});
     for (const bool ambient : {false, true}) {
-        gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient}, .resolution = 64});
+        gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient, .two_sided = false}, .resolution = 64});
         for (int s = 0; s < 10; ++s) REQUIRE(solver.step());
         const auto expected = solver.radiosity_lightmap();
         const gl::texture_ref t = solver.update_lightmap_texture();
@@ -431,8 +433,9 @@ TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosit
     const auto throws_naming = [&](gl::radiosity_options o, const char* name) {
         CHECK_THROWS_WITH(gl::progressive_radiosity(scene.view(), atlas, o), Catch::Contains(name));
     };
-    throws_naming({.shooting = {.near_field = -1}}, "radiosity_options.near_field");
-    throws_naming({.shooting = {.shooters_per_step = 2}}, "radiosity_options.shooters_per_step");
+    throws_naming({.shooting = {.near_field = -1, .two_sided = false}}, "radiosity_options.near_field");
+    throws_naming({.shooting = {.shooters_per_step = 2, .two_sided = false}}, "radiosity_options.shooters_per_step");
+    throws_naming({.shooting = {.two_sided = true}}, "radiosity_options.two_sided");  // one-sided only
     throws_naming({.resolution = 4}, "radiosity_options.resolution");
     throws_naming({.visibility = gl::radiosity_visibility::hemicube, .resolution = 65}, "radiosity_options.resolution");
     throws_naming({.tolerance_px = 0.f}, "radiosity_options.tolerance_px");

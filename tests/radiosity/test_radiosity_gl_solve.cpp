@@ -19,7 +19,7 @@ TEST_CASE("the GL solver's solve(options) stops where the CPU solver's does", "[
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400, .block_texels = 4});
     gl::progressive_radiosity g(scene.view(), atlas, {.visibility = gl::radiosity_visibility::none});
-    cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{});
+    cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{}, {.two_sided = false});  // the GL is one-sided
     radiosity_solve_options o;
     o.converge = 0.8;
     o.checkpoints = 2;

@@ -169,12 +169,14 @@ TEST_CASE("the CPU solver's solve gives what step() by step gives, with the repo
     CHECK(c.atlas().size() > atlas.size());
 }
 
-TEST_CASE("reversed winding is an error naming it, not a black answer", "[radiosity][solve][errors]") {
+TEST_CASE("reversed winding is an error naming it, not a black answer, on one-sided surfaces", "[radiosity][solve][errors]") {
     // An emitting quad in a box, every triangle wound the other way: the lamp faces the
     // ceiling's back and every wall faces out, so nothing the lamp shoots is received.
+    const radiosity_options one_sided{.two_sided = false};
     const auto box = reversed(closed_box(1.f, 0.7f, 2.f));
     const auto atlas = build_lightmap_atlas(box.view(), {.elements = 400});
-    cpu::progressive_radiosity solver(box.view(), atlas, cpu::item_buffer_visibility(box.view(), atlas, {.resolution = 64}));
+    cpu::progressive_radiosity solver(box.view(), atlas, cpu::item_buffer_visibility(box.view(), atlas, {.resolution = 64}),
+                                      one_sided);
     CHECK_THROWS_AS(solver.solve(0.1), radiosity_error);
     CHECK_THROWS_WITH(solver.solve(0.1), Catch::Contains("reversed winding"));
     // The same box wound the right way solves.
@@ -186,9 +188,12 @@ TEST_CASE("reversed winding is an error naming it, not a black answer", "[radios
     // A point light inside a reversed box reaches only the walls' backs: the constructor says so.
     const auto lit = reversed(box_with_point_light());
     const auto lit_atlas = build_lightmap_atlas(lit.view(), {.elements = 300});
-    CHECK_THROWS_AS(cpu::progressive_radiosity(lit.view(), lit_atlas, cpu::all_visible{}), radiosity_error);
-    CHECK_THROWS_WITH(cpu::progressive_radiosity(lit.view(), lit_atlas, cpu::all_visible{}),
+    CHECK_THROWS_AS(cpu::progressive_radiosity(lit.view(), lit_atlas, cpu::all_visible{}, one_sided), radiosity_error);
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(lit.view(), lit_atlas, cpu::all_visible{}, one_sided),
                       Catch::Contains("reversed winding") && Catch::Contains("back of"));
+    // Two-sided (the default), the reversed box is lit on its walls' backs.
+    cpu::progressive_radiosity two(lit.view(), lit_atlas, cpu::all_visible{});
+    CHECK(two.emitted_power().x > 0);
     const auto right = box_with_point_light();
     const auto right_atlas = build_lightmap_atlas(right.view(), {.elements = 300});
     cpu::progressive_radiosity ok(right.view(), right_atlas, cpu::all_visible{});
@@ -200,7 +205,8 @@ TEST_CASE("reversed winding is an error naming it, not a black answer", "[radios
     const auto out_atlas = build_lightmap_atlas(outside.view(), {.elements = 300});
     const auto hidden = [&] {
         return cpu::progressive_radiosity(outside.view(), out_atlas,
-                                          cpu::item_buffer_visibility(outside.view(), out_atlas, {.resolution = 64}));
+                                          cpu::item_buffer_visibility(outside.view(), out_atlas, {.resolution = 64}),
+                                          one_sided);
     };
     CHECK_THROWS_WITH(hidden(), Catch::Contains("occluded"));
     // A spot aimed away from everything reaches no surface.
@@ -214,6 +220,37 @@ TEST_CASE("reversed winding is an error naming it, not a black answer", "[radios
     const auto away_atlas = build_lightmap_atlas(away.view(), {.elements = 300});
     CHECK_THROWS_WITH(cpu::progressive_radiosity(away.view(), away_atlas, cpu::all_visible{}),
                       Catch::Contains("reaches no surface"));
+}
+
+TEST_CASE("two-sided elements light a reversed box from inside as one-sided ones light the right one",
+          "[radiosity][solve][sides]") {
+    // A point light in a box wound inwards (one-sided) and in the same box wound outwards
+    // (two-sided, the default): the second's back sides must carry what the first's fronts do
+    // (the same texels, perhaps in another order: compared by the power they hold), and its
+    // front sides, which face out of the box, nothing.
+    const auto right = box_with_point_light(), wrong = reversed(box_with_point_light());
+    const auto right_atlas = build_lightmap_atlas(right.view(), {.elements = 300});
+    const auto wrong_atlas = build_lightmap_atlas(wrong.view(), {.elements = 300});
+    REQUIRE(right_atlas.size() == wrong_atlas.size());
+    cpu::progressive_radiosity<cpu::all_visible, double> one(right.view(), right_atlas, {}, {.two_sided = false});
+    cpu::progressive_radiosity<cpu::all_visible, double> two(wrong.view(), wrong_atlas, {});
+    CHECK(two.sides() == 2);
+    one.solve(1e-9);
+    two.solve(1e-9);
+    const auto power = [](const auto& solver, int side) {
+        glm::dvec3 sum(0);
+        const auto b = solver.radiosity(side);
+        for (std::size_t i = 0; i < b.size(); ++i) sum += glm::dvec3(b[i]) * double(solver.atlas().area[i]);
+        return sum;
+    };
+    const glm::dvec3 expected = power(one, 0), got = power(two, 1);
+    for (int c = 0; c < 3; ++c) CHECK(got[c] == Approx(expected[c]).epsilon(1e-6));
+    CHECK(power(two, 0) == glm::dvec3(0));
+    CHECK(two.emitted_power().x == Approx(one.emitted_power().x).epsilon(1e-9));
+    // The balance holds over both sides.
+    const glm::dvec3 balance = two.absorbed_power() + two.unshot_power() + two.escaped_power() - two.emitted_power();
+    CHECK(std::abs(balance.x) < 1e-9 * two.emitted_power().x);
+    CHECK_THROWS_AS(one.radiosity(1), parameter_error);  // a one-sided solver has no back
 }
 
 TEST_CASE("a stereographic tolerance below what the buffer resolves is refused with the floor", "[radiosity][solve][errors]") {

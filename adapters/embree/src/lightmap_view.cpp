@@ -17,6 +17,12 @@ namespace bounce::embree {
 image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const lightmap_atlas& atlas,
                                image_view<const glm::vec3> lightmap, int level, const bounce::camera& cam,
                                std::size_t width, std::size_t height) {
+    return lightmap_view(bvh, scene, atlas, lightmap, lightmap, level, cam, width, height);
+}
+
+image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const lightmap_atlas& atlas,
+                               image_view<const glm::vec3> front, image_view<const glm::vec3> back, int level,
+                               const bounce::camera& cam, std::size_t width, std::size_t height) {
     require_match(bvh, scene);
     cam.validate();
     require(width > 0 && height > 0, "width/height", "must be positive");
@@ -24,8 +30,9 @@ image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const 
             "was not built from this scene (triangle counts differ)");
     require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
     const std::size_t f = std::size_t(1) << level;
-    require(lightmap.width() == std::size_t(atlas.width) * f && lightmap.height() == std::size_t(atlas.height) * f,
-            "lightmap", "must be the atlas's size times 2^level");
+    for (const auto& lightmap : {front, back})
+        require(lightmap.width() == std::size_t(atlas.width) * f && lightmap.height() == std::size_t(atlas.height) * f,
+                "lightmap", "must be the atlas's size times 2^level");
     image<glm::vec3> out(width, height, glm::vec3(0.f));
     const float scale = float(f);
     const float inv_pi = float(1.0 / std::numbers::pi);
@@ -45,6 +52,8 @@ image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const 
                 const std::uint32_t chart = atlas.chart_of_triangle[hits[x].triangle];
                 if (chart == lightmap_atlas::none) continue;
                 const glm::vec3 p = rays[x].origin + hits[x].t * rays[x].direction;
+                const bool sees_back = glm::dot(atlas.charts[chart].normal, rays[x].direction) > 0.f;
+                const image_view<const glm::vec3>& lightmap = sees_back ? back : front;
                 // Texel (i, j) spans [i, i+1]: its centre is at i + 1/2.
                 const glm::vec2 uv = atlas.atlas_coords(chart, p) * scale - 0.5f;
                 const float fx = std::floor(uv.x), fy = std::floor(uv.y);

@@ -65,8 +65,8 @@ technique_run run_radiosity(const scene_setup& s) {
     r.technique = bench_technique::radiosity;
     r.quantity = bench_quantity::all_bounces;
     const auto tv = std::chrono::steady_clock::now();
-    const image<glm::vec3> lightmap = solver.radiosity_lightmap(0);
-    r.radiance = embree::lightmap_view(s.bvh, s.scene, solver.atlas(), lightmap.view(), 0, s.scene.camera,
+    const image<glm::vec3> lightmap = solver.radiosity_lightmap(0), back = solver.radiosity_lightmap(0, 1);  // two-sided
+    r.radiance = embree::lightmap_view(s.bvh, s.scene, solver.atlas(), lightmap.view(), back.view(), 0, s.scene.camera,
                                        s.g.width(), s.g.height());
     const double view_ms = ms_since(tv);
     // The solve is the technique's work; the view from the lightmap is a texture lookup in

@@ -31,6 +31,10 @@ struct radiosity_options {
     double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
                                    ///< times its side (sqrt of its area), else as its quadrants,
                                    ///< recursively; 0: always one disc (typical: 2-4)
+    bool two_sided = true;         ///< every element receives and shoots on both sides, a radiosity
+                                   ///< per side (the reference integrator's convention, issue 30);
+                                   ///< false: only the front (counter-clockwise) side. The GL
+                                   ///< solver is one-sided and refuses true
 
     /// Throws parameter_error naming the option ("radiosity_options.near_field" ...).
     void validate() const {

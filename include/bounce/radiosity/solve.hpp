@@ -26,6 +26,7 @@
 #include <bounce/radiosity/options.hpp>
 #include <bounce/scene_view.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
@@ -229,6 +230,12 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
     // Shots were made (in this solve or before) and none of their power, nor any light's,
     // reached the front of a surface.
     const double emitted = channel_total(solver.emitted_power());
+    bool two_sided = false;
+    if constexpr (requires { solver.two_sided(); }) two_sided = solver.two_sided();
+    if (solver.progress().steps > 0 && emitted > 0 && !(channel_total(solver.intercepted_power()) > 0) && two_sided)
+        throw radiosity_error("bounce: radiosity: all of the power shot (" +
+                              radiosity_number(emitted - channel_total(solver.unshot_power())) + " of " +
+                              radiosity_number(emitted) + " W emitted) left the scene without reaching any surface");
     if (solver.progress().steps > 0 && emitted > 0 && !(channel_total(solver.intercepted_power()) > 0))
         throw radiosity_error(
             "bounce: radiosity: all of the power shot (" + radiosity_number(emitted - channel_total(solver.unshot_power())) +
@@ -316,12 +323,15 @@ inline void check_lights_face_surfaces(const scene_view& scene) {
 /// `atlas`), and the power the lights delivered to the elements (`delivered`, W per
 /// channel, visibility included) is zero, naming the cause: the lights face only the back
 /// sides of surfaces (reversed winding), or no surface at all (outside the scene or aimed
-/// away), or every surface they face is occluded from them.
-inline void check_lights_reach_surfaces(const scene_view& scene, const lightmap_atlas& atlas, const glm::dvec3& delivered) {
+/// away), or every surface they face is occluded from them. With `two_sided` surfaces
+/// (radiosity_options::two_sided) both sides count as faced and reversed winding is no error.
+inline void check_lights_reach_surfaces(const scene_view& scene, const lightmap_atlas& atlas, const glm::dvec3& delivered,
+                                        bool two_sided = false) {
     if (scene.lights.empty() || detail::channel_total(delivered) > 0 || !detail::lights_emit(scene)) return;
     for (const glm::vec3& e : atlas.emission)
         if (e.x > 0.f || e.y > 0.f || e.z > 0.f) return;
-    const light_sides s = triangles_lit_by_lights(scene);
+    light_sides s = triangles_lit_by_lights(scene);
+    if (two_sided) s.front = std::max(s.front, s.back);
     if (s.front == 0 && s.back > 0) detail::throw_reversed(scene, s);
     if (s.front == 0)
         throw radiosity_error("bounce: radiosity: the scene's " + detail::lights_verb(scene, "reaches", "reach") +

@@ -50,6 +50,8 @@
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
 #include <bounce/radiosity/shooters.hpp>
+#include <bounce/radiosity/sides.hpp>
+#include <bounce/cpu/radiosity_memory.hpp>
 #include <bounce/radiosity/options.hpp>
 #include <bounce/radiosity/solve.hpp>
 #include <bounce/radiosity/subdivision.hpp>
@@ -80,27 +82,6 @@ using bounce::radiosity_options;
 using bounce::radiosity_progress;
 using bounce::radiosity_timings;
 
-/// Bytes that building an atlas (build_lightmap_atlas(scene, options)) and then a
-/// progressive_radiosity<V, float> over it hold at their peak, with the solver's lightmap()
-/// and the unshot radiosity laid out as texels at the end: an estimate from the element budget
-/// and the triangle count made before anything is allocated, so a caller can refuse a budget
-/// that cannot fit (`--elements 50000000`) instead of dying in std::bad_alloc or the OOM
-/// killer. Per element: the atlas's arrays (64 bytes), twice while the solver copies it, and
-/// the solver's radiosity, unshot, direct, gathered and received arrays (60); per texel of the atlas (elements
-/// plus each chart's padding ring and the packing's waste, at most one chart per triangle):
-/// element_at, the build's overlap sums and the lightmaps laid out (56); per triangle the
-/// build's adjacency (about 200). Visibility is not included (an item buffer: about 112
-/// bytes per triangle and 12 per pixel of its buffers). Measured peaks are lower by 10-25%
-/// (docs/radiosity.md, section 7).
-inline double radiosity_memory_estimate(const scene_view& scene, const atlas_options& options) {
-    // Each chart takes at least one element whatever the budget: at most one chart per triangle.
-    const double n = double(scene.triangles.size()), e = std::max(double(options.elements), n);
-    const double p = double(options.padding);
-    const double texels = 1.25 * (1.3 * e + 4 * p * std::sqrt(e * n) + 4 * p * p * n);
-    const double shooters = e / double(options.block_texels * options.block_texels) + n;
-    return e * (2 * 64 + 60) + texels * 56 + shooters * 60 + n * 200 + double(scene.positions.size()) * 48;
-}
-
 /// The solver. `Real` is the type of the radiosity arrays and of the kernel's arithmetic
 /// (float, as a GPU would; double for reference solutions). `Visibility` models
 /// shot_visibility.
@@ -121,24 +102,29 @@ public:
         require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
                 "was not built from this scene (triangle counts differ)");
         const std::size_t n = atlas.size();
-        radiosity_.resize(n);
-        unshot_.resize(n);
+        sides_ = options.two_sided ? 2 : 1;
+        radiosity_.assign(sides_ * n, vec(0));
+        unshot_.assign(sides_ * n, vec(0));
+        // Two-sided, an emitter emits on the side the reference integrator gives it (its
+        // vertex normals' side, emission_sides); one-sided, on its front.
+        if (sides_ == 2) emits_back_ = emission_sides(scene, atlas);
         for (std::size_t i = 0; i < n; ++i) {
-            radiosity_[i] = vec(atlas.emission[i]);
-            unshot_[i] = vec(atlas.emission[i]);
+            const std::size_t j = emits_on(i, 0) ? i : n + i;
+            radiosity_[j] = vec(atlas.emission[i]);
+            unshot_[j] = vec(atlas.emission[i]);
             emitted_ += glm::dvec3(atlas.emission[i]) * double(atlas.area[i]);
             total_area_ += double(atlas.area[i]);
             albedo_area_ += glm::dvec3(atlas.albedo[i]) * double(atlas.area[i]);
         }
         build_shooters();
         const auto start = clock::now();
-        direct_.assign(n, vec(0));
-        gathered_.assign(n, vec(0));
+        direct_.assign(sides_ * n, vec(0));
+        gathered_.assign(sides_ * n, vec(0));
         for (const light& l : scene.lights) lights_.push_back(pack(l));
         for (const packed_light& l : lights_) shoot_light(l, false);
         timings_.lights_ms = ms_since(start);
         refresh_powers();
-        check_lights_reach_surfaces(scene, atlas_, emitted_);
+        check_lights_reach_surfaces(scene, atlas_, emitted_, sides_ == 2);
     }
 
     /// One step: choose shooters_per_step shooters by unshot power and shoot each in turn.
@@ -215,14 +201,19 @@ public:
     glm::dvec3 intercepted_power() const noexcept { return intercepted_; }
     glm::dvec3 unshot_power() const {
         glm::dvec3 s(0);
-        for (std::size_t i = 0; i < unshot_.size(); ++i) s += glm::dvec3(unshot_[i]) * double(atlas_.area[i]);
+        const std::size_t n = atlas_.size();
+        for (std::size_t i = 0; i < unshot_.size(); ++i) s += glm::dvec3(unshot_[i]) * double(atlas_.area[i % n]);
         return s;
     }
 
-    /// Radiosity B per element, W/m^2 per channel (emission included).
-    std::span<const vec> radiosity() const noexcept { return radiosity_; }
-    /// Unshot radiosity per element, W/m^2 per channel.
-    std::span<const vec> unshot() const noexcept { return unshot_; }
+    /// Radiosity B per element of `side` (0: front, counter-clockwise; 1: back, two-sided
+    /// only), W/m^2 per channel (emission included).
+    std::span<const vec> radiosity(int side = 0) const { return side_span(radiosity_, side); }
+    /// Unshot radiosity per element of `side`, W/m^2 per channel.
+    std::span<const vec> unshot(int side = 0) const { return side_span(unshot_, side); }
+    /// 2 when elements are two-sided (radiosity_options::two_sided), else 1.
+    int sides() const noexcept { return int(sides_); }
+    bool two_sided() const noexcept { return sides_ == 2; }
 
     /// The ambient radiosity (Cohen et al. 1988): 1 / (1 - rho_avg) times the area-weighted
     /// mean unshot radiosity, per channel.
@@ -236,16 +227,19 @@ public:
     /// directional lights' irradiance times visibility (as radiance, plus the emission
     /// L_e); indirect: what the shots delivered (emissive surfaces' light included), plus the
     /// ambient term when the options ask. Radiance of `all` is display_radiosity() / pi.
+    /// `side`: 0 the front, 1 the back (two-sided solvers only); the emission is counted on
+    /// the side that emits.
     std::vector<glm::vec3> output(output_quantity quantity = output_quantity::irradiance,
-                                  light_paths paths = light_paths::indirect) const {
-        std::vector<glm::vec3> out(radiosity_.size());
+                                  light_paths paths = light_paths::indirect, int side = 0) const {
+        const std::size_t n = atlas_.size(), o = n * std::size_t(checked_side(side));
+        std::vector<glm::vec3> out(n);
         const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
         const glm::vec3 amb = options_.ambient && indirect ? glm::vec3(ambient()) : glm::vec3(0.f);
         for (std::size_t i = 0; i < out.size(); ++i) {
-            const glm::vec3 e = (direct ? glm::vec3(direct_[i]) : glm::vec3(0.f)) +
-                                (indirect ? glm::vec3(gathered_[i]) + amb : glm::vec3(0.f));
+            const glm::vec3 e = (direct ? glm::vec3(direct_[o + i]) : glm::vec3(0.f)) +
+                                (indirect ? glm::vec3(gathered_[o + i]) + amb : glm::vec3(0.f));
             out[i] = quantity == output_quantity::irradiance ? e : lambertian_radiance<float, glm::vec3>(atlas_.albedo[i], e);
-            if (quantity == output_quantity::radiance && direct)
+            if (quantity == output_quantity::radiance && direct && emits_on(i, side))
                 out[i] += atlas_.emission[i] * float(1.0 / std::numbers::pi);
         }
         return out;
@@ -256,24 +250,26 @@ public:
     /// level > 0 shows what adaptive subdivision added): the lightmap a renderer samples with
     /// the atlas's corner_uvs.
     image<glm::vec3> lightmap(output_quantity quantity = output_quantity::irradiance,
-                              light_paths paths = light_paths::indirect, int level = 0) const {
-        const auto values = output(quantity, paths);
+                              light_paths paths = light_paths::indirect, int level = 0, int side = 0) const {
+        const auto values = output(quantity, paths, side);
         return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level, glm::vec3(0.f), true);
     }
 
-    /// Radiosity to display now: B, plus rho times the ambient term when the options ask.
-    std::vector<glm::vec3> display_radiosity() const {
-        std::vector<glm::vec3> out(radiosity_.size());
+    /// Radiosity to display now on `side` (0 front, 1 back): B, plus rho times the ambient
+    /// term when the options ask.
+    std::vector<glm::vec3> display_radiosity(int side = 0) const {
+        const auto b = radiosity(side);
+        std::vector<glm::vec3> out(b.size());
         const glm::vec3 amb = options_.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
         for (std::size_t i = 0; i < out.size(); ++i)
-            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(radiosity_[i]), atlas_.albedo[i], amb);
+            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(b[i]), atlas_.albedo[i], amb);
         return out;
     }
 
-    /// display_radiosity (B, W/m^2) laid out as lightmap() lays outputs out: what
-    /// embree::lightmap_view takes.
-    image<glm::vec3> radiosity_lightmap(int level = 0) const {
-        const auto values = display_radiosity();
+    /// display_radiosity (B, W/m^2) of `side` laid out as lightmap() lays outputs out: what
+    /// embree::lightmap_view takes (the back's for the views of back sides).
+    image<glm::vec3> radiosity_lightmap(int level = 0, int side = 0) const {
+        const auto values = display_radiosity(side);
         return atlas_.to_fine_texels(std::span<const glm::vec3>(values), level, glm::vec3(0.f), true);
     }
 
@@ -310,19 +306,22 @@ public:
     /// every few steps from the first shots on keeps most of the light at the finer level.
     std::size_t subdivide(const scene_view& scene, const subdivision_options& options) {
         const auto start = clock::now();
-        std::vector<glm::vec3> b(radiosity_.size());
-        for (std::size_t i = 0; i < b.size(); ++i) b[i] = glm::vec3(radiosity_[i]);
+        // The test sees both sides' radiosity together (where two-sided elements are lit).
+        std::vector<glm::vec3> b(atlas_.size());
+        for (std::size_t i = 0; i < radiosity_.size(); ++i) b[i % b.size()] += glm::vec3(radiosity_[i]);
         const auto split = blocks_to_subdivide(atlas_, std::span<const glm::vec3>(b), options);
         if (!split.empty()) {
             atlas_refinement r = refine_lightmap_atlas(scene, atlas_, split);
-            std::vector<vec> radiosity(r.parent.size()), unshot(r.parent.size()), direct(r.parent.size()),
-                gathered(r.parent.size());
-            for (std::size_t i = 0; i < r.parent.size(); ++i) {
-                radiosity[i] = radiosity_[r.parent[i]];
-                unshot[i] = unshot_[r.parent[i]];
-                direct[i] = direct_[r.parent[i]];
-                gathered[i] = gathered_[r.parent[i]];
-            }
+            const std::size_t m = r.parent.size(), n = atlas_.size();
+            std::vector<vec> radiosity(sides_ * m), unshot(sides_ * m), direct(sides_ * m), gathered(sides_ * m);
+            for (std::size_t side = 0; side < sides_; ++side)
+                for (std::size_t i = 0; i < m; ++i) {
+                    const std::size_t to = side * m + i, from = side * n + r.parent[i];
+                    radiosity[to] = radiosity_[from];
+                    unshot[to] = unshot_[from];
+                    direct[to] = direct_[from];
+                    gathered[to] = gathered_[from];
+                }
             atlas_ = std::move(r.atlas);
             radiosity_ = std::move(radiosity);
             unshot_ = std::move(unshot);
@@ -341,13 +340,14 @@ public:
 private:
     using clock = std::chrono::steady_clock;
 
-    // Shooters: the atlas's blocks, or one per element; their centres, areas and powers.
+    // Shooters: the atlas's blocks, or one per element, once per side (shooter k is block
+    // k % blocks on side k / blocks); the blocks' centres and areas, the shooters' powers.
     void build_shooters() {
         first_ = shooter_ranges(atlas_, options_.shoot_blocks);
         const std::size_t shooters = first_.size() - 1;
         centre_.resize(shooters);
         shooter_area_.resize(shooters);
-        power_.resize(shooters);
+        power_.resize(sides_ * shooters);
         for (std::size_t k = 0; k < shooters; ++k) {
             const shooter_disc disc = shooter_disc_of(atlas_, first_[k], first_[k + 1]);
             centre_[k] = disc.centre;
@@ -388,33 +388,40 @@ private:
 
     void refresh_powers() {
         unshot_total_ = 0;
+        const std::size_t blocks = first_.size() - 1, n = atlas_.size();
         for (std::size_t k = 0; k < power_.size(); ++k) {
+            const std::size_t b = k % blocks, o = n * (k / blocks);
             double p = 0;
-            for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) p += channel_sum(unshot_[i]) * double(atlas_.area[i]);
+            for (std::uint32_t i = first_[b]; i < first_[b + 1]; ++i) p += channel_sum(unshot_[o + i]) * double(atlas_.area[i]);
             power_[k] = p;
             unshot_total_ += p;
         }
     }
 
-    // Runs `receive(i, sums)` for every element, chunk by chunk of shooters in parallel,
-    // refreshing each shooter's power (with `refresh`); then adds the chunks' sums in order.
+    // Runs `receive(i, sums)` for every element, chunk by chunk of blocks in parallel,
+    // refreshing each block's shooters' powers (with `refresh`, both sides); then adds the
+    // chunks' sums in order.
     template <class Receive>
     chunk_sums for_elements(const Receive& receive, bool refresh = false) {
-        const std::size_t shooters = power_.size(), chunks = (shooters + chunk - 1) / chunk;
+        const std::size_t blocks = first_.size() - 1, chunks = (blocks + chunk - 1) / chunk, n = atlas_.size();
         sums_.assign(chunks, chunk_sums{});
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t c = r.begin(); c != r.end(); ++c) {
                 chunk_sums s;
-                const std::size_t k1 = std::min(shooters, (c + 1) * chunk);
+                const std::size_t k1 = std::min(blocks, (c + 1) * chunk);
                 for (std::size_t k = c * chunk; k < k1; ++k) {
-                    double p = 0;
+                    double p[2] = {0, 0};
                     for (std::uint32_t i = first_[k]; i < first_[k + 1]; ++i) {
                         receive(i, s);
-                        if (refresh) p += channel_sum(unshot_[i]) * double(atlas_.area[i]);
+                        if (!refresh) continue;
+                        for (std::size_t side = 0; side < sides_; ++side)
+                            p[side] += channel_sum(unshot_[side * n + i]) * double(atlas_.area[i]);
                     }
                     if (!refresh) continue;
-                    power_[k] = p;
-                    s.unshot += p;
+                    for (std::size_t side = 0; side < sides_; ++side) {
+                        power_[side * blocks + k] = p[side];
+                        s.unshot += p[side];
+                    }
                 }
                 sums_[c] = s;
             }
@@ -439,21 +446,25 @@ private:
     // power (shot_scale), added to the receivers.
     void shoot(std::uint32_t k) {
         const lightmap_atlas& at = atlas_;
-        const std::uint32_t i0 = first_[k], i1 = first_[k + 1];
+        // Block b's elements on `side`: they shoot into the hemisphere of that side's normal.
+        const std::size_t blocks = first_.size() - 1, b = k % blocks, side = k / blocks;
+        const std::uint32_t i0 = first_[b], i1 = first_[b + 1];
+        vec* unshot = unshot_.data() + side * at.size();
         // The shooter's unshot power, summed over its elements; then zeroed, so its elements'
         // power (refreshed in the distribution) starts from 0. Its elements are kept for the
         // near field.
         glm::dvec3 power(0);
-        for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot_[i]) * double(at.area[i]);
-        build_near_tree(k);
-        for (std::uint32_t i = i0; i < i1; ++i) unshot_[i] = vec(0);
+        for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot[i]) * double(at.area[i]);
+        build_near_tree(std::uint32_t(b), unshot);
+        for (std::uint32_t i = i0; i < i1; ++i) unshot[i] = vec(0);
+        const glm::vec3 normal = side == 0 ? at.normal[i0] : -at.normal[i0];
 
         auto start = clock::now();
-        visibility_.begin_shot(shot_frame{centre_[k], at.normal[i0], false, at.chart[i0]});
+        visibility_.begin_shot(shot_frame{centre_[b], normal, false, at.chart[i0]});
         timings_.visibility_ms += ms_since(start);
 
         start = clock::now();
-        const glm::dvec3 incident = gather_shot(at.chart[i0], vec(at.normal[i0]));
+        const glm::dvec3 incident = gather_shot(at.chart[i0], vec(normal));
         const glm::dvec3 scale = shot_scale(power, incident);
         const chunk_sums total = apply_shot(Real(scale.x), Real(scale.y), Real(scale.z));
         timings_.distribution_ms += ms_since(start);
@@ -469,17 +480,21 @@ private:
     // Pass 1 of a shot from the near-field tree near_ (normal `ns`, chart `chart`): each
     // element's incident radiosity sum_j dB_j F_{r->j} V (element_form_factor, the receiver's
     // area in it) into received_, and the power they intercept together (W per channel).
+    // Two-sided, each node of the tree lights the receiver's side that faces it (its normal
+    // flipped towards the node), so a receiver may take light on both sides from one shot.
     glm::dvec3 gather_shot(std::uint32_t chart, const vec ns) {
         const lightmap_atlas& at = atlas_;
         const std::uint32_t root = std::uint32_t(near_.size() - 1);
         const Real near2 = Real(options_.near_field) * Real(options_.near_field);
-        received_.assign(at.size(), vec(0));
+        const std::size_t n = at.size();
+        const bool two = sides_ == 2;
+        received_.assign(sides_ * n, vec(0));
         const Visibility& vis = visibility_;
         const chunk_sums total = for_elements([&](std::uint32_t i, chunk_sums& s) {
             if (at.chart[i] == chart) return;  // coplanar with the shooter: F = 0
             const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
             const Real ar = Real(at.area[i]);
-            vec incident(0);
+            vec incident(0), incident_back(0);
             // The block as one disc where the receiver is farther than near_field times its
             // side, else as its four quadrants, recursively, down to elements.
             std::array<std::uint32_t, 64> stack;
@@ -488,17 +503,20 @@ private:
             while (top > 0) {
                 const near_node& node = near_[stack[--top]];
                 if (node.child_count == 0 || !(near_field_opens<Real, vec>(pr, node.position, node.area, near2) > Real(0.5))) {
-                    const Real f = element_form_factor<Real, vec>(pr, nr, ar, node.position, ns, node.area);
-                    if (f > Real(0)) incident += node.unshot * f;
+                    const bool back = two && glm::dot(nr, node.position - pr) < Real(0);
+                    const Real f = element_form_factor<Real, vec>(pr, back ? -nr : nr, ar, node.position, ns, node.area);
+                    if (f > Real(0)) (back ? incident_back : incident) += node.unshot * f;
                 } else {
                     for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = node.first_child + c;
                 }
             }
-            if (!(incident.x > Real(0) || incident.y > Real(0) || incident.z > Real(0))) return;
+            const auto positive = [](const vec& x) { return x.x > Real(0) || x.y > Real(0) || x.z > Real(0); };
+            if (!positive(incident) && !positive(incident_back)) return;
             const Real v = Real(vis.visible(at.position[i], at.chart[i]));
             if (!(v > Real(0))) return;
             received_[i] = incident * v;
-            s.intercepted += glm::dvec3(received_[i]) * double(at.area[i]);
+            if (two) received_[n + i] = incident_back * v;
+            s.intercepted += (glm::dvec3(received_[i]) + glm::dvec3(incident_back * v)) * double(at.area[i]);
         });
         return total.intercepted;
     }
@@ -510,19 +528,22 @@ private:
     chunk_sums apply_shot(Real sx, Real sy, Real sz) {
         const lightmap_atlas& at = atlas_;
         const vec scale(sx, sy, sz);
+        const std::size_t n = at.size();
         return distribute([&](std::uint32_t i, chunk_sums& s) {
-            if (received_[i] == vec(0)) return;
-            const vec incident = received_[i] * scale;
-            const vec rho = vec(at.albedo[i]);
-            const vec gain = rho * incident;
-            radiosity_[i] += gain;
-            unshot_[i] += gain;
-            gathered_[i] += incident;
-            const glm::dvec3 intercepted = glm::dvec3(incident) * double(at.area[i]);
-            s.intercepted += intercepted;
-            s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
-            const double taken = bounce::detail::channel_total(intercepted);
-            if (taken > s.top_power) s.top_power = taken, s.top_receiver = i;
+            for (std::size_t j = i; j < sides_ * n; j += n) {
+                if (received_[j] == vec(0)) continue;
+                const vec incident = received_[j] * scale;
+                const vec rho = vec(at.albedo[i]);
+                const vec gain = rho * incident;
+                radiosity_[j] += gain;
+                unshot_[j] += gain;
+                gathered_[j] += incident;
+                const glm::dvec3 intercepted = glm::dvec3(incident) * double(at.area[i]);
+                s.intercepted += intercepted;
+                s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
+                const double taken = bounce::detail::channel_total(intercepted);
+                if (taken > s.top_power) s.top_power = taken, s.top_receiver = i;
+            }
         });
     }
 
@@ -534,13 +555,14 @@ private:
         direct_.assign(inherited.size(), vec(0));
         for (const packed_light& l : lights_) shoot_light(l, true);
         glm::dvec3 added(0), absorbed(0);
+        const std::size_t n = atlas_.size();
         for (std::size_t i = 0; i < direct_.size(); ++i) {
             const vec d = direct_[i] - inherited[i];
             if (d == vec(0)) continue;
-            const vec rho = vec(atlas_.albedo[i]);
+            const vec rho = vec(atlas_.albedo[i % n]);
             radiosity_[i] += rho * d;
             unshot_[i] += rho * d;
-            const glm::dvec3 power = glm::dvec3(d) * double(atlas_.area[i]);
+            const glm::dvec3 power = glm::dvec3(d) * double(atlas_.area[i % n]);
             added += power;
             absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * power;
         }
@@ -569,6 +591,7 @@ private:
             const shot_frame& frame = frames[h];
             visibility_.begin_shot(frame);
             const Visibility& vis = visibility_;
+            const std::size_t count = at.size();
             const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
                 const glm::vec3 p = at.position[i], n = at.normal[i];
                 if (!frame.parallel) {
@@ -577,16 +600,20 @@ private:
                     if (!(light_hemisphere_side<float, glm::vec3>(p, frame.position, frame.axis, h == 0 ? 0.f : 1.f) > 0.5f))
                         return;
                 }
-                const glm::vec3 e = light_irradiance(l, p, n);
-                if (!(e.x > 0.f || e.y > 0.f || e.z > 0.f)) return;
+                const auto positive = [](const glm::vec3& x) { return x.x > 0.f || x.y > 0.f || x.z > 0.f; };
+                // The side facing the light: the front, or (two-sided) the back.
+                glm::vec3 e = light_irradiance(l, p, n);
+                std::size_t j = i;
+                if (!positive(e) && sides_ == 2) e = light_irradiance(l, p, -n), j = count + i;
+                if (!positive(e)) return;
                 const float v = vis.visible(p, at.chart[i]);
                 if (!(v > 0.f)) return;
-                direct_[i] += vec(e * v);
+                direct_[j] += vec(e * v);
                 if (measure_only) return;
                 const vec rho = vec(at.albedo[i]);
                 const vec gain = rho * vec(e * v);
-                radiosity_[i] += gain;
-                unshot_[i] += gain;
+                radiosity_[j] += gain;
+                unshot_[j] += gain;
                 const glm::dvec3 intercepted = glm::dvec3(e * v) * double(at.area[i]);
                 s.intercepted += intercepted;
                 s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
@@ -625,16 +652,33 @@ private:
     };
     std::vector<near_node> near_;
 
-    // The tree of radiosity/shooters.hpp (the GL solver builds the same).
-    void build_near_tree(std::uint32_t k) {
+    // The tree of radiosity/shooters.hpp (the GL solver builds the same) of block k, from the
+    // unshot radiosity of one side (`unshot`, indexed by element).
+    void build_near_tree(std::uint32_t k, const vec* unshot) {
         near_.clear();
         build_near_field_tree(
             atlas_, first_[k], first_[k + 1], options_.shoot_blocks, k,
-            [&](std::uint32_t i) { return glm::dvec3(unshot_[i]); },
+            [&](std::uint32_t i) { return glm::dvec3(unshot[i]); },
             [&](glm::dvec3 centre, double node_area, glm::dvec3 mean_unshot, std::uint32_t first_child,
                 std::uint32_t children) {
                 near_.push_back({vec(centre), Real(node_area), vec(mean_unshot), first_child, children});
             });
+    }
+    // The two sides (radiosity_options::two_sided): radiosity_, unshot_, direct_, gathered_
+    // and received_ hold sides_ x elements entries, the front's first; emits_back_ per chart,
+    // whether its emission leaves from the back (two-sided only; emission_sides).
+    std::size_t sides_ = 1;
+    std::vector<std::uint8_t> emits_back_;
+    std::span<const vec> side_span(const std::vector<vec>& v, int side) const {
+        return std::span<const vec>(v).subspan(atlas_.size() * std::size_t(checked_side(side)), atlas_.size());
+    }
+    int checked_side(int side) const {
+        require(side >= 0 && std::size_t(side) < sides_, "side", sides_ == 2 ? "must be 0 or 1" : "must be 0 (one-sided)");
+        return side;
+    }
+    bool emits_on(std::size_t i, int side) const {
+        const bool back = !emits_back_.empty() && emits_back_[atlas_.chart[i]];
+        return back == (side == 1);
     }
     double unshot_total_ = 0, total_area_ = 0;
     double shot_power_ = 0;  // power shot by surfaces so far, channels summed (W)

@@ -27,4 +27,11 @@ image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const 
                                image_view<const glm::vec3> lightmap, int level, const bounce::camera& cam,
                                std::size_t width, std::size_t height);
 
+/// The same for two-sided elements (radiosity_options::two_sided): `front` where the ray meets
+/// a chart's front side (counter-clockwise), `back` where it meets its back, both laid out as
+/// `atlas` (cpu::progressive_radiosity::radiosity_lightmap(level, 0) and (level, 1)).
+image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const lightmap_atlas& atlas,
+                               image_view<const glm::vec3> front, image_view<const glm::vec3> back, int level,
+                               const bounce::camera& cam, std::size_t width, std::size_t height);
+
 }  // namespace bounce::embree

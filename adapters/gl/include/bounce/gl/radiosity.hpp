@@ -69,7 +69,8 @@ enum class radiosity_visibility {
 /// (radiosity/options.hpp; shooters_per_step must be 1 here) and the item-buffer options of
 /// cpu::item_buffer_visibility::options, with the same meanings and defaults.
 struct radiosity_options {
-    bounce::radiosity_options shooting{};  ///< as cpu::progressive_radiosity takes them
+    bounce::radiosity_options shooting{.two_sided = false};  ///< as cpu::progressive_radiosity takes them;
+                                                         ///< one-sided only (two_sided is refused)
     radiosity_visibility visibility = radiosity_visibility::stereographic;
     int resolution = 256;            ///< item buffer side, pixels (hemicube: per face, even; typical: 128-512)
     float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
