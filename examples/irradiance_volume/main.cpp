@@ -25,6 +25,7 @@
 #include "../common/run_program.hpp"
 
 #include <bounce/embree/probe_baker.hpp>
+#include <bounce/embree/probe_relocation.hpp>
 #include <bounce/embree/probe_visibility_baker.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
@@ -79,6 +80,7 @@ struct options {
     std::size_t surface_size = 128;
     embree::probe_visibility_settings visibility;
     float self_shadow_bias = 0.3f;
+    std::string relocate = "off";
 };
 
 const examples::choices<volume_visibility> visibility_names{{"none", volume_visibility::none},
@@ -87,9 +89,9 @@ const examples::choices<volume_visibility> visibility_names{{"none", volume_visi
 // --surface: the volume at the camera's G-buffer, without and with visibility, against the
 // one-bounce reference at the same points; printed, and written to --json.
 int run_surface(const options& o, const io::scene& scene, const embree::accel& bvh, const embree::reference_integrator& light,
-                const irradiance_volume& volume, glm::vec3 extent, ojson report) {
+                const irradiance_volume& volume, std::span<const glm::vec3> baked_at, glm::vec3 extent, ojson report) {
     const auto vis_start = std::chrono::steady_clock::now();
-    const probe_visibility vis = embree::bake_probe_visibility(bvh, volume, o.visibility);
+    const probe_visibility vis = embree::bake_probe_visibility(bvh, volume, o.visibility, baked_at);
     const double vis_ms = study::ms_since(vis_start);
     const glm::vec3 cell = extent / float(1 << o.max_depth);
     const float wall = std::min({cell.x, cell.y, cell.z});
@@ -219,19 +221,23 @@ int run(const options& o) {
         if (done == total) ++batch;
     };
     const embree::probe_baker baker(light, bvh, scene, bs);
+    embree::relocating_probe_source relocating(baker, bvh, scene, std::min({finest.x, finest.y, finest.z}));
     irradiance_volume_build_stats stats;
     const auto bake_start = std::chrono::steady_clock::now();
-    const irradiance_volume volume = irradiance_volume::build(scene, lo, hi, vs, baker, &stats);
+    const irradiance_volume volume = o.relocate == "on" ? irradiance_volume::build(scene, lo, hi, vs, relocating, &stats)
+                                                        : irradiance_volume::build(scene, lo, hi, vs, baker, &stats);
     const double bake_ms = study::ms_since(bake_start);
     std::fprintf(stderr, "\n");
     std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms\n", scene.name.c_str(),
                 examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(), stats.probes_inside,
                 volume.leaf_count(), bake_ms);
+    if (o.relocate == "on") std::printf("relocation: %zu probes baked away from their lattice points\n", relocating.moved());
     if (o.surface)
-        return run_surface(o, scene, bvh, light, volume, extent,
+        return run_surface(o, scene, bvh, light, volume, relocating.positions_of(volume), extent,
                            {{"scene", scene.name}, {"mode", examples::name_of(mode_names, o.mode)}, {"max_depth", o.max_depth},
                             {"rays", o.rays}, {"probes", volume.probes().size()}, {"probes_inside", stats.probes_inside},
-                            {"leaves", volume.leaf_count()}, {"bake_ms", bake_ms},
+                            {"leaves", volume.leaf_count()}, {"bake_ms", bake_ms}, {"relocate", o.relocate},
+                            {"probes_relocated", relocating.moved()},
                             {"light_transport", "one-bounce indirect irradiance: probes and reference at the G-buffer's points"}});
 
     // Every lookup on the same volume, against the reference on the sphere; popping at the
@@ -374,6 +380,8 @@ int main(int argc, char** argv) {
     app.add_option("--visibility-resolution", o.visibility.resolution, "texels per side of each probe's distance map")
         ->check(CLI::Range(1u, 64u));
     app.add_option("--visibility-rays", o.visibility.rays, "rays per probe for its distance map")->check(CLI::Range(1u, 1u << 20));
+    app.add_option("--relocate", o.relocate, "on: probes inside geometry are baked moved into free space within their cell")
+        ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--self-shadow-bias", o.self_shadow_bias, "visibility test's self-shadow bias (fraction of 0.75 cell)")
         ->check(number_in(0, 4, true, "a bias"));
     CLI11_PARSE(app, argc, argv);

@@ -39,3 +39,5 @@ bounce_cli_refusal("an unknown --refit" PROGRAM irradiance_volume MATCH "--refit
                    ARGS ${iv_big} --refit maybe)
 bounce_cli_refusal("a --surface-size of 0" PROGRAM irradiance_volume MATCH "--surface-size.*0"
                    ARGS ${iv_big} --surface --surface-size 0)
+bounce_cli_refusal("an unknown --relocate" PROGRAM irradiance_volume MATCH "--relocate: maybe not in .on,off."
+                   ARGS ${iv_big} --relocate maybe)

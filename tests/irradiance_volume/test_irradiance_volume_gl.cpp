@@ -104,16 +104,20 @@ TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_vo
                                         output_quantity::radiance),
                     parameter_error);
 
-    // Visibility (DDGI, volume/probe_visibility.hpp): random distance moments in 8 x 8 maps,
-    // points at probes too (distance 0), the eye inside the volume; the same tolerance.
+    // Visibility (DDGI, volume/probe_visibility.hpp): random distance moments in 8 x 8 maps
+    // and relocated probe positions, points at probes too, the eye inside the volume; the
+    // same tolerance.
     std::vector<float> moments;
     for (std::size_t j = 0; j < volume.probes().size() * 64; ++j) {
         const float mean = 1.2f * rng.next_float(), variance = 0.05f * rng.next_float() * rng.next_float();
         moments.push_back(mean);
         moments.push_back(mean * mean + variance);
     }
-    const probe_visibility vis(8, moments);
-    for (std::size_t j = 0; j < volume.probes().size(); j += 17) points[j] = volume.probes()[j].position;
+    std::vector<glm::vec3> baked_at;  // relocated probes: a few hundredths off their lattice points
+    for (const auto& pr : volume.probes())
+        baked_at.push_back(pr.position + 0.04f * glm::vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, rng.next_float() - 0.5f));
+    const probe_visibility vis(8, moments, baked_at);
+    for (std::size_t j = 0; j < volume.probes().size(); j += 17) points[j] = baked_at[j];  // distance 0 from the probe
     const glm::vec3 eye(0.1f, 0.2f, -0.3f);
     const gl::irradiance_volume_buffers with_moments(volume, &vis);
     CHECK_THROWS_AS(lookup.light_points(buffers, points, normals, eye, visibility_lookup{}), parameter_error);

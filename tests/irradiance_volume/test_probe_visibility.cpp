@@ -8,6 +8,7 @@
 
 #include <bounce/cpu/irradiance_volume.hpp>
 #include <bounce/embree/probe_baker.hpp>
+#include <bounce/embree/probe_relocation.hpp>
 #include <bounce/embree/probe_visibility_baker.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/volume/probe_visibility.hpp>
@@ -207,4 +208,47 @@ TEST_CASE("a visibility lookup at a probe stays finite", "[irradiance_volume][vi
                 CHECK(e.x > 0);
             }
         }
+}
+
+TEST_CASE("relocation moves a probe out of a solid box within its cell, and leaves free probes", "[irradiance_volume][visibility][embree]") {
+    // A solid box [-0.1, 0.1]^3 wound outwards (seen from outside), lit from above, on no floor.
+    hand_built::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.5f));
+    for (int k = 0; k < 3; ++k)
+        for (const float side : {-1.f, 1.f}) {
+            glm::vec3 e(0.f), u(0.f), v(0.f);
+            e[k] = side;
+            u[(k + 1) % 3] = 0.1f;
+            v[(k + 2) % 3] = 0.1f;
+            const glm::vec3 c = 0.1f * e;
+            glm::vec3 q[4] = {c - u - v, c + u - v, c + u + v, c - u + v};  // counter-clockwise seen from +e
+            if (side < 0) std::swap(q[1], q[3]);
+            hand_built::add_quad(s, q[0], q[1], q[2], q[3], e, m);
+        }
+    s.lights.push_back(bounce::point_light{{0.f, 2.f, 0.f}, glm::vec3(1.f)});
+    const embree::accel bvh(s);
+    const embree::reference_integrator light(bvh, s);
+    embree::probe_baker_settings bs;
+    bs.rays = 64;
+    const embree::probe_baker baker(light, bvh, s, bs);
+    const float cell = 0.5f;
+    embree::relocating_probe_source relocating(baker, bvh, s, cell);
+    const glm::vec3 inside(0.02f, 0.03f, -0.01f), free(0.4f, 0.f, 0.f);
+    const glm::vec3 moved = relocating.relocate(inside);
+    INFO("moved to " << moved.x << " " << moved.y << " " << moved.z);
+    CHECK(glm::any(glm::greaterThan(glm::abs(moved), glm::vec3(0.1f))));               // out of the box
+    CHECK(glm::all(glm::lessThanEqual(glm::abs(moved - inside), glm::vec3(0.45f * cell))));  // within its cell
+    CHECK(relocating.relocate(free) == free);
+    // Baked through the source: returned at the lattice point, outside geometry, and the
+    // place it was baked is remembered.
+    const glm::vec3 positions[2] = {inside, free};
+    irradiance_probe out[2];
+    relocating(positions, out);
+    CHECK(out[0].position == inside);
+    CHECK_FALSE(out[0].inside);
+    CHECK(baker.bake(inside).inside);  // without relocation it is inside
+    CHECK(relocating.moved() == 1);
+    // A cell too small to leave the box in: the probe stays (and stays inside).
+    embree::relocating_probe_source tight(baker, bvh, s, 0.05f);
+    CHECK(tight.relocate(inside) == inside);
 }

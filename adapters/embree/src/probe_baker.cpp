@@ -1,4 +1,5 @@
 #include <bounce/embree/probe_baker.hpp>
+#include <bounce/embree/probe_relocation.hpp>
 #include <bounce/embree/probe_visibility_baker.hpp>
 
 #include <bounce/luminance.hpp>
@@ -65,11 +66,7 @@ probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t see
             inverse_distance_sum += 1.0 / std::max(double(distance), 1e-30);
             nearest = std::min(nearest, distance);
             const hit h = bvh_.intersect(r);
-            if (h.found()) {
-                const glm::uvec3 t = scene_.triangles[h.triangle];
-                const glm::vec3 a = scene_.positions[t.x], b = scene_.positions[t.y], c = scene_.positions[t.z];
-                if (glm::dot(glm::cross(b - a, c - a), r.direction) > 0) ++back;
-            }
+            if (h.found() && hits_back_face(scene_, h, r.direction)) ++back;
         }
     }
     if (details) {

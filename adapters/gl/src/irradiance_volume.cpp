@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/vec4.hpp>
+
 namespace bounce::gl {
 
 namespace {
@@ -36,7 +38,7 @@ buffer upload(const std::vector<T>& v, const char* what) {
 }  // namespace
 
 irradiance_volume_buffers::irradiance_volume_buffers(const irradiance_volume& volume, const probe_visibility* visibility)
-    : nodes_(1), probes_(1), owners_(1), moments_(16), reference_reach_(volume.reference_reach()) {
+    : nodes_(1), probes_(1), owners_(1), moments_(16), positions_(16), reference_reach_(volume.reference_reach()) {
     require(!visibility || visibility->probe_count() == volume.probes().size(), "visibility",
             "one distance map per probe of the volume");
     const auto flat = volume.flatten();
@@ -45,6 +47,10 @@ irradiance_volume_buffers::irradiance_volume_buffers(const irradiance_volume& vo
     owners_ = upload(volume.probe_owners(), "owners");
     if (visibility) {
         moments_ = upload(visibility->moments(), "distance moments");
+        std::vector<glm::vec4> at;  // where each probe was baked (relocated or on its lattice point)
+        for (std::size_t j = 0; j < volume.probes().size(); ++j)
+            at.emplace_back(visibility->position(j, volume.probes()[j].position), 0.f);
+        positions_ = upload(at, "probe positions");
         visibility_resolution_ = visibility->resolution();
     }
 }
@@ -91,6 +97,7 @@ std::string irradiance_volume_lookup::shader_source() {
            "layout(std430, binding = 3) readonly buffer iv_points { vec4 points[]; };\n"
            "layout(std430, binding = 4) writeonly buffer iv_results { vec4 results[]; };\n"
            "layout(std430, binding = 5) readonly buffer iv_moments { float moments[]; };\n"
+           "layout(std430, binding = 6) readonly buffer iv_positions { vec4 positions[]; };\n"
            "layout(location = 0) uniform uint count;\n"
            "layout(location = 1) uniform int weighted;\n"
            "layout(location = 2) uniform float b;\n"
@@ -145,9 +152,9 @@ std::string irradiance_volume_lookup::shader_source() {
            "            if (visible != 0) {\n"
            "                vec3 dir;\n"
            "                float distance, mean, square;\n"
-           "                iv_probe_to_point(probes[j].position.xyz, biased, dir, distance);\n"
+           "                iv_probe_to_point(positions[j].xyz, biased, dir, distance);\n"
            "                load_moments(j, dir, mean, square);\n"
-           "                weight = iv_visibility_weight(p, n, probes[j].position.xyz, distance, mean, square, w[k]);\n"
+           "                weight = iv_visibility_weight(p, n, positions[j].xyz, distance, mean, square, w[k]);\n"
            "            }\n"
            "            iv_trilinear_add(sum, wsum, n, weight, probes[j].position.w > 0.0 ? 1.0 : 0.0, c, sum, wsum);\n"
            "        }\n"
@@ -226,7 +233,7 @@ std::vector<glm::vec3> irradiance_volume_lookup::run(const irradiance_volume_buf
     const buffer in(packed.size() * sizeof(float), packed.data());
     buffer result(points.size() * 4 * sizeof(float));
 
-    const detail::program_and_storage_state saved({0u, 1u, 2u, 3u, 4u, 5u});
+    const detail::program_and_storage_state saved({0u, 1u, 2u, 3u, 4u, 5u, 6u});
     glUseProgram(program_.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, volume.nodes().id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, volume.probes().id());
@@ -234,6 +241,7 @@ std::vector<glm::vec3> irradiance_volume_lookup::run(const irradiance_volume_buf
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, in.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, result.id());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, volume.moments().id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, volume.positions().id());
     program_.set(0, unsigned(points.size()));
     program_.set(1, d.weighted);
     program_.set(2, d.how.b);

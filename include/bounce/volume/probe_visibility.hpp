@@ -45,23 +45,36 @@ struct visibility_lookup {
 
 /// Per-probe distance moments: an N x N octahedral map (octahedral_encode; texel (x, y) at
 /// index y * N + x) of (mean, mean square) of the distance to the first hit, for each probe
-/// of a volume in the order of `irradiance_volume::probes()`.
+/// of a volume in the order of `irradiance_volume::probes()`, and optionally each probe's
+/// actual position: where a relocated probe (embree::relocating_probe_source, Majercik et
+/// al. 2021) was baked, which the visibility test measures from while the trilinear
+/// weights keep its lattice position.
 class probe_visibility {
 public:
     probe_visibility() = default;
-    /// Throws parameter_error naming "resolution" outside 1 .. 64 and "moments" when its
-    /// size is not a multiple of 2 N^2 or a value is negative or not finite.
-    probe_visibility(std::uint32_t resolution, std::vector<float> moments)
-        : resolution_(resolution), moments_(std::move(moments)) {
+    /// Throws parameter_error naming "resolution" outside 1 .. 64, "moments" when its size
+    /// is not a multiple of 2 N^2 or a value is negative or not finite, and "positions"
+    /// when not empty and not one finite position per probe.
+    probe_visibility(std::uint32_t resolution, std::vector<float> moments, std::vector<glm::vec3> positions = {})
+        : resolution_(resolution), moments_(std::move(moments)), positions_(std::move(positions)) {
         require(resolution >= 1 && resolution <= 64, "resolution", "must lie in 1 .. 64");
         require(moments_.size() % texel_floats() == 0, "moments", "2 N^2 values (mean, mean square) per probe");
         for (const float m : moments_) require(std::isfinite(m) && m >= 0, "moments", "must be finite and >= 0");
+        require(positions_.empty() || positions_.size() == probe_count(), "positions", "one position per probe");
+        for (const glm::vec3& q : positions_)
+            require(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z), "positions", "must be finite");
     }
 
     std::uint32_t resolution() const noexcept { return resolution_; }
     std::size_t probe_count() const noexcept { return resolution_ ? moments_.size() / texel_floats() : 0; }
     /// Every probe's map, probe-major, (mean, mean square) per texel: the GPU's buffer.
     const std::vector<float>& moments() const noexcept { return moments_; }
+    /// The probes' actual positions (empty: their lattice positions).
+    const std::vector<glm::vec3>& positions() const noexcept { return positions_; }
+    /// Probe `probe`'s actual position, `lattice` (its position in the volume) when none is kept.
+    glm::vec3 position(std::size_t probe, glm::vec3 lattice) const {
+        return positions_.empty() ? lattice : positions_[probe];
+    }
 
     /// (mean, mean square) of texel `index` (y * N + x) of probe `probe`.
     std::pair<float, float> texel(std::size_t probe, std::size_t index) const {
@@ -87,6 +100,7 @@ private:
     std::size_t texel_floats() const noexcept { return 2 * std::size_t(resolution_) * resolution_; }
     std::uint32_t resolution_ = 0;
     std::vector<float> moments_;
+    std::vector<glm::vec3> positions_;
 };
 
 /// One probe's map from its rays (Majercik et al. 2019, section 5: "cosine-power"
@@ -128,7 +142,8 @@ inline void filter_ray_distances(std::span<const glm::vec3> directions, std::spa
 }
 
 /// Trilinear lookup of `volume` at p (normal n, unit) with each of the leaf's 8 corner
-/// probes weighed by its visibility (visibility_probe_weight) from the point biased towards
+/// probes (at vis.position: where it was baked) weighed by its visibility
+/// (visibility_probe_weight) from the point biased towards
 /// the viewer (`view`: unit direction from p to the eye, view_direction; n when there is none) by
 /// how.self_shadow_bias times the leaf's shortest edge; renormalized over the usable
 /// corners, 0 if none is. With how.mode = none it is `volume.trilinear(p, n)`. Throws
@@ -148,9 +163,10 @@ inline glm::vec3 trilinear_visible(const irradiance_volume& volume, const probe_
     for (std::size_t k = 0; k < 8; ++k) {
         const std::uint32_t idx = leaf.corner[k];
         const irradiance_probe& pr = volume.probes()[idx];
-        const auto [dir, distance] = probe_to_point<float, glm::vec3>(pr.position, biased);
+        const glm::vec3 s = vis.position(idx, pr.position);
+        const auto [dir, distance] = probe_to_point<float, glm::vec3>(s, biased);
         const auto [mean, square] = vis.sample(idx, dir);
-        const float weight = visibility_probe_weight<float, glm::vec3>(p, n, pr.position, distance, mean, square, w[k]);
+        const float weight = visibility_probe_weight<float, glm::vec3>(p, n, s, distance, mean, square, w[k]);
         std::tie(sum, wsum) = trilinear_probe_accumulate<irradiance_volume_bands, float, glm::vec3>(
             sum, wsum, n, weight, pr.inside ? 0.f : 1.f, pr.radiance);
     }

@@ -54,16 +54,21 @@ struct probe_visibility_settings {
 };
 
 /// The distance moments of every probe of `volume` over the scene `bvh` holds (in parallel,
-/// TBB; probes inside geometry get maps of zeros, as lookups skip them). Throws
-/// parameter_error naming the setting: resolution outside 1 .. 64, rays = 0, sharpness or
-/// max_distance_ratio not positive and finite.
+/// TBB; probes inside geometry get maps of zeros, as lookups skip them), cast from
+/// `positions` (one per probe: where relocated probes were baked,
+/// relocating_probe_source::positions_of; empty: the probes' lattice positions), which the
+/// result keeps. Throws parameter_error naming the setting: resolution outside 1 .. 64,
+/// rays = 0, sharpness or max_distance_ratio not positive and finite, "positions" of
+/// another size.
 inline probe_visibility bake_probe_visibility(const accel& bvh, const irradiance_volume& volume,
-                                              const probe_visibility_settings& s = {}) {
+                                              const probe_visibility_settings& s = {},
+                                              std::span<const glm::vec3> positions = {}) {
     require(s.resolution >= 1 && s.resolution <= 64, "resolution", "must lie in 1 .. 64");
     require(s.rays > 0, "rays", "a probe needs at least one ray");
     require(std::isfinite(s.sharpness) && s.sharpness > 0, "sharpness", "must be finite and > 0");
     require(std::isfinite(s.max_distance_ratio) && s.max_distance_ratio > 0, "max_distance_ratio",
             "must be finite and > 0");
+    require(positions.empty() || positions.size() == volume.probes().size(), "positions", "one position per probe");
     std::vector<glm::vec3> directions;
     for (const glm::dvec3& d : spherical_fibonacci_directions(s.rays)) directions.push_back(glm::vec3(d));
     const std::size_t floats = 2 * std::size_t(s.resolution) * s.resolution;
@@ -77,14 +82,15 @@ inline probe_visibility bake_probe_visibility(const accel& bvh, const irradiance
             const irradiance_probe& p = probes[i];
             if (p.inside) continue;
             const float max_distance = s.max_distance_ratio * 2 * p.reach;  // reach: half the diagonal
-            for (std::size_t j = 0; j < rays.size(); ++j) rays[j] = ray{p.position, directions[j], 0.f, max_distance};
+            const glm::vec3 from = positions.empty() ? p.position : positions[i];
+            for (std::size_t j = 0; j < rays.size(); ++j) rays[j] = ray{from, directions[j], 0.f, max_distance};
             bvh.intersect(std::span<const ray>(rays), std::span<hit>(hits));
             for (std::size_t j = 0; j < rays.size(); ++j) distances[j] = hits[j].found() ? hits[j].t : max_distance;
             filter_ray_distances(directions, distances, s.resolution, s.sharpness,
                                  std::span<float>(moments.data() + i * floats, floats));
         }
     });
-    return probe_visibility(s.resolution, std::move(moments));
+    return probe_visibility(s.resolution, std::move(moments), std::vector<glm::vec3>(positions.begin(), positions.end()));
 }
 
 }  // namespace bounce::embree

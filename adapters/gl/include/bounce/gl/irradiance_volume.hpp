@@ -36,11 +36,13 @@ public:
     const buffer& owners() const noexcept { return owners_; }  ///< uint[]: probe_owners()
     float reference_reach() const noexcept { return reference_reach_; }
     const buffer& moments() const noexcept { return moments_; }  ///< float[]: probe_visibility::moments()
+    /// vec4[]: each probe's actual position (probe_visibility::position), with the moments.
+    const buffer& positions() const noexcept { return positions_; }
     /// The moments' map resolution N; 0 when none were uploaded.
     std::uint32_t visibility_resolution() const noexcept { return visibility_resolution_; }
 
 private:
-    buffer nodes_, probes_, owners_, moments_;
+    buffer nodes_, probes_, owners_, moments_, positions_;
     float reference_reach_;
     std::uint32_t visibility_resolution_ = 0;
 };
