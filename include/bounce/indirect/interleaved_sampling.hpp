@@ -258,6 +258,23 @@ constexpr std::uint32_t spread_bits3(std::uint32_t v) noexcept {
     v = (v | (v << 2)) & 0x09249249u;
     return v;
 }
+
+/// The 30-bit Morton code of each of `positions` on a 1024^3 grid over their bounding box.
+inline std::vector<std::uint32_t> morton_codes(std::span<const glm::vec3> positions) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const auto& p : positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    const glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
+    std::vector<std::uint32_t> code(positions.size());
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+        const glm::vec3 t = (positions[k] - lo) / extent * 1023.f;
+        code[k] = spread_bits3(std::uint32_t(t.x)) | (spread_bits3(std::uint32_t(t.y)) << 1) |
+                  (spread_bits3(std::uint32_t(t.z)) << 2);
+    }
+    return code;
+}
 }  // namespace bounce::detail
 
 namespace bounce::inline indirect {
@@ -275,18 +292,7 @@ inline light_groups assign_lights(std::size_t count, int cells, light_assignment
     std::iota(rank.begin(), rank.end(), 0u);
     if (how == light_assignment::similarity) {
         require(positions.size() == count, "positions", "need one position per light for similarity assignment");
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-        for (const auto& p : positions) {
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-        const glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
-        std::vector<std::uint32_t> code(count);
-        for (std::size_t k = 0; k < count; ++k) {
-            const glm::vec3 t = (positions[k] - lo) / extent * 1023.f;
-            code[k] = detail::spread_bits3(std::uint32_t(t.x)) | (detail::spread_bits3(std::uint32_t(t.y)) << 1) |
-                      (detail::spread_bits3(std::uint32_t(t.z)) << 2);
-        }
+        const std::vector<std::uint32_t> code = detail::morton_codes(positions);
         std::stable_sort(rank.begin(), rank.end(), [&](std::uint32_t a, std::uint32_t b) { return code[a] < code[b]; });
     }
     const std::size_t c = std::size_t(cells);

@@ -47,19 +47,11 @@ std::vector<double> view_importances(std::span<const Candidate> candidates, std:
 /// the systematic draw (draw_for_view) takes them as spatial strata.
 template <class Candidate, class Key>
 void sort_along_curve(std::vector<Candidate>& c, Key&& key) {
-    if (c.empty()) return;
-    glm::vec3 lo(key(c[0])), hi(lo);
-    for (const auto& x : c) {
-        lo = glm::min(lo, key(x));
-        hi = glm::max(hi, key(x));
-    }
-    const glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
-    std::vector<std::uint32_t> code(c.size()), order(c.size());
-    for (std::size_t k = 0; k < c.size(); ++k) {
-        const glm::vec3 t = glm::clamp((key(c[k]) - lo) / extent, 0.f, 1.f) * 1023.f;
-        code[k] = bounce::detail::spread_bits3(std::uint32_t(t.x)) | (bounce::detail::spread_bits3(std::uint32_t(t.y)) << 1) |
-                  (bounce::detail::spread_bits3(std::uint32_t(t.z)) << 2);
-    }
+    std::vector<glm::vec3> positions;
+    positions.reserve(c.size());
+    for (const auto& x : c) positions.push_back(key(x));
+    const std::vector<std::uint32_t> code = bounce::detail::morton_codes(positions);
+    std::vector<std::uint32_t> order(c.size());
     std::iota(order.begin(), order.end(), 0u);
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return code[a] < code[b]; });
     std::vector<Candidate> sorted;
