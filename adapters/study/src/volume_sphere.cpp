@@ -367,7 +367,9 @@ nlohmann::ordered_json build_stats_json(const irradiance_volume_build_stats& sta
     return {{"split_min_depth", stats.split_min_depth}, {"split_distance", stats.split_distance},
             {"split_neighbour", stats.split_neighbour}, {"split_geometry", stats.split_geometry},
             {"split_gradient", stats.split_gradient},   {"split_prediction", stats.split_prediction},
-            {"culled", stats.culled},                   {"inside_cells", stats.inside_cells}};
+            {"culled", stats.culled},                   {"inside_cells", stats.inside_cells},
+            {"merged", stats.merged},                   {"hanging_corners", stats.hanging_corners},
+            {"noise_scale", stats.noise_scale}};
 }
 
 void print_sh_environments(const nlohmann::ordered_json& environments) {

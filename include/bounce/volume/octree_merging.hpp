@@ -73,7 +73,7 @@ bool cell_bias_within_budget(const Lattice& lattice, const std::array<std::uint3
                              const irradiance_volume_settings& s) {
     const auto& all = lattice.probes();
     const glm::vec3 lo = all[corner[0]].position, size = all[corner[7]].position - lo;
-    double miss2 = 0, expected = 0, level = 0;
+    double miss2 = 0, expected = 0, expected2 = 0, level = 0;
     std::size_t n = 0;
     for (const std::uint32_t idx : tested) {
         const auto w = trilinear_weights<float, glm::vec3>(all[idx].position, lo, size);
@@ -90,13 +90,20 @@ bool cell_bias_within_budget(const Lattice& lattice, const std::array<std::uint3
             const double d = actual[a] - predicted[a] / wsum;
             miss2 += d * d, level += std::abs(predicted[a] / wsum);
         }
-        expected += 6 * double(noise_scale2) * sigma2 * (1 + w2sum / (wsum * wsum)), n += 6;
+        double corner_var = 0;  // each probe's own noise, not the cell's pooled one
+        for (std::size_t j = 0; j < 8; ++j) {
+            const double wj = double(w[j]) * parent.corner_valid[j] / wsum, sj = all[corner[j]].noise;
+            corner_var += wj * wj * sj * sj;
+        }
+        const double var = double(noise_scale2) * (double(all[idx].noise) * all[idx].noise + corner_var);
+        expected += 6 * var, expected2 += 6 * var * var, n += 6;
     }
     if (n == 0) return true;
-    const double bias2 = (miss2 - expected) / double(n), noise2 = expected / double(n);
+    // The slack: noise_sigmas standard deviations of sum (m^2 - var) under noise alone,
+    // sqrt(2 sum var^2) over the probes (the 6 normals of a probe counted as one).
+    const double bias2 = (miss2 - expected) / double(n), slack = s.noise_sigmas * std::sqrt(2 * expected2 * 6) / double(n);
     const double floor2 = std::pow(1e-3 * (level / double(n) + parent.floor_level), 2);
-    return bias2 <= s.bias_budget * (8.0 / 27.0) * noise_scale2 * sigma2 +
-                        s.noise_sigmas * std::sqrt(2.0 / double(tested.size())) * noise2 + floor2;
+    return bias2 <= s.bias_budget * (8.0 / 27.0) * noise_scale2 * sigma2 + slack + floor2;
 }
 
 /// The scale of the probes' reported noise variance the finest grid supports: the median
