@@ -56,6 +56,7 @@ namespace {
 /// --mode: a uniform grid of probes, or an octree refined where the light changes.
 enum class volume_mode { uniform, adaptive };
 const examples::choices<volume_mode> mode_names{{"uniform", volume_mode::uniform}, {"adaptive", volume_mode::adaptive}};
+const examples::choices<volume_refinement> refine_names{{"merge", volume_refinement::merge}, {"split", volume_refinement::split}};
 const examples::choices<cpu::volume_interpolation> interp_names{{"trilinear", cpu::volume_interpolation::trilinear},
                                                                 {"weighted", cpu::volume_interpolation::weighted}};
 
@@ -76,7 +77,9 @@ struct options {
     std::uint64_t seed = 1;
     int threads = 0;
     bool sh_study = false, surface = false;
-    std::string refit = "on";
+    std::string refit = "on", conforming = "on", calibrate = "on";
+    float bias_budget = 0.f;
+    volume_refinement refine = volume_refinement::merge;
     std::size_t surface_size = 128;
     embree::probe_visibility_settings visibility;
     float self_shadow_bias = 0.3f;
@@ -208,6 +211,10 @@ int run(const options& o) {
     vs.prediction_tolerance = o.prediction_tolerance;
     vs.noise_sigmas = o.noise_sigmas;
     vs.refit_culled = o.refit == "on";
+    vs.refinement = o.refine;
+    vs.conforming_corners = o.conforming == "on";
+    vs.bias_budget = o.bias_budget;
+    vs.calibrate_noise = o.calibrate == "on";
     vs.memory_limit_bytes = study::available_memory_bytes();
     const glm::vec3 finest = extent / float(1 << o.max_depth);
     embree::probe_baker_settings bs;
@@ -292,7 +299,9 @@ int run(const options& o) {
                          {"distance_ratio", o.distance_ratio}, {"neighbour_change", o.neighbour_change},
                          {"geometry_triangles", o.geometry_triangles}, {"gradient_ratio", o.gradient_ratio},
                          {"cull_tolerance", o.cull}, {"prediction_tolerance", o.prediction_tolerance},
-                         {"noise_sigmas", o.noise_sigmas}, {"refit", o.refit}, {"gradient_noise_ratio", o.gradient_noise},
+                         {"noise_sigmas", o.noise_sigmas}, {"refit", o.refit},
+                         {"refine", examples::name_of(refine_names, o.refine)}, {"conforming", o.conforming},
+                         {"bias_budget", o.bias_budget}, {"calibrate_noise", o.calibrate}, {"gradient_noise_ratio", o.gradient_noise},
                          {"seed", o.seed}, {"threads", o.threads}};
     report.timings_ms = {{"bake", bake_ms}, {"reference", sphere.reference_ms()}};
     report.error = best.error;
@@ -363,6 +372,14 @@ int main(int argc, char** argv) {
     app.add_option("--noise-sigmas", o.noise_sigmas, "differences within this many standard errors of the probes are noise")
         ->check(finite_non_negative);
     app.add_option("--refit", o.refit, "on: the samples of culled splits refit the kept probes (least squares)")
+        ->check(CLI::IsMember({"on", "off"}));
+    examples::add_choice(app, "--refine", o.refine, refine_names,
+                         "adaptive: merge cells from the finest grid up, or split them from the root down");
+    app.add_option("--conforming", o.conforming, "on: corners at level boundaries take the coarser leaf's interpolation")
+        ->check(CLI::IsMember({"on", "off"}));
+    app.add_option("--bias-budget", o.bias_budget, "merge: the bias a merge may add, fraction of the noise it removes "
+                                                   "(0: the per-probe test)")->check(finite_non_negative);
+    app.add_option("--calibrate-noise", o.calibrate, "on: scale the probes' noise to the finest grid's second differences")
         ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--gradient-noise", o.gradient_noise, "keep a probe's gradient only where it exceeds this times its noise "
                                                          "(0: keep all)")->check(finite_non_negative);
