@@ -125,7 +125,7 @@ struct indirect_options {
     indirect_visibility visibility = indirect_visibility::none;
     /// With visibility rays (CPU): SII's VPLs drawn again from a larger pool by their
     /// visible contribution to a sparse grid of pixels (indirect/view_selection.hpp; docs
-    /// section 15). candidates 1 turns it off.
+    /// section 15; the RSM gather keeps its pattern). candidates 1 turns it off.
     view_selection_params view_selection;
     /// Imperfect shadow maps' parameters (visibility ism; SII only, the renderer needs an
     /// ism_point_sampler of the scene).

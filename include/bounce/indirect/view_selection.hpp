@@ -3,9 +3,9 @@
 /// Senders chosen by what the camera sees (after Georgiev and Slusallek 2010, "Simple and
 /// robust iterative importance sampling of virtual point lights", and Segovia et al. 2006,
 /// "Bidirectional instant radiosity"): a pool of `candidates` x count senders drawn as
-/// usual (VPLs by flux warping, disc samples of the RSM gather) is measured at a sparse,
-/// fixed set of receivers (G-buffer pixels), with visibility, and count of them are drawn
-/// again with probability
+/// usual (SII's VPLs by flux warping; the template takes any sender with a weight) is
+/// measured at a sparse, fixed set of receivers (G-buffer pixels), with visibility, and count
+/// of them are drawn again with probability
 ///
 ///   P_j = a / M + (1 - a) t_j / sum_i t_i,   t_j = sqrt(sum_g (rho_g E_jg V_jg)^2)
 ///
@@ -17,17 +17,19 @@
 /// corner no receiver sits in) is lost, and where the receivers see none of them (t = 0)
 /// the draw is uniform.
 ///
-/// The draw is systematic resampling, once per sub-buffer of an interleave pattern of
-/// `cells` sub-buffers: sub-buffer s gets its n_s draws from the points (i + xi_s) / n_s,
-/// i < n_s, of the probabilities' cumulative sum, with its own uniform xi_s, so candidate j
-/// is drawn E[n_js] = n_s P_j times and each draw is scaled by 1 / (cells n_s P_j): the sum
-/// over a sub-buffer's draws, times cells (the interleaved weight), has the expectation of
-/// the candidates' own sum, for every sub-buffer (Horvitz and Thompson's estimator); the
-/// candidates' sum has the expectation of the map's. Unbiased whatever t is: t only decides
-/// the variance. The draws are listed so that light k goes to sub-buffer k mod cells, as
-/// assign_lights(light_assignment::interleaved) deals them. Candidates next to each other
-/// in the list given are drawn as strata (a candidate list sorted along a space-filling
-/// curve gives spatially stratified draws).
+/// The draw is systematic resampling: the points (i + xi) / count, i < count, of the
+/// probabilities' cumulative sum, draw i dealt to sub-buffer (i + r) mod cells for a uniform
+/// rotation r. Each sub-buffer then holds a systematic sample of n_s = count / cells with a
+/// uniform offset, so candidate j is drawn E[n_js] = n_s P_j times there, and each draw is
+/// scaled by 1 / (cells n_s P_j): the sum over a sub-buffer's draws, times cells (the
+/// interleaved weight), has the expectation of the candidates' own sum, for every sub-buffer
+/// (Horvitz and Thompson's estimator), while the union of the sub-buffers' draws is one
+/// stratified sample. (When cells does not divide count, each sub-buffer draws its own
+/// systematic sample.) The candidates' sum has the expectation of the map's. Unbiased
+/// whatever t is: t only decides the variance. The draws are listed so that light k goes to
+/// sub-buffer k mod cells, as assign_lights(light_assignment::interleaved) deals them.
+/// Candidates next to each other in the list given are drawn as strata (a candidate list
+/// sorted along a space-filling curve gives spatially stratified draws).
 ///
 /// Backend-free: the caller measures the terms (a functor per receiver) and answers the
 /// occlusion queries (indirect/visibility.hpp).
@@ -162,8 +164,8 @@ struct selection_draw {
     double scale = 0;
 };
 
-/// `count` draws from the candidates by `probability`, systematic within each of the
-/// `cells` sub-buffers (file comment), listed so that draw k belongs to sub-buffer
+/// `count` draws from the candidates by `probability`, systematic and dealt to the `cells`
+/// sub-buffers with a rotation (file comment), listed so that draw k belongs to sub-buffer
 /// k mod cells. With `merge` (a single sub-buffer only) a candidate drawn several times
 /// comes back once with the scales added: the same sum with fewer senders.
 inline std::vector<selection_draw> draw_for_view(std::span<const double> probability, std::size_t count, int cells,

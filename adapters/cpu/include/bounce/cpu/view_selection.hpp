@@ -1,12 +1,11 @@
 #pragma once
 /// \file view_selection.hpp
-/// The senders of a CPU frame chosen by what the camera sees (indirect/view_selection.hpp):
-/// SII's VPLs and the RSM gather's disc samples, each from a pool of candidates measured at
-/// a sparse grid of G-buffer pixels with visibility, the candidates measured in parallel.
-/// cpu::indirect_renderer calls these when its options ask for visibility rays and
-/// view_selection is enabled (docs/rsm-sii-interleaved.md, section 15).
+/// SII's VPLs of a CPU frame chosen by what the camera sees (indirect/view_selection.hpp):
+/// a pool of candidates measured at a sparse grid of G-buffer pixels with visibility, the
+/// candidates measured in parallel. cpu::indirect_renderer calls it when its options ask for
+/// visibility rays and view_selection is enabled (docs/rsm-sii-interleaved.md, section 15;
+/// the RSM gather keeps its disc pattern: given the same treatment it did not improve).
 
-#include <bounce/cpu/rsm_gather.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
 #include <bounce/indirect/options.hpp>
