@@ -297,17 +297,22 @@ void main() {
 )";
 }
 
-// 2: the pull, one coarse texel of 2 x 2 finer ones (levels stored one after another).
-std::string ism_pull_compute() {
-    glsl::function_set k;
-    k.add("ism_pull", ism_pull<glsl::f32>, "a", "b", "c", "d");
-    return std::string("#version 450 core\nlayout(local_size_x = 8, local_size_y = 8) in;\n") +
-           R"(layout(std430, binding = 2) buffer bounce_ism_depth { float depth[]; };
+// What the pull and the push share: the depth pyramid (levels stored one after another,
+// finest first), the two levels' offsets and the coarser one's size.
+const std::string ism_level_glsl = R"(#version 450 core
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std430, binding = 2) buffer bounce_ism_depth { float depth[]; };
 layout(location = 0) uniform uint fine_offset;
 layout(location = 1) uniform uint coarse_offset;
 layout(location = 2) uniform uvec2 coarse_size;
 
-)" + k.source() + R"(
+)";
+
+// 2: the pull, one coarse texel of 2 x 2 finer ones.
+std::string ism_pull_compute() {
+    glsl::function_set k;
+    k.add("ism_pull", ism_pull<glsl::f32>, "a", "b", "c", "d");
+    return ism_level_glsl + k.source() + R"(
 void main() {
     uvec2 c = gl_GlobalInvocationID.xy;
     if (c.x >= coarse_size.x || c.y >= coarse_size.y) return;
@@ -322,13 +327,7 @@ void main() {
 std::string ism_push_compute() {
     glsl::function_set k;
     k.add("ism_push", ism_push<glsl::f32>, "fine", "coarse");
-    return std::string("#version 450 core\nlayout(local_size_x = 8, local_size_y = 8) in;\n") +
-           R"(layout(std430, binding = 2) buffer bounce_ism_depth { float depth[]; };
-layout(location = 0) uniform uint fine_offset;
-layout(location = 1) uniform uint coarse_offset;
-layout(location = 2) uniform uvec2 coarse_size;
-
-)" + k.source() + R"(
+    return ism_level_glsl + k.source() + R"(
 void main() {
     uvec2 f = gl_GlobalInvocationID.xy;
     uint fw = 2u * coarse_size.x;
