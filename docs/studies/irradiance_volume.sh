@@ -6,7 +6,7 @@
 # sphere. Every run goes into docs/results/irradiance_volume.json; the strip pictures into
 # docs/figures/irradiance_volume_*.png. Sponza needs BOUNCE_SCENES (or ../shared/scenes).
 # About 40 minutes on 2 shared cores (the adaptive Sponza bake dominates).
-# Usage: docs/studies/irradiance_volume.sh [cornell|sponza|sh]   (BOUNCE_BIN: default build/bin)
+# Usage: docs/studies/irradiance_volume.sh [cornell|sponza|adaptive|sh]   (BOUNCE_BIN: default build/bin)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bin="${BOUNCE_BIN:-build/bin}/irradiance_volume"
@@ -50,6 +50,29 @@ if [[ $part == all || $part == sponza ]]; then
     --neighbour-change 0.6 --gradient-ratio 0.6 --geometry-triangles 0 --cull 0.1 "${common[@]}"
   run sponza-adaptive-5-lighting --scene sponza --mode adaptive --max-depth 5 --distance-ratio 0 \
     --geometry-triangles 0 "${common[@]}" --out "$figures/irradiance_volume_sponza.png"
+fi
+
+if [[ $part == all || $part == adaptive ]]; then
+  # Issue 31, the headline: every shared scene and the built-in box with the program's
+  # defaults (depth 4, 512 rays, trilinear), the uniform grid against the adaptive octree
+  # merged from the finest grid (the default) and split from the root (--refine split);
+  # then the settings tried on the three scenes where adaptive lost most.
+  for sc in cornell cornell-box bunny living-room modern-hall sponza conference; do
+    run "issue31-uniform-$sc" --scene "$sc" --mode uniform
+    run "issue31-merge-$sc" --scene "$sc"
+    run "issue31-split-$sc" --scene "$sc" --refine split
+  done
+  for sc in cornell modern-hall conference; do
+    run "issue31-merge-k3-$sc" --scene "$sc" --noise-sigmas 3
+    run "issue31-merge-k2-$sc" --scene "$sc" --noise-sigmas 2
+    run "issue31-merge-k0-$sc" --scene "$sc" --noise-sigmas 0
+    run "issue31-merge-bias1-$sc" --scene "$sc" --bias-budget 1
+    run "issue31-merge-bias1-norefit-$sc" --scene "$sc" --bias-budget 1 --refit off
+  done
+  for sc in modern-hall conference; do
+    run "issue31-merge-k2-norefit-$sc" --scene "$sc" --noise-sigmas 2 --refit off
+    run "issue31-merge-k2-noconforming-$sc" --scene "$sc" --noise-sigmas 2 --conforming off
+  done
 fi
 
 if [[ $part == all || $part == sh ]]; then
