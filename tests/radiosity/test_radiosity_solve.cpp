@@ -251,6 +251,13 @@ TEST_CASE("two-sided elements light a reversed box from inside as one-sided ones
     const glm::dvec3 balance = two.absorbed_power() + two.unshot_power() + two.escaped_power() - two.emitted_power();
     CHECK(std::abs(balance.x) < 1e-9 * two.emitted_power().x);
     CHECK_THROWS_AS(one.radiosity(1), parameter_error);  // a one-sided solver has no back
+    // The box wound inwards, two-sided: its backs never face a shooter, so its fronts are the
+    // one-sided answer bit for bit.
+    cpu::progressive_radiosity<cpu::all_visible, double> both(right.view(), right_atlas, {});
+    both.solve(1e-9);
+    const auto b1 = one.radiosity(0), b2 = both.radiosity(0);
+    CHECK(std::equal(b1.begin(), b1.end(), b2.begin(), b2.end()));
+    CHECK(power(both, 1) == glm::dvec3(0));
 }
 
 TEST_CASE("a stereographic tolerance below what the buffer resolves is refused with the floor", "[radiosity][solve][errors]") {
