@@ -12,7 +12,7 @@ bounce_cli_refusal("a depth whose grid exceeds memory" PROGRAM irradiance_volume
                    ARGS --max-depth 10)
 bounce_cli_refusal("a --seed of -1" PROGRAM irradiance_volume MATCH "--seed.*'-1' is not a whole number"
                    ARGS ${iv_big} --seed -1)
-foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull --prediction-tolerance --noise-sigmas --gradient-noise --self-shadow-bias)
+foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull --prediction-tolerance --noise-sigmas --gradient-noise --self-shadow-bias --bias-budget)
   bounce_cli_refusal("${option} nan" PROGRAM irradiance_volume MATCH "${option}.*'nan' is not" ARGS ${iv_big} ${option} nan)
 endforeach()
 # --support must exceed 1; the refusal prints the open bound as such, "(1, 16]", not 1.000001
@@ -37,6 +37,10 @@ bounce_cli_refusal("an unknown --interp" PROGRAM irradiance_volume MATCH "--inte
                    ARGS --interp nearest)
 bounce_cli_refusal("an unknown --refit" PROGRAM irradiance_volume MATCH "--refit: maybe not in .on,off."
                    ARGS ${iv_big} --refit maybe)
+bounce_cli_refusal("an unknown --refine" PROGRAM irradiance_volume MATCH "--refine: grow not in .merge,split."
+                   ARGS ${iv_big} --refine grow)
+bounce_cli_refusal("an unknown --conforming" PROGRAM irradiance_volume MATCH "--conforming: maybe not in .on,off."
+                   ARGS ${iv_big} --conforming maybe)
 bounce_cli_refusal("a --surface-size of 0" PROGRAM irradiance_volume MATCH "--surface-size.*0"
                    ARGS ${iv_big} --surface --surface-size 0)
 bounce_cli_refusal("an unknown --relocate" PROGRAM irradiance_volume MATCH "--relocate: maybe not in .on,off."

@@ -6,10 +6,12 @@
 /// looked up to light moving objects.
 ///
 /// - A uniform grid is the octree subdivided everywhere to one depth; an adaptive octree
-///   subdivides a cell when one of Oat's heuristics fires, each with its threshold
-///   (`irradiance_volume_settings`), between a minimum and a maximum depth, and culls
-///   children whose probes do not differ from their parent's interpolation. The probes,
-///   the settings and the heuristics are in volume/octree_subdivision.hpp.
+///   is merged from the finest grid where a cell's interpolation predicts its probes
+///   (volume/octree_merging.hpp, the default), or split from the root by prediction error
+///   or by Oat's heuristics, each with its threshold (`irradiance_volume_settings`),
+///   between a minimum and a maximum depth. The probes, the settings and the heuristics
+///   are in volume/octree_subdivision.hpp. Corners at level boundaries take the coarser
+///   leaf's interpolation (conforming_corners), so trilinear lookups are continuous.
 /// - Probes sit at cell corners and are shared: a corner is an integer point of the
 ///   lattice of the finest level, and each lattice point holds at most one probe. A probe
 ///   inside geometry (flagged by its source) is kept but skipped by every lookup.
