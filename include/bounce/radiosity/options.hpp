@@ -35,6 +35,10 @@ struct radiosity_options {
                                    ///< per side (the reference integrator's convention, issue 30);
                                    ///< false: only the front (counter-clockwise) side. The GL
                                    ///< solver is one-sided and refuses true
+    int light_samples = 1;         ///< point, spot and directional lights are taken at k x k points of
+                                   ///< each whole texel (light_sample_point), not only at its element's
+                                   ///< point, so light narrower than a texel (the sun through a slit) is
+                                   ///< not missed; 1: the element's point (CPU solver; typical: 1-4)
 
     /// Throws parameter_error naming the option ("radiosity_options.near_field" ...).
     void validate() const {
@@ -42,6 +46,7 @@ struct radiosity_options {
                 "must lie in [1, 4096]");
         require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
                 "must be finite and non-negative");
+        require(light_samples >= 1 && light_samples <= 16, "radiosity_options.light_samples", "must lie in [1, 16]");
     }
 };
 

@@ -33,10 +33,9 @@
 /// deliveries still sum above its power is scaled down to it (shot_scale), so each shot is
 /// two passes, the incident radiosity per element (received_), then the scaled update; the
 /// solve checks after every step that the unshot power fell. The solver keeps, in double per
-/// channel, absorbed power (the
-/// (1 - rho) share of what each element intercepts) and escaped power (shot power less
-/// intercepted power, negative where the disc approximation over-delivers), so that
-/// absorbed + unshot + escaped = emitted after every step, to rounding.
+/// channel, absorbed power (the (1 - rho) share of what each element intercepts) and escaped
+/// power (shot power less intercepted power), so that absorbed + unshot + escaped = emitted
+/// after every step, to rounding. Elements are two-sided by default (radiosity/sides.hpp).
 ///
 /// Determinism: elements are updated by exactly one task each, and sums run over fixed chunks
 /// of shooters added in chunk order, so results are bitwise the same for any thread count.
@@ -76,8 +75,7 @@
 
 namespace bounce::cpu {
 
-// The options, timings and progress are the core's (radiosity/options.hpp), shared with the
-// GL solver.
+// The options, timings and progress are the core's (radiosity/options.hpp), as the GL's.
 using bounce::radiosity_options;
 using bounce::radiosity_progress;
 using bounce::radiosity_timings;
@@ -572,9 +570,10 @@ private:
         timings_.lights_ms += ms_since(start);
     }
 
-    // Direct light from one point, spot or directional light: each element's irradiance
-    // E (direct_light.hpp) times visibility becomes incident power; rho E is its first radiosity.
-    // With `measure_only` the irradiance is only added to direct_ (regather_lights).
+    // Direct light from one light: each element's irradiance E (direct_light.hpp) times
+    // visibility, on the side facing the light, becomes incident power and rho E its first
+    // radiosity (only direct_ with `measure_only`, regather_lights); light_samples^2 points of
+    // whole texels with options.light_samples.
     void shoot_light(const packed_light& l, bool measure_only) {
         const lightmap_atlas& at = atlas_;
         const light_kind kind = l.kind();
@@ -592,6 +591,8 @@ private:
             visibility_.begin_shot(frame);
             const Visibility& vis = visibility_;
             const std::size_t count = at.size();
+            const int k = options_.light_samples;
+            const std::vector<std::uint8_t> whole = k > 1 ? whole_texels(at) : std::vector<std::uint8_t>{};
             const chunk_sums total = distribute([&](std::uint32_t i, chunk_sums& s) {
                 const glm::vec3 p = at.position[i], n = at.normal[i];
                 if (!frame.parallel) {
@@ -606,15 +607,24 @@ private:
                 std::size_t j = i;
                 if (!positive(e) && sides_ == 2) e = light_irradiance(l, p, -n), j = count + i;
                 if (!positive(e)) return;
-                const float v = vis.visible(p, at.chart[i]);
-                if (!(v > 0.f)) return;
-                direct_[j] += vec(e * v);
+                // At the element's point, or the mean over k x k points of its whole texel.
+                glm::vec3 ev = e * vis.visible(p, at.chart[i]);
+                if (k > 1 && whole[i]) {
+                    ev = glm::vec3(0.f);
+                    for (int a = 0; a < k * k; ++a) {
+                        const glm::vec3 q = light_sample_point(at, i, a % k, a / k, k);
+                        ev += light_irradiance(l, q, j == i ? n : -n) * vis.visible(q, at.chart[i]);
+                    }
+                    ev /= float(k * k);
+                }
+                if (!positive(ev)) return;
+                direct_[j] += vec(ev);
                 if (measure_only) return;
                 const vec rho = vec(at.albedo[i]);
-                const vec gain = rho * vec(e * v);
+                const vec gain = rho * vec(ev);
                 radiosity_[j] += gain;
                 unshot_[j] += gain;
-                const glm::dvec3 intercepted = glm::dvec3(e * v) * double(at.area[i]);
+                const glm::dvec3 intercepted = glm::dvec3(ev) * double(at.area[i]);
                 s.intercepted += intercepted;
                 s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
             });
