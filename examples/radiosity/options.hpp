@@ -54,6 +54,7 @@ struct options {
     double near_field = 4;
     bool ambient = false;
     bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
+    int light_samples = 4;            // the lights' shot at k x k points of each whole texel (CPU)
     int repeat = 1;                   // solves timed (medians reported)
     std::size_t width = 256, height = 256;
     bool reference = true;
@@ -101,6 +102,9 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--near-field", o.near_field, "a block shoots as its quadrants within this many sides (0: one disc)")
         ->check(examples::finite_non_negative)->capture_default_str();
     on_off("--ambient", o.ambient, "show the ambient term (Cohen et al. 1988): on | off");
+    app.add_option("--light-samples", o.light_samples,
+                   "point, spot and directional lights taken at k x k points of each whole texel (1: its element's point)")
+        ->check(CLI::Range(1, 16))->capture_default_str();
     app.add_flag("--one-sided", o.one_sided,
                  "only the front (counter-clockwise) side of a surface receives and shoots (default: both sides, "
                  "as the reference; the GL backend needs it)");
@@ -140,6 +144,7 @@ inline radiosity_options solver_options_for(const options& o) {
     r.ambient = o.ambient;
     r.near_field = o.near_field;
     r.two_sided = !o.one_sided;
+    r.light_samples = o.light_samples;
     return r;
 }
 
@@ -186,6 +191,7 @@ inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
 inline gl::radiosity_options gl_options_for(const options& o) {
     gl::radiosity_options g;
     g.shooting = solver_options_for(o);  // --shooters-per-step is refused unless 1
+    g.shooting.light_samples = 1;        // the GL solver takes lights at element points (--light-samples: CPU)
     g.visibility = o.visibility == visibility_kind::hemicube ? gl::radiosity_visibility::hemicube
                                                               : gl::radiosity_visibility::stereographic;
     g.resolution = o.resolution;
@@ -202,7 +208,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
             {"converge", o.converge}, {"converge_on", name_of(measure_names, o.converge_on)}, {"max_seconds", o.max_seconds},
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
-            {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2},
+            {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 

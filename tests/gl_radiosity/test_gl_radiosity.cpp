@@ -436,6 +436,7 @@ TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosit
     throws_naming({.shooting = {.near_field = -1, .two_sided = false}}, "radiosity_options.near_field");
     throws_naming({.shooting = {.shooters_per_step = 2, .two_sided = false}}, "radiosity_options.shooters_per_step");
     throws_naming({.shooting = {.two_sided = true}}, "radiosity_options.two_sided");  // one-sided only
+    throws_naming({.shooting = {.two_sided = false, .light_samples = 2}}, "radiosity_options.light_samples");
     throws_naming({.resolution = 4}, "radiosity_options.resolution");
     throws_naming({.visibility = gl::radiosity_visibility::hemicube, .resolution = 65}, "radiosity_options.resolution");
     throws_naming({.tolerance_px = 0.f}, "radiosity_options.tolerance_px");

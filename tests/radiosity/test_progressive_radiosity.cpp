@@ -347,6 +347,8 @@ TEST_CASE("bad solver input raises parameter_error naming it", "[radiosity][solv
     } catch (const parameter_error& e) {
         CHECK(e.parameter() == "radiosity_options.shooters_per_step");
     }
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(box.view(), atlas, cpu::all_visible{}, {.light_samples = 0}),
+                      Catch::Contains("radiosity_options.light_samples"));
     cpu::progressive_radiosity solver(box.view(), atlas, cpu::all_visible{});
     try {
         solver.solve(1.5);
