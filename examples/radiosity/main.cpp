@@ -71,8 +71,7 @@ struct comparison {
     std::size_t black_pixels(const image<glm::vec3>& v) const { return examples::black_pixels(v, reference->radiance, mask); }
 };
 
-// The back sides' radiosity lightmap of a two-sided solver, else an empty image.
-template <class Solver>
+template <class Solver>  // the back sides' radiosity lightmap of a two-sided solver, else an empty image
 image<glm::vec3> back_lightmap(const Solver& solver, int level) {
     if constexpr (requires { solver.sides(); })
         if (solver.sides() == 2) return solver.radiosity_lightmap(level, 1);
@@ -256,8 +255,7 @@ int run(const options& o) {
     if (versus) {
         const auto e = study::compare_luminance(r.view.view(), versus->view(), cmp.mask.view());
         j["versus"] = {{"file", o.versus.filename().string()}, {"rel_rms", e.rel_rms}, {"max_abs", e.max_abs}};
-        // Against another seed's reference, this is that reference's noise (times sqrt 2).
-        if (cmp.reference) j["versus"]["reference_rel_rms"] = cmp.rel_rms(*versus);
+        if (cmp.reference) j["versus"]["reference_rel_rms"] = cmp.rel_rms(*versus);  // another seed's: its noise
     }
     const auto write_view = [](const std::filesystem::path& f, const image<glm::vec3>& v) {
         if (f.extension() == ".exr") io::write_exr(f, v.view());
