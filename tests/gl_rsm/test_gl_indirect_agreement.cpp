@@ -22,6 +22,7 @@
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/gl/indirect_renderer.hpp>
 #include <bounce/gl/splat_pass.hpp>
+#include <bounce/owned_scene.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -121,30 +122,23 @@ frame check_agreement(const corner_scene& s, const indirect_options& o, const is
 
 // The corner scene's floor and wall and a square hovering over the floor (not in the
 // G-buffer: it only casts indirect shadows), as the points of imperfect shadow maps.
-struct corner_points {
-    std::vector<glm::vec3> positions = {{-1, -1, 0}, {1, -1, 0},  {1, 1, 0},     {-1, 1, 0},     {1, -1, 0},  {1, 1, 0},
-                                        {1, 1, 2},   {1, -1, 2},  {-0.4f, -0.4f, 0.4f}, {0.4f, -0.4f, 0.4f},
-                                        {0.4f, 0.4f, 0.4f}, {-0.4f, 0.4f, 0.4f}};
-    std::vector<glm::uvec3> triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {8, 9, 10}, {8, 10, 11}};
-    std::vector<std::uint32_t> material_of = std::vector<std::uint32_t>(6, 0);
-    std::vector<material> materials = std::vector<material>(1);
-    scene_view view() const {
-        scene_view v;
-        v.positions = positions;
-        v.triangles = triangles;
-        v.material_of = material_of;
-        v.materials = materials;
-        return v;
-    }
-};
+owned_scene corner_points() {
+    owned_scene s;
+    s.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0},  {-1, 1, 0}, {1, -1, 0}, {1, 1, 0},
+                   {1, 1, 2},   {1, -1, 2}, {-0.4f, -0.4f, 0.4f}, {0.4f, -0.4f, 0.4f}, {0.4f, 0.4f, 0.4f},
+                   {-0.4f, 0.4f, 0.4f}};
+    s.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}, {8, 9, 10}, {8, 10, 11}};
+    s.material_of.assign(6, 0);
+    s.materials.resize(1);
+    return s;
+}
 
 }  // namespace
 
 TEST_CASE("GL SII with imperfect shadow maps equals the CPU's, and the maps shadow", "[gl][rsm][ism]") {
     gl_test::shared_context();
     const corner_scene s(61, 47);
-    const corner_points cp;
-    const ism_point_sampler points(cp.view());
+    const ism_point_sampler points(corner_points().view());
     for (const interleave_pattern p : {interleave_pattern{1, 1}, interleave_pattern{4, 4}, interleave_pattern{3, 2}})
         for (const int size : {8, 32}) {
             indirect_options o;

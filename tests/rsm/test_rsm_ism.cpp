@@ -6,6 +6,7 @@
 #include <bounce/cpu/imperfect_shadow_maps.hpp>
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/errors.hpp>
+#include <bounce/owned_scene.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -102,17 +103,12 @@ TEST_CASE("pull-push averages the filled texels and fills only the empty ones", 
 TEST_CASE("the point set is stratified by area and each VPL's subset covers the scene", "[rsm][ism]") {
     // Two unit squares far apart, one of area 1 and one of area 3: a quarter of every
     // subset on the first.
-    std::vector<glm::vec3> pos = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                                  {10, 0, 0}, {13, 0, 0}, {13, 1, 0}, {10, 1, 0}};
-    std::vector<glm::uvec3> tri = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
-    std::vector<std::uint32_t> mat(4, 0);
-    std::vector<material> mats(1);
-    scene_view s;
-    s.positions = pos;
-    s.triangles = tri;
-    s.material_of = mat;
-    s.materials = mats;
-    const ism_point_sampler sampler(s);
+    owned_scene s;
+    s.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {10, 0, 0}, {13, 0, 0}, {13, 1, 0}, {10, 1, 0}};
+    s.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+    s.material_of.assign(4, 0);
+    s.materials.resize(1);
+    const ism_point_sampler sampler(s.view());
     CHECK(sampler.area() == Approx(4.0));
     const std::size_t v = 8, k = 64;
     const auto pts = sampler.points(v * k, 3);

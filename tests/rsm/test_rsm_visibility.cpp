@@ -67,6 +67,20 @@ hand_built::scene partition_room() {
     return s;
 }
 
+// The camera at the partition room's ceiling looking down (both halves of the floor in
+// view) and its size x size G-buffer.
+struct ceiling_view {
+    camera cam;
+    gbuffer<float> g;
+    ceiling_view(const embree::accel& bvh, const hand_built::scene& s, std::size_t size) {
+        cam.position = {0.f, 2.45f, 0.f};
+        cam.look_at = {0.f, 0.f, 0.f};
+        cam.up = {0.f, 0.f, -1.f};
+        cam.fov_y_deg = 90.f;
+        g = embree::ray_cast_gbuffer(bvh, s.view(), cam, size, size);
+    }
+};
+
 // Mean luminance-free brightness (channel sum) of `e` over the floor pixels of `g` whose
 // x lies in [x0, x1] and |z| <= 0.5.
 double floor_mean(gbuffer<float>& g, const image<glm::vec3>& e, float x0, float x1) {
@@ -169,13 +183,10 @@ TEST_CASE("behind a partition the floor is darker than the open floor by the ref
     // 10%; without visibility the light leaking through the partition makes it brighter.
     const hand_built::scene s = partition_room();
     const embree::accel bvh(s.view());
-    camera cam;
-    cam.position = {0.f, 2.45f, 0.f};
-    cam.look_at = {0.f, 0.f, 0.f};
-    cam.up = {0.f, 0.f, -1.f};
-    cam.fov_y_deg = 90.f;
     const std::size_t size = 96;
-    gbuffer<float> g = embree::ray_cast_gbuffer(bvh, s.view(), cam, size, size);
+    ceiling_view view(bvh, s, size);
+    const camera& cam = view.cam;
+    gbuffer<float>& g = view.g;
 
     // The reference at the same pixels: 256 stratified samples each, ~400 pixels a region,
     // so its mean's noise is far below the 10% asked.
@@ -237,13 +248,10 @@ TEST_CASE("imperfect shadow maps darken the floor behind the partition as the ra
     // darker than the open floor, and its ratio near the one the exact rays give.
     const hand_built::scene s = partition_room();
     const embree::accel bvh(s.view());
-    camera cam;
-    cam.position = {0.f, 2.45f, 0.f};
-    cam.look_at = {0.f, 0.f, 0.f};
-    cam.up = {0.f, 0.f, -1.f};
-    cam.fov_y_deg = 90.f;
     const std::size_t size = 96;
-    gbuffer<float> g = embree::ray_cast_gbuffer(bvh, s.view(), cam, size, size);
+    ceiling_view view(bvh, s, size);
+    const camera& cam = view.cam;
+    gbuffer<float>& g = view.g;
     embree::rsm_ray_caster caster(bvh, s.view(), {128, 60.f});
     caster.render();
     const embree::occlusion_rays rays(bvh);
