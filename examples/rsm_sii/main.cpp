@@ -68,7 +68,7 @@ void check_arguments(const options& o) {
     check_backend_built(o.backend);
     if (o.backend == backend::gl)
         require(o.visibility != indirect_visibility::rays, "--visibility",
-                "'rays' runs on the CPU backend only (the GL renderer has no receiver-sender visibility yet)");
+                "'rays' runs on the CPU backend only (GL offers 'ism', imperfect shadow maps)");
     if (o.study) require(!o.json.empty(), "--study", "needs --json for the study's report");
     if (o.study)
         require(o.out.empty() && o.indirect_out.empty(), "--out/--indirect-out",
