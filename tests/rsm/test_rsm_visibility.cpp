@@ -97,6 +97,17 @@ double floor_mean(gbuffer<float>& g, const image<glm::vec3>& e, float x0, float 
     return sum / double(n);
 }
 
+// The partition tests' frame: 1024 lights at 4 x 4 and blur, the scene's 1/d^2 clamp.
+indirect_options partition_options(indirect_technique technique, const scene_view& v) {
+    indirect_options o;
+    o.technique = technique;
+    o.count = 1024;
+    o.pattern = {4, 4};
+    const float clamp = scene_clamp_distance(v);
+    o.light.min_distance2 = clamp * clamp;
+    return o;
+}
+
 }  // namespace
 
 TEST_CASE("with occlusion rays the texels an occluder hides from a receiver stop lighting it",
@@ -202,13 +213,8 @@ TEST_CASE("behind a partition the floor is darker than the open floor by the ref
     embree::rsm_ray_caster caster(bvh, s.view(), {128, 60.f});
     caster.render();
     const embree::occlusion_rays rays(bvh);
-    const float clamp = scene_clamp_distance(s.view());
     for (const auto technique : {indirect_technique::sii, indirect_technique::rsm_gather}) {
-        indirect_options o;
-        o.technique = technique;
-        o.count = 1024;
-        o.pattern = {4, 4};
-        o.light.min_distance2 = clamp * clamp;
+        indirect_options o = partition_options(technique, s.view());
         image<glm::vec3> none(size, size), visible(size, size);
         cpu::indirect_renderer(o).render(g.view(), cam, caster.views(), none.view());
         o.visibility = indirect_visibility::rays;
@@ -256,11 +262,7 @@ TEST_CASE("imperfect shadow maps darken the floor behind the partition as the ra
     caster.render();
     const embree::occlusion_rays rays(bvh);
     const ism_point_sampler points(s.view());
-    const float clamp = scene_clamp_distance(s.view());
-    indirect_options o;
-    o.count = 1024;
-    o.pattern = {4, 4};
-    o.light.min_distance2 = clamp * clamp;
+    indirect_options o = partition_options(indirect_technique::sii, s.view());
     image<glm::vec3> none(size, size), exact(size, size), ism(size, size);
     cpu::indirect_renderer(o).render(g.view(), cam, caster.views(), none.view());
     o.visibility = indirect_visibility::rays;
