@@ -74,6 +74,25 @@ inline owned_scene closed_box(float size, float albedo, float radiance) {
     return s;
 }
 
+// A floor 2 x 2 m (y = 0, facing +y) running around the base of a column 0.4 m square and
+// `height` tall standing in the middle (the column's four sides and its top; the floor has a
+// hole where the column stands, as published scenes model it), lit by a sun from above:
+// the floor is one chart of four trapezoids whose texels' overlap is not convex.
+inline owned_scene floor_around_column(float height) {
+    owned_scene s;
+    s.use_emission = false;
+    const auto m = s.add_material(glm::vec3(0.6f));
+    const glm::vec2 outer[4] = {{0, 0}, {0, 2}, {2, 2}, {2, 0}}, inner[4] = {{0.8f, 0.8f}, {0.8f, 1.2f}, {1.2f, 1.2f}, {1.2f, 0.8f}};
+    const auto at = [](glm::vec2 p, float y) { return glm::vec3(p.x, y, p.y); };
+    for (int k = 0; k < 4; ++k)  // the floor's trapezoids, counter-clockwise from +y
+        s.add_quad(at(outer[k], 0), at(outer[(k + 1) % 4], 0), at(inner[(k + 1) % 4], 0), at(inner[k], 0), m);
+    for (int k = 0; k < 4; ++k)  // the column's sides, facing outwards
+        s.add_quad(at(inner[k], 0), at(inner[k], height), at(inner[(k + 1) % 4], height), at(inner[(k + 1) % 4], 0), m);
+    s.add_quad(at(inner[0], height), at(inner[1], height), at(inner[2], height), at(inner[3], height), m);
+    s.lights.push_back(directional_light{glm::normalize(glm::vec3(0.3f, -1.f, 0.2f)), glm::vec3(20.f)});
+    return s;
+}
+
 // The Cornell box of ../shared/scenes/cornell-box (Goral et al. 1984; the Williams College
 // OBJ, public domain), copied by hand: five walls, the two boxes (without their hidden bottom
 // faces) and the ceiling light as an emitting quad (Ke 17 12 4), or, with `spot`, the spot

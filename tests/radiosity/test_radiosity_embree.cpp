@@ -342,3 +342,24 @@ TEST_CASE("a sun strip narrower than a texel: missed at element points, caught b
     CHECK(black_where_lit(scene, 2, 1) > 5);
     CHECK(black_where_lit(scene, 2, 4) == 0);
 }
+
+TEST_CASE("a floor running around a column's base is lit: its element's point lies on it, not under the column",
+          "[radiosity][embree][holes]") {
+    // Sponza's column bases and the living room's furniture: a chart of one texel whose
+    // overlap (the floor around the column) is not convex has its centroid, (1, 0, 1), inside
+    // the column, where every shot finds it occluded, so the whole floor rendered black. The
+    // point moves to the centroid of its largest triangle's overlap, which lies on the floor.
+    const auto scene = floor_around_column(0.5f);
+    const lightmap_atlas atlas = build_lightmap_atlas(scene.view(), {.elements = 1});
+    const lightmap_chart& floor = atlas.charts[atlas.chart_of_triangle[0]];
+    REQUIRE(floor.triangle_count == 8);
+    REQUIRE(floor.element_count == 1);
+    const glm::vec3 p = atlas.position[floor.first_element];
+    CHECK(std::max(std::abs(p.x - 1.f), std::abs(p.z - 1.f)) >= 0.2f);  // not in the column's hole
+    CHECK(std::abs(p.y) < 1e-6f);
+    cpu::progressive_radiosity solver(scene.view(), atlas, embree_visibility(scene, atlas), {.two_sided = true});
+    radiosity_solve_options o;
+    o.converge = 0.999;
+    solver.solve(o);
+    CHECK(solver.radiosity(0)[floor.first_element].y > 1.f);
+}

@@ -23,6 +23,7 @@
 
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
+#include <bounce/radiosity/cell_overlap.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <algorithm>
@@ -244,63 +245,6 @@ struct lightmap_atlas {
 
 namespace bounce::detail {
 
-/// Area and area-weighted centroid sum of the triangle (a, b, c) clipped to the unit square
-/// [0, 1]^2 (Sutherland-Hodgman against its four sides), in the square's coordinates.
-inline void clipped_triangle_moments(const std::array<glm::dvec2, 3>& tri, double& area, glm::dvec2& moment) {
-    std::array<glm::dvec2, 9> poly{}, next{};
-    int n = 3;
-    for (int i = 0; i < 3; ++i) poly[std::size_t(i)] = tri[std::size_t(i)];
-    // Keep the side where coordinate `axis` * sign >= bound.
-    const auto clip = [&](int axis, double sign, double bound) {
-        int m = 0;
-        for (int i = 0; i < n; ++i) {
-            const glm::dvec2 a = poly[std::size_t(i)], b = poly[std::size_t((i + 1) % n)];
-            const double da = sign * a[axis] - bound, db = sign * b[axis] - bound;
-            if (da >= 0) next[std::size_t(m++)] = a;
-            if ((da >= 0) != (db >= 0)) next[std::size_t(m++)] = a + (b - a) * (da / (da - db));
-        }
-        n = m;
-        poly = next;
-    };
-    clip(0, 1, 0);
-    clip(0, -1, -1);
-    clip(1, 1, 0);
-    clip(1, -1, -1);
-    area = 0;
-    moment = glm::dvec2(0);
-    for (int i = 0; i + 2 < n; ++i) {
-        // Fan from vertex 0; signed areas, the triangle's orientation fixed below.
-        const glm::dvec2 a = poly[0], b = poly[std::size_t(i + 1)], c = poly[std::size_t(i + 2)];
-        const double s = 0.5 * ((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x));
-        area += s;
-        moment += s * (a + b + c) / 3.0;
-    }
-    if (area < 0) {
-        area = -area;
-        moment = -moment;
-    }
-}
-
-/// Calls add(cell, area, moment) for each cell of a width x height grid that triangle `q`
-/// overlaps (grid coordinates: cell (i, j), index j * width + i, is [i, i + 1] x [j, j + 1]),
-/// with the exact overlap's area and first moment, in grid coordinates.
-template <class Add>
-void for_each_cell_overlap(const std::array<glm::dvec2, 3>& q, std::uint32_t width, std::uint32_t height, Add&& add) {
-    const glm::dvec2 mn = glm::min(q[0], glm::min(q[1], q[2])), mx = glm::max(q[0], glm::max(q[1], q[2]));
-    const int i0 = std::max(0, int(std::floor(mn.x))), i1 = std::min(int(width) - 1, int(std::floor(mx.x)));
-    const int j0 = std::max(0, int(std::floor(mn.y))), j1 = std::min(int(height) - 1, int(std::floor(mx.y)));
-    for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) {
-            std::array<glm::dvec2, 3> local;
-            for (int m = 0; m < 3; ++m) local[std::size_t(m)] = q[std::size_t(m)] - glm::dvec2(i, j);
-            double a;
-            glm::dvec2 mom;
-            clipped_triangle_moments(local, a, mom);
-            if (a <= 0) continue;
-            add(std::size_t(j) * width + std::size_t(i), a, mom + a * glm::dvec2(i, j));
-        }
-}
-
 inline glm::dvec3 to_d(const glm::vec3& v) { return glm::dvec3(v); }
 
 /// Unit normals and areas of a scene's triangles, in double; degenerate triangles have area
@@ -485,7 +429,22 @@ inline chart_extent smallest_bounding_frame(const scene_view& scene, const light
 struct texel_sum {
     double area = 0;
     glm::dvec2 moment{0};
+    double piece_area = 0;   ///< the largest one triangle's overlap
+    glm::dvec2 piece{0};     ///< its centroid, which lies on it
 };
+
+/// Moves each texel's point (moment / area) that lies on none of `triangles` (a non-convex
+/// overlap: a floor's border around a column's base, whose centroid lies under the column) to
+/// the centroid of its largest one triangle's overlap, which lies on the chart.
+inline void place_points_on_chart(std::span<const std::array<glm::dvec2, 3>> triangles, std::uint32_t width,
+                                  std::uint32_t height, std::vector<texel_sum>& sums) {
+    std::vector<glm::dvec2> point(sums.size());
+    for (std::size_t c = 0; c < sums.size(); ++c) point[c] = sums[c].area > 0 ? sums[c].moment / sums[c].area : glm::dvec2(0);
+    std::vector<std::uint8_t> on(sums.size(), 0);
+    for (const auto& q : triangles) mark_points_on_triangle(q, width, height, point, on);
+    for (std::size_t c = 0; c < sums.size(); ++c)
+        if (!on[c] && sums[c].piece_area > 0) sums[c].moment = sums[c].piece * sums[c].area;
+}
 
 /// A texel is an element when its overlap exceeds 1e-6 of a texel: slivers below carry no
 /// measurable power and their centroids are ill-conditioned.
@@ -503,6 +462,7 @@ inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atla
     ch.axis_u = glm::vec3(ex.u * su);
     ch.axis_v = glm::vec3(ex.v * sv);
     sums.assign(std::size_t(ch.width) * ch.height, texel_sum{});
+    std::vector<std::array<glm::dvec2, 3>> triangles_in_texels;
     for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
         const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
         std::array<glm::dvec2, 3> q;
@@ -513,8 +473,11 @@ inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atla
         for_each_cell_overlap(q, ch.width, ch.height, [&](std::size_t cell, double a, glm::dvec2 moment) {
             sums[cell].area += a;
             sums[cell].moment += moment;
+            if (a > sums[cell].piece_area) sums[cell].piece_area = a, sums[cell].piece = moment / a;
         });
+        triangles_in_texels.push_back(q);
     }
+    place_points_on_chart(triangles_in_texels, ch.width, ch.height, sums);
     std::size_t count = 0;
     for (const auto& ts : sums) count += holds_element(ts) ? 1 : 0;
     return count;
