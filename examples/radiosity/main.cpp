@@ -33,6 +33,7 @@
 #endif
 
 #include "../common/run_program.hpp"
+#include "holes.hpp"
 #include "memory.hpp"
 #include "options.hpp"
 #include "report.hpp"
@@ -137,6 +138,9 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     r.unshot = a.to_fine_texels(std::span<const glm::vec3>(unshot), level);
     timer.time("lightmap_view", [&] { r.view = cmp.view(a, r.lightmap, r.lightmap_back, level, o); });
     if (cmp.reference) r.black_pixels = cmp.black_pixels(r.view);
+    if (cmp.reference && !o.holes_out.empty())
+        write_holes(o.holes_out, cmp.bvh, a, r.lightmap, r.lightmap_back.width() ? r.lightmap_back : r.lightmap,
+                    cmp.scene.camera, r.view, cmp.reference->radiance, cmp.mask, level);
     return r;
 }
 

@@ -62,7 +62,7 @@ struct options {
     std::uint64_t seed = 1;           // the reference's base seed
     int curve_points = 16;            // error checkpoints along the solve (0: none)
     bool quiet = false;
-    std::filesystem::path json, out, lightmaps, versus, reference_out;
+    std::filesystem::path json, out, lightmaps, versus, reference_out, holes_out;
 };
 
 inline void add_options(CLI::App& app, options& o) {
@@ -123,6 +123,7 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--json", o.json, "write the run report (JSON) here");
     app.add_option("--out", o.out, "write the rendered view here (.png or .exr)");
     app.add_option("--lightmaps", o.lightmaps, "write the lightmaps (EXR) into this folder");
+    app.add_option("--holes-out", o.holes_out, "write a CSV of the view's black pixels where the reference is lit (holes.hpp)");
     app.add_option("--reference-out", o.reference_out, "write the reference view here (.png or .exr)");
     app.add_option("--versus", o.versus, "also compare the view with this EXR view of another run (same size)");
 }
