@@ -14,6 +14,8 @@
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/scene_view.hpp>
 
+#include "report.hpp"
+
 #include <fmt/core.h>
 
 #include <glm/geometric.hpp>
@@ -50,18 +52,14 @@ inline void write_holes(const std::filesystem::path& file, const embree::accel& 
                         const bounce::camera& cam, const image<glm::vec3>& view, const image<glm::vec3>& reference,
                         const image<float>& mask, int level) {
     const auto lum = [](const glm::vec3& c) { return rec709_luminance<float, glm::vec3>(c); };
-    double mean = 0, n = 0;
-    for (std::size_t y = 0; y < view.height(); ++y)
-        for (std::size_t x = 0; x < view.width(); ++x)
-            if (mask(x, y) > 0.f) mean += lum(reference(x, y)), n += 1;
-    mean /= std::max(n, 1.0);
+    const double mean = reference_mean(reference, mask);
     std::FILE* f = std::fopen(file.string().c_str(), "w");
     if (!f) throw parameter_error("--holes-out", "cannot write " + file.string());
     fmt::print(f, "x,y,triangle,chart,chart_w,chart_h,chart_triangles,sees_back,element,texel_own,"
                   "b_seen,b_other,albedo,closed_seen,closed_other,seen_from_pixel,distance\n");
     for (std::size_t y = 0; y < view.height(); ++y)
         for (std::size_t x = 0; x < view.width(); ++x) {
-            if (!(mask(x, y) > 0.f && lum(reference(x, y)) > 0.01 * mean && lum(view(x, y)) < 1e-3 * mean)) continue;
+            if (!black_pixel(view, reference, mask, mean, x, y)) continue;
             embree::ray r;
             r.origin = cam.position;
             r.direction = cam.direction(float(x) + 0.5f, float(y) + 0.5f, view.width(), view.height());

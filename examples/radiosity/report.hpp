@@ -35,19 +35,29 @@ struct solve_result {
     std::size_t black_pixels = 0;    // view pixels black where the reference is lit (comparison::black_pixels)
 };
 
-/// Pixels of `view` that are black (luminance below 1e-3 of the reference's mean over `mask`)
-/// where the reference is lit (above 1% of that mean): holes in the lightmap (issue 30).
-inline std::size_t black_pixels(const image<glm::vec3>& view, const image<glm::vec3>& reference, const image<float>& mask) {
-    const auto lum = [](const glm::vec3& c) { return rec709_luminance<float, glm::vec3>(c); };
+/// The reference's mean luminance over `mask`: black_pixels' scale.
+inline double reference_mean(const image<glm::vec3>& reference, const image<float>& mask) {
     double mean = 0, n = 0;
-    for (std::size_t y = 0; y < view.height(); ++y)
-        for (std::size_t x = 0; x < view.width(); ++x)
-            if (mask(x, y) > 0.f) mean += lum(reference(x, y)), n += 1;
-    mean /= std::max(n, 1.0);
+    for (std::size_t y = 0; y < reference.height(); ++y)
+        for (std::size_t x = 0; x < reference.width(); ++x)
+            if (mask(x, y) > 0.f) mean += rec709_luminance<float, glm::vec3>(reference(x, y)), n += 1;
+    return mean / std::max(n, 1.0);
+}
+
+/// Whether pixel (x, y) of `view` is black (luminance below 1e-3 of `mean`, reference_mean)
+/// where the reference is lit (above 1% of it): a hole in the lightmap (issue 30).
+inline bool black_pixel(const image<glm::vec3>& view, const image<glm::vec3>& reference, const image<float>& mask,
+                        double mean, std::size_t x, std::size_t y) {
+    const auto lum = [](const glm::vec3& c) { return rec709_luminance<float, glm::vec3>(c); };
+    return mask(x, y) > 0.f && lum(reference(x, y)) > 0.01 * mean && lum(view(x, y)) < 1e-3 * mean;
+}
+
+/// The pixels of `view` that are black_pixel.
+inline std::size_t black_pixels(const image<glm::vec3>& view, const image<glm::vec3>& reference, const image<float>& mask) {
+    const double mean = reference_mean(reference, mask);
     std::size_t black = 0;
     for (std::size_t y = 0; y < view.height(); ++y)
-        for (std::size_t x = 0; x < view.width(); ++x)
-            black += mask(x, y) > 0.f && lum(reference(x, y)) > 0.01 * mean && lum(view(x, y)) < 1e-3 * mean ? 1 : 0;
+        for (std::size_t x = 0; x < view.width(); ++x) black += black_pixel(view, reference, mask, mean, x, y) ? 1 : 0;
     return black;
 }
 
