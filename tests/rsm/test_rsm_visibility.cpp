@@ -81,6 +81,14 @@ struct ceiling_view {
     }
 };
 
+// The partition room seen from its ceiling at 96 x 96: the partition tests' scene and view.
+struct partition_view {
+    static constexpr std::size_t size = 96;
+    hand_built::scene s = partition_room();
+    embree::accel bvh{s.view()};
+    ceiling_view view{bvh, s, size};
+};
+
 // Mean luminance-free brightness (channel sum) of `e` over the floor pixels of `g` whose
 // x lies in [x0, x1] and |z| <= 0.5.
 double floor_mean(gbuffer<float>& g, const image<glm::vec3>& e, float x0, float x1) {
@@ -192,10 +200,9 @@ TEST_CASE("behind a partition the floor is darker than the open floor by the ref
     // the ceiling. The ratio of the mean indirect irradiance behind the partition (x in
     // [-1.6, -0.7]) to the open floor's (x in [0.7, 1.6]) must be the reference's within
     // 10%; without visibility the light leaking through the partition makes it brighter.
-    const hand_built::scene s = partition_room();
-    const embree::accel bvh(s.view());
-    const std::size_t size = 96;
-    ceiling_view view(bvh, s, size);
+    partition_view room;
+    auto& [s, bvh, view] = room;
+    const std::size_t size = partition_view::size;
     const camera& cam = view.cam;
     gbuffer<float>& g = view.g;
 
@@ -252,10 +259,9 @@ TEST_CASE("imperfect shadow maps darken the floor behind the partition as the ra
     // The partition room above, SII with 1024 VPLs, 4 x 4 and blur: with imperfect shadow
     // maps (indirect/imperfect_shadow_maps.hpp) the floor behind the partition must be
     // darker than the open floor, and its ratio near the one the exact rays give.
-    const hand_built::scene s = partition_room();
-    const embree::accel bvh(s.view());
-    const std::size_t size = 96;
-    ceiling_view view(bvh, s, size);
+    partition_view room;
+    auto& [s, bvh, view] = room;
+    const std::size_t size = partition_view::size;
     const camera& cam = view.cam;
     gbuffer<float>& g = view.g;
     embree::rsm_ray_caster caster(bvh, s.view(), {128, 60.f});
