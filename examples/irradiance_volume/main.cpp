@@ -86,9 +86,6 @@ struct options {
     std::string relocate = "off";
 };
 
-const examples::choices<volume_visibility> visibility_names{{"none", volume_visibility::none},
-                                                            {"chebyshev", volume_visibility::chebyshev}};
-
 // --surface: the volume at the camera's G-buffer, without and with visibility, against the
 // one-bounce reference at the same points; printed, and written to --json.
 int run_surface(const options& o, const io::scene& scene, const embree::accel& bvh, const embree::reference_integrator& light,
@@ -103,29 +100,15 @@ int run_surface(const options& o, const io::scene& scene, const embree::accel& b
     ss.reference_samples = std::max(2u, o.sphere.reference_samples);
     ss.seed = o.sphere.seed;
     const study::volume_surface_study surface(light, bvh, scene, scene.camera, wall, ss);
-    ojson lookups = ojson::object();
-    std::vector<image<glm::vec3>> pictures{surface.reference()};
-    for (const auto& [name, mode] : visibility_names) {
-        cpu::volume_lookup how;
-        how.visibility = {mode, o.self_shadow_bias};
-        const auto f = surface.measure(volume, &vis, how);
-        lookups["trilinear_" + name] = f.to_json();
-        std::printf("surface %-10s rel_rms all %.4f (debiased %.4f)  near walls %.4f (debiased %.4f)  lookup %.0f ns\n",
-                    name.c_str(), f.all.rel_rms, f.all.rel_rms_debiased, f.near_wall.rel_rms, f.near_wall.rel_rms_debiased,
-                    f.lookup_ns);
-        if (!o.out.empty()) pictures.push_back(surface.light(volume, &vis, how));
-    }
+    const study::probe_visibility_comparison c =
+        study::compare_probe_visibility(surface, volume, vis, o.self_shadow_bias, !o.out.empty());
     std::printf("%s: %zu covered pixels, %zu within %.4g of a wall; reference noise %.4f; moments %ux%u from %u rays, %.0f ms\n",
                 scene.name.c_str(), surface.covered_pixels(), surface.near_wall_pixels(), wall,
-                lookups["trilinear_none"]["near_wall"]["reference_noise_rel_rms"].get<double>(), o.visibility.resolution,
+                c.lookups["trilinear_none"]["near_wall"]["reference_noise_rel_rms"].get<double>(), o.visibility.resolution,
                 o.visibility.resolution, o.visibility.rays, vis_ms);
     if (!o.out.empty()) {  // reference | no visibility | Chebyshev, irradiance
-        image<glm::vec3> strip(pictures.size() * ss.width, ss.height);
-        for (std::size_t k = 0; k < pictures.size(); ++k)
-            for (std::size_t y = 0; y < ss.height; ++y)
-                for (std::size_t x = 0; x < ss.width; ++x) strip(k * ss.width + x, y) = pictures[k](x, y);
-        if (std::filesystem::path(o.out).extension() == ".exr") io::write_exr(o.out, strip.view());
-        else io::write_png(o.out, strip.view(), io::auto_exposure(pictures.front().view()));
+        if (std::filesystem::path(o.out).extension() == ".exr") io::write_exr(o.out, c.strip.view());
+        else io::write_png(o.out, c.strip.view(), io::auto_exposure(surface.reference().view()));
     }
     if (o.json.empty()) return 0;
     report["technique"] = "irradiance_volume_surface";
@@ -135,7 +118,7 @@ int run_surface(const options& o, const io::scene& scene, const embree::accel& b
                          {"visibility_resolution", o.visibility.resolution}, {"visibility_rays", o.visibility.rays},
                          {"visibility_sharpness", o.visibility.sharpness},
                          {"max_distance_ratio", o.visibility.max_distance_ratio}, {"self_shadow_bias", o.self_shadow_bias},
-                         {"visibility_bake_ms", vis_ms}, {"lookups", lookups}};
+                         {"visibility_bake_ms", vis_ms}, {"lookups", c.lookups}};
     report["timings_note"] = "wall-clock times on a loaded shared 2-core machine";
     report["provenance"] = study::collect_provenance().to_json();
     io::write_text_file(o.json, report.dump(2, ' ', false, ojson::error_handler_t::replace) + "\n");

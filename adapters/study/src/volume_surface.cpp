@@ -10,6 +10,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -95,6 +98,28 @@ volume_surface_figures volume_surface_study::measure(const irradiance_volume& vo
     f.all = compare_luminance_debiased(lit.view(), a_.view(), b_.view(), covered_mask_.view());
     if (near_wall_ > 0) f.near_wall = compare_luminance_debiased(lit.view(), a_.view(), b_.view(), near_.view());
     return f;
+}
+
+probe_visibility_comparison compare_probe_visibility(const volume_surface_study& study, const irradiance_volume& volume,
+                                                     const probe_visibility& vis, float self_shadow_bias, bool pictures) {
+    probe_visibility_comparison c;
+    std::vector<image<glm::vec3>> frames{study.reference()};
+    for (const auto& [name, mode] : {std::pair{"none", volume_visibility::none}, std::pair{"chebyshev", volume_visibility::chebyshev}}) {
+        cpu::volume_lookup how;
+        how.visibility = {mode, self_shadow_bias};
+        const volume_surface_figures f = study.measure(volume, &vis, how);
+        c.lookups[std::string("trilinear_") + name] = f.to_json();
+        std::printf("surface %-10s rel_rms all %.4f (debiased %.4f)  near walls %.4f (debiased %.4f)  lookup %.0f ns\n", name,
+                    f.all.rel_rms, f.all.rel_rms_debiased, f.near_wall.rel_rms, f.near_wall.rel_rms_debiased, f.lookup_ns);
+        if (pictures) frames.push_back(study.light(volume, &vis, how));
+    }
+    if (!pictures) return c;
+    const std::size_t w = frames.front().width(), h = frames.front().height();
+    c.strip = image<glm::vec3>(frames.size() * w, h);
+    for (std::size_t k = 0; k < frames.size(); ++k)
+        for (std::size_t y = 0; y < h; ++y)
+            for (std::size_t x = 0; x < w; ++x) c.strip(k * w + x, y) = frames[k](x, y);
+    return c;
 }
 
 }  // namespace bounce::study

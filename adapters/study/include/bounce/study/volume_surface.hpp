@@ -78,4 +78,18 @@ private:
     double reference_ms_ = 0;
 };
 
+/// The volume at a surface study's points by trilinear lookups without and with the probes'
+/// visibility (`vis`, DDGI's Chebyshev test with `self_shadow_bias`), what `irradiance_volume
+/// --surface` reports.
+struct probe_visibility_comparison {
+    /// {"trilinear_none": figures, "trilinear_chebyshev": figures} (volume_surface_figures::to_json)
+    nlohmann::ordered_json lookups = nlohmann::ordered_json::object();
+    image<glm::vec3> strip;  ///< reference | no visibility | Chebyshev side by side (empty unless asked)
+};
+
+/// Measures both lookups, prints a line each ("surface <name> rel_rms ..."), and with
+/// `pictures` lays out their irradiance beside the reference.
+probe_visibility_comparison compare_probe_visibility(const volume_surface_study& study, const irradiance_volume& volume,
+                                                     const probe_visibility& vis, float self_shadow_bias, bool pictures);
+
 }  // namespace bounce::study
