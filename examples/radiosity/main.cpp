@@ -74,9 +74,7 @@ struct comparison {
 
 template <class Solver>  // the back sides' radiosity lightmap of a two-sided solver, else an empty image
 image<glm::vec3> back_lightmap(const Solver& solver, int level) {
-    if constexpr (requires { solver.sides(); })
-        if (solver.sides() == 2) return solver.radiosity_lightmap(level, 1);
-    return {};
+    return solver.sides() == 2 ? solver.radiosity_lightmap(level, 1) : image<glm::vec3>{};
 }
 
 // Solves with `solver` (built after `setup_ms` of atlas and lights) as the options ask, through

@@ -346,6 +346,8 @@ TEST_CASE("the GL lightmap texture is the solver's radiosity lightmap, padding f
         gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient, .two_sided = false}, .resolution = 64});
         for (int s = 0; s < 10; ++s) REQUIRE(solver.step());
         const auto expected = solver.radiosity_lightmap();
+        CHECK(solver.sides() == 1);  // one-sided: a back lightmap is refused by name
+        CHECK_THROWS_WITH(solver.radiosity_lightmap(0, 1), Catch::Contains("side"));
         const gl::texture_ref t = solver.update_lightmap_texture();
         REQUIRE(t.width == atlas.width);
         REQUIRE(t.height == atlas.height);

@@ -144,7 +144,8 @@ image<glm::vec3> progressive_radiosity::lightmap(output_quantity quantity, light
     const auto values = output(quantity, paths);
     return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
 }
-image<glm::vec3> progressive_radiosity::radiosity_lightmap(int level) const {
+image<glm::vec3> progressive_radiosity::radiosity_lightmap(int level, int side) const {
+    require(side == 0, "side", "the GL solver is one-sided: only side 0 has a lightmap");
     const auto values = display_radiosity();
     return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
 }

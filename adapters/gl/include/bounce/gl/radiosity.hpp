@@ -167,7 +167,10 @@ public:
     image<glm::vec3> lightmap(output_quantity quantity = output_quantity::irradiance,
                               light_paths paths = light_paths::indirect, int level = 0) const;
     /// display_radiosity (B, W/m^2) laid out the same way: what embree::lightmap_view takes.
-    image<glm::vec3> radiosity_lightmap(int level = 0) const;
+    /// `side` as cpu::progressive_radiosity takes it; only 0 here (parameter_error otherwise).
+    image<glm::vec3> radiosity_lightmap(int level = 0, int side = 0) const;
+    /// 1: the GL solver is one-sided (it refuses radiosity_options::two_sided).
+    int sides() const noexcept { return 1; }
     /// Writes display_radiosity laid out as the atlas into the solver's lightmap texture
     /// (RGBA32F, atlas size, alpha 1 on charts, 0 elsewhere) on the GPU, padding texels
     /// filled from their element as radiosity_lightmap() fills them, so a renderer can sample it
