@@ -218,9 +218,10 @@ int run(const options& o) {
                                                         : irradiance_volume::build(scene, lo, hi, vs, baker, &stats);
     const double bake_ms = study::ms_since(bake_start);
     std::fprintf(stderr, "\n");
-    std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms\n", scene.name.c_str(),
-                examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(), stats.probes_inside,
-                volume.leaf_count(), bake_ms);
+    if (o.surface)  // the sphere path prints this line below, with the reference's popping
+        std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms\n", scene.name.c_str(),
+                    examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(), stats.probes_inside,
+                    volume.leaf_count(), bake_ms);
     if (o.relocate == "on") std::printf("relocation: %zu probes baked away from their lattice points\n", relocating.moved());
     if (o.surface)
         return run_surface(o, scene, bvh, light, volume, relocating.positions_of(volume), extent,
