@@ -20,13 +20,12 @@
 // with and without the probes' visibility (DDGI distance moments baked by Embree) and
 // reports rel_rms against the one-bounce reference over every covered pixel and over the
 // pixels within one finest cell of another surface (where walls meet floors).
-#include "../common/cli_choices.hpp"
-#include "../common/cli_number_checks.hpp"
-#include "../common/run_program.hpp"
+#include "/work/main/examples/common/cli_choices.hpp"
+#include "/work/main/examples/common/cli_number_checks.hpp"
+#include "/work/main/examples/common/run_program.hpp"
 
 #include <bounce/embree/probe_baker.hpp>
 #include <bounce/embree/probe_relocation.hpp>
-#include <bounce/embree/probe_visibility_baker.hpp>
 #include <bounce/io/image_io.hpp>
 #include <bounce/io/output_files.hpp>
 #include <bounce/io/scene.hpp>
@@ -90,35 +89,19 @@ struct options {
 // one-bounce reference at the same points; printed, and written to --json.
 int run_surface(const options& o, const io::scene& scene, const embree::accel& bvh, const embree::reference_integrator& light,
                 const irradiance_volume& volume, std::span<const glm::vec3> baked_at, glm::vec3 extent, ojson report) {
-    const auto vis_start = std::chrono::steady_clock::now();
-    const probe_visibility vis = embree::bake_probe_visibility(bvh, volume, o.visibility, baked_at);
-    const double vis_ms = study::ms_since(vis_start);
+    study::probe_visibility_report_settings s;
+    s.visibility = o.visibility;
+    s.surface.width = s.surface.height = o.surface_size;
+    s.surface.reference_samples = std::max(2u, o.sphere.reference_samples);
+    s.surface.seed = o.sphere.seed;
     const glm::vec3 cell = extent / float(1 << o.max_depth);
-    const float wall = std::min({cell.x, cell.y, cell.z});
-    study::volume_surface_settings ss;
-    ss.width = ss.height = o.surface_size;
-    ss.reference_samples = std::max(2u, o.sphere.reference_samples);
-    ss.seed = o.sphere.seed;
-    const study::volume_surface_study surface(light, bvh, scene, scene.camera, wall, ss);
-    const study::probe_visibility_comparison c =
-        study::compare_probe_visibility(surface, volume, vis, o.self_shadow_bias, !o.out.empty());
-    std::printf("%s: %zu covered pixels, %zu within %.4g of a wall; reference noise %.4f; moments %ux%u from %u rays, %.0f ms\n",
-                scene.name.c_str(), surface.covered_pixels(), surface.near_wall_pixels(), wall,
-                c.lookups["trilinear_none"]["near_wall"]["reference_noise_rel_rms"].get<double>(), o.visibility.resolution,
-                o.visibility.resolution, o.visibility.rays, vis_ms);
-    if (!o.out.empty()) {  // reference | no visibility | Chebyshev, irradiance
-        if (std::filesystem::path(o.out).extension() == ".exr") io::write_exr(o.out, c.strip.view());
-        else io::write_png(o.out, c.strip.view(), io::auto_exposure(surface.reference().view()));
-    }
+    s.wall_distance = std::min({cell.x, cell.y, cell.z});
+    s.self_shadow_bias = o.self_shadow_bias;
+    s.picture = o.out;
+    const ojson surface = study::report_probe_visibility(light, bvh, scene, volume, baked_at, s);
     if (o.json.empty()) return 0;
     report["technique"] = "irradiance_volume_surface";
-    report["surface"] = {{"width", ss.width}, {"height", ss.height}, {"reference_samples", ss.reference_samples},
-                         {"wall_distance", wall}, {"covered_pixels", surface.covered_pixels()},
-                         {"near_wall_pixels", surface.near_wall_pixels()}, {"reference_ms", surface.reference_ms()},
-                         {"visibility_resolution", o.visibility.resolution}, {"visibility_rays", o.visibility.rays},
-                         {"visibility_sharpness", o.visibility.sharpness},
-                         {"max_distance_ratio", o.visibility.max_distance_ratio}, {"self_shadow_bias", o.self_shadow_bias},
-                         {"visibility_bake_ms", vis_ms}, {"lookups", c.lookups}};
+    report["surface"] = surface;
     report["timings_note"] = "wall-clock times on a loaded shared 2-core machine";
     report["provenance"] = study::collect_provenance().to_json();
     io::write_text_file(o.json, report.dump(2, ' ', false, ojson::error_handler_t::replace) + "\n");

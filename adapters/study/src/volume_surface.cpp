@@ -3,6 +3,7 @@
 #include <bounce/embree/probe_visibility_baker.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/errors.hpp>
+#include <bounce/io/image_io.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <tbb/blocked_range.h>
@@ -11,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -120,6 +122,31 @@ probe_visibility_comparison compare_probe_visibility(const volume_surface_study&
         for (std::size_t y = 0; y < h; ++y)
             for (std::size_t x = 0; x < w; ++x) c.strip(k * w + x, y) = frames[k](x, y);
     return c;
+}
+
+nlohmann::ordered_json report_probe_visibility(const embree::reference_integrator& light, const embree::accel& bvh,
+                                               const io::scene& scene, const irradiance_volume& volume,
+                                               std::span<const glm::vec3> baked_at,
+                                               const probe_visibility_report_settings& s) {
+    const auto vis_start = std::chrono::steady_clock::now();
+    const probe_visibility vis = embree::bake_probe_visibility(bvh, volume, s.visibility, baked_at);
+    const double vis_ms = ms_since(vis_start);
+    const volume_surface_study surface(light, bvh, scene, scene.camera, s.wall_distance, s.surface);
+    const probe_visibility_comparison c = compare_probe_visibility(surface, volume, vis, s.self_shadow_bias, !s.picture.empty());
+    std::printf("%s: %zu covered pixels, %zu within %.4g of a wall; reference noise %.4f; moments %ux%u from %u rays, %.0f ms\n",
+                scene.name.c_str(), surface.covered_pixels(), surface.near_wall_pixels(), s.wall_distance,
+                c.lookups["trilinear_none"]["near_wall"]["reference_noise_rel_rms"].get<double>(), s.visibility.resolution,
+                s.visibility.resolution, s.visibility.rays, vis_ms);
+    if (!s.picture.empty()) {  // reference | no visibility | Chebyshev, irradiance
+        if (std::filesystem::path(s.picture).extension() == ".exr") io::write_exr(s.picture, c.strip.view());
+        else io::write_png(s.picture, c.strip.view(), io::auto_exposure(surface.reference().view()));
+    }
+    return {{"width", s.surface.width}, {"height", s.surface.height}, {"reference_samples", s.surface.reference_samples},
+            {"wall_distance", s.wall_distance}, {"covered_pixels", surface.covered_pixels()},
+            {"near_wall_pixels", surface.near_wall_pixels()}, {"reference_ms", surface.reference_ms()},
+            {"visibility_resolution", s.visibility.resolution}, {"visibility_rays", s.visibility.rays},
+            {"visibility_sharpness", s.visibility.sharpness}, {"max_distance_ratio", s.visibility.max_distance_ratio},
+            {"self_shadow_bias", s.self_shadow_bias}, {"visibility_bake_ms", vis_ms}, {"lookups", c.lookups}};
 }
 
 }  // namespace bounce::study

@@ -12,14 +12,17 @@
 #include <bounce/camera.hpp>
 #include <bounce/cpu/irradiance_volume.hpp>
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/probe_visibility_baker.hpp>
 #include <bounce/embree/reference.hpp>
 #include <bounce/gbuffer.hpp>
 #include <bounce/image.hpp>
+#include <bounce/io/scene.hpp>
 #include <bounce/scene_view.hpp>
 #include <bounce/study/image_comparison.hpp>
 #include <bounce/volume/probe_visibility.hpp>
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include <glm/vec3.hpp>
@@ -91,5 +94,29 @@ struct probe_visibility_comparison {
 /// `pictures` lays out their irradiance beside the reference.
 probe_visibility_comparison compare_probe_visibility(const volume_surface_study& study, const irradiance_volume& volume,
                                                      const probe_visibility& vis, float self_shadow_bias, bool pictures);
+
+/// What `irradiance_volume --surface` measures for a built volume.
+struct probe_visibility_report_settings {
+    embree::probe_visibility_settings visibility;  ///< the distance moments' bake
+    volume_surface_settings surface;               ///< the G-buffer and its reference
+    /// Pixels with another surface within this distance are near a wall (world units;
+    /// typical: the finest cell's shortest edge). Must be positive and finite.
+    float wall_distance = 0;
+    float self_shadow_bias = 0.3f;  ///< the Chebyshev test's, fraction of 0.75 cell
+    /// Reference | no visibility | Chebyshev side by side is written here (.exr: linear;
+    /// else 8-bit sRGB exposed for the reference); empty: no picture.
+    std::string picture;
+};
+
+/// Bakes `volume`'s visibility from `baked_at` (embree::bake_probe_visibility; empty: the
+/// lattice points), builds the surface study of the scene's camera, compares the lookups
+/// without and with visibility (compare_probe_visibility, a line each), prints the
+/// study's line (pixels, reference noise, moments), writes the picture, and returns the
+/// run report's "surface" object: the settings, the pixel counts, the reference's and the
+/// moments' times, and "lookups".
+nlohmann::ordered_json report_probe_visibility(const embree::reference_integrator& light, const embree::accel& bvh,
+                                               const io::scene& scene, const irradiance_volume& volume,
+                                               std::span<const glm::vec3> baked_at,
+                                               const probe_visibility_report_settings& settings);
 
 }  // namespace bounce::study
