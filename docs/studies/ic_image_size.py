@@ -10,6 +10,7 @@ usage: ic_image_size.py TAG SIZES SPP [scenes...] [-- ic_splatting options]
 
   docs/studies/ic_image_size.py base 256x256,512x512 1024
   docs/studies/ic_image_size.py hess 1920x1080 2 sponza -- --radius hessian
+  RESULTS=docs/results/ic_verification.jsonl docs/studies/ic_image_size.py verify 512x512 256 -- --verify 2 --mc-compare
 """
 import json, os, subprocess, sys, tempfile, time
 
@@ -46,8 +47,18 @@ with open(results, 'a') as out, tempfile.TemporaryDirectory() as tmp:
                    'rel_rms_debiased': e.get('rel_rms_debiased'), 'reference_noise': e.get('reference_noise_rel_rms'),
                    'total_ms_loaded_machine': j['timings_ms']['total'], 'options': ' '.join(extra), 'commit': commit,
                    'load_average': os.getloadavg()[0], 'cores': os.cpu_count()}
+            # --mc-compare: Monte Carlo at equal (debiased) error and its time over the cache's.
+            if 'mc_equal_error' in j:
+                row['mc_equal_error'] = j['mc_equal_error']
+            # --verify: the verification pass's counts (docs/irradiance-splatting.md, "Error the
+            # records cannot see").
+            for k in ('verify_tiles', 'verify_disagreed', 'verify_shrunk', 'verify_ms'):
+                if k in j:
+                    row[k] = j[k]
             out.write(json.dumps(row) + '\n')
             out.flush()
             deb = row['rel_rms_debiased']
             print(f"{tag} {s} {size}: {row['records']} records ({row['records_per_pixel']:.3f} per pixel), "
-                  f"debiased rel_rms {deb if deb is None else round(deb, 4)}, {time.time() - t0:.0f} s", flush=True)
+                  f"debiased rel_rms {deb if deb is None else round(deb, 4)}, {time.time() - t0:.0f} s"
+                  + (f", Monte Carlo {row['mc_equal_error'].get('speedup', 0):.1f}x" if 'mc_equal_error' in row else ''),
+                  flush=True)

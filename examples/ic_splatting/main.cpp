@@ -13,6 +13,7 @@
 #include <bounce/cpu/cache_walkthrough.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/irradiance_probe.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
@@ -123,6 +124,9 @@ int run_with(const options& o) {
         sampler = std::cref(embree_sampler);
     cpu::irradiance_cache_options cache_options = cache_options_for(o, o.a);
     cpu::irradiance_cache<W> cache(lo, hi, cache_options);
+    // --verify's probe: a few rays per pixel from the records' integrator.
+    const embree::irradiance_probe probe(integrator, o.verify_rays);
+    if (o.verify_rounds > 0) cache.set_probe(std::cref(probe));
     std::function<cache_frame(const camera&)> frame = [&](const camera& cam) {
         const auto ray_cast = [&](const camera& c) { return embree::ray_cast_gbuffer(bvh, scene, c, o.width, o.height); };
         return cpu::render_frame(cache, cam, ray_cast, sampler);
@@ -228,6 +232,15 @@ int run_with(const options& o) {
         if (o.filter_k > 0.f) {
             report.set_count("records_filter_merged", last.frame.filter_merged);
             report.set_count("records_filter_refused", last.frame.filter_refused);
+        }
+        if (o.verify_rounds > 0) {
+            const cpu::cache_frame_stats& v = cache.last_stats();
+            report.set_count("verify_tiles", v.verify_tiles);
+            report.set_count("verify_disagreed", v.verify_disagreed);
+            report.set_count("verify_shrunk", v.verify_shrunk);
+            extra["verify_ms"] = v.verify_ms;
+            fmt::print("verification: {} of {} tiles disagreed, {} older records shrunk, {:.0f} ms of probes and tests\n",
+                       v.verify_disagreed, v.verify_tiles, v.verify_shrunk, v.verify_ms);
         }
         if (o.mc_compare) extra.update(study::monte_carlo_report(measure, last, timer.median_ms("total")));
         if (o.ray_rates) extra["ray_rates"] = study::ray_rates(embree_sampler, cache.records());

@@ -80,6 +80,11 @@ struct options {
     float filter_k = 0.f;      // neighbour filter: merge within this many standard errors (0: off)
     float filter_reach = 2.f;  // neighbour filter: neighbours' weights at this times a
     bool filter_soft = true;   // neighbour filter: count the prediction's bias estimated from the difference
+    std::uint32_t verify_rounds = 0;  // verification passes after the scan (0: off)
+    std::uint32_t verify_rays = 8;    // verification: probe rays per pixel
+    std::uint32_t verify_tile = 4;    // verification: pixels per side of a pooled tile
+    float verify_k = 3.f;             // verification: standard errors of the tile's mean residual
+    float verify_tolerance = 0.1f;    // verification: and this times the cache's mean there
     cpu::scan_kind scan = cpu::scan_kind::batched;
     cpu::scan_order scan_order = cpu::scan_order::linear;  // unless given: coarse-to-fine when progressive
     std::size_t scan_batch = 0;
@@ -127,6 +132,7 @@ inline cpu::irradiance_cache_options cache_options_for(const options& o, float a
     c.filter.k = o.filter_k;
     c.filter.reach = o.filter_reach;
     c.filter.soft = o.filter_soft;
+    c.verify = {o.verify_rounds, o.verify_tile, o.verify_k, o.verify_tolerance};
     return c;
 }
 
@@ -209,6 +215,10 @@ inline void check_combinations(const options& o, bool with_gl) {
         throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --adaptive-rays");
     if (o.adaptive_rays && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "adaptive rays aim at a standard error tied to a: sweep a over separate runs");
+    if (o.verify_rounds > 0 && o.interp != interpolation::splat_cpu)
+        throw parameter_error("--verify", "runs in the CPU splat frame only (--interp splat-cpu)");
+    if (o.verify_rounds > 0 && o.progressive > 0)
+        throw parameter_error("--verify", "checks a whole frame: not with --progressive's record budget");
     if (o.ray_rates && raster) throw parameter_error("--ray-rates", "applies to --sampler embree only");
     if (!with_gl && raster)
         throw parameter_error("--sampler", "'raster' needs the GL adapter, which this build does not have");
@@ -234,6 +244,8 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
             {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
             {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
             {"record_filter", o.filter_k}, {"filter_reach", o.filter_reach}, {"filter_soft", o.filter_soft},
+            {"verify_rounds", o.verify_rounds}, {"verify_rays", o.verify_rays}, {"verify_tile", o.verify_tile},
+            {"verify_k", o.verify_k}, {"verify_tolerance", o.verify_tolerance},
             {"max_extrapolation", o.max_extrapolation},
             {"front_tolerance", o.front_tolerance},
             {"min_weight", o.min_weight > 0.f ? o.min_weight : o.a}, {"progressive", o.progressive},
@@ -345,6 +357,22 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
         ->capture_default_str();
     app.add_flag("--filter-soft,!--no-filter-soft", o.filter_soft,
                  "--record-filter: also weigh the prediction's bias, estimated from the difference (default on)");
+    app.add_option("--verify", o.verify_rounds,
+                   "after the scan, check the image against a few-ray Monte Carlo probe per pixel pooled over tiles, "
+                   "and add records where a tile disagrees, this many rounds (0: off; docs/irradiance-splatting.md, "
+                   "\"Error the records cannot see\")")
+        ->check(CLI::Range(0u, 16u))
+        ->capture_default_str();
+    app.add_option("--verify-rays", o.verify_rays, "--verify: probe rays per pixel")->check(CLI::Range(2u, 4096u))->capture_default_str();
+    app.add_option("--verify-tile", o.verify_tile, "--verify: pixels per side of the tiles whose residuals are pooled")
+        ->check(CLI::Range(1u, 256u))
+        ->capture_default_str();
+    app.add_option("--verify-k", o.verify_k, "--verify: a tile disagrees beyond this many standard errors ...")
+        ->check(examples::finite_positive)
+        ->capture_default_str();
+    app.add_option("--verify-tolerance", o.verify_tolerance, "--verify: ... and beyond this times the cache's mean over the tile")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
     app.add_flag("--neighbour-clamp,!--no-neighbour-clamp", o.neighbour_clamp,
                  "clamp radii to neighbours (R_i <= R_j + |p_i - p_j|), new records and, each frame, older ones (default on)");
     app.add_option("--walkthrough", o.walkthrough,

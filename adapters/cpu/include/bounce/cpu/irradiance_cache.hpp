@@ -33,11 +33,13 @@
 #include <bounce/cache/record.hpp>
 #include <bounce/cache/record_filter.hpp>
 #include <bounce/cache/record_sampler.hpp>
+#include <bounce/cache/verification.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -90,6 +92,11 @@ struct irradiance_cache_options {
     /// (cache/record_filter.hpp); off by default (k = 0). Needs records with a variance
     /// (embree::record_sampler's); others pass unchanged.
     record_filter filter{};
+    /// After the scan, the image checked against a cheap Monte Carlo probe per pixel (the
+    /// cache's probe: set_probe), pooled over tiles; where a tile disagrees, a record is
+    /// measured at its pixel, the older records around it shrink to it, and the scan runs
+    /// again (cache/verification.hpp). Off by default (rounds = 0); splatting (render) only.
+    verification_options verify{};
 
     /// The weight-sum threshold the scan uses.
     float miss_threshold() const noexcept { return min_weight > 0.f ? min_weight : splat.a; }
@@ -104,6 +111,7 @@ struct irradiance_cache_options {
         require(std::isfinite(fill_holes) && fill_holes >= 0.f, "fill_holes", "must be a non-negative number (0: off)");
         require(max_new_records > 0, "max_new_records", "must be positive");
         filter.validate();
+        verify.validate();
         require(interpolation == cache_interpolation::splat || !fills_holes(), "fill_holes",
                 "applies to splatting only (set 0 for the octree)");
     }
@@ -122,7 +130,15 @@ struct cache_frame_stats {
     double records_ms = 0;        ///< step 2's record computation (the sampler)
     double interpolate_ms = 0;    ///< step 3: the image from every record (octree: the lookups)
     double normalize_ms = 0;      ///< sum / weight per pixel
+    double verify_ms = 0;         ///< the verification's probes and tests (its records: records_ms, its scans: scan_ms)
+    std::size_t verify_tiles = 0;     ///< tiles the verification tested (over its rounds)
+    std::size_t verify_disagreed = 0; ///< tiles that disagreed, one record measured at each
+    std::size_t verify_shrunk = 0;    ///< older records shrunk to those records
 };
+
+/// A cheap Monte Carlo estimate of the irradiance at a pixel's point and normal
+/// (cache/verification.hpp); `pixel` (y * width + x) seeds it. Called from many threads.
+using irradiance_probe = std::function<probe_estimate(glm::vec3 p, glm::vec3 n, std::size_t pixel)>;
 
 template <class Weight>
 class irradiance_cache {
@@ -146,6 +162,12 @@ public:
     }
 
     const std::vector<irradiance_record>& records() const noexcept { return records_; }
+
+    /// The probe the verification pass (options().verify) asks at every pixel; without one
+    /// the pass is skipped.
+    void set_probe(irradiance_probe probe) { probe_ = std::move(probe); }
+    /// What the last render() did (the verification's counts included).
+    const cache_frame_stats& last_stats() const noexcept { return last_; }
     /// Replaces the records (a saved cache, or a restart from an earlier state).
     void assign(std::vector<irradiance_record> records) {
         records_ = std::move(records);
@@ -226,6 +248,7 @@ public:
         if (options_.interpolation == cache_interpolation::splat) {
             timed(stats.splat_existing_ms, [&] { splat_records<Weight>(g, cam, records_, sp, splat.view()); });
             scan_into(g, cam, sampler, splat.view(), record_points, stats);
+            if (options_.verify.enabled() && probe_) verify_into(g, cam, sampler, splat.view(), record_points, stats);
             // Step 5: the image comes from splatting every record into a clean buffer.
             timed(stats.interpolate_ms, [&] {
                 std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
@@ -244,6 +267,7 @@ public:
             if (wide) normalize_splats(splat.view(), wide->view(), 1e-3f, indirect);
             else normalize_splats(splat.view(), indirect);
         });
+        last_ = stats;
         return stats;
     }
 
@@ -358,6 +382,111 @@ private:
         }
     }
 
+    // The verification pass (cache/verification.hpp): probes at every pixel (once), then per
+    // round the tiles whose pooled residual disagrees, a record at each (measured as the scan
+    // measures, committed in tile order), the older records within their zone of it shrunk to
+    // R_new + distance (neighbour clamping towards the new record alone), and the splat and
+    // scan redone on what that uncovered. Odd rounds shift the tiles by half a tile, so a
+    // feature on a tile border is pooled whole once.
+    template <class Sampler>
+    void verify_into(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler, image_view<glm::vec4> splat,
+                     const gbuffer_view<float>* record_points, cache_frame_stats& stats) {
+        const verification_options& vo = options_.verify;
+        const std::size_t w = g.width(), h = g.height();
+        std::vector<probe_estimate> probes(w * h);
+        timed(stats.verify_ms, [&] {
+            tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
+                for (std::size_t x = 0; x < w; ++x)
+                    probes[y * w + x] = g.covered(x, y) ? probe_(g.position(x, y), g.normal(x, y), y * w + x)
+                                                        : probe_estimate{glm::vec3(0.f), -1.f};
+            });
+        });
+        const gbuffer_view<float>& where = record_points ? *record_points : g;
+        auto measure = batch_measurer(where, cam, sampler);
+        auto commit = committer(stats);
+        for (std::uint32_t round = 0; round < vo.rounds; ++round) {
+            std::vector<pixel_xy> seeds;
+            timed(stats.verify_ms, [&] {
+                const std::size_t t = vo.tile, shift = (round % 2) ? t / 2 : 0;
+                const std::size_t tw = (w + shift + t - 1) / t, th = (h + shift + t - 1) / t;
+                std::vector<std::optional<pixel_xy>> found(tw * th);
+                tbb::parallel_for(std::size_t(0), th, [&](std::size_t ty) {
+                    for (std::size_t tx = 0; tx < tw; ++tx) {
+                        tile_residuals tile;
+                        const std::size_t x0 = tx * t > shift ? tx * t - shift : 0, y0 = ty * t > shift ? ty * t - shift : 0;
+                        const std::size_t x1 = std::min(w, (tx + 1) * t - shift), y1 = std::min(h, (ty + 1) * t - shift);
+                        for (std::size_t y = y0; y < y1; ++y)
+                            for (std::size_t x = x0; x < x1; ++x)
+                                tile.add(residual_at(splat(x, y), g.albedo(x, y), probes[y * w + x]));
+                        if (!tile.disagrees(vo)) continue;
+                        // The pixel whose residual points furthest the tile's way.
+                        const double sign = tile.residual < 0 ? -1.0 : 1.0;
+                        double best = -std::numeric_limits<double>::infinity();
+                        for (std::size_t y = y0; y < y1; ++y)
+                            for (std::size_t x = x0; x < x1; ++x) {
+                                const pixel_residual r = residual_at(splat(x, y), g.albedo(x, y), probes[y * w + x]);
+                                if (r.valid && sign * r.residual > best) {
+                                    best = sign * r.residual;
+                                    found[ty * tw + tx] = pixel_xy{x, y};
+                                }
+                            }
+                    }
+                });
+                stats.verify_tiles += tw * th;
+                for (const auto& f : found)
+                    if (f) seeds.push_back(*f);
+            });
+            stats.verify_disagreed += seeds.size();
+            if (seeds.empty()) break;
+            std::vector<std::optional<irradiance_record>> measured(seeds.size());
+            timed(stats.records_ms, [&] {
+                measure(std::span<const pixel_xy>(seeds), std::span<std::optional<irradiance_record>>(measured));
+            });
+            const auto t0 = clock::now();
+            const std::size_t first = records_.size();
+            for (auto& rec : measured) {
+                if (!rec) continue;
+                commit(*rec);
+                records_.push_back(*rec);
+                stats.new_records += 1;
+            }
+            stats.verify_shrunk += shrink_to(first);
+            std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
+            splat_records<Weight>(g, cam, records_, options_.splat, splat);
+            stats.scan_ms += ms_since(t0);
+            scan_into(g, cam, sampler, splat, record_points, stats);
+        }
+    }
+
+    // Records before `first` whose zone holds a record from `first` on shrink to
+    // R_new + |p - p_new| (neighbour clamping towards the new ones); the neighbour index is
+    // rebuilt when any did. Returns how many shrank.
+    std::size_t shrink_to(std::size_t first) {
+        const float a = options_.splat.a;
+        std::vector<float> radius(first);
+        tbb::parallel_for(std::size_t(0), first, [&](std::size_t i) {
+            float r = records_[i].radius;
+            const float zone = Weight::template influence_radius<float>(r, a);
+            for (std::size_t j = first; j < records_.size(); ++j) {
+                const float d = glm::length(records_[i].position - records_[j].position);
+                if (d < zone) r = std::min(r, records_[j].radius + d);
+            }
+            radius[i] = r;
+        });
+        std::size_t shrunk = 0;
+        for (std::size_t i = 0; i < first; ++i)
+            if (radius[i] < records_[i].radius) {
+                records_[i].radius = radius[i];
+                ++shrunk;
+            }
+        if (shrunk > 0) {
+            clamp_ = neighbour_index(lo_, hi_);
+            clamp_.sync(records_);
+            ++generation_;
+        }
+        return shrunk;
+    }
+
     // The classical two passes: insert the records in an octree (built for this frame's a),
     // fill it by the same scan driver (lookups as the miss test), then one lookup per pixel.
     template <class Sampler>
@@ -405,6 +534,8 @@ private:
     irradiance_cache_options options_;
     std::vector<irradiance_record> records_;
     neighbour_index clamp_;
+    irradiance_probe probe_;
+    cache_frame_stats last_;
     std::size_t settled_ = 0;  // records_.size() at the last clamp_to_neighbours
     std::uint64_t generation_ = 0;
     std::vector<std::uint32_t> order_;
