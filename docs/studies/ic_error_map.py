@@ -6,7 +6,11 @@ its share in the worst pixels, the connected regions of the worst 1% with their 
 bounding box and sign (cache above or below the reference), and a picture: the cache, the
 reference and the signed error (red: cache too bright, blue: too dark).
 
-    /usr/bin/python3 docs/studies/ic_error_map.py REF_A.exr REF_B.exr CACHE.exr [--png OUT.png] [--regions N]
+    /usr/bin/python3 docs/studies/ic_error_map.py REF_A.exr REF_B.exr CACHE.exr [CACHE2.exr ...]
+        [--png OUT.png] [--rows Y0:Y1] [--regions N]
+
+With several cache images, each is reported in turn and the picture has one row per image
+(--rows crops every panel to those image rows).
 
 Reads EXRs through `oiiotool --dumpdata` (no Python binding needed). The images are the
 indirect radiance ic_splatting writes with --indirect-exr and the reference cache's
@@ -59,11 +63,26 @@ def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("ref_a")
     p.add_argument("ref_b")
-    p.add_argument("cache")
+    p.add_argument("caches", nargs="+")
     p.add_argument("--png")
+    p.add_argument("--rows", help="Y0:Y1, the image rows the picture keeps")
     p.add_argument("--regions", type=int, default=8)
     o = p.parse_args()
-    a, b, c = luminance(o.ref_a), luminance(o.ref_b), luminance(o.cache)
+    a, b = luminance(o.ref_a), luminance(o.ref_b)
+    panels = []
+    for path in o.caches:
+        print(path)
+        panels.append(report(a, b, luminance(path), o))
+    if o.png:
+        from PIL import Image
+
+        y0, y1 = (int(v) for v in o.rows.split(":")) if o.rows else (0, a.shape[0])
+        Image.fromarray(np.concatenate([p[y0:y1] for p in panels], axis=0)).save(o.png, optimize=True)
+        print(f"wrote {o.png}")
+
+
+def report(a, b, c, o):
+    """Prints where the error of cache image c sits; returns its picture row."""
     if not (a.shape == b.shape == c.shape):
         sys.exit(f"sizes differ: {a.shape} {b.shape} {c.shape}")
     r = 0.5 * (a + b)
@@ -92,9 +111,7 @@ def main():
     # Share by the sign of the error.
     print(f"  cache above the reference: {100 * e[d > 0].sum() / total:.0f}% of the squared error, below: "
           f"{100 * e[d < 0].sum() / total:.0f}%")
-    if o.png:
-        from PIL import Image
-
+    if True:
         scale = np.percentile(r[r > 0], 99) if np.any(r > 0) else 1.0
         tone = lambda x: (255 * np.clip(x / scale, 0, 1) ** (1 / 2.2)).astype(np.uint8)
         lim = np.sqrt(np.percentile(np.maximum(e, 0), 99.5)) or 1.0
@@ -104,9 +121,7 @@ def main():
         err[..., 2] = (255 * t * (d < 0)).astype(np.uint8)
         err[..., 1] = (60 * t).astype(np.uint8)
         grey = lambda x: np.repeat(tone(x)[..., None], 3, axis=2)
-        strip = np.concatenate([grey(c), grey(r), err], axis=1)
-        Image.fromarray(strip).save(o.png, optimize=True)
-        print(f"  wrote {o.png}")
+        return np.concatenate([grey(c), grey(r), err], axis=1)
 
 
 if __name__ == "__main__":
