@@ -55,6 +55,8 @@ struct options {
     bool ambient = false;
     bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
     int light_samples = 4;            // the lights' shot at k x k points of each whole texel (CPU)
+    int shooter_groups = 0;           // grouped shooters: at most N groups of blocks (0: off; rays only)
+    int group_rays = 1;               // grouped shots: visibility rays per receiver
     int repeat = 1;                   // solves timed (medians reported)
     std::size_t width = 256, height = 256;
     bool reference = true;
@@ -105,6 +107,11 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--light-samples", o.light_samples,
                    "point, spot and directional lights taken at k x k points of each whole texel (1: its element's point)")
         ->check(CLI::Range(1, 16))->capture_default_str();
+    app.add_option("--shooter-groups", o.shooter_groups,
+                   "shoot groups of nearby, similarly oriented blocks across charts, at most N (0: each block; rays only)")
+        ->check(CLI::Range(0, 1 << 24))->capture_default_str();
+    app.add_option("--group-rays", o.group_rays, "grouped shots: visibility rays per receiver, from members drawn by their light")
+        ->check(CLI::Range(1, 16))->capture_default_str();
     app.add_flag("--one-sided", o.one_sided,
                  "only the front (counter-clockwise) side of a surface receives and shoots (default: both sides, "
                  "as the reference; the GL backend needs it)");
@@ -146,6 +153,8 @@ inline radiosity_options solver_options_for(const options& o) {
     r.near_field = o.near_field;
     r.two_sided = !o.one_sided;
     r.light_samples = o.light_samples;
+    r.shooter_groups = o.shooter_groups;
+    r.group_visibility_samples = o.group_rays;
     return r;
 }
 
@@ -168,6 +177,9 @@ inline void check_options(const options& o) {
     if (o.visibility == visibility_kind::hemicube && o.resolution % 2 != 0)
         throw parameter_error("--resolution", "a hemicube needs an even resolution");
     check_backend_built(o.backend);
+    if (o.shooter_groups > 0 && o.visibility != visibility_kind::rays)
+        throw parameter_error("--shooter-groups", "needs --visibility rays: a group's rays leave from its members, and "
+                                                  "an item buffer renders from one point per shot");
     if (o.backend != backend::gl) return;
     // What the GL solver does not offer (docs/radiosity-gl.md).
     if (o.visibility == visibility_kind::rays)
@@ -210,6 +222,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"converge", o.converge}, {"converge_on", name_of(measure_names, o.converge_on)}, {"max_seconds", o.max_seconds},
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
             {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
+            {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
             {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 

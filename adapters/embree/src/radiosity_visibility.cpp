@@ -115,6 +115,26 @@ float radiosity_visibility::visible(const glm::vec3& point, std::uint32_t chart)
     return (r.tfar < 0.f && std::isinf(r.tfar)) ? 0.f : 1.f;
 }
 
+float radiosity_visibility::visible_from(const glm::vec3& origin, std::uint32_t origin_chart, const glm::vec3& point,
+                                         std::uint32_t chart) const {
+    chart_context ctx = context_for(*chart_, origin_chart, false);
+    RTCRay r;
+    r.org_x = origin.x;
+    r.org_y = origin.y;
+    r.org_z = origin.z;
+    r.tnear = 0.f;
+    r.dir_x = point.x - origin.x;
+    r.dir_y = point.y - origin.y;
+    r.dir_z = point.z - origin.z;
+    r.time = 0.f;
+    r.tfar = 1.f - options_.end_tolerance;
+    r.mask = ~0u;
+    r.id = chart;
+    r.flags = 0;
+    rtcOccluded1(bvh_.native(), &ctx.base, &r);
+    return (r.tfar < 0.f && std::isinf(r.tfar)) ? 0.f : 1.f;
+}
+
 void radiosity_visibility::visible(std::span<const glm::vec3> points, std::span<const std::uint32_t> charts,
                                    std::span<float> out) const {
     require(charts.size() == points.size(), "charts", "must have one chart per point");

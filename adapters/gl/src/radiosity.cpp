@@ -13,6 +13,8 @@ void radiosity_options::validate() const {
             "must be false on the GL solver, which is one-sided (cpu::progressive_radiosity solves two-sided surfaces)");
     require(shooting.light_samples == 1, "radiosity_options.light_samples",
             "must be 1 on the GL solver, which takes lights at element points");
+    require(shooting.shooter_groups == 0, "radiosity_options.shooter_groups",
+            "must be 0 on the GL solver, whose item buffers render from one point per shot (grouped shooters: CPU, ray casts)");
     require(resolution >= 8 && resolution <= 8192, "radiosity_options.resolution", "must lie in [8, 8192]");
     require(tolerance_px > 0.f && std::isfinite(tolerance_px), "radiosity_options.tolerance_px", "must be positive");
     require(max_tessellation_depth >= 0 && max_tessellation_depth <= 16, "radiosity_options.max_tessellation_depth",

@@ -39,6 +39,14 @@ struct radiosity_options {
                                    ///< each whole texel (light_sample_point), not only at its element's
                                    ///< point, so light narrower than a texel (the sun through a slit) is
                                    ///< not missed; 1: the element's point (CPU solver; typical: 1-4)
+    int shooter_groups = 0;        ///< grouped shooters (radiosity/shooter_groups.hpp, issue 30): the
+                                   ///< block-sides gathered into at most this many groups of nearby,
+                                   ///< similarly oriented blocks across charts, each shooting as one
+                                   ///< with visibility sampled per receiver from a member element; needs
+                                   ///< a visibility with visible_from (ray casts). 0: every block-side
+                                   ///< shoots alone (CPU solver; typical: 256-4096)
+    int group_visibility_samples = 1;  ///< grouped shots: rays per receiver, each from an element drawn
+                                       ///< in proportion to its share of the receiver's light (1-16)
 
     /// Throws parameter_error naming the option ("radiosity_options.near_field" ...).
     void validate() const {
@@ -47,6 +55,9 @@ struct radiosity_options {
         require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
                 "must be finite and non-negative");
         require(light_samples >= 1 && light_samples <= 16, "radiosity_options.light_samples", "must lie in [1, 16]");
+        require(shooter_groups >= 0, "radiosity_options.shooter_groups", "must be non-negative (0: off)");
+        require(group_visibility_samples >= 1 && group_visibility_samples <= 16,
+                "radiosity_options.group_visibility_samples", "must lie in [1, 16]");
     }
 };
 

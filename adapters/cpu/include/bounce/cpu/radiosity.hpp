@@ -48,6 +48,7 @@
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/shooter_groups.hpp>
 #include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/sides.hpp>
 #include <bounce/cpu/radiosity_memory.hpp>
@@ -57,6 +58,7 @@
 #include <bounce/scene_view.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -97,6 +99,9 @@ public:
         : atlas_(atlas), visibility_(std::move(visibility)), options_(options) {
         options.validate();
         scene.validate();
+        require(options.shooter_groups == 0 || casts_from_any_point, "radiosity_options.shooter_groups",
+                "needs a visibility that casts rays from any point (visible_from: ray casts, all_visible); item "
+                "buffers render from one point per shot");
         require(atlas.chart_of_triangle.size() == scene.triangles.size(), "atlas",
                 "was not built from this scene (triangle counts differ)");
         const std::size_t n = atlas.size();
@@ -129,26 +134,33 @@ public:
     /// Returns false (and does nothing) when no unshot power is left.
     bool step() {
         auto start = clock::now();
-        const std::size_t count = std::min<std::size_t>(std::size_t(options_.shooters_per_step), power_.size());
+        const bool grouped = !groups_.roots.empty();
+        if (grouped) {
+            // A group's power: its block-sides' (refreshed by the last distribution).
+            group_power_.assign(groups_.size(), 0.0);
+            for (std::size_t k = 0; k < power_.size(); ++k) group_power_[groups_.group_of_leaf[k]] += power_[k];
+        }
+        const std::vector<double>& power = grouped ? group_power_ : power_;
+        const std::size_t count = std::min<std::size_t>(std::size_t(options_.shooters_per_step), power.size());
         std::vector<std::uint32_t> chosen;
         if (count == 1) {
-            const auto best = largest_power();
+            const auto best = largest_power(power);
             if (best.first > 0) chosen.push_back(best.second);
         } else {
-            std::vector<std::uint32_t> order(power_.size());
+            std::vector<std::uint32_t> order(power.size());
             std::iota(order.begin(), order.end(), std::uint32_t(0));
             const auto larger = [&](std::uint32_t a, std::uint32_t b) {
-                return power_[a] > power_[b] || (power_[a] == power_[b] && a < b);
+                return power[a] > power[b] || (power[a] == power[b] && a < b);
             };
             std::nth_element(order.begin(), order.begin() + std::ptrdiff_t(count - 1), order.end(), larger);
             order.resize(count);
             std::sort(order.begin(), order.end(), larger);
             for (const std::uint32_t k : order)
-                if (power_[k] > 0) chosen.push_back(k);
+                if (power[k] > 0) chosen.push_back(k);
         }
         timings_.choice_ms += ms_since(start);
         if (chosen.empty()) return false;
-        for (const std::uint32_t k : chosen) shoot(k);
+        for (const std::uint32_t k : chosen) grouped ? shoot_group(k) : shoot(k);
         ++steps_;
         return true;
     }
@@ -281,7 +293,8 @@ public:
         const glm::dvec3 rho = albedo_area_ / total_area_;
         return bounce::indirect_unshot_fraction(unshot_total_, shot_power_, (rho.x + rho.y + rho.z) / 3.0);
     }
-    std::size_t shooters() const noexcept { return power_.size(); }
+    /// Shooters: groups (radiosity_options::shooter_groups), else block-sides.
+    std::size_t shooters() const noexcept { return groups_.roots.empty() ? power_.size() : groups_.size(); }
     /// The last shot: its shooter, its first element, the element that took the most of it
     /// and its share, and the scale that kept its delivered power within its own
     /// (radiosity/shooters.hpp, shot_scale; 1 unless the form factors summed above 1).
@@ -351,6 +364,8 @@ private:
             centre_[k] = disc.centre;
             shooter_area_[k] = Real(disc.area);
         }
+        if (options_.shooter_groups > 0)
+            groups_ = build_shooter_groups(atlas_, first_, sides_, std::size_t(options_.shooter_groups));
         refresh_powers();
     }
     static double ms_since(clock::time_point t) {
@@ -370,15 +385,15 @@ private:
 
     // Largest (power, lowest index among equals): associative, so the reduction's grouping
     // does not change the answer.
-    std::pair<double, std::uint32_t> largest_power() const {
+    std::pair<double, std::uint32_t> largest_power(const std::vector<double>& power) const {
         using best = std::pair<double, std::uint32_t>;
         const auto better = [](const best& a, const best& b) {
             return (b.first > a.first || (b.first == a.first && b.second < a.second)) ? b : a;
         };
         return tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, power_.size(), 1024), best{-1.0, 0},
+            tbb::blocked_range<std::size_t>(0, power.size(), 1024), best{-1.0, 0},
             [&](const tbb::blocked_range<std::size_t>& r, best acc) {
-                for (std::size_t k = r.begin(); k != r.end(); ++k) acc = better(acc, best{power_[k], std::uint32_t(k)});
+                for (std::size_t k = r.begin(); k != r.end(); ++k) acc = better(acc, best{power[k], std::uint32_t(k)});
                 return acc;
             },
             better);
@@ -515,6 +530,180 @@ private:
             received_[i] = incident * v;
             if (two) received_[n + i] = incident_back * v;
             s.intercepted += (glm::dvec3(received_[i]) + glm::dvec3(incident_back * v)) * double(at.area[i]);
+        });
+        return total.intercepted;
+    }
+
+    // A grouped shot (radiosity/shooter_groups.hpp): group g's block-sides that hold unshot
+    // power shoot together, as one hierarchy (the group's subtree of halves above each
+    // block's near-field tree), in the same two passes as shoot(): every element's incident
+    // radiosity, then the deliveries scaled to the shot's power (shot_scale) and added.
+    void shoot_group(std::uint32_t g) {
+        glm::dvec3 power(0);
+        group_nodes_.clear();
+        links_.clear();
+        std::uint32_t first_element = shooter_group_node::none;
+        const std::uint32_t root = build_group_node(groups_.roots[g], power, first_element);
+        if (root == shooter_group_node::none) return;
+        const auto start = clock::now();
+        const glm::dvec3 incident = gather_group(root);
+        const glm::dvec3 scale = shot_scale(power, incident);
+        const chunk_sums total = apply_shot(Real(scale.x), Real(scale.y), Real(scale.z));
+        timings_.distribution_ms += ms_since(start);
+        absorbed_ += total.absorbed;
+        escaped_ += power - total.intercepted;
+        intercepted_ += total.intercepted;
+        last_shot_ = {shots_, g, first_element, total.top_receiver,
+                      total.top_power / std::max(bounce::detail::channel_total(power), 1e-300), scale};
+        if (scale != glm::dvec3(1.0)) ++clamped_shots_;
+        shot_power_ += bounce::detail::channel_total(power);
+        ++shots_;
+    }
+
+    // The shot's hierarchy below static node `s` of the grouping: its block-sides with power,
+    // each as its near-field tree (their unshot radiosity then zeroed), joined by the node's
+    // two halves where both hold power. Adds the shot power (W per channel) to `power`; returns
+    // the node's index in group_nodes_, or none when no leaf below holds power.
+    std::uint32_t build_group_node(std::uint32_t s, glm::dvec3& power, std::uint32_t& first_element) {
+        const shooter_group_node& sn = groups_.nodes[s];
+        const std::size_t blocks = first_.size() - 1, n = atlas_.size();
+        if (sn.left == shooter_group_node::none) {
+            const std::uint32_t k = groups_.leaves[sn.first];
+            if (!(power_[k] > 0)) return shooter_group_node::none;
+            const std::size_t b = k % blocks, side = k / blocks;
+            const std::uint32_t i0 = first_[b], i1 = first_[b + 1], chart = atlas_.chart[i0];
+            vec* unshot = unshot_.data() + side * n;
+            const vec normal = side == 0 ? vec(atlas_.normal[i0]) : -vec(atlas_.normal[i0]);
+            const std::uint32_t base = std::uint32_t(group_nodes_.size());
+            build_near_field_tree(
+                atlas_, i0, i1, options_.shoot_blocks, b, [&](std::uint32_t i) { return glm::dvec3(unshot[i]); },
+                [&](glm::dvec3 centre, double node_area, glm::dvec3 mean_unshot, std::uint32_t first_child, std::uint32_t children) {
+                    group_node q{vec(centre), Real(node_area), Real(node_area), vec(mean_unshot), normal, Real(0),
+                                 std::uint32_t(links_.size()), children, chart, Real(bounce::detail::channel_total(mean_unshot) * node_area)};
+                    for (std::uint32_t c = 0; c < children; ++c) links_.push_back(base + first_child + c);
+                    group_nodes_.push_back(q);
+                });
+            for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot[i]) * double(atlas_.area[i]), unshot[i] = vec(0);
+            if (first_element == shooter_group_node::none) first_element = i0;
+            return std::uint32_t(group_nodes_.size() - 1);
+        }
+        const std::uint32_t l = build_group_node(sn.left, power, first_element);
+        const std::uint32_t r = build_group_node(sn.right, power, first_element);
+        if (l == shooter_group_node::none || r == shooter_group_node::none) return l == shooter_group_node::none ? r : l;
+        const group_node &a = group_nodes_[l], &c = group_nodes_[r];
+        const Real area = a.area + c.area, weight = a.power + c.power;
+        const glm::vec3 d = sn.hi - sn.lo;
+        group_node q;
+        // At the power's centroid (where the light leaves from), with the area-weighted mean
+        // normal (not normalized: its length is the members' projected share, so the disc's
+        // cosine sums theirs where all face the receiver, which the cone test ensures).
+        q.position = weight > Real(0) ? (a.position * a.power + c.position * c.power) / weight
+                                      : (a.position * a.area + c.position * c.area) / area;
+        q.area = area;
+        q.size2 = std::max(area, Real(0.25) * Real(glm::dot(d, d)));  // the square of its half-diagonal
+        q.unshot = (a.unshot * a.area + c.unshot * c.area) / area;
+        q.normal = (a.normal * a.area + c.normal * c.area) / area;
+        q.cone_sin = Real(sn.cone_sin);
+        q.first_link = std::uint32_t(links_.size());
+        q.child_count = 2;
+        q.chart = shooter_group_node::none;
+        q.power = weight;
+        links_.push_back(l);
+        links_.push_back(r);
+        group_nodes_.push_back(q);
+        return std::uint32_t(group_nodes_.size() - 1);
+    }
+
+    // Pass 1 of a grouped shot: each element's incident radiosity from the hierarchy below
+    // `root` (a node as one disc unless the receiver is in its near field or some member may
+    // face away from it, then its children), into received_, times the visibility of rays
+    // from group_visibility_samples member elements, each drawn with probability its share
+    // of the receiver's light (a weighted reservoir over the discs taken, then down the tree
+    // by power): the mean of those rays is an unbiased estimate of the visible share of the
+    // receiver's (channel-summed) light. The draws are hash_uniform(shot, element, draw), so
+    // results do not depend on the thread count. Returns the intercepted power (W per channel).
+    glm::dvec3 gather_group(std::uint32_t root) {
+        const lightmap_atlas& at = atlas_;
+        const Real near2 = Real(options_.near_field) * Real(options_.near_field);
+        const std::size_t n = at.size();
+        const bool two = sides_ == 2;
+        const int samples = options_.group_visibility_samples;
+        received_.assign(sides_ * n, vec(0));
+        const Visibility& vis = visibility_;
+        const std::uint64_t shot = shots_;
+        const chunk_sums total = for_elements([&](std::uint32_t i, chunk_sums& s) {
+            const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
+            const Real ar = Real(at.area[i]);
+            const std::uint32_t chart = at.chart[i];
+            vec incident[2] = {vec(0), vec(0)};
+            double weight[2] = {0, 0};
+            std::array<std::uint32_t, 16> pick[2];
+            std::uint64_t draws = 0;
+            std::array<std::uint32_t, 256> stack;
+            std::size_t top = 0;
+            stack[top++] = root;
+            while (top > 0) {
+                const std::uint32_t j = stack[--top];
+                const group_node& node = group_nodes_[j];
+                if (node.chart == chart) continue;  // the receiver's own chart: coplanar, F = 0
+                const vec r = pr - node.position;
+                const Real d2 = glm::dot(r, r);
+                bool open = node.child_count > 0 && d2 < near2 * node.size2;
+                if (!open && node.child_count > 0) {
+                    // Every member faces away from the receiver: nothing to take. (Where only
+                    // some do, the node's normal sum counts their cosines against the others':
+                    // opening those nodes too made every receiver within the members' cone
+                    // of grazing open the group, 1.5 times the solve's time on Sponza.)
+                    const Real len = std::sqrt(glm::dot(node.normal, node.normal) * d2);
+                    const Real c = len > Real(0) ? glm::dot(node.normal, r) / len : Real(0);
+                    if (c < -node.cone_sin) continue;
+                }
+                if (open && top + node.child_count <= stack.size()) {
+                    for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = links_[node.first_link + c];
+                    continue;
+                }
+                const int side = two && glm::dot(nr, node.position - pr) < Real(0) ? 1 : 0;
+                const Real f = element_form_factor<Real, vec>(pr, side ? -nr : nr, ar, node.position, node.normal, node.area);
+                if (!(f > Real(0))) continue;
+                const vec light = node.unshot * f;
+                const double w = channel_sum(light);
+                if (!(w > 0)) continue;
+                incident[side] += light;
+                weight[side] += w;
+                for (int k = 0; k < samples; ++k)
+                    if (double(hash_uniform(shot, i, draws * 16 + std::uint64_t(k))) * weight[side] < w) pick[side][k] = j;
+                ++draws;
+            }
+            for (int side = 0; side < int(sides_); ++side) {
+                if (!(weight[side] > 0)) continue;
+                int seen = 0;
+                for (int k = 0; k < samples; ++k) {
+                    // Down from the disc drawn to one element, by power.
+                    std::uint32_t j = pick[side][k];
+                    std::uint64_t level = 0;
+                    while (group_nodes_[j].child_count > 0) {
+                        const group_node& node = group_nodes_[j];
+                        double sum = 0;
+                        for (std::uint32_t c = 0; c < node.child_count; ++c) sum += double(group_nodes_[links_[node.first_link + c]].power);
+                        double u = double(hash_uniform(shot, i, (1ull << 40) + std::uint64_t(side * 16 + k) * 4096 + level++)) * sum;
+                        std::uint32_t next = links_[node.first_link + node.child_count - 1];
+                        for (std::uint32_t c = 0; c < node.child_count; ++c) {
+                            const std::uint32_t child = links_[node.first_link + c];
+                            u -= double(group_nodes_[child].power);
+                            if (u < 0 && group_nodes_[child].power > Real(0)) {
+                                next = child;
+                                break;
+                            }
+                        }
+                        j = next;
+                    }
+                    if constexpr (casts_from_any_point)
+                        seen += vis.visible_from(glm::vec3(group_nodes_[j].position), group_nodes_[j].chart, at.position[i], chart) > 0.5f;
+                }
+                if (seen == 0) continue;
+                received_[side * n + i] = incident[side] * (Real(seen) / Real(samples));
+                s.intercepted += glm::dvec3(received_[side * n + i]) * double(ar);
+            }
         });
         return total.intercepted;
     }
@@ -661,6 +850,23 @@ private:
         std::uint32_t first_child = 0, child_count = 0;
     };
     std::vector<near_node> near_;
+    // Grouped shooters (radiosity_options::shooter_groups): the grouping, the groups' powers
+    // (refreshed each step from power_), and a grouped shot's hierarchy, children by links_.
+    struct group_node {
+        vec position;
+        Real area, size2;  // size2: the square of the node's extent, for the near-field test
+        vec unshot, normal;
+        Real cone_sin;     // the members' normal cone (0 for a block's nodes: one plane)
+        std::uint32_t first_link = 0, child_count = 0, chart = shooter_group_node::none;
+        Real power;        // channels summed, W: for drawing the ray's member
+    };
+    static constexpr bool casts_from_any_point = requires(const Visibility& v, const glm::vec3& p, std::uint32_t c) {
+        { v.visible_from(p, c, p, c) } -> std::convertible_to<float>;
+    };
+    shooter_groups groups_;
+    std::vector<double> group_power_;
+    std::vector<group_node> group_nodes_;
+    std::vector<std::uint32_t> links_;
 
     // The tree of radiosity/shooters.hpp (the GL solver builds the same) of block k, from the
     // unshot radiosity of one side (`unshot`, indexed by element).

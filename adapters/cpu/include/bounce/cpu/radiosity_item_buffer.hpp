@@ -87,6 +87,7 @@ concept shot_visibility = requires(V& v, const V& cv, const shot_frame& s, const
 struct all_visible {
     void begin_shot(const shot_frame&) noexcept {}
     float visible(const glm::vec3&, std::uint32_t) const noexcept { return 1.f; }
+    float visible_from(const glm::vec3&, std::uint32_t, const glm::vec3&, std::uint32_t) const noexcept { return 1.f; }
 };
 
 /// Chart id, depth and the drawing's own primitive number per pixel; `none` where nothing

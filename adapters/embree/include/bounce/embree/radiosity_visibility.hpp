@@ -80,6 +80,13 @@ public:
     /// shooter's, else 0. Thread-safe.
     float visible(const glm::vec3& point, std::uint32_t chart) const;
 
+    /// 1 when the segment from `origin` (a point of chart `origin_chart`) to `point` meets no
+    /// triangle of a chart other than those two, else 0: visibility from any point, without
+    /// begin_shot (grouped shooters, radiosity/shooter_groups.hpp, sample one member per
+    /// receiver). Thread-safe.
+    float visible_from(const glm::vec3& origin, std::uint32_t origin_chart, const glm::vec3& point,
+                       std::uint32_t chart) const;
+
     /// visible() for many points at once, in packets of eight rays (rtcOccluded8): the
     /// same answers. Sizes must match (parameter_error otherwise). Thread-safe.
     void visible(std::span<const glm::vec3> points, std::span<const std::uint32_t> charts, std::span<float> out) const;
