@@ -257,6 +257,38 @@ TEST_CASE("the geometry-aware tent, the discontinuity test and the upsampling we
         for (std::size_t e = 0; e < in.size(); ++e) REQUIRE(gpu[e] == cpu[e]);
     }
     {
+        // The blur's visibility edges: sums of n terms of random brightness, a random share
+        // of them visible, some pixels unlit; away from the threshold.
+        std::vector<std::tuple<float, float, float, float, float, float, float>> in;
+        while (in.size() < std::size_t(random_count)) {
+            float sums[2][3];
+            for (auto& s : sums) {
+                const int n = int(1 + 60 * rng.next_float());
+                s[0] = s[1] = s[2] = 0.f;
+                if (rng.next_float() < 0.1f) continue;  // unlit
+                const float share = rng.next_float();
+                for (int k = 0; k < n; ++k) {
+                    const float b = 0.01f + rng.next_float();
+                    s[0] += b;
+                    s[1] += rng.next_float() < share ? b : 0.f;
+                    s[2] += b * b;
+                }
+            }
+            const float sigmas = 3.f * rng.next_float();
+            if (sums[0][0] > 0.f && sums[1][0] > 0.f) {
+                const float d = sums[0][1] / sums[0][0] - sums[1][1] / sums[1][0];
+                const float t = sigmas * sigmas * (sums[0][2] / (sums[0][0] * sums[0][0]) +
+                                                   sums[1][2] / (sums[1][0] * sums[1][0]));
+                if (std::abs(4.f * d * d - t) < 1e-3f * (t + 1e-3f)) continue;
+            }
+            in.emplace_back(sums[0][0], sums[0][1], sums[0][2], sums[1][0], sums[1][1], sums[1][2], sigmas);
+        }
+        std::vector<float> cpu;
+        for (const auto& a : in) cpu.push_back(std::apply(visibility_discontinuity<float>, a));
+        const auto gpu = gl::map_kernel(visibility_discontinuity<f32>, in);
+        for (std::size_t e = 0; e < in.size(); ++e) REQUIRE(gpu[e] == cpu[e]);
+    }
+    {
         using args = std::tuple<glm::vec3, glm::vec3, std::array<glm::vec3, 4>, std::array<glm::vec3, 4>, float, float,
                                 float, float>;
         std::vector<args> in;

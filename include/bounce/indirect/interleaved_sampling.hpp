@@ -162,6 +162,26 @@ T geometry_discontinuity(T depth_a, const V& n_a, T depth_b, const V& n_b, T rel
     return select(far_apart || turned, T(1), T(0));
 }
 
+/// Whether two neighbouring pixels of the gathered buffer see different shares of their
+/// senders (a visibility edge the G-buffer does not show: the rim of a shadow on one surface,
+/// docs/rsm-sii-interleaved.md, "Issue 29, fourth session"). Each pixel brings the sums of its
+/// own sub-buffer's terms before visibility: `sum` = sum_k e_k, `visible` = sum_k e_k V_k and
+/// `sum_sq` = sum_k e_k^2 (e_k a term's brightness, V_k in {0, 1}). Its visible fraction is
+/// r = visible / sum, from Kish's effective number of terms n = sum^2 / sum_sq; r's variance
+/// is at most r (1 - r) / n <= 1 / (4 n) (the binomial bound, kept because a handful of
+/// terms that agree would otherwise claim certainty). Returns 1 when both pixels receive
+/// light and |r_a - r_b| exceeds `sigmas` standard errors of the difference,
+/// sigmas^2 (1 / n_a + 1 / n_b) / 4 < (r_a - r_b)^2; 0 otherwise (sigmas 0: never).
+template <real T>
+T visibility_discontinuity(T sum_a, T visible_a, T sum_sq_a, T sum_b, T visible_b, T sum_sq_b, T sigmas) {
+    const auto lit = sum_a > T(0) && sum_b > T(0) && sum_sq_a > T(0) && sum_sq_b > T(0) && sigmas > T(0);
+    const T sa = select(lit, sum_a, T(1)), sb = select(lit, sum_b, T(1));
+    const T d = visible_a / sa - visible_b / sb;
+    // 1 / n = sum_sq / sum^2 for each pixel.
+    const T inv_n = select(lit, sum_sq_a / (sa * sa) + sum_sq_b / (sb * sb), T(0));
+    return select(lit && T(4) * d * d > sigmas * sigmas * inv_n, T(1), T(0));
+}
+
 /// Weights of the geometry-aware bilinear upsampling of a low-resolution result (DS05
 /// section 3.3): the four low-resolution samples around a full-resolution pixel at `x`
 /// (unit normal `n`) with bilinear weights from `frac` (the pixel's position between them,

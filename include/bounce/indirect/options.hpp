@@ -70,10 +70,15 @@ struct pixel_light_params {
     }
 };
 
-/// Tolerances of the discontinuity buffer (geometry_discontinuity).
+/// Tolerances of the discontinuity buffer (geometry_discontinuity, visibility_discontinuity).
 struct discontinuity_params {
     float relative_depth = 0.05f;  ///< depth step, relative to the nearer depth (typical: 0.02-0.1)
     float cos_normal = 0.9f;       ///< smallest cosine between normals of one surface (typical: 0.9, 25 deg)
+    /// With visibility by rays, interleaved SII also cuts the blur between neighbours whose
+    /// visible fractions differ by more than this many standard errors
+    /// (visibility_discontinuity; docs section 15, "Issue 29, fourth session"); 0: no
+    /// visibility edges (the blur of geometry alone). Typical: 3.
+    float visibility_sigmas = 3.f;
 
     bool operator==(const discontinuity_params&) const = default;
 
@@ -81,6 +86,8 @@ struct discontinuity_params {
         require(std::isfinite(relative_depth) && relative_depth >= 0.f, "relative_depth", "must be finite and >= 0");
         require(std::isfinite(cos_normal) && cos_normal >= -1.f && cos_normal <= 1.f, "cos_normal",
                 "must lie in [-1, 1]");
+        require(std::isfinite(visibility_sigmas) && visibility_sigmas >= 0.f, "visibility_sigmas",
+                "must be finite and >= 0");
     }
 };
 

@@ -145,7 +145,17 @@ private:
         gbuffer<float> split_gb;
         image<glm::vec3> split_out, gathered, scratch;
         image<glm::vec2> edges;
+        /// Visibility edges (rays, interleaved, blurred): the splat's per-pixel sums in the
+        /// split buffer and gathered back (add_visibility_edges).
+        image<glm::vec3> split_stats, stats;
     };
+
+    /// Whether the frame cuts its blur at visibility edges too: interleaved SII blurred
+    /// with rays and discontinuity.visibility_sigmas > 0.
+    bool visibility_edges() const noexcept {
+        return options_.technique == indirect_technique::sii && options_.pattern.cells() > 1 && options_.blur &&
+               occlusion() != nullptr && options_.discontinuity.visibility_sigmas > 0.f;
+    }
 
     void frame(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
                image_view<glm::vec3> out, buffers& b, indirect_timings& t) {
@@ -163,6 +173,10 @@ private:
                 b.edges = image<glm::vec2>(w, h);
             }
         }
+        if (visibility_edges() && (b.stats.width() != w || b.stats.height() != h)) {
+            b.split_stats = image<glm::vec3>(w, h);
+            b.stats = image<glm::vec3>(w, h);
+        }
         gbuffer_view<float> shaded_gb = gb;
         image_view<glm::vec3> shaded_out = out;
         if (interleaved) {
@@ -176,17 +190,21 @@ private:
         if (options_.technique == indirect_technique::rsm_gather)
             shade_gather(shaded_gb, maps, b.maps, shaded_out, t);
         else
-            shade_splat(shaded_gb, cam, maps, b.maps, shaded_out, t);
+            shade_splat(shaded_gb, cam, maps, b.maps, shaded_out, t,
+                        visibility_edges() ? b.split_stats.view() : image_view<glm::vec3>());
         t.shade_ms += ms_since(start);
         if (!interleaved) return;
 
         start = clock::now();
         image_view<glm::vec3> gathered = options_.blur ? b.gathered.view() : out;
         gather_image<glm::vec3>(b.split_out.view(), gathered, b.maps);
+        if (visibility_edges()) gather_image<glm::vec3>(b.split_stats.view(), b.stats.view(), b.maps);
         t.gather_ms += ms_since(start);
         if (!options_.blur) return;
         start = clock::now();
         discontinuity_buffer(gb, options_.discontinuity, b.edges.view());
+        if (visibility_edges())
+            add_visibility_edges(b.stats.view(), options_.discontinuity.visibility_sigmas, b.edges.view());
         geometry_aware_blur(b.gathered.view(), b.edges.view(), gb.depth, p, b.scratch.view(), out);
         t.blur_ms += ms_since(start);
     }
@@ -212,13 +230,15 @@ private:
     }
 
     void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
-                     const interleave_maps& imaps, image_view<glm::vec3> out, indirect_timings& t) {
+                     const interleave_maps& imaps, image_view<glm::vec3> out, indirect_timings& t,
+                     image_view<glm::vec3> stats) {
         // With rays, VPLs chosen by their visible contribution to the view (view_selection.hpp).
         vpls_ = occlusion() && options_.view_selection.enabled()
                     ? select_vpls_for_view(maps, options_, gb, occlusion(), imaps.pattern.cells())
                     : select_vpls(maps, options_);
         t.vpls = vpls_.size();
         fill_zero(out);
+        if (!stats.empty()) fill_zero(stats);
         std::vector<glm::vec3> positions;
         if (options_.assignment == light_assignment::similarity)
             for (const auto& l : vpls_) positions.push_back(l.position);
@@ -233,7 +253,7 @@ private:
             build_ism();
             ism = &ism_;
         }
-        splat_vpls(gb, imaps, cam, vpls_, g, sp, out, occlusion(), ism);
+        splat_vpls(gb, imaps, cam, vpls_, g, sp, out, occlusion(), ism, stats);
     }
 
     /// The frame's imperfect shadow maps: the point set (count x points_per_vpl points,

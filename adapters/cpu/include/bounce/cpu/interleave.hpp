@@ -13,7 +13,9 @@
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/interleaved_sampling.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -114,6 +116,29 @@ inline void discontinuity_buffer(const gbuffer_view<float>& gb, const discontinu
     tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
         for (std::size_t x = 0; x < w; ++x)
             edges(x, y) = glm::vec2(x + 1 < w ? edge(x, y, x + 1, y) : 1.f, y + 1 < h ? edge(x, y, x, y + 1) : 1.f);
+    });
+}
+
+/// Adds the visibility edges (visibility_discontinuity) to `edges`: .x becomes 1 where
+/// pixel (x, y) and its right neighbour see different shares of their senders by more than
+/// `sigmas` standard errors, .y likewise with the pixel below. `stats` holds each pixel's
+/// (sum, visible sum, sum of squares) of its terms' brightness (cpu::splat_vpls's
+/// visibility_stats, gathered back to image order).
+inline void add_visibility_edges(image_view<const glm::vec3> stats, float sigmas, image_view<glm::vec2> edges) {
+    require(std::isfinite(sigmas) && sigmas >= 0.f, "sigmas", "must be finite and >= 0");
+    require(edges.width() == stats.width() && edges.height() == stats.height(), "edges",
+            "size differs from the stats");
+    const std::size_t w = stats.width(), h = stats.height();
+    const auto edge = [&](std::size_t xa, std::size_t ya, std::size_t xb, std::size_t yb) {
+        const glm::vec3 a = stats(xa, ya), b = stats(xb, yb);
+        return visibility_discontinuity<float>(a.x, a.y, a.z, b.x, b.y, b.z, sigmas);
+    };
+    tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
+        for (std::size_t x = 0; x < w; ++x) {
+            glm::vec2& e = edges(x, y);
+            if (x + 1 < w) e.x = std::max(e.x, edge(x, y, x + 1, y));
+            if (y + 1 < h) e.y = std::max(e.y, edge(x, y, x, y + 1));
+        }
     });
 }
 

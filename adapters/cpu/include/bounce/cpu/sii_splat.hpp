@@ -94,10 +94,13 @@ struct visible_splat_scratch {
     std::vector<std::uint8_t> blocked;
 };
 
-/// splat, adding only where `occlusion` finds the pixel sees the VPL (one batch).
+/// splat, adding only where `occlusion` finds the pixel sees the VPL (one batch). With
+/// `stats` (not empty), each term's brightness b (its channels' sum) also adds (b, b V, b^2)
+/// to the pixel's stats, V 1 where it sees the VPL (visibility_discontinuity's sums).
 inline void splat_visible(const gbuffer_view<float>& gb, const vpl& l, float scale, const pixel_light_params& lp,
                           const bounce::pixel_rect& rect, const bounce::pixel_rect& tile,
-                          const occlusion_query& occlusion, visible_splat_scratch& s, image_view<glm::vec3> out) {
+                          const occlusion_query& occlusion, visible_splat_scratch& s, image_view<glm::vec3> out,
+                          image_view<glm::vec3> stats = {}) {
     s.segments.clear();
     s.pixels.clear();
     s.terms.clear();
@@ -112,6 +115,11 @@ inline void splat_visible(const gbuffer_view<float>& gb, const vpl& l, float sca
     occlusion.occluded(s.segments, s.blocked);
     for (std::size_t k = 0; k < s.terms.size(); ++k)
         if (!s.blocked[k]) out(s.pixels[k][0], s.pixels[k][1]) += s.terms[k];
+    if (stats.empty()) return;
+    for (std::size_t k = 0; k < s.terms.size(); ++k) {
+        const float b = s.terms[k].x + s.terms[k].y + s.terms[k].z;
+        stats(s.pixels[k][0], s.pixels[k][1]) += glm::vec3(b, s.blocked[k] ? 0.f : b, b * b);
+    }
 }
 }  // namespace detail
 
@@ -120,14 +128,18 @@ inline void splat_visible(const gbuffer_view<float>& gb, const vpl& l, float sca
 /// G-buffer; `cam` the camera of the full image (maps.width x maps.height). With
 /// `occlusion`, a VPL lights only the pixels that see it (indirect/visibility.hpp; the
 /// pixels of one VPL and tile asked in one batch); with `ism` instead (built for `vpls`),
-/// each term is multiplied by imperfect_shadow_maps::visible.
+/// each term is multiplied by imperfect_shadow_maps::visible. `visibility_stats` (with
+/// `occlusion`; empty: not kept) receives each pixel's sums of its terms' brightness before
+/// visibility, after it, and squared (visibility_discontinuity's inputs; the caller zeroes it).
 inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& maps, const camera& cam,
                        std::span<const vpl> vpls, const light_groups& groups, const sii_params& params,
                        image_view<glm::vec3> out, const occlusion_query* occlusion = nullptr,
-                       const imperfect_shadow_maps* ism = nullptr) {
+                       const imperfect_shadow_maps* ism = nullptr, image_view<glm::vec3> visibility_stats = {}) {
     params.validate();
     detail::require_size(gb.width(), gb.height(), maps, "gb");
     detail::require_size(out.width(), out.height(), maps, "out");
+    if (!visibility_stats.empty()) detail::require_size(visibility_stats.width(), visibility_stats.height(), maps,
+                                                        "visibility_stats");
     const interleave_pattern& p = maps.pattern;
     require(groups.begin.size() == std::size_t(p.cells()) + 1 && groups.order.size() == vpls.size(), "groups",
             "must deal every VPL to the pattern's sub-buffers");
@@ -167,7 +179,7 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
             const vpl& l = vpls[groups.order[k]];
             if (occlusion)
                 detail::splat_visible(gb, l, scale, params.light, rects[k], tile_rect, *occlusion, scratches.local(),
-                                      out);
+                                      out, visibility_stats);
             else if (ism)
                 detail::splat(gb, l, scale, params.light, rects[k], tile_rect,
                               [&](std::size_t u, std::size_t v, const glm::vec3& e) {

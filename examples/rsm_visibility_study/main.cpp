@@ -1,0 +1,261 @@
+// rsm_visibility_study: where the error that indirect visibility adds comes from (issue 29).
+// For each scene, at the benchmark's settings (256x256, rsm_sii's defaults, references of
+// 1024 rays a pixel with visibility and 512 without, each in two halves, from the cache), it
+// renders SII with and without occlusion rays plain, interleaved 4x4 before the blur and
+// after it, and measures each frame's debiased rel_rms against the reference of what it
+// computes (with rays the occluded one-bounce light, without it the unoccluded one), the same
+// bench::measure_error as the benchmark. It also blurs each reference itself with the 4x4
+// geometry-aware tent (the blur's bias on the true light: what the blurred frame averages to
+// over the VPLs' draws). --dump DIR writes every image as raw float32 (W H 3, row-major) for
+// per-pixel analysis.
+//
+//   build/bin/rsm_visibility_study --scenes cornell-box,conference --vpls 4096 [--dump DIR]
+#include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/embree/accel.hpp>
+#include <bounce/embree/occlusion_rays.hpp>
+#include <bounce/embree/rsm_ray_cast.hpp>
+#include <bounce/io/scene.hpp>
+#include <bounce/output.hpp>
+#include <bounce/study/benchmark_parts.hpp>
+
+#include "../common/run_program.hpp"
+
+#include <bounce/io/output_files.hpp>
+
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+using namespace bounce;
+namespace bench = bounce::study::bench;
+
+namespace {
+
+struct options {
+    std::vector<std::string> scenes{"cornell-box"};
+    std::size_t vpls = 4096;
+    std::uint64_t seed = 1;
+    std::size_t width = 256, height = 256;
+    std::string dump;
+    std::string json;
+    std::vector<std::string> configs;
+    bool flat_normals = false;
+    float sigmas = discontinuity_params{}.visibility_sigmas;
+};
+
+/// `s` with every triangle's corners its own vertices carrying the triangle's geometric normal
+/// (the per-face normals an OBJ without `vn` stands for, instead of the loader's smoothed ones).
+io::scene flat_shaded(const io::scene& s) {
+    io::scene f = s;
+    f.name = s.name + "-flat";
+    f.positions.clear();
+    f.normals.clear();
+    f.triangles.clear();
+    for (const glm::uvec3& t : s.triangles) {
+        const glm::vec3 a = s.positions[t.x], b = s.positions[t.y], c = s.positions[t.z];
+        glm::vec3 n = glm::cross(b - a, c - a);
+        const float len = glm::length(n);
+        n = len > 0.f ? n / len : s.normals[t.x];
+        // Keep the side the smoothed normals gave (the winding's side, as the loader's).
+        if (glm::dot(n, s.normals[t.x] + s.normals[t.y] + s.normals[t.z]) < 0.f) n = -n;
+        const std::uint32_t k = std::uint32_t(f.positions.size());
+        for (const glm::vec3& p : {a, b, c}) {
+            f.positions.push_back(p);
+            f.normals.push_back(n);
+        }
+        f.triangles.push_back({k, k + 1, k + 2});
+    }
+    return f;
+}
+
+void dump_image(const options& o, const std::string& scene, const std::string& name, image_view<const glm::vec3> img) {
+    if (o.dump.empty()) return;
+    std::filesystem::create_directories(o.dump);
+    const auto file = std::filesystem::path(o.dump) / (scene + "." + name + ".f32");
+    std::FILE* f = std::fopen(file.string().c_str(), "wb");
+    if (f == nullptr) throw parameter_error("--dump", "cannot write " + file.string());
+    for (std::size_t y = 0; y < img.height(); ++y) std::fwrite(img.row(y).data(), sizeof(glm::vec3), img.width(), f);
+    std::fclose(f);
+}
+
+/// Irradiance from the references' radiance rho / pi E (0 where rho is 0), blurred by the
+/// frame's own 4x4 geometry-aware tent, and back to radiance.
+image<glm::vec3> blurred_reference(const gbuffer_view<float>& g, image_view<const glm::vec3> radiance,
+                                   const indirect_options& o) {
+    const std::size_t w = g.width(), h = g.height();
+    image<glm::vec3> e(w, h), scratch(w, h), out(w, h);
+    image<glm::vec2> edges(w, h);
+    for (std::size_t y = 0; y < h; ++y)
+        for (std::size_t x = 0; x < w; ++x) {
+            const glm::vec3 rho = g.albedo(x, y);
+            for (int c = 0; c < 3; ++c)
+                e(x, y)[c] = rho[c] > 0.f ? radiance(x, y)[c] * float(std::numbers::pi) / rho[c] : 0.f;
+        }
+    cpu::discontinuity_buffer(g, o.discontinuity, edges.view());
+    cpu::geometry_aware_blur(e.view(), edges.view(), g.depth, o.pattern, scratch.view(), out.view());
+    apply_output(output_quantity::radiance, image_view<const glm::vec3>(g.albedo), out.view());
+    return out;
+}
+
+int run(const options& o) {
+    if (!o.json.empty()) io::check_output_file("--json", o.json);
+    nlohmann::ordered_json report = {{"technique", "rsm_visibility_study"},
+                                     {"parameters",
+                                      {{"vpls", o.vpls},
+                                       {"seed", o.seed},
+                                       {"width", o.width},
+                                       {"height", o.height},
+                                       {"flat_normals", o.flat_normals},
+                                       {"rsm_resolution", 256},
+                                       {"visibility_sigmas", o.sigmas}}},
+                                     {"frames", nlohmann::ordered_json::array()},
+                                     {"blurred_references", nlohmann::ordered_json::array()}};
+    const study::benchmark_settings settings = study::benchmark_settings::defaults(false, o.width, o.height);
+    bench::run_clock clock({}, o.scenes.size(), 1.0);
+    for (std::size_t si = 0; si < o.scenes.size(); ++si) {
+        const io::scene loaded = io::load_scene_arg(o.scenes[si]);
+        const io::scene scene = o.flat_normals ? flat_shaded(loaded) : loaded;
+        const embree::accel bvh(scene);
+        clock.begin_scene(scene.name, si);
+        const bench::scene_setup s = bench::make_scene_setup(scene, bvh, settings, clock);
+        const auto t0 = std::chrono::steady_clock::now();
+        const bench::halves_reference occluded = bench::one_bounce_reference(s);
+        const bench::halves_reference unoccluded = bench::unoccluded_reference(s);
+        fmt::print("{}: references {} / {} ({:.0f} s), noise {:.4f} / {:.4f}\n", scene.name,
+                   occluded.cached ? "cached" : "computed", unoccluded.cached ? "cached" : "computed",
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                   occluded.noise_rel_rms, unoccluded.noise_rel_rms);
+        std::fflush(stdout);
+        dump_image(o, scene.name, "ref_occluded", occluded.mean.view());
+        dump_image(o, scene.name, "ref_occluded_a", occluded.a.view());
+        dump_image(o, scene.name, "ref_occluded_b", occluded.b.view());
+        dump_image(o, scene.name, "ref_unoccluded", unoccluded.mean.view());
+        dump_image(o, scene.name, "ref_unoccluded_a", unoccluded.a.view());
+        dump_image(o, scene.name, "ref_unoccluded_b", unoccluded.b.view());
+        dump_image(o, scene.name, "albedo", image_view<const glm::vec3>(s.g.view().albedo));
+        dump_image(o, scene.name, "normal", image_view<const glm::vec3>(s.g.view().normal));
+        dump_image(o, scene.name, "position", image_view<const glm::vec3>(s.g.view().position));
+
+        embree::rsm_ray_cast_settings rs;
+        rs.resolution = 256;
+        embree::rsm_ray_caster caster(bvh, scene, rs);
+        caster.render();
+        const embree::occlusion_rays rays(bvh);
+        cpu::indirect_renderer renderer({}, &rays);
+
+        indirect_options base;
+        base.technique = indirect_technique::sii;
+        base.count = o.vpls;
+        base.seed = o.seed;
+        const interleave_pattern p44{4, 4}, p11{1, 1};
+
+        {  // The blur's bias on the true light.
+            indirect_options b = base;
+            b.pattern = p44;
+            for (const bool vis : {false, true}) {
+                const bench::halves_reference& ref = vis ? occluded : unoccluded;
+                const image<glm::vec3> blurred = blurred_reference(s.g.view(), ref.mean.view(), b);
+                const bench::measured_error e = bench::measure_error(blurred.view(), ref, s.mask.view());
+                fmt::print("{} reference {} blurred 4x4: raw {:.4f} debiased {:.4f}\n", scene.name,
+                           vis ? "occluded" : "unoccluded", e.rel_rms, e.rel_rms_debiased);
+                report["blurred_references"].push_back({{"scene", scene.name},
+                                                        {"reference", vis ? "occluded" : "unoccluded"},
+                                                        {"rel_rms", e.rel_rms},
+                                                        {"rel_rms_debiased", e.rel_rms_debiased}});
+                dump_image(o, scene.name, vis ? "ref_occluded_blurred" : "ref_unoccluded_blurred", blurred.view());
+            }
+        }
+
+        struct config {
+            std::string name;
+            interleave_pattern pattern;
+            bool blur;
+            bool footprint;
+            bool view = true;  // with rays: VPLs chosen by the view (the library's default)
+            indirect_technique technique = indirect_technique::sii;
+            float sigmas = -1.f;  // visibility edges of the blur; -1: --sigmas
+        };
+        const std::vector<config> configs = {{"plain-footprint", p11, false, true},
+                                             {"plain-fixed", p11, false, false},
+                                             {"4x4-noblur", p44, false, false},
+                                             {"4x4-blur", p44, true, false},
+                                             {"plain-fixed-noview", p11, false, false, false},
+                                             {"4x4-noblur-noview", p44, false, false, false},
+                                             {"4x4-blur-noview", p44, true, false, false},
+                                             {"gather", p11, false, false, true, indirect_technique::rsm_gather},
+                                             {"4x4-blur-geometry-edges", p44, true, false, true,
+                                              indirect_technique::sii, 0.f}};
+        for (const auto& c : configs) {
+            if (!o.configs.empty() && std::find(o.configs.begin(), o.configs.end(), c.name) == o.configs.end())
+                continue;
+            for (const indirect_visibility vis : {indirect_visibility::none, indirect_visibility::rays}) {
+                if (!c.view && vis == indirect_visibility::none) continue;  // the same frames as with the view
+                indirect_options opt = base;
+                opt.pattern = c.pattern;
+                opt.technique = c.technique;
+                opt.blur = c.blur;
+                opt.visibility = vis;
+                opt.light = default_pixel_light(scene.view(), c.pattern);
+                opt.light.footprint_scale = c.footprint ? 1.f : 0.f;
+                if (!c.view) opt.view_selection.candidates = 1;
+                opt.discontinuity.visibility_sigmas = c.sigmas < 0.f ? o.sigmas : c.sigmas;
+                image<glm::vec3> e(s.g.width(), s.g.height());
+                const auto f0 = std::chrono::steady_clock::now();
+                renderer.render(opt, s.g.view(), scene.camera, caster.views(), e.view(), output_quantity::radiance);
+                const double ms =
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - f0).count();
+                const bool rays_on = vis == indirect_visibility::rays;
+                const bench::measured_error err =
+                    bench::measure_error(e.view(), rays_on ? occluded : unoccluded, s.mask.view());
+                fmt::print("{} {} {} vpls {}: raw {:.4f} debiased {:.4f} (se {:.4f}) {:.0f} ms\n", scene.name, c.name,
+                           rays_on ? "rays" : "none", o.vpls, err.rel_rms, err.rel_rms_debiased,
+                           err.rel_rms_debiased_se, ms);
+                std::fflush(stdout);
+                report["frames"].push_back({{"scene", scene.name},
+                                            {"config", c.name},
+                                            {"visibility", rays_on ? "rays" : "none"},
+                                            {"vpls", o.vpls},
+                                            {"pattern", c.pattern.cells() > 1 ? "4x4" : "1x1"},
+                                            {"blur", c.blur},
+                                            {"view_selection", rays_on && c.view},
+                                            {"visibility_sigmas",
+                                             rays_on && c.blur ? opt.discontinuity.visibility_sigmas : 0.f},
+                                            {"reference", rays_on ? "occluded" : "unoccluded"},
+                                            {"rel_rms", err.rel_rms},
+                                            {"rel_rms_debiased", err.rel_rms_debiased},
+                                            {"rel_rms_debiased_se", err.rel_rms_debiased_se},
+                                            {"ms_loaded_machine", ms}});
+                dump_image(o, scene.name, c.name + (rays_on ? "-rays" : "-none"), e.view());
+            }
+        }
+    }
+    if (!o.json.empty()) io::write_text_file(o.json, report.dump(2) + "\n");
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"bounce: where indirect visibility's error comes from in SII (issue 29)"};
+    options o;
+    app.add_option("--scenes", o.scenes, "cornell, or names under the scenes folder")->delimiter(',');
+    app.add_option("--vpls", o.vpls, "VPLs a frame")->check(CLI::Range(16, 1 << 20));
+    app.add_option("--seed", o.seed, "seed of the VPLs");
+    app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 4096));
+    app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 4096));
+    app.add_option("--configs", o.configs, "only these: plain-footprint, plain-fixed, 4x4-noblur, 4x4-blur")
+        ->delimiter(',');
+    app.add_option("--sigmas", o.sigmas, "the blur's visibility edges (discontinuity_params::visibility_sigmas)")
+        ->check(CLI::Range(0.f, 100.f));
+    app.add_flag("--flat-normals", o.flat_normals, "every triangle shaded with its own geometric normal");
+    app.add_option("--json", o.json, "write the frames' errors here (docs/studies/results.py adds it)");
+    app.add_option("--dump", o.dump, "write every image as raw float32 into this folder");
+    CLI11_PARSE(app, argc, argv);
+    return bounce::examples::run_program("rsm_visibility_study", [&] { return run(o); });
+}
