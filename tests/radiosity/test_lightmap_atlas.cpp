@@ -5,7 +5,10 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <numbers>
 #include <set>
 
 using namespace bounce;
@@ -45,7 +48,11 @@ TEST_CASE("element areas add up to each chart's area and elements lie on their c
             for (std::uint32_t e = ch.first_element; e < ch.first_element + ch.element_count; ++e) {
                 sum += atlas.area[e];
                 CHECK(atlas.chart[e] == c);
-                // On the plane: within float rounding of the coordinates (box of size 2: 1e-6).
+                // On a planar chart, on the plane: within float rounding of the coordinates
+                // (box of size 2: 1e-6). The left wall, 0.99 to 1.02 in x, is one curved
+                // chart (its two quads 0.4 degrees apart): its elements lie on its triangles
+                // (a test case below checks that on curved charts).
+                if (!ch.planar) continue;
                 CHECK(std::abs(glm::dot(atlas.position[e] - ch.origin, ch.normal)) < 1e-5f);
                 CHECK(atlas.normal[e] == ch.normal);
             }
@@ -184,6 +191,8 @@ TEST_CASE("bad atlas options and scenes raise parameter_error naming them", "[ra
     named({.padding = -1}, "atlas_options.padding");
     named({.block_texels = 0}, "atlas_options.block_texels");
     named({.coplanar_degrees = 90}, "atlas_options.coplanar_degrees");
+    named({.cone_degrees = 90}, "atlas_options.cone_degrees");
+    named({.cone_degrees = -1}, "atlas_options.cone_degrees");
     auto broken = box;
     broken.material_of[3] = 99;
     CHECK_THROWS_AS(build_lightmap_atlas(broken.view()), parameter_error);
@@ -195,5 +204,193 @@ TEST_CASE("bad atlas options and scenes raise parameter_error naming them", "[ra
         FAIL("no exception");
     } catch (const parameter_error& e) {
         CHECK(e.parameter() == "scene.triangles");
+    }
+}
+
+// Charts that follow surfaces (issue 30): generated meshes of many small triangles.
+namespace {
+
+// A grid mesh of nu x nv quads (two triangles each, vertices shared) over (s, t) in [0, 1]^2,
+// mapped to 3D by f; counter-clockwise seen from the side f's ds x dt points to.
+template <class F>
+void add_grid(owned_scene& s, int nu, int nv, std::uint32_t m, F&& f) {
+    const auto base = std::uint32_t(s.positions.size());
+    for (int j = 0; j <= nv; ++j)
+        for (int i = 0; i <= nu; ++i) s.positions.push_back(f(float(i) / float(nu), float(j) / float(nv)));
+    const auto at = [&](int i, int j) { return base + std::uint32_t(j * (nu + 1) + i); };
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            s.triangles.emplace_back(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+            s.triangles.emplace_back(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+            s.material_of.insert(s.material_of.end(), {m, m});
+        }
+}
+
+// Half a cylinder of radius 1 about the z axis (angles 0 to pi), `around` x `along` quads,
+// facing outwards.
+owned_scene half_cylinder(int around, int along) {
+    owned_scene s;
+    const auto m = s.add_material(glm::vec3(0.5f));
+    add_grid(s, along, around, m, [](float a, float b) {
+        const float phi = b * float(std::numbers::pi);
+        return glm::vec3(std::cos(phi), std::sin(phi), 2.f * a);
+    });
+    return s;
+}
+
+// Two turns of a spiral ramp (a helicoid strip between radii 1 and 2, rising 0.3 a turn):
+// its normals stay within 10 degrees of +z, yet a projection onto one plane folds its turns
+// over each other.
+owned_scene spiral_ramp() {
+    owned_scene s;
+    const auto m = s.add_material(glm::vec3(0.5f));
+    add_grid(s, 4, 96, m, [](float a, float b) {
+        const float phi = b * 4.f * float(std::numbers::pi), r = 1.f + a;
+        return glm::vec3(r * std::cos(phi), r * std::sin(phi), 0.3f * phi / (2.f * float(std::numbers::pi)));
+    });
+    return s;
+}
+
+// The worst angle between a chart's triangles' normals and its normal (degrees).
+double chart_tilt(const owned_scene& s, const lightmap_atlas& atlas, std::size_t c) {
+    const auto& ch = atlas.charts[c];
+    double worst = 0;
+    for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
+        const auto& t = s.triangles[atlas.chart_triangles[ch.first_triangle + k]];
+        const glm::dvec3 a(s.positions[t.x]), b(s.positions[t.y]), cc(s.positions[t.z]);
+        const glm::dvec3 n = glm::normalize(glm::cross(b - a, cc - a));
+        worst = std::max(worst, std::acos(std::clamp(glm::dot(n, glm::dvec3(ch.normal)), -1.0, 1.0)) * 180 / std::numbers::pi);
+    }
+    return worst;
+}
+
+// Whether two of a chart's triangles, projected onto its texel grid, overlap (brute force).
+bool chart_overlaps(const owned_scene& s, const lightmap_atlas& atlas, std::size_t c) {
+    const auto& ch = atlas.charts[c];
+    std::vector<std::array<glm::dvec2, 3>> q;
+    for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
+        const auto& t = s.triangles[atlas.chart_triangles[ch.first_triangle + k]];
+        std::array<glm::dvec2, 3> p;
+        for (int m = 0; m < 3; ++m) p[std::size_t(m)] = glm::dvec2(atlas.atlas_coords(std::uint32_t(c), s.positions[t[m]]));
+        q.push_back(p);
+    }
+    for (std::size_t i = 0; i < q.size(); ++i)
+        for (std::size_t j = i + 1; j < q.size(); ++j)
+            if (detail::triangles_overlap(q[i], q[j])) return true;
+    return false;
+}
+
+// The distance from p to triangle t of s (brute force over the triangle's plane and edges).
+double distance_to_triangle(const owned_scene& s, std::uint32_t t, const glm::dvec3& p) {
+    const auto& tri = s.triangles[t];
+    const glm::dvec3 a(s.positions[tri.x]), b(s.positions[tri.y]), c(s.positions[tri.z]);
+    const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+    const glm::dvec3 q = p - n * glm::dot(p - a, n);
+    const auto inside = [&](glm::dvec3 u, glm::dvec3 v) { return glm::dot(glm::cross(v - u, q - u), n) >= 0; };
+    if (inside(a, b) && inside(b, c) && inside(c, a)) return std::abs(glm::dot(p - a, n));
+    const auto seg = [&](glm::dvec3 u, glm::dvec3 v) {
+        const double h = std::clamp(glm::dot(p - u, v - u) / glm::dot(v - u, v - u), 0.0, 1.0);
+        return glm::length(p - (u + (v - u) * h));
+    };
+    return std::min({seg(a, b), seg(b, c), seg(c, a)});
+}
+
+}  // namespace
+
+TEST_CASE("charts merge coplanar neighbours into one chart, and a curved surface into charts of many triangles",
+          "[radiosity][atlas][charts]") {
+    owned_scene floor;
+    const auto m = floor.add_material(glm::vec3(0.5f));
+    add_grid(floor, 40, 30, m, [](float a, float b) { return glm::vec3(4.f * a, 3.f * b, 0.f); });
+    const auto flat = build_lightmap_atlas(floor.view(), {.elements = 500});
+    CHECK(flat.charts.size() == 1);
+    CHECK(flat.charts[0].planar);
+
+    // 24 x 20 quads around half a cylinder: 7.5 degrees a quad. Made a chart per triangle
+    // before charts followed surfaces (960 charts, at least one element each).
+    const auto cyl = half_cylinder(24, 20);
+    const auto atlas = build_lightmap_atlas(cyl.view(), {.elements = 2000});
+    INFO("charts " << atlas.charts.size());
+    CHECK(atlas.charts.size() <= 6);
+    CHECK(atlas.statistics.curved_charts == atlas.charts.size());
+    CHECK(atlas.statistics.stretch_max > 1.0);
+    CHECK(atlas.statistics.stretch_max <= 1.0 / std::cos(30.0 * std::numbers::pi / 180.0) + 1e-9);
+}
+
+TEST_CASE("charts stop at the cone: no triangle leaves its chart's cone", "[radiosity][atlas][charts]") {
+    const auto cyl = half_cylinder(36, 10);  // 5 degrees a quad over 180 degrees
+    for (double cone : {10.0, 30.0, 45.0}) {
+        const auto atlas = build_lightmap_atlas(cyl.view(), {.elements = 1000, .cone_degrees = cone});
+        INFO("cone " << cone << ", charts " << atlas.charts.size());
+        // Every chart within the cone of its normal, so 180 degrees need at least 180 / (2 cone) charts.
+        CHECK(double(atlas.charts.size()) >= std::floor(180.0 / (2.0 * cone)));
+        for (std::size_t c = 0; c < atlas.charts.size(); ++c) CHECK(chart_tilt(cyl, atlas, c) <= cone + 1e-6);
+        CHECK(atlas.statistics.cone_max_degrees <= cone + 1e-6);
+    }
+    // A cone of 0 keeps the planar charts of before: one per triangle pair at most.
+    const auto planar = build_lightmap_atlas(cyl.view(), {.elements = 1000, .cone_degrees = 0});
+    CHECK(planar.charts.size() >= 36);
+}
+
+TEST_CASE("a chart never folds over itself: a spiral ramp within the cone is cut where its turns overlap",
+          "[radiosity][atlas][charts]") {
+    const auto ramp = spiral_ramp();
+    const auto atlas = build_lightmap_atlas(ramp.view(), {.elements = 3000});
+    INFO("charts " << atlas.charts.size() << ", refused " << atlas.statistics.overlaps_refused);
+    CHECK(atlas.charts.size() >= 2);     // two turns cannot share one plane
+    CHECK(atlas.charts.size() <= 8);     // but it is not a chart per triangle (768 triangles)
+    CHECK(atlas.statistics.overlaps_refused > 0);
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) CHECK_FALSE(chart_overlaps(ramp, atlas, c));
+    // And no texel holds two layers: every element's point lies on its chart's surface.
+}
+
+TEST_CASE("elements of curved charts lie on their triangles and add up to the surface's area",
+          "[radiosity][atlas][charts]") {
+    for (const auto& s : {half_cylinder(24, 20), spiral_ramp()}) {
+        const auto atlas = build_lightmap_atlas(s.view(), {.elements = 1500});
+        double scene_area = 0, sum = 0;
+        for (std::size_t t = 0; t < s.triangles.size(); ++t) scene_area += triangle_area(s, t);
+        for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+            const auto& ch = atlas.charts[c];
+            for (std::uint32_t e = ch.first_element; e < ch.first_element + ch.element_count; ++e) {
+                sum += atlas.area[e];
+                double nearest = 1e30;
+                for (std::uint32_t k = 0; k < ch.triangle_count; ++k)
+                    nearest = std::min(nearest, distance_to_triangle(s, atlas.chart_triangles[ch.first_triangle + k],
+                                                                     glm::dvec3(atlas.position[e])));
+                CHECK(nearest < 1e-5);  // on the surface, not on the chart's plane (up to 0.13 off it)
+                CHECK(std::abs(glm::length(atlas.normal[e]) - 1.f) < 1e-5f);
+                CHECK(glm::dot(atlas.normal[e], ch.normal) > 0.5f);
+                // The element's point maps into its own texel.
+                const glm::vec2 uv = atlas.atlas_coords(std::uint32_t(c), atlas.position[e]);
+                CHECK(std::abs(uv.x - (float(atlas.texel[e].x) + 0.5f)) <= 0.5f + 1e-3f);
+                CHECK(std::abs(uv.y - (float(atlas.texel[e].y) + 0.5f)) <= 0.5f + 1e-3f);
+            }
+        }
+        CHECK(std::abs(sum - scene_area) <= 1e-5 * scene_area);
+    }
+}
+
+TEST_CASE("the element budget holds within 10% on a scene of many small triangles", "[radiosity][atlas][charts]") {
+    // A floor, and 60 small spheres (480 triangles each, 2 cm across) standing on it: 28,800
+    // small triangles. Before charts followed surfaces, each sphere's triangle was a chart of
+    // one element at least: 28,802 elements for any count asked below that.
+    owned_scene s;
+    const auto m = s.add_material(glm::vec3(0.5f));
+    const auto ball = s.add_material(glm::vec3(0.7f, 0.2f, 0.2f));
+    s.add_quad({0, 0, 0}, {4, 0, 0}, {4, 4, 0}, {0, 4, 0}, m);
+    for (int k = 0; k < 60; ++k) {
+        const glm::vec3 centre(0.3f + 0.5f * float(k % 8), 0.3f + 0.5f * float(k / 8), 0.01f);
+        add_grid(s, 24, 10, ball, [&](float a, float b) {
+            const float phi = 2.f * float(std::numbers::pi) * a, theta = float(std::numbers::pi) * (1.f - b);
+            return centre + 0.01f * glm::vec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+        });
+    }
+    for (std::size_t asked : {3000u, 10000u}) {
+        const auto atlas = build_lightmap_atlas(s.view(), {.elements = asked});
+        INFO("asked " << asked << ", made " << atlas.size() << ", charts " << atlas.charts.size());
+        CHECK(std::abs(double(atlas.size()) - double(asked)) <= 0.10 * double(asked));
+        // Every chart has an element.
+        for (const auto& ch : atlas.charts) CHECK(ch.element_count >= 1);
     }
 }

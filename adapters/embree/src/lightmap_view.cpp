@@ -52,7 +52,12 @@ image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const 
                 const std::uint32_t chart = atlas.chart_of_triangle[hits[x].triangle];
                 if (chart == lightmap_atlas::none) continue;
                 const glm::vec3 p = rays[x].origin + hits[x].t * rays[x].direction;
-                const bool sees_back = glm::dot(atlas.charts[chart].normal, rays[x].direction) > 0.f;
+                // The side seen: the hit triangle's own (a chart that follows a curved surface
+                // tilts its triangles up to its cone from the chart's normal).
+                const glm::uvec3 tri = scene.triangles[hits[x].triangle];
+                const glm::vec3 ng = glm::cross(scene.positions[tri.y] - scene.positions[tri.x],
+                                                scene.positions[tri.z] - scene.positions[tri.x]);
+                const bool sees_back = glm::dot(ng, rays[x].direction) > 0.f;
                 const image_view<const glm::vec3>& lightmap = sees_back ? back : front;
                 // Texel (i, j) spans [i, i+1]: its centre is at i + 1/2.
                 const glm::vec2 uv = atlas.atlas_coords(chart, p) * scale - 0.5f;

@@ -24,6 +24,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
 #include <bounce/radiosity/cell_overlap.hpp>
+#include <bounce/radiosity/chart_growth.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <algorithm>
@@ -35,6 +36,7 @@
 #include <numbers>
 #include <span>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -50,18 +52,19 @@ struct atlas_options {
                                    ///< result is within a few percent of it (typical: 1e4-1e5)
     int padding = 1;               ///< texels around each chart in the atlas, >= 0 (typical: 1; 2 for mipmaps)
     int block_texels = 4;          ///< side of a shooting block, texels, >= 1 (typical: 4; 1 = no substructuring)
-    double coplanar_degrees = 0.05;  ///< largest angle between the normals of one chart's triangles (degrees)
-    double coplanar_distance = 1e-5; ///< largest distance of a chart's vertices from its plane,
-                                     ///< relative to the scene's bounding-box diagonal
+    double cone_degrees = 30;        ///< largest angle between a chart's triangles' normals and the
+                                     ///< seed's and the chart's mean normal, in [0, 90) (degrees;
+                                     ///< 0 = planar charts only); chart_growth.hpp
+    double coplanar_degrees = 0.05;  ///< a chart whose normals all lie within this of its normal is
+                                     ///< planar: its elements take the chart's normal and plane
 
     void validate() const {
         require(elements > 0, "atlas_options.elements", "must be positive");
         require(padding >= 0 && padding <= 64, "atlas_options.padding", "must lie in [0, 64]");
         require(block_texels >= 1 && block_texels <= 256, "atlas_options.block_texels", "must lie in [1, 256]");
+        require(cone_degrees >= 0 && cone_degrees < 90, "atlas_options.cone_degrees", "must lie in [0, 90)");
         require(coplanar_degrees >= 0 && coplanar_degrees < 90, "atlas_options.coplanar_degrees",
                 "must lie in [0, 90)");
-        require(coplanar_distance >= 0 && std::isfinite(coplanar_distance), "atlas_options.coplanar_distance",
-                "must be finite and non-negative");
     }
 };
 
@@ -75,6 +78,24 @@ struct lightmap_chart {
     std::uint32_t material = 0;
     std::uint32_t first_triangle = 0, triangle_count = 0;  ///< range of lightmap_atlas::chart_triangles
     std::uint32_t first_element = 0, element_count = 0;    ///< range of the elements
+    float tilt_degrees = 0;  ///< largest angle between a triangle's normal and `normal`
+    bool planar = true;      ///< tilt_degrees within atlas_options::coplanar_degrees
+};
+
+/// What build_lightmap_atlas made (charts, texels, packing, stretch), for reports.
+struct atlas_statistics {
+    std::size_t triangles = 0, charts = 0, curved_charts = 0, one_element_charts = 0;
+    std::size_t elements = 0;
+    std::size_t chart_texels = 0;  ///< texels of the charts' rectangles (without padding)
+    std::size_t atlas_texels = 0;  ///< width x height
+    double packing_efficiency = 0; ///< elements / atlas_texels
+    std::uint32_t median_elements_per_chart = 0;
+    double stretch_mean = 1;       ///< surface area over its area on the charts' planes
+    double stretch_max = 1;        ///< the largest 1 / cos(tilt) of a triangle: a texel's side across the tilt
+    double cone_max_degrees = 0;   ///< the largest tilt of a triangle from its chart's normal
+    std::size_t seed_plane_kept = 0, overlaps_refused = 0;  ///< chart_growth.hpp
+    double texel_size = 0;         ///< h (m on the charts' planes): density 1 / h^2 texels per m^2
+    int densities_tried = 0;       ///< cut_to_element_count's iterations
 };
 
 /// The elements of a scene and where they lie in the lightmap atlas.
@@ -110,6 +131,8 @@ struct lightmap_atlas {
     /// Element at each atlas texel: the texel's own element, the nearest element of the same
     /// chart for padding texels and texels that miss the chart's triangles, -1 elsewhere.
     image<std::int32_t> element_at;
+
+    atlas_statistics statistics;  ///< what build_lightmap_atlas made
 
     std::size_t size() const noexcept { return area.size(); }
     std::size_t blocks() const noexcept { return block_first.empty() ? 0 : block_first.size() - 1; }
@@ -245,138 +268,29 @@ struct lightmap_atlas {
 
 namespace bounce::detail {
 
-inline glm::dvec3 to_d(const glm::vec3& v) { return glm::dvec3(v); }
-
-/// Unit normals and areas of a scene's triangles, in double; degenerate triangles have area
-/// 0 and normal 0.
-struct triangle_faces {
-    std::vector<glm::dvec3> normal;
-    std::vector<double> area;
-};
-inline triangle_faces face_normals_and_areas(const scene_view& scene) {
-    const std::size_t nt = scene.triangles.size();
-    triangle_faces faces{std::vector<glm::dvec3>(nt), std::vector<double>(nt, 0.0)};
-    for (std::size_t t = 0; t < nt; ++t) {
-        const auto& tri = scene.triangles[t];
-        const glm::dvec3 a = to_d(scene.positions[tri.x]), b = to_d(scene.positions[tri.y]), c = to_d(scene.positions[tri.z]);
-        const glm::dvec3 cr = glm::cross(b - a, c - a);
-        const double len = glm::length(cr);
-        faces.area[t] = 0.5 * len;
-        faces.normal[t] = len > 0 ? cr / len : glm::dvec3(0);
-    }
-    return faces;
-}
-
-/// Each position's index of the first position equal to it: meshes often split vertices
-/// for normals or UVs, and charts must see through that.
-inline std::vector<std::uint32_t> welded_positions(std::span<const glm::vec3> positions) {
-    std::unordered_map<std::uint64_t, std::uint32_t> weld;
-    std::vector<std::uint32_t> welded(positions.size());
-    const auto bits = [](float f) {
-        f = f == 0.f ? 0.f : f;  // -0 and +0 are one position
-        std::uint32_t u;
-        std::memcpy(&u, &f, 4);
-        return std::uint64_t(u);
-    };
-    for (std::size_t i = 0; i < positions.size(); ++i) {
-        const glm::vec3 p = positions[i];
-        std::uint64_t key = bits(p.x) * 0x9e3779b97f4a7c15ULL ^ (bits(p.y) * 0xc2b2ae3d27d4eb4fULL) ^
-                            (bits(p.z) * 0x165667b19e3779f9ULL);
-        // Resolve the rare hash collision between different positions by probing.
-        for (;;) {
-            auto [it, inserted] = weld.try_emplace(key, std::uint32_t(i));
-            if (inserted || positions[it->second] == p) {
-                welded[i] = it->second;
-                break;
-            }
-            ++key;
+/// Every triangle of positive area in a chart (chart_growth.hpp), the charts in the atlas
+/// with their triangles and normals; returns what the growth counted.
+inline grown_charts group_into_charts(const scene_view& scene, const triangle_faces& faces,
+                                      const atlas_options& options, lightmap_atlas& atlas) {
+    grown_charts g = grow_charts(scene, faces, options.cone_degrees);
+    const double cos_planar = std::cos(options.coplanar_degrees * std::numbers::pi / 180.0);
+    for (std::size_t c = 0; c < g.triangles.size(); ++c) {
+        lightmap_chart ch;
+        ch.material = g.material[c];
+        ch.first_triangle = std::uint32_t(atlas.chart_triangles.size());
+        ch.triangle_count = std::uint32_t(g.triangles[c].size());
+        ch.normal = glm::vec3(g.normal[c]);
+        double worst = 1;
+        for (const std::uint32_t t : g.triangles[c]) {
+            atlas.chart_triangles.push_back(t);
+            atlas.chart_of_triangle[t] = std::uint32_t(c);
+            worst = std::min(worst, glm::dot(faces.normal[t], g.normal[c]));
         }
+        ch.tilt_degrees = float(std::acos(std::clamp(worst, -1.0, 1.0)) * 180.0 / std::numbers::pi);
+        ch.planar = worst >= cos_planar;
+        atlas.charts.push_back(ch);
     }
-    return welded;
-}
-
-/// The triangles of positive area on each edge, edges keyed by their welded end points.
-class edge_adjacency {
-public:
-    edge_adjacency(const scene_view& scene, const triangle_faces& faces) : welded_(welded_positions(scene.positions)) {
-        triangles_.reserve(3 * scene.triangles.size());
-        for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
-            if (faces.area[t] <= 0) continue;
-            const auto& tri = scene.triangles[t];
-            for (int k = 0; k < 3; ++k) triangles_.emplace(key(tri[k], tri[(k + 1) % 3]), std::uint32_t(t));
-        }
-    }
-    /// The triangles on the edge between positions i and j, as a range of (key, triangle).
-    auto triangles_on(std::uint32_t i, std::uint32_t j) const { return triangles_.equal_range(key(i, j)); }
-
-private:
-    std::uint64_t key(std::uint32_t i, std::uint32_t j) const {
-        const std::uint64_t a = welded_[i], b = welded_[j];
-        return std::min(a, b) << 32 | std::max(a, b);
-    }
-    std::vector<std::uint32_t> welded_;
-    std::unordered_multimap<std::uint64_t, std::uint32_t> triangles_;
-};
-
-/// Chart `c` grown from triangle `seed` by flood fill over shared edges: a neighbour joins
-/// when it has the seed's material, its normal is within cos_tol of the seed's and its
-/// vertices lie within dist_tol of the seed's plane (measuring against the seed, not the
-/// neighbour, keeps a gently curved surface from drifting into one chart). Appends the
-/// chart's triangles, in index order, to atlas.chart_triangles.
-inline lightmap_chart grow_chart(const scene_view& scene, const triangle_faces& faces, const edge_adjacency& edges,
-                                 std::uint32_t seed, double cos_tol, double dist_tol, lightmap_atlas& atlas) {
-    const std::uint32_t c = std::uint32_t(atlas.charts.size());
-    lightmap_chart chart;
-    chart.material = scene.material_of[seed];
-    chart.first_triangle = std::uint32_t(atlas.chart_triangles.size());
-    const glm::dvec3 n0 = faces.normal[seed];
-    const glm::dvec3 p0 = to_d(scene.positions[scene.triangles[seed].x]);
-    const auto joins = [&](std::uint32_t u) {
-        if (scene.material_of[u] != chart.material || glm::dot(faces.normal[u], n0) < cos_tol) return false;
-        bool in_plane = true;
-        for (int m = 0; m < 3; ++m)
-            in_plane = in_plane && std::abs(glm::dot(to_d(scene.positions[scene.triangles[u][m]]) - p0, n0)) <= dist_tol;
-        return in_plane;
-    };
-    atlas.chart_of_triangle[seed] = c;
-    std::vector<std::uint32_t> stack(1, seed);
-    while (!stack.empty()) {
-        const std::uint32_t t = stack.back();
-        stack.pop_back();
-        atlas.chart_triangles.push_back(t);
-        const auto& tri = scene.triangles[t];
-        for (int k = 0; k < 3; ++k) {
-            const auto range = edges.triangles_on(tri[k], tri[(k + 1) % 3]);
-            for (auto it = range.first; it != range.second; ++it) {
-                const std::uint32_t u = it->second;
-                if (atlas.chart_of_triangle[u] != lightmap_atlas::none || !joins(u)) continue;
-                atlas.chart_of_triangle[u] = c;
-                stack.push_back(u);
-            }
-        }
-    }
-    chart.triangle_count = std::uint32_t(atlas.chart_triangles.size()) - chart.first_triangle;
-    // Keep the triangles in index order within a chart (deterministic layout).
-    std::sort(atlas.chart_triangles.begin() + chart.first_triangle, atlas.chart_triangles.end());
-    glm::dvec3 n_sum(0);
-    for (std::uint32_t k = 0; k < chart.triangle_count; ++k) {
-        const std::uint32_t t = atlas.chart_triangles[chart.first_triangle + k];
-        n_sum += faces.area[t] * faces.normal[t];
-    }
-    chart.normal = glm::vec3(glm::normalize(n_sum));
-    return chart;
-}
-
-/// Every triangle of positive area in a chart, charts grown from seeds in triangle order.
-inline void group_into_charts(const scene_view& scene, const triangle_faces& faces, const atlas_options& options,
-                              double diagonal, lightmap_atlas& atlas) {
-    const edge_adjacency edges(scene, faces);
-    const double cos_tol = std::cos(options.coplanar_degrees * std::numbers::pi / 180.0);
-    const double dist_tol = options.coplanar_distance * std::max(diagonal, 1e-30);
-    for (std::size_t seed = 0; seed < scene.triangles.size(); ++seed) {
-        if (faces.area[seed] <= 0 || atlas.chart_of_triangle[seed] != lightmap_atlas::none) continue;
-        atlas.charts.push_back(grow_chart(scene, faces, edges, std::uint32_t(seed), cos_tol, dist_tol, atlas));
-    }
+    return g;
 }
 
 /// A chart's frame on its plane (origin, unit in-plane axes u and v) and its extent along
@@ -424,37 +338,57 @@ inline chart_extent smallest_bounding_frame(const scene_view& scene, const light
     return out;
 }
 
-/// The exact overlap of one texel with its chart's triangles: area and first moment, in
-/// texels of the chart's grid.
+/// The exact overlap of one texel with its chart's triangles, in texels of the chart's grid:
+/// its area on the chart's plane, its area on the surface (each triangle's projected area
+/// over the cosine of its tilt from the plane), the first moment of the surface area on the
+/// plane and the surface-area-weighted sum of the triangles' normals.
 struct texel_sum {
-    double area = 0;
-    glm::dvec2 moment{0};
-    double piece_area = 0;   ///< the largest one triangle's overlap
+    double area = 0;         ///< on the plane
+    double world = 0;        ///< on the surface
+    glm::dvec2 moment{0};    ///< of the surface area, plane coordinates
+    glm::dvec3 normal{0};    ///< surface-area-weighted normals
+    double piece_area = 0;   ///< the largest one triangle's overlap (on the plane)
     glm::dvec2 piece{0};     ///< its centroid, which lies on it
+    std::uint32_t piece_triangle = 0;  ///< that triangle, its index in the chart
+    std::uint32_t on_triangle = 0;     ///< a triangle (index in the chart) the element's point lies on
+    bool keep = false;       ///< the texel is an element
 };
 
-/// Moves each texel's point (moment / area) that lies on none of `triangles` (a non-convex
+/// Moves each texel's point (moment / world) that lies on none of `triangles` (a non-convex
 /// overlap: a floor's border around a column's base, whose centroid lies under the column) to
-/// the centroid of its largest one triangle's overlap, which lies on the chart.
+/// the centroid of its largest one triangle's overlap, which lies on the chart; records in
+/// on_triangle a triangle each point lies on.
 inline void place_points_on_chart(std::span<const std::array<glm::dvec2, 3>> triangles, std::uint32_t width,
                                   std::uint32_t height, std::vector<texel_sum>& sums) {
+    constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
     std::vector<glm::dvec2> point(sums.size());
-    for (std::size_t c = 0; c < sums.size(); ++c) point[c] = sums[c].area > 0 ? sums[c].moment / sums[c].area : glm::dvec2(0);
-    std::vector<std::uint8_t> on(sums.size(), 0);
-    for (const auto& q : triangles) mark_points_on_triangle(q, width, height, point, on);
-    for (std::size_t c = 0; c < sums.size(); ++c)
-        if (!on[c] && sums[c].piece_area > 0) sums[c].moment = sums[c].piece * sums[c].area;
+    for (std::size_t c = 0; c < sums.size(); ++c) point[c] = sums[c].world > 0 ? sums[c].moment / sums[c].world : glm::dvec2(0);
+    std::vector<std::uint32_t> on(sums.size(), none);
+    for (std::size_t k = 0; k < triangles.size(); ++k)
+        for_each_point_on_triangle(triangles[k], width, height, point, [&](std::size_t cell) {
+            if (on[cell] == none) on[cell] = std::uint32_t(k);
+        });
+    for (std::size_t c = 0; c < sums.size(); ++c) {
+        if (on[c] != none) sums[c].on_triangle = on[c];
+        else if (sums[c].piece_area > 0) {
+            sums[c].moment = sums[c].piece * sums[c].world;
+            sums[c].on_triangle = sums[c].piece_triangle;
+        }
+    }
 }
 
-/// A texel is an element when its overlap exceeds 1e-6 of a texel: slivers below carry no
-/// measurable power and their centroids are ill-conditioned.
+/// A texel is an element when its overlap exceeds 1e-6 of a texel (slivers below carry no
+/// measurable power and their centroids are ill-conditioned), and a chart with no such texel
+/// keeps its largest overlap: every chart has at least one element.
 inline bool holds_element(const texel_sum& ts) { return ts.area > 1e-6; }
 
 /// Chart `ch` cut into texels of about h (m): a grid of ceil(extent / h) texels stretched
 /// to fit the extent exactly. Sets the chart's size and axes, fills `sums` with each
-/// texel's overlap and returns the number of elements.
-inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atlas, const chart_extent& ex, double h,
-                             lightmap_chart& ch, std::vector<texel_sum>& sums) {
+/// texel's overlap and returns the number of elements; with `place`, each element's point
+/// is put on the chart (place_points_on_chart).
+inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atlas, const triangle_faces& faces,
+                             const chart_extent& ex, double h, bool place, lightmap_chart& ch,
+                             std::vector<texel_sum>& sums) {
     ch.width = std::uint32_t(std::clamp(std::ceil(ex.eu / h), 1.0, 65536.0));
     ch.height = std::uint32_t(std::clamp(std::ceil(ex.ev / h), 1.0, 65536.0));
     const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
@@ -462,7 +396,9 @@ inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atla
     ch.axis_u = glm::vec3(ex.u * su);
     ch.axis_v = glm::vec3(ex.v * sv);
     sums.assign(std::size_t(ch.width) * ch.height, texel_sum{});
+    const glm::dvec3 n = glm::dvec3(ch.normal);
     std::vector<std::array<glm::dvec2, 3>> triangles_in_texels;
+    if (place) triangles_in_texels.reserve(ch.triangle_count);
     for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
         const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
         std::array<glm::dvec2, 3> q;
@@ -470,47 +406,111 @@ inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atla
             const glm::dvec3 d = to_d(scene.positions[scene.triangles[t][m]]) - ex.origin;
             q[std::size_t(m)] = {glm::dot(d, ex.u) / su, glm::dot(d, ex.v) / sv};
         }
+        // Surface area per plane area: 1 on a planar chart (exactly, as before charts bent).
+        const double w = ch.planar ? 1.0 : 1.0 / std::max(glm::dot(faces.normal[t], n), 1e-6);
+        const glm::dvec3 nt = faces.normal[t];
         for_each_cell_overlap(q, ch.width, ch.height, [&](std::size_t cell, double a, glm::dvec2 moment) {
-            sums[cell].area += a;
-            sums[cell].moment += moment;
-            if (a > sums[cell].piece_area) sums[cell].piece_area = a, sums[cell].piece = moment / a;
+            texel_sum& ts = sums[cell];
+            ts.area += a;
+            ts.world += a * w;
+            ts.moment += moment * w;
+            ts.normal += (a * w) * nt;
+            if (a > ts.piece_area) ts.piece_area = a, ts.piece = moment / a, ts.piece_triangle = k;
         });
-        triangles_in_texels.push_back(q);
+        if (place) triangles_in_texels.push_back(q);
     }
-    place_points_on_chart(triangles_in_texels, ch.width, ch.height, sums);
-    std::size_t count = 0;
-    for (const auto& ts : sums) count += holds_element(ts) ? 1 : 0;
+    std::size_t count = 0, largest = 0;
+    for (std::size_t c = 0; c < sums.size(); ++c) {
+        sums[c].keep = holds_element(sums[c]);
+        count += sums[c].keep ? 1 : 0;
+        if (sums[c].area > sums[largest].area) largest = c;
+    }
+    if (count == 0 && sums[largest].area > 0) {
+        sums[largest].keep = true;
+        count = 1;
+    }
+    if (place) place_points_on_chart(triangles_in_texels, ch.width, ch.height, sums);
     return count;
 }
 
 /// Every chart cut into texels of about h (m); returns the element count.
-inline std::size_t cut_charts(const scene_view& scene, const std::vector<chart_extent>& extents, double h,
-                              lightmap_atlas& atlas, std::vector<std::vector<texel_sum>>& sums) {
+inline std::size_t cut_charts(const scene_view& scene, const triangle_faces& faces,
+                              const std::vector<chart_extent>& extents, double h, bool place, lightmap_atlas& atlas,
+                              std::vector<std::vector<texel_sum>>& sums) {
     std::size_t count = 0;
     for (std::size_t c = 0; c < atlas.charts.size(); ++c)
-        count += cut_chart(scene, atlas, extents[c], h, atlas.charts[c], sums[c]);
+        count += cut_chart(scene, atlas, faces, extents[c], h, place, atlas.charts[c], sums[c]);
     return count;
 }
 
-/// Cuts the charts with the texel size whose element count comes closest to
-/// options.elements. The count grows like 1/h^2 plus the charts' boundaries and jumps where
-/// a chart's ceil(extent / h) steps: secant steps on h, keeping the closest count seen.
-inline void cut_to_element_count(const scene_view& scene, const std::vector<chart_extent>& extents,
-                                 double total_area, const atlas_options& options, lightmap_atlas& atlas,
-                                 std::vector<std::vector<texel_sum>>& sums) {
-    double h = std::sqrt(total_area / double(options.elements)), best_h = h;
-    double best_miss = std::numeric_limits<double>::infinity();
-    for (int iteration = 0; iteration < 8; ++iteration) {
-        const std::size_t count = cut_charts(scene, extents, h, atlas, sums);
-        const double miss = std::abs(double(count) - double(options.elements));
-        if (miss < best_miss) {
-            best_miss = miss;
-            best_h = h;
-        }
-        if (miss <= 0.01 * double(options.elements)) break;
-        h *= std::sqrt(double(count) / double(options.elements));
+/// Cuts the charts with the texel density (texels per m^2 of the charts' planes, 1 / h^2)
+/// whose element count comes closest to options.elements, and returns h and the number of
+/// densities tried. The count grows about linearly in the density, plus the charts' edges,
+/// and never falls below one per chart; it jumps where a chart's ceil(extent / h) steps.
+/// Density x: x N / count until the count is bracketed, then secant steps inside the
+/// bracket (bisection where a step would leave it), until within 0.5% of the count or 32
+/// densities, keeping the closest count seen.
+inline std::pair<double, int> cut_to_element_count(const scene_view& scene, const triangle_faces& faces,
+                                                   const std::vector<chart_extent>& extents, double plane_area,
+                                                   const atlas_options& options, lightmap_atlas& atlas,
+                                                   std::vector<std::vector<texel_sum>>& sums) {
+    const double target = double(options.elements);
+    double x = target / plane_area, best_x = x, best_miss = std::numeric_limits<double>::infinity();
+    double lo = 0, lo_count = 0, hi = std::numeric_limits<double>::infinity(), hi_count = 0;
+    int tried = 0;
+    for (; tried < 32; ++tried) {
+        const double count = double(cut_charts(scene, faces, extents, 1.0 / std::sqrt(x), false, atlas, sums));
+        const double miss = std::abs(count - target);
+        if (miss < best_miss) best_miss = miss, best_x = x;
+        if (miss <= 0.005 * target) break;
+        if (count < target) lo = x, lo_count = count;
+        else hi = x, hi_count = count;
+        double next;
+        if (lo > 0 && std::isfinite(hi)) {
+            next = lo + (target - lo_count) * (hi - lo) / (hi_count - lo_count);
+            if (!(next > lo && next < hi) || hi_count == lo_count) next = std::sqrt(lo * hi);
+            if (hi / lo < 1 + 1e-9) break;  // a step in the count no density splits
+        } else
+            next = x * target / std::max(count, 1.0);
+        if (next == x) break;
+        x = next;
     }
-    cut_charts(scene, extents, best_h, atlas, sums);
+    cut_charts(scene, faces, extents, 1.0 / std::sqrt(best_x), true, atlas, sums);
+    return {1.0 / std::sqrt(best_x), tried + 1};
+}
+
+/// The point of chart c's surface over `coords` (chart texel coordinates: the plane point
+/// origin + axis_u x + axis_v y) and that surface's unit normal: on a planar chart the plane
+/// point and the chart's normal; on a curved one the point lifted onto the triangle whose
+/// projection holds it (else the nearest, clamped onto it). For subdivision.hpp's leaves.
+inline std::pair<glm::vec3, glm::vec3> chart_surface_point(const scene_view& scene, const lightmap_atlas& atlas,
+                                                           std::uint32_t c, glm::dvec2 coords) {
+    const lightmap_chart& ch = atlas.charts[c];
+    const glm::dvec3 origin(ch.origin), au(ch.axis_u), av(ch.axis_v);
+    if (ch.planar) return {glm::vec3(origin + au * coords.x + av * coords.y), ch.normal};
+    const double uu = glm::dot(au, au), vv = glm::dot(av, av);
+    double best = std::numeric_limits<double>::infinity();
+    glm::dvec3 point(0), normal(ch.normal);
+    for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
+        const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
+        std::array<glm::dvec2, 3> q;
+        std::array<glm::dvec3, 3> corner;
+        for (int m = 0; m < 3; ++m) {
+            corner[std::size_t(m)] = to_d(scene.positions[scene.triangles[t][m]]);
+            const glm::dvec3 d = corner[std::size_t(m)] - origin;
+            q[std::size_t(m)] = {glm::dot(d, au) / uu, glm::dot(d, av) / vv};
+        }
+        const glm::dvec3 p = lift_to_triangle(q, corner, coords);
+        const glm::dvec3 d = p - origin;
+        const double miss = glm::length(glm::dvec2(glm::dot(d, au) / uu, glm::dot(d, av) / vv) - coords);
+        if (miss < best) {
+            best = miss;
+            point = p;
+            normal = glm::normalize(glm::cross(corner[1] - corner[0], corner[2] - corner[0]));
+        }
+        if (best == 0) break;
+    }
+    return {glm::vec3(point), glm::vec3(normal)};
 }
 
 /// Shelf packing: charts by decreasing height, each with `pad` texels around it, on rows as
@@ -546,8 +546,9 @@ inline void pack_charts_on_shelves(std::uint32_t pad, lightmap_atlas& atlas) {
 }
 
 /// The elements of chart c, block by block and row by row within a block: one per texel
-/// that holds_element, at the centroid of its overlap; a block with elements becomes a
-/// shooting block.
+/// kept (cut_chart), at its point on the chart (the overlap's centroid, or its largest
+/// piece's), lifted from the chart's plane onto the triangle it lies on; a block with
+/// elements becomes a shooting block.
 inline void add_chart_elements(const scene_view& scene, std::uint32_t c, const chart_extent& ex,
                                const std::vector<texel_sum>& sums, std::uint32_t b, lightmap_atlas& atlas) {
     lightmap_chart& ch = atlas.charts[c];
@@ -556,17 +557,29 @@ inline void add_chart_elements(const scene_view& scene, std::uint32_t c, const c
     const glm::vec3 emitted = emits ? float(std::numbers::pi) * mat.emission : glm::vec3(0.f);
     ch.first_element = std::uint32_t(atlas.size());
     const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
+    const auto point_of = [&](const texel_sum& ts) {
+        const glm::dvec2 p = ts.moment / ts.world;
+        if (ch.planar) return glm::vec3(ex.origin + ex.u * (p.x * su) + ex.v * (p.y * sv));
+        const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + ts.on_triangle];
+        std::array<glm::dvec2, 3> q;
+        std::array<glm::dvec3, 3> corner;
+        for (int m = 0; m < 3; ++m) {
+            corner[std::size_t(m)] = to_d(scene.positions[scene.triangles[t][m]]);
+            const glm::dvec3 d = corner[std::size_t(m)] - ex.origin;
+            q[std::size_t(m)] = {glm::dot(d, ex.u) / su, glm::dot(d, ex.v) / sv};
+        }
+        return glm::vec3(lift_to_triangle(q, corner, p));
+    };
     for (std::uint32_t by = 0; by < ch.height; by += b)
         for (std::uint32_t bx = 0; bx < ch.width; bx += b) {
             const std::uint32_t first = std::uint32_t(atlas.size());
             for (std::uint32_t j = by; j < std::min(by + b, ch.height); ++j)
                 for (std::uint32_t i = bx; i < std::min(bx + b, ch.width); ++i) {
                     const texel_sum& ts = sums[std::size_t(j) * ch.width + i];
-                    if (!holds_element(ts)) continue;
-                    const glm::dvec2 centroid = ts.moment / ts.area;
-                    atlas.position.push_back(glm::vec3(ex.origin + ex.u * (centroid.x * su) + ex.v * (centroid.y * sv)));
-                    atlas.normal.push_back(ch.normal);
-                    atlas.area.push_back(float(ts.area * su * sv));
+                    if (!ts.keep) continue;
+                    atlas.position.push_back(point_of(ts));
+                    atlas.normal.push_back(ch.planar ? ch.normal : glm::vec3(glm::normalize(ts.normal)));
+                    atlas.area.push_back(float(ts.world * su * sv));
                     atlas.albedo.push_back(mat.albedo);
                     atlas.emission.push_back(emitted);
                     atlas.chart.push_back(c);
@@ -629,18 +642,32 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
     atlas.chart_of_triangle.assign(nt, lightmap_atlas::none);
 
     const detail::triangle_faces faces = detail::face_normals_and_areas(scene);
-    const auto [lo, hi] = scene.bounds();
-    const double diagonal = glm::length(detail::to_d(hi) - detail::to_d(lo));
-    detail::group_into_charts(scene, faces, options, diagonal, atlas);
+    double total_area = 0;
+    for (std::size_t t = 0; t < nt; ++t) total_area += faces.area[t];
+    require(total_area > 0, "scene.triangles", "the scene has no triangle of positive area");
+    const detail::grown_charts grown = detail::group_into_charts(scene, faces, options, atlas);
     std::vector<detail::chart_extent> extents(atlas.charts.size());
     for (std::size_t c = 0; c < atlas.charts.size(); ++c)
         extents[c] = detail::smallest_bounding_frame(scene, atlas, atlas.charts[c]);
 
-    double total_area = 0;
-    for (std::size_t t = 0; t < nt; ++t) total_area += faces.area[t];
-    require(total_area > 0, "scene.triangles", "the scene has no triangle of positive area");
+    // Area on the charts' planes, and the surface's stretch over it.
+    atlas_statistics& st = atlas.statistics;
+    double plane_area = 0;
+    st.stretch_max = 1;
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+        const lightmap_chart& ch = atlas.charts[c];
+        for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
+            const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
+            const double cosine = ch.planar ? 1.0 : std::max(glm::dot(faces.normal[t], glm::dvec3(ch.normal)), 1e-6);
+            plane_area += faces.area[t] * cosine;
+            st.stretch_max = std::max(st.stretch_max, 1.0 / cosine);
+        }
+        st.cone_max_degrees = std::max(st.cone_max_degrees, double(ch.tilt_degrees));
+    }
+    st.stretch_mean = total_area / plane_area;
     std::vector<std::vector<detail::texel_sum>> sums(atlas.charts.size());
-    detail::cut_to_element_count(scene, extents, total_area, options, atlas, sums);
+    std::tie(st.texel_size, st.densities_tried) =
+        detail::cut_to_element_count(scene, faces, extents, plane_area, options, atlas, sums);
 
     const std::uint32_t pad = std::uint32_t(options.padding);
     detail::pack_charts_on_shelves(pad, atlas);
@@ -651,6 +678,23 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
     }
     atlas.block_first.push_back(std::uint32_t(atlas.size()));
     require(atlas.size() > 0, "scene.triangles", "the scene gives no element");
+
+    st.charts = atlas.charts.size();
+    st.elements = atlas.size();
+    st.triangles = nt;
+    st.atlas_texels = std::size_t(atlas.width) * atlas.height;
+    st.packing_efficiency = double(st.elements) / double(std::max<std::size_t>(st.atlas_texels, 1));
+    std::vector<std::uint32_t> per_chart(atlas.charts.size());
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+        per_chart[c] = atlas.charts[c].element_count;
+        st.chart_texels += std::size_t(atlas.charts[c].width) * atlas.charts[c].height;
+        st.one_element_charts += per_chart[c] == 1 ? 1 : 0;
+        st.curved_charts += atlas.charts[c].planar ? 0 : 1;
+    }
+    std::nth_element(per_chart.begin(), per_chart.begin() + std::ptrdiff_t(per_chart.size() / 2), per_chart.end());
+    st.median_elements_per_chart = per_chart.empty() ? 0 : per_chart[per_chart.size() / 2];
+    st.seed_plane_kept = grown.seed_plane_kept;
+    st.overlaps_refused = grown.overlaps_refused;
     return atlas;
 }
 

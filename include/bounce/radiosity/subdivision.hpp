@@ -69,8 +69,9 @@ namespace bounce::detail {
 /// the grid `grid` over the rectangle `rect` (chart texel coordinates) with chart `c`'s
 /// triangles, in double.
 struct grid_overlap {
-    double area = 0;
-    glm::dvec2 moment{0};
+    double area = 0;       ///< on the chart's plane
+    double world = 0;      ///< on the surface (a curved chart's triangles tilt from its plane)
+    glm::dvec2 moment{0};  ///< of the surface area
 };
 inline std::vector<grid_overlap> grid_overlaps(const scene_view& scene, const lightmap_atlas& atlas, std::uint32_t c,
                                                glm::dvec4 rect, glm::uvec2 grid) {
@@ -86,16 +87,23 @@ inline std::vector<grid_overlap> grid_overlaps(const scene_view& scene, const li
             const glm::dvec3 d = glm::dvec3(scene.positions[scene.triangles[t][m]]) - origin;
             q[std::size_t(m)] = (glm::dvec2(glm::dot(d, au) / uu, glm::dot(d, av) / vv) - glm::dvec2(rect)) / cell;
         }
+        const glm::dvec3 a0(scene.positions[scene.triangles[t].x]), a1(scene.positions[scene.triangles[t].y]),
+            a2(scene.positions[scene.triangles[t].z]);
+        const double w = ch.planar ? 1.0
+                                   : 1.0 / std::max(glm::dot(glm::normalize(glm::cross(a1 - a0, a2 - a0)),
+                                                             glm::dvec3(ch.normal)), 1e-6);
         for_each_cell_overlap(q, grid.x, grid.y, [&](std::size_t cell, double a, glm::dvec2 moment) {
             out[cell].area += a;
-            out[cell].moment += moment;
+            out[cell].world += a * w;
+            out[cell].moment += moment * w;
         });
     }
     // To base texels: areas scale by the cell's area, centroids map back to chart coordinates.
     for (grid_overlap& o : out) {
         const double scale = cell.x * cell.y;
-        o.moment = (o.moment * cell + o.area * glm::dvec2(rect)) * scale;
+        o.moment = (o.moment * cell + o.world * glm::dvec2(rect)) * scale;
         o.area *= scale;
+        o.world *= scale;
     }
     return out;
 }
@@ -166,8 +174,8 @@ inline void add_quadrant(const scene_view& scene, const lightmap_atlas& atlas, s
     const glm::uvec2 grid = atlas.block_grid[k];
     const std::uint32_t c = atlas.chart[e0];
     const lightmap_chart& ch = atlas.charts[c];
-    const glm::dvec3 origin(ch.origin), au(ch.axis_u), av(ch.axis_v);
-    const double texel_area = glm::length(glm::cross(au, av));  // m^2 per base texel
+    const glm::dvec3 au(ch.axis_u), av(ch.axis_v);
+    const double texel_area = glm::length(glm::cross(au, av));  // m^2 per base texel (on the chart's plane)
     const glm::dvec4 child(rect.x + qx * rect.z / 2.0, rect.y + qy * rect.w / 2.0, rect.z / 2.0, rect.w / 2.0);
     const auto overlaps = grid_overlaps(scene, atlas, c, child, grid);
     const std::uint32_t first = std::uint32_t(out.size());
@@ -175,7 +183,7 @@ inline void add_quadrant(const scene_view& scene, const lightmap_atlas& atlas, s
     for (std::size_t idx = 0; idx < overlaps.size(); ++idx) {
         const auto& o = overlaps[idx];
         if (!(o.area > 1e-6 * cell_area)) continue;
-        const glm::dvec2 centroid = o.moment / o.area;
+        const glm::dvec2 centroid = o.moment / o.world;
         // The parent cell, exactly: child cell (i, j) of quadrant (qx, qy) spans half a
         // parent cell starting at ((qx gx + i) / 2, (qy gy + j) / 2) parent cells.
         const std::size_t i = idx % grid.x, j = idx / grid.x;
@@ -184,9 +192,10 @@ inline void add_quadrant(const scene_view& scene, const lightmap_atlas& atlas, s
         // A child whose parent cell held only a dropped sliver takes the block's
         // first element as parent (its radiosity is the nearest estimate there is).
         const std::uint32_t parent = p >= 0 ? std::uint32_t(p) : e0;
-        out.position.push_back(glm::vec3(origin + au * centroid.x + av * centroid.y));
-        out.normal.push_back(atlas.normal[e0]);
-        out.area.push_back(float(o.area * texel_area));
+        const auto [point, normal] = chart_surface_point(scene, atlas, c, centroid);
+        out.position.push_back(point);
+        out.normal.push_back(ch.planar ? atlas.normal[e0] : normal);
+        out.area.push_back(float(o.world * texel_area));
         out.albedo.push_back(atlas.albedo[e0]);
         out.emission.push_back(atlas.emission[e0]);
         out.chart.push_back(c);
