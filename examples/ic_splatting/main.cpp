@@ -88,6 +88,12 @@ adaptive_rays adaptive_settings(const options& o, const embree::accel& bvh, cons
                                 const embree::reference_integrator& integrator, const radius_limits& limits,
                                 study::stage_timer& setup) {
     adaptive_rays a;
+    if (o.importance_rays) {  // a fixed budget: no target, no floor
+        a = {true, o.min_record_samples, o.record_samples, 1.0, 0.0,
+             o.importance_contrast ? ray_allocation::contrast : ray_allocation::radiance, double(o.importance_defensive)};
+        a.validate();
+        return a;
+    }
     if (!o.adaptive_rays) return a;
     a = {true, o.min_record_samples, o.record_samples, double(o.record_error) * o.a, 0.0};
     if (o.record_error_floor > 0.f)
@@ -116,7 +122,7 @@ int run_with(const options& o) {
     const radius_limits limits = radius_limits_for(o, lo, hi);
     const adaptive_rays adaptive = adaptive_settings(o, bvh, scene, integrator, limits, setup);
     const embree::record_sampler embree_sampler =
-        o.adaptive_rays ? embree::record_sampler(integrator, adaptive, limits)
+        adaptive.enabled ? embree::record_sampler(integrator, adaptive, limits)
                         : embree::record_sampler(integrator, embree::hemisphere_grid_for(o.record_samples), limits);
     // The record sampler the options chose, behind one type (a bounce::record_sampler).
     std::function<void(std::span<const glm::vec3>, std::span<const glm::vec3>, std::span<const double>,

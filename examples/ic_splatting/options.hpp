@@ -76,6 +76,9 @@ struct options {
     std::uint32_t min_record_samples = 256;  // adaptive: the first round's rays
     float record_error = 0.2f;               // adaptive: target relative standard error of E, times a
     float record_error_floor = 1.f;          // adaptive: irradiance floor, times the scene's mean irradiance
+    bool importance_rays = false;            // record_samples rays per record, min_record_samples first, the rest by radiance
+    float importance_defensive = 0.5f;       // importance: every pair's floor, times the mean first-round luminance
+    bool importance_contrast = false;        // importance: by the neighbours' range of luminance, not its largest
     bool neighbour_clamp = true;
     float filter_k = 0.f;      // neighbour filter: merge within this many standard errors (0: off)
     float filter_reach = 2.f;  // neighbour filter: neighbours' weights at this times a
@@ -161,6 +164,7 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
     if (hessian && std::isfinite(limits.hessian_zone_cap)) p["hessian_zone_cap"] = limits.hessian_zone_cap;
     // Filtered records depend on the filter and on a; keyed only where on.
     if (o.filter_k > 0.f) p["record_filter"] = {o.filter_k, o.filter_reach, o.a, o.filter_soft};
+    if (o.importance_rays) p["importance_rays"] = {o.min_record_samples, o.importance_defensive, o.importance_contrast};
     return p;
 }
 
@@ -207,6 +211,11 @@ inline void check_combinations(const options& o, bool with_gl) {
     if (hessian && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "the Hessian radius depends on a: sweep a over separate runs");
     if (o.adaptive_rays && raster) throw parameter_error("--adaptive-rays", "needs the Embree sampler");
+    if (o.importance_rays && raster) throw parameter_error("--importance-rays", "needs the Embree sampler");
+    if (o.importance_rays && o.adaptive_rays)
+        throw parameter_error("--importance-rays", "allocates a fixed budget: not with --adaptive-rays");
+    if (o.importance_rays && o.ray_rates)
+        throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --importance-rays");
     if (o.filter_k > 0.f && raster)
         throw parameter_error("--record-filter", "needs the Embree sampler (the raster's records carry no variance)");
     if (o.filter_k > 0.f && !o.a_sweep.empty())
@@ -242,6 +251,8 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
             {"radius", name_of(radius_names, o.radius)},
             {"adaptive_rays", o.adaptive_rays}, {"min_record_samples", o.min_record_samples},
             {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
+            {"importance_rays", o.importance_rays}, {"importance_defensive", o.importance_defensive},
+            {"importance_by", o.importance_contrast ? "contrast" : "radiance"},
             {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
             {"record_filter", o.filter_k}, {"filter_reach", o.filter_reach}, {"filter_soft", o.filter_soft},
             {"verify_rounds", o.verify_rounds}, {"verify_rays", o.verify_rays}, {"verify_tile", o.verify_tile},
@@ -300,7 +311,18 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                  "records refine their strata until the standard error of E is below --record-error * a * max(E, floor) "
                  "(docs/irradiance-splatting.md, \"Adaptive rays per record\")")
         ->capture_default_str();
-    app.add_option("--min-record-samples", o.min_record_samples, "adaptive rays: the first round's rays per record")
+    app.add_flag("--importance-rays,!--no-importance-rays", o.importance_rays,
+                 "records cast --record-samples rays, --min-record-samples on a grid first and the rest to the strata "
+                 "whose neighbours saw the most light (docs/irradiance-splatting.md, \"Importance-sampled records\")")
+        ->capture_default_str();
+    app.add_option("--importance-defensive", o.importance_defensive,
+                   "importance rays: the floor of every stratum pair's share, in units of the mean first-round luminance")
+        ->check(examples::finite_non_negative)
+        ->capture_default_str();
+    app.add_flag("--importance-contrast,!--importance-radiance", o.importance_contrast,
+                 "importance rays: by the range of the luminance the neighbouring strata saw, not by its largest")
+        ->capture_default_str();
+    app.add_option("--min-record-samples", o.min_record_samples, "adaptive and importance rays: the first round's rays per record")
         ->check(CLI::Range(4u, 1u << 20))
         ->capture_default_str();
     app.add_option("--record-error", o.record_error, "adaptive rays: target relative standard error of a record's E, in units of a")

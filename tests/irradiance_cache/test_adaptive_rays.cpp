@@ -12,6 +12,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -454,4 +455,302 @@ TEST_CASE("adaptive rays off: the sampler casts the fixed grid of max_rays, reco
     }
     CHECK(a.rays_cast().rays == 2 * std::uint64_t(a.grid().count()));
     CHECK(b.rays_cast().records == 2);
+}
+
+// ---------------------------------------------------------------------------------------
+// Importance-sampled records (ray_allocation::radiance, issue 28): the rays after the first
+// round go to the strata whose neighbours saw the most light.
+
+namespace {
+
+// The half-lit ceiling of tests/core (an infinite plane at height h, radiance L0 where
+// x cos(rot) + y sin(rot) > -x0): closed forms for E, its translation gradient along
+// (cos rot, sin rot), its rotation gradient along (-sin rot, cos rot), and, every ray hitting
+// the plane at r = h / cos(theta), E[1 / r] = 2 / (3 h) and E[r] = 2 h over cosine-distributed
+// directions.
+struct lit_ceiling {
+    double h, x0, L0, rot;
+    std::pair<glm::vec3, float> trace(const glm::vec3& w) const {
+        const glm::dvec3 d(w);
+        const double t = h / d.z;
+        const double along = t * (d.x * std::cos(rot) + d.y * std::sin(rot));
+        return {glm::vec3(float(along > -x0 ? L0 : 0.0)), float(t)};
+    }
+    double E() const { return pi * L0 / 2 * (1 + x0 / std::hypot(x0, h)); }
+    double dE_dx() const { return pi * L0 / 2 * h * h / std::pow(x0 * x0 + h * h, 1.5); }
+    double rot_y() const { return pi * L0 / 2 * h / std::hypot(x0, h); }
+    glm::dvec3 along() const { return {std::cos(rot), std::sin(rot), 0}; }
+    glm::dvec3 across() const { return {-std::sin(rot), std::cos(rot), 0}; }
+};
+
+// One importance-sampled hemisphere as embree::record_sampler draws it: one jittered sample per
+// cell of adaptive_grid(pilot), then the counts of allocate_by_radiance(budget) reached by
+// doublings. With `own_sample` the allocation instead doubles a pair when its own first
+// samples' luminance is above the hemisphere's mean (the rule the allocation must not use).
+template <class Trace>
+adaptive_hemisphere importance_sampled(std::uint32_t pilot, std::uint32_t budget, double defensive, std::uint64_t seed,
+                                       const Trace& trace, bool own_sample = false, bool contrast = false) {
+    const adaptive_grid_size g = adaptive_grid(pilot);
+    adaptive_hemisphere h(g.rings, g.wedges);
+    pcg32 rng(seed);
+    auto next = [&] { return rng.next_float(); };
+    auto add = [&](std::size_t c, glm::vec2 u) {
+        const glm::vec3 w = h.direction_in(c, u);
+        const auto [L, r] = trace(w);
+        h.add(c, u, w, L, r);
+    };
+    for (std::size_t c = 0; c < h.cells(); ++c) add(c, {next(), next()});
+    std::vector<std::uint32_t> target;
+    if (own_sample) {
+        const double mean = h.luminance_irradiance() / pi;
+        target.assign(h.cells(), 1);
+        for (std::size_t p = 0; p < h.pairs(); ++p)
+            if (h.pair_luminance(p) > mean) target[2 * p] = target[2 * p + 1] = 2;
+    } else {
+        target = h.allocate_by_radiance(budget, defensive, contrast);
+    }
+    for (bool any = true; any;) {
+        any = false;
+        std::vector<std::uint32_t> grow(h.cells(), 0);
+        for (std::size_t c = 0; c < h.cells(); ++c) any |= (grow[c] = h.count(c) < target[c] ? 1u : 0u) != 0;
+        for (std::size_t c = 0; c < h.cells(); ++c)
+            if (grow[c])
+                for (const glm::vec2 u : h.refinement_jitters(c, next)) add(c, u);
+    }
+    return h;
+}
+
+}  // namespace
+
+TEST_CASE("importance allocation: powers of two, equal in pairs, within budget, rays to lit neighbourhoods",
+          "[adaptive_rays][importance]") {
+    const lit_ceiling c{1.0, 0.3, 2.0, 0.4};
+    const adaptive_hemisphere pilot = importance_sampled(256, 0, 0.5, 3, [&](const glm::vec3& w) { return c.trace(w); });
+    REQUIRE(pilot.samples() == pilot.cells());
+    for (const std::uint64_t budget : {0ull, 1ull, 64ull, 768ull, 100000ull})
+        for (const double defensive : {0.0, 0.5, 4.0}) {
+            const std::vector<std::uint32_t> t = pilot.allocate_by_radiance(budget, defensive);
+            REQUIRE(t.size() == pilot.cells());
+            std::uint64_t extra = 0;
+            for (std::size_t k = 0; k < t.size(); ++k) {
+                CHECK(t[k] >= 1);
+                CHECK((t[k] & (t[k] - 1)) == 0);
+                CHECK(t[k] <= adaptive_hemisphere::max_allocated_per_cell);
+                extra += t[k] - 1;
+            }
+            for (std::size_t p = 0; p < pilot.pairs(); ++p) CHECK(t[2 * p] == t[2 * p + 1]);
+            CHECK(extra <= budget);
+            // The budget is spent down to what no doubling fits (a pair of n costs 2n).
+            std::uint64_t cheapest = ~0ull;
+            for (const std::uint32_t n : t)
+                if (n < adaptive_hemisphere::max_allocated_per_cell) cheapest = std::min<std::uint64_t>(cheapest, 2 * n);
+            if (defensive > 0) CHECK(budget - extra < cheapest);
+            if (budget == 100000 && defensive > 0) CHECK(extra == (adaptive_hemisphere::max_allocated_per_cell - 1) * t.size());
+        }
+    // Pairs whose whole neighbourhood is dark get nothing without the defensive floor, and
+    // their share with it; lit neighbourhoods get more per pair.
+    const std::vector<std::uint32_t> none = pilot.allocate_by_radiance(768, 0.0), some = pilot.allocate_by_radiance(768, 2.0);
+    const std::uint32_t half_n = pilot.wedges() / 2;
+    double lit = 0, dark = 0, dark_some = 0;
+    std::size_t n_lit = 0, n_dark = 0;
+    for (std::size_t p = 0; p < pilot.pairs(); ++p) {
+        const std::size_t j = p / half_n, i = p % half_n;
+        double nb = std::max(pilot.pair_luminance(j * half_n + (i + 1) % half_n),
+                             pilot.pair_luminance(j * half_n + (i + half_n - 1) % half_n));
+        if (j > 0) nb = std::max(nb, pilot.pair_luminance((j - 1) * half_n + i));
+        if (j + 1 < pilot.rings()) nb = std::max(nb, pilot.pair_luminance((j + 1) * half_n + i));
+        if (nb == 0) {
+            dark += none[2 * p];
+            dark_some += some[2 * p];
+            ++n_dark;
+        } else {
+            lit += none[2 * p];
+            ++n_lit;
+        }
+    }
+    REQUIRE(n_dark > 0);
+    REQUIRE(n_lit > 0);
+    CHECK(dark == double(n_dark));
+    CHECK(dark_some > double(n_dark));
+    CHECK(lit / double(n_lit) > 2.0);
+    // By contrast: the rays go where the neighbours differ (the lit edge), not to the inside
+    // of the lit half, which gets nothing without the floor.
+    const std::vector<std::uint32_t> edge = pilot.allocate_by_radiance(768, 0.0, true);
+    double flat = 0, changing = 0;
+    std::size_t n_flat = 0, n_changing = 0;
+    for (std::size_t p = 0; p < pilot.pairs(); ++p) {
+        const std::size_t j = p / half_n, i = p % half_n;
+        std::vector<double> nb{pilot.pair_luminance(j * half_n + (i + 1) % half_n),
+                               pilot.pair_luminance(j * half_n + (i + half_n - 1) % half_n)};
+        if (j > 0) nb.push_back(pilot.pair_luminance((j - 1) * half_n + i));
+        if (j + 1 < pilot.rings()) nb.push_back(pilot.pair_luminance((j + 1) * half_n + i));
+        const bool uniform = *std::max_element(nb.begin(), nb.end()) == *std::min_element(nb.begin(), nb.end());
+        (uniform ? flat : changing) += edge[2 * p];
+        ++(uniform ? n_flat : n_changing);
+    }
+    REQUIRE(n_flat > 0);
+    REQUIRE(n_changing > 0);
+    CHECK(flat == double(n_flat));
+    CHECK(changing / double(n_changing) > 4.0);
+    // A black hemisphere: every pair alike.
+    const adaptive_hemisphere black = importance_sampled(64, 0, 0.5, 4, [](const glm::vec3&) {
+        return std::pair<glm::vec3, float>(glm::vec3(0.f), 1.f);
+    });
+    const std::vector<std::uint32_t> even = black.allocate_by_radiance(black.cells(), 0.0);
+    for (const std::uint32_t n : even) CHECK(n == 2);
+    CHECK_THROWS_WITH(black.allocate_by_radiance(8, -1.0), Catch::Contains("defensive"));
+    CHECK_THROWS_WITH(black.allocate_by_radiance(8, std::nan("")), Catch::Contains("defensive"));
+}
+
+TEST_CASE("importance-sampled hemispheres are unbiased: E, gradients, distances, Hessian against closed forms",
+          "[adaptive_rays][importance]") {
+    // Over 3000 seeds per ceiling, 64 first-round rays and 192 allocated: the mean of each
+    // quantity against its closed form (tolerance four standard errors of the mean plus, for
+    // the gradients, Krivanek's own bias on these grids: section "Gradients" of
+    // docs/irradiance-splatting.md) and against a fixed grid of the same rays. Weighting the
+    // rays by count instead of by their strata's measure (pi times the mean over all rays)
+    // and letting a pair's own first samples pick its count both fail.
+    const int seeds = 3000;
+    for (const bool contrast : {false, true})
+    for (const lit_ceiling c : {lit_ceiling{1.0, 0.3, 2.0, 0.4}, lit_ceiling{0.6, -0.5, 1.0, 2.0}}) {
+        auto trace = [&](const glm::vec3& w) { return c.trace(w); };
+        std::vector<double> e(seeds), by_count(seeds), own(seeds), grad_t(seeds), grad_r(seeds), inv_r(seeds),
+            mean_r(seeds), hxx(seeds), fixed_e(seeds), fixed_t(seeds), rays(seeds);
+        const std::uint32_t fixed_m = 9, fixed_n = 28;  // 252 rays, about the same
+        // The Hessian's integral from a fine midpoint grid (its estimator has no closed form here).
+        double hessian_xx = 0;
+        {
+            const std::uint32_t fm = 180, fn = 560;
+            hemisphere_samples s;
+            s.rings = fm;
+            s.wedges = fn;
+            s.direction = stratified_cosine_directions(fm, fn, std::vector<glm::vec2>(std::size_t(fm) * fn, glm::vec2(0.5f)));
+            for (const glm::vec3& w : s.direction) {
+                const auto [L, r] = c.trace(w);
+                s.radiance.push_back(L);
+                s.distance.push_back(r);
+            }
+            const hemisphere_estimate f = estimate_hemisphere(s);
+            hessian_xx = glm::dot(c.along(), glm::dvec3(f.hessian[0] * glm::dvec2(c.along()), 0.0));
+        }
+        const hemisphere_strata fixed_strata(fixed_m, fixed_n);
+        for (int k = 0; k < seeds; ++k) {
+            double total = 0;
+            std::size_t count = 0;
+            auto counting = [&](const glm::vec3& w) {
+                const auto hit = c.trace(w);
+                total += hit.first.x;
+                ++count;
+                return hit;
+            };
+            const adaptive_hemisphere h = importance_sampled(64, 192, 0.5, 50000 + std::uint64_t(k), counting, false, contrast);
+            rays[k] = double(h.samples());
+            const hemisphere_estimate est = estimate_hemisphere(h.fine_samples());
+            e[k] = est.irradiance.x;
+            grad_t[k] = glm::dot(est.translation[0], c.along());
+            grad_r[k] = glm::dot(est.rotation[0], c.across());
+            inv_r[k] = 1.0 / est.harmonic_mean_distance;
+            mean_r[k] = est.mean_distance;
+            hxx[k] = glm::dot(c.along(), glm::dvec3(est.hessian[0] * glm::dvec2(c.along()), 0.0));
+            by_count[k] = pi * total / double(count);
+            own[k] = importance_sampled(64, 192, 0.5, 50000 + std::uint64_t(k), trace, true).irradiance().x;
+            // The fixed grid of about the same rays.
+            pcg32 rng(90000 + std::uint64_t(k));
+            std::vector<glm::vec2> u(std::size_t(fixed_m) * fixed_n);
+            for (glm::vec2& x : u) x = {rng.next_float(), rng.next_float()};
+            hemisphere_samples s;
+            s.rings = fixed_m;
+            s.wedges = fixed_n;
+            s.direction = stratified_cosine_directions(fixed_m, fixed_n, u);
+            for (const glm::vec3& w : s.direction) {
+                const auto [L, r] = c.trace(w);
+                s.radiance.push_back(L);
+                s.distance.push_back(r);
+            }
+            const hemisphere_estimate f = estimate_hemisphere(s, fixed_strata);
+            fixed_e[k] = f.irradiance.x;
+            fixed_t[k] = glm::dot(f.translation[0], c.along());
+        }
+        const moments me = moments_of(e), mc = moments_of(by_count), mo = moments_of(own), mt = moments_of(grad_t),
+                      mr = moments_of(grad_r), mi = moments_of(inv_r), md = moments_of(mean_r), mh = moments_of(hxx),
+                      fe = moments_of(fixed_e), ft = moments_of(fixed_t), mrays = moments_of(rays);
+        INFO((contrast ? "contrast" : "radiance") << ", ceiling h " << c.h << " x0 " << c.x0 << ": E " << me.mean << " +- " << me.mean_se << " (spread "
+                          << std::sqrt(me.variance) << ", fixed grid " << fe.mean << " spread " << std::sqrt(fe.variance)
+                          << "), exact " << c.E() << "; by count " << mc.mean << ", own-sample allocation " << mo.mean
+                          << "; grad_t " << mt.mean << " +- " << mt.mean_se << " (fixed " << ft.mean << ") exact " << c.dE_dx()
+                          << "; grad_r " << mr.mean << " exact " << c.rot_y() << "; 1/R " << mi.mean << " exact "
+                          << 2 / (3 * c.h) << "; mean r " << md.mean << " exact " << 2 * c.h << "; H_xx " << mh.mean
+                          << " +- " << mh.mean_se << " fine grid " << hessian_xx << "; rays " << mrays.mean);
+        CHECK(mrays.mean <= 256);
+        CHECK(mrays.mean >= 250);
+        CHECK(agree(me.mean, me.mean_se, c.E(), 0));
+        CHECK_FALSE(agree(mc.mean, mc.mean_se, c.E(), 0));
+        CHECK_FALSE(agree(mo.mean, mo.mean_se, c.E(), 0));
+        CHECK(agree(mt.mean, mt.mean_se, c.dE_dx(), 0.03 * c.dE_dx()));
+        CHECK(agree(mr.mean, mr.mean_se, c.rot_y(), 0.002 * c.rot_y()));
+        CHECK(agree(mi.mean, mi.mean_se, 2 / (3 * c.h), 0));
+        CHECK(agree(md.mean, md.mean_se, 2 * c.h, 0));
+        CHECK(agree(mh.mean, mh.mean_se, hessian_xx, 0.03 * std::abs(hessian_xx)));
+        // Rays to where the light changes: less spread than the fixed grid of the same rays.
+        if (contrast) CHECK(me.variance < fe.variance);
+    }
+}
+
+TEST_CASE("importance-sampled records are unbiased and cast their budget", "[adaptive_rays][importance][embree]") {
+    // The black square under the sky, points under and beside its edges: the mean over seeds
+    // is the exact irradiance, every record casts max_rays (less what no doubling fits), and
+    // its variance estimate is not below the spread over seeds.
+    const sky_and_square s;
+    const embree::accel bvh(s.scene);
+    const embree::reference_integrator integrator(bvh, s.scene, s.settings());
+    adaptive_rays a;
+    a.enabled = true;
+    a.allocation = ray_allocation::radiance;
+    a.min_rays = 64;
+    a.max_rays = 256;
+    const int seeds = 300;
+    for (const glm::vec3 p : {glm::vec3(0.4f, -0.1f, 0.f), glm::vec3(0.6f, 0.3f, 0.f), glm::vec3(0.1f, -0.2f, 0.f)}) {
+        std::vector<double> e(seeds), v(seeds);
+        std::uint32_t fewest = ~0u, most = 0;
+        for (int k = 0; k < seeds; ++k) {
+            const embree::record_sampler sampler(integrator, a, radius_limits{}, translation_gradient_kind::krivanek_2005,
+                                                 300 + std::uint64_t(k));
+            std::uint32_t r = 0;
+            const auto rec = sampler.measure(p, {0, 0, 1}, 0.0, &r);
+            REQUIRE(rec);
+            e[k] = luminance(rec->irradiance);
+            v[k] = rec->variance;
+            fewest = std::min(fewest, r);
+            most = std::max(most, r);
+        }
+        const moments m = moments_of(e), mv = moments_of(v);
+        const double exact = s.exact_luminance(p, integrator.ray_epsilon());
+        INFO("point " << p.x << ", " << p.y << ": " << m.mean << " +- " << m.mean_se << " exact " << exact << ", spread^2 "
+                      << m.variance << " estimated " << mv.mean << ", rays " << fewest << "-" << most);
+        CHECK(agree(m.mean, m.mean_se, exact, 0));
+        CHECK(most <= 256);
+        CHECK(fewest >= 250);
+        CHECK(mv.mean >= m.variance - 4 * std::sqrt(mv.mean_se * mv.mean_se + m.variance_se * m.variance_se));
+    }
+    a.defensive = -1;
+    CHECK_THROWS_WITH(embree::record_sampler(integrator, a, radius_limits{}), Catch::Contains("defensive"));
+}
+
+TEST_CASE("refinement jitters stay in their half when the uniform is at its ends", "[adaptive_rays]") {
+    // A uniform just below 1 puts the new sample at the top of its half; rounded to float it
+    // must stay below the half's bound, or two samples share a sub-stratum (an importance
+    // run on Sponza met one in a few million rays).
+    for (const float end : {0.f, 0x1.fffffep-1f}) {
+        adaptive_hemisphere h(2, 4);
+        auto add = [&](std::size_t c, glm::vec2 u) { h.add(c, u, h.direction_in(c, u), glm::vec3(1.f), 1.f); };
+        for (std::size_t c = 0; c < h.cells(); ++c) add(c, {end, end});
+        for (int level = 0; level < 6; ++level)
+            for (const glm::vec2 u : h.refinement_jitters(0, [&] { return end; })) {
+                CHECK(u.x < 1.f);
+                CHECK(u.y < 1.f);
+                add(0, u);
+            }
+        CHECK(h.count(0) == 64);
+        CHECK_NOTHROW(h.fine_samples());
+    }
 }

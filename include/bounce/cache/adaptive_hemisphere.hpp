@@ -48,11 +48,30 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 namespace bounce::inline cache {
+
+/// How the rays after the first round are given to the strata.
+enum class ray_allocation {
+    /// To the strata whose neighbours' rays disagree, round by round, until the record's
+    /// estimated standard error meets `target` (or max_rays): adaptive rays per record.
+    variance,
+    /// Importance sampling of the hemisphere by a coarse estimate of its incoming radiance
+    /// (issue 28): every record casts max_rays, min_rays of them in the first round; the rest
+    /// go to the strata in proportion to the luminance their neighbours' first-round rays saw
+    /// (never their own) plus `defensive` times the mean, by adaptive_hemisphere::
+    /// allocate_by_radiance. `target` and `irradiance_floor` are not used.
+    radiance,
+    /// As radiance, the importance being the range (largest less smallest) of the luminance
+    /// the neighbours' first-round rays saw: rays go where the light changes, the strata
+    /// whose own variance is large (Neyman's allocation, n ~ sigma), not to the inside of a
+    /// bright patch, whose strata vary no more than a dark patch's.
+    contrast,
+};
 
 /// Settings of adaptive rays per record. Default off: a sampler then casts a fixed grid.
 struct adaptive_rays {
@@ -70,6 +89,12 @@ struct adaptive_rays {
     /// W/m^2; 0 makes the target purely relative. A floor stops records in near darkness,
     /// whose relative error is large but whose absolute error is not, from taking max_rays.
     double irradiance_floor = 0.0;
+    /// Which strata the later rounds' rays go to (variance: adaptive; radiance: importance).
+    ray_allocation allocation = ray_allocation::variance;
+    /// Radiance allocation: the floor added to every pair's importance, in units of the mean
+    /// first-round luminance over the pairs, so that dark strata are still refined (the
+    /// defensive part of the mixture). Non-negative; 0 gives rays to lit neighbourhoods only.
+    double defensive = 0.5;
 
     /// Throws parameter_error naming the first bad field.
     void validate() const {
@@ -79,6 +104,10 @@ struct adaptive_rays {
         require(std::isfinite(target) && target > 0.0, "target", "must be a positive number");
         require(std::isfinite(irradiance_floor) && irradiance_floor >= 0.0, "irradiance_floor",
                 "must be a non-negative number");
+        require(std::isfinite(defensive) && defensive >= 0.0, "defensive", "must be a non-negative number");
+        require(allocation == ray_allocation::variance || allocation == ray_allocation::radiance ||
+                    allocation == ray_allocation::contrast,
+                "allocation", "must be variance, radiance or contrast");
     }
 };
 
@@ -105,6 +134,23 @@ public:
         require(rings >= 1 && wedges >= 2 && wedges % 2 == 0, "rings/wedges",
                 "need at least one ring and an even number of wedges (at least 2)");
         cells_.resize(std::size_t(rings) * wedges);
+    }
+
+    /// Empties every cell for a new hemisphere on a rings x wedges grid, keeping the buffers
+    /// (a sampler reuses one object from record to record without allocating). Throws as the
+    /// constructor.
+    void reset(std::uint32_t rings, std::uint32_t wedges) {
+        require(rings >= 1 && wedges >= 2 && wedges % 2 == 0, "rings/wedges",
+                "need at least one ring and an even number of wedges (at least 2)");
+        m_ = rings;
+        n_ = wedges;
+        cells_.resize(std::size_t(rings) * wedges);
+        for (cell& c : cells_) {
+            c.n = 0;
+            c.sum = glm::dvec3(0.0);
+            c.y = c.inverse_distance = 0;
+            c.samples.clear();
+        }
     }
 
     std::uint32_t rings() const noexcept { return m_; }
@@ -189,7 +235,13 @@ public:
             (double(s.u[d]) < mid ? lo[d] : hi[d]) = mid;  // the other half
             const double a = double(next()), b = double(next());
             const glm::dvec2 u(lo.x + a * (hi.x - lo.x), lo.y + b * (hi.y - lo.y));
-            out.emplace_back(float(std::min(u.x, std::nextafter(hi.x, lo.x))), float(std::min(u.y, std::nextafter(hi.y, lo.y))));
+            // Kept below the half's upper bound after rounding to float: the double just below
+            // it can round up onto the bound, putting the sample in its sibling's half (then
+            // two samples share a sub-stratum and fine_samples refuses the cell).
+            const auto below = [](double x, double upper) {
+                return std::min(float(x), std::nextafter(float(upper), 0.f));
+            };
+            out.emplace_back(below(u.x, hi.x), below(u.y, hi.y));
         }
         return out;
     }
@@ -235,6 +287,14 @@ public:
     }
 
     std::size_t pairs() const noexcept { return cells_.size() / 2; }
+
+    /// Mean luminance of pair p's two cells (each its own samples' mean). Throws
+    /// parameter_error if either is empty.
+    double pair_luminance(std::size_t p) const {
+        const cell& a = cells_.at(2 * p);
+        const cell& b = cells_.at(2 * p + 1);
+        return 0.5 * (a.y / double(nonempty(a)) + b.y / double(nonempty(b)));
+    }
 
     /// Estimated variance of luminance_irradiance() (see the file comment).
     double variance() const {
@@ -301,6 +361,87 @@ public:
         return extra;
     }
 
+    /// The most samples allocate_by_radiance gives one cell (4 splits: the fine grid of
+    /// fine_samples is then at most 4 x 4 times the first round's).
+    static constexpr std::uint32_t max_allocated_per_cell = 16;
+
+    /// Importance allocation (ray_allocation::radiance): the sample count every cell should
+    /// reach (a power of two, equal in the two cells of a pair, never below the count it holds)
+    /// with at most `budget` more samples. A pair's importance is the largest mean luminance
+    /// of its neighbouring pairs (the next pair either side in phi, the rings above and
+    /// below, as plan's neighbours), never its own, plus `defensive` times the mean over all
+    /// pairs (all pairs alike where everything is black). Pairs are doubled greedily in
+    /// decreasing order of importance / count, each doubling of a pair of n costing 2n, up to
+    /// max_allocated_per_cell, so counts end up about proportional to the importance.
+    ///
+    /// Unbiasedness: a cell's count depends on its neighbours' samples, not on its own, so
+    /// its mean (each sub-stratum by its measure) stays an unbiased estimate of the cell's
+    /// mean radiance; only the greedy order, through the neighbours' keys, sees a cell's own
+    /// sample, an effect of order one over the number of pairs. Letting a cell's own first
+    /// sample pick its count biases it: a bright first sample in a half-lit cell gets a dark
+    /// second, a dark one none (the mean is a quarter of the patch low; tested).
+    /// With `contrast`, a pair's importance is instead the range (largest less smallest) of
+    /// those neighbours' mean luminance (ray_allocation::contrast), plus the same floor.
+    /// Throws parameter_error if a cell is empty or `defensive` is negative or not finite.
+    std::vector<std::uint32_t> allocate_by_radiance(std::uint64_t budget, double defensive, bool contrast = false) const {
+        require(std::isfinite(defensive) && defensive >= 0.0, "defensive", "must be a non-negative number");
+        const std::size_t np = pairs();
+        const std::uint32_t half_n = n_ / 2;
+        std::vector<double> lum(np);
+        double mean = 0;
+        for (std::size_t p = 0; p < np; ++p) mean += lum[p] = std::max(pair_luminance(p), 0.0);
+        mean /= double(np);
+        std::vector<double> key(np, 1.0);
+        if (mean > 0)
+            for (std::size_t p = 0; p < np; ++p) {
+                const std::size_t j = p / half_n, i = p % half_n;
+                double hi = 0, lo = std::numeric_limits<double>::infinity();
+                auto see = [&](double y) {
+                    hi = std::max(hi, y);
+                    lo = std::min(lo, y);
+                };
+                if (half_n > 1) {
+                    see(lum[j * half_n + (i + 1) % half_n]);
+                    see(lum[j * half_n + (i + half_n - 1) % half_n]);
+                }
+                if (j > 0) see(lum[(j - 1) * half_n + i]);
+                if (j + 1 < m_) see(lum[(j + 1) * half_n + i]);
+                const double importance = contrast ? (lo <= hi ? hi - lo : 0.0) : hi;
+                key[p] = importance + defensive * mean;
+            }
+        std::vector<std::uint32_t> count(np);
+        std::vector<std::uint64_t> held(np);  // samples the pair's two cells hold (or will)
+        using entry = std::pair<double, std::size_t>;  // (importance / count, pair); ties to the lower pair
+        auto before = [](const entry& x, const entry& y) { return x.first < y.first || (x.first == y.first && x.second > y.second); };
+        std::vector<entry> heap;
+        heap.reserve(np);
+        for (std::size_t p = 0; p < np; ++p) {
+            count[p] = std::max(cells_[2 * p].n, cells_[2 * p + 1].n);
+            held[p] = std::uint64_t(cells_[2 * p].n) + cells_[2 * p + 1].n;
+            if (key[p] > 0 && count[p] < max_allocated_per_cell) heap.emplace_back(key[p] / count[p], p);
+        }
+        std::make_heap(heap.begin(), heap.end(), before);
+        std::uint64_t spent = 0;
+        while (!heap.empty() && budget - spent >= 2) {
+            std::pop_heap(heap.begin(), heap.end(), before);
+            const std::size_t p = heap.back().second;
+            heap.pop_back();
+            const std::uint32_t n = count[p];
+            const std::uint64_t cost = 4 * std::uint64_t(n) - held[p];  // both cells to 2n
+            if (cost > budget - spent) continue;  // its next doubling never fits; smaller ones may
+            count[p] = 2 * n;
+            held[p] = 4 * std::uint64_t(n);
+            spent += cost;
+            if (count[p] < max_allocated_per_cell) {
+                heap.emplace_back(key[p] / count[p], p);
+                std::push_heap(heap.begin(), heap.end(), before);
+            }
+        }
+        std::vector<std::uint32_t> target(cells_.size());
+        for (std::size_t p = 0; p < np; ++p) target[2 * p] = target[2 * p + 1] = count[p];
+        return target;
+    }
+
     /// The samples as one grid for estimate_hemisphere, fine enough for the most refined
     /// cell: with L = max(2, the deepest split level), every cell is cut into 2^ceil(L/2)
     /// wedges by 2^floor(L/2) rings (the kd splits alternate phi, theta), and each fine cell
@@ -313,18 +454,25 @@ public:
     /// two distances, and a mean of distances there would shrink it. Throws parameter_error
     /// if a cell is empty.
     hemisphere_samples fine_samples() const {
+        hemisphere_samples s;
+        fine_samples(s);
+        return s;
+    }
+    /// As above into `s`, reusing its vectors. `centre_directions` false gives every fine cell
+    /// its sample's direction instead of the centre (no trigonometry): for callers that read
+    /// no directions (Krivanek's gradient without the Hessian), the estimate is the same.
+    void fine_samples(hemisphere_samples& s, bool centre_directions = true) const {
         unsigned deepest = 2;
         for (const cell& c : cells_) deepest = std::max(deepest, level_of(nonempty(c)));
         const unsigned lx = (deepest + 1) / 2, ly = deepest / 2;
         const std::uint32_t sx = 1u << lx, sy = 1u << ly;
-        hemisphere_samples s;
         s.rings = m_ * sy;
         s.wedges = n_ * sx;
         const std::size_t fine = std::size_t(s.rings) * s.wedges;
         s.direction.resize(fine);
         s.radiance.resize(fine);
         s.distance.resize(fine);
-        std::vector<std::int32_t> owner;
+        thread_local std::vector<std::int32_t> owner;
         for (std::size_t index = 0; index < cells_.size(); ++index) {
             const cell& c = cells_[index];
             const unsigned level = level_of(c.n);
@@ -342,10 +490,9 @@ public:
                     s.radiance[f] = glm::vec3(x.radiance);
                     s.distance[f] = x.inverse_distance > 0 ? float(1.0 / x.inverse_distance) : std::numeric_limits<float>::infinity();
                     const bool inside = std::uint32_t(x.u.x * float(sx)) == a && std::uint32_t(x.u.y * float(sy)) == b;
-                    s.direction[f] = inside ? x.direction : direction_in(index, centre);
+                    s.direction[f] = inside || !centre_directions ? x.direction : direction_in(index, centre);
                 }
         }
-        return s;
     }
 
 private:

@@ -10,7 +10,11 @@
 ///
 /// With adaptive rays (bounce/cache/adaptive_hemisphere.hpp) a record starts from a grid of about
 /// min_rays strata and adds rays to the strata next to uncertain ones until the estimated
-/// relative standard error of its irradiance is below the target or max_rays are cast.
+/// relative standard error of its irradiance is below the target or max_rays are cast. With
+/// ray_allocation::radiance (importance-sampled records) every record casts max_rays: min_rays
+/// on that grid first, the rest to the strata whose neighbours' first rays saw the most light
+/// (adaptive_hemisphere::allocate_by_radiance), reached by doublings of the strata; the
+/// estimator (each stratum by its measure), gradients and variance are the adaptive ones.
 /// rays_cast() counts the rays and records of every call, adaptive or not. Each record
 /// carries the variance of its irradiance's luminance from its own rays (collapsed strata,
 /// cache/record_filter.hpp), for the cache's neighbour filter.
@@ -211,6 +215,8 @@ private:
         std::vector<ray> rays;
         std::vector<std::uint64_t> seeds;
         std::vector<std::shared_ptr<const hemisphere_strata>> fine_strata;
+        std::optional<adaptive_hemisphere> hemisphere;  // the adaptive record's strata
+        bounce::hemisphere_samples fine;                // and its fine grid
 
         const hemisphere_strata& strata_for(std::uint32_t rings, std::uint32_t wedges) {
             for (std::size_t i = 0; i < fine_strata.size(); ++i)
@@ -311,7 +317,9 @@ private:
     // Returns the estimate, the rays cast and the variance of E's luminance (collapsed strata).
     std::tuple<hemisphere_estimate, std::uint32_t, double> adaptive_estimate(const embree::hemisphere_samples& samples,
                                                                              std::uint64_t key, scratch& w) const {
-        adaptive_hemisphere h(grid_.m, grid_.n);
+        if (!w.hemisphere) w.hemisphere.emplace(grid_.m, grid_.n);
+        adaptive_hemisphere& h = *w.hemisphere;
+        h.reset(grid_.m, grid_.n);
         const float eps = integrator_.ray_epsilon();
         auto local_of = [&](const glm::vec3& d) {
             return glm::vec3(glm::dot(d, samples.tangent), glm::dot(d, samples.bitangent), glm::dot(d, samples.normal));
@@ -327,14 +335,9 @@ private:
         std::vector<glm::vec3>& local = w.directions;
         std::vector<glm::vec3>& radiance = w.radiance;
         std::vector<float>& distance = w.distance;
-        for (std::uint64_t round = 1; used < cap && round <= 16; ++round) {
-            const double scale = std::max(h.luminance_irradiance(), adaptive_.irradiance_floor);
-            const double allowed = adaptive_.target * scale;
-            const double v = h.variance();
-            if (!(v > allowed * allowed)) break;
-            const std::uint64_t budget = std::min(cap - used, used);
-            const std::vector<std::uint32_t> extra = h.plan(budget, allowed * allowed, std::min(budget, used / 8));
-            if (extra.empty()) break;
+        // One round: doubles every cell with extra[c] > 0 (the jitters from a stream keyed by
+        // the point and the round), shaded in one batched query.
+        auto cast_round = [&](const std::vector<std::uint32_t>& extra, std::uint64_t round) {
             const std::uint64_t stream = derive_seed(seed_, 0x1d, key ^ (round * 0x9e3779b97f4a7c15ULL));
             pcg32 rng(stream);
             cell_of.clear();
@@ -366,8 +369,36 @@ private:
             for (std::size_t i = 0; i < count; ++i)
                 h.add(cell_of[i], jitter[i], local[i], radiance[i], std::max(distance[i], eps));
             used += count;
+        };
+        if (adaptive_.allocation != ray_allocation::variance) {
+            // Importance: every count decided from the first round, then reached by doublings.
+            const std::vector<std::uint32_t> target =
+                h.allocate_by_radiance(cap - used, adaptive_.defensive, adaptive_.allocation == ray_allocation::contrast);
+            std::vector<std::uint32_t> extra(target.size());
+            for (std::uint64_t round = 1;; ++round) {
+                bool any = false;
+                for (std::size_t c = 0; c < target.size(); ++c) {
+                    extra[c] = h.count(c) < target[c] ? h.count(c) : 0u;
+                    any |= extra[c] > 0;
+                }
+                if (!any) break;
+                cast_round(extra, round);
+            }
+        } else {
+            for (std::uint64_t round = 1; used < cap && round <= 16; ++round) {
+                const double scale = std::max(h.luminance_irradiance(), adaptive_.irradiance_floor);
+                const double allowed = adaptive_.target * scale;
+                const double v = h.variance();
+                if (!(v > allowed * allowed)) break;
+                const std::uint64_t budget = std::min(cap - used, used);
+                const std::vector<std::uint32_t> extra = h.plan(budget, allowed * allowed, std::min(budget, used / 8));
+                if (extra.empty()) break;
+                cast_round(extra, round);
+            }
         }
-        const bounce::hemisphere_samples fine = h.fine_samples();
+        // Directions matter to the Hessian and Ward and Heckbert's walls only.
+        bounce::hemisphere_samples& fine = w.fine;
+        h.fine_samples(fine, needs_hessian() || kind_ != translation_gradient_kind::krivanek_2005);
         return {estimate_hemisphere(fine, w.strata_for(fine.rings, fine.wedges), kind_, needs_hessian()), std::uint32_t(used),
                 h.variance()};
     }
