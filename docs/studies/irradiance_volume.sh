@@ -6,11 +6,11 @@
 # sphere. Every run goes into docs/results/irradiance_volume.json; the strip pictures into
 # docs/figures/irradiance_volume_*.png. Sponza needs BOUNCE_SCENES (or ../shared/scenes).
 # About 40 minutes on 2 shared cores (the adaptive Sponza bake dominates).
-# Usage: docs/studies/irradiance_volume.sh [cornell|sponza|adaptive|sh]   (BOUNCE_BIN: default build/bin)
+# Usage: docs/studies/irradiance_volume.sh [cornell|sponza|adaptive|sweep|sh]   (BOUNCE_BIN: default build/bin; BOUNCE_RUNS: default build/runs)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bin="${BOUNCE_BIN:-build/bin}/irradiance_volume"
-out=build/runs/irradiance_volume
+out="${BOUNCE_RUNS:-build/runs}/irradiance_volume"
 results=docs/results/irradiance_volume.json
 figures=docs/figures
 mkdir -p "$out" "$figures"
@@ -72,6 +72,37 @@ if [[ $part == all || $part == adaptive ]]; then
   for sc in modern-hall conference; do
     run "issue31-merge-k2-norefit-$sc" --scene "$sc" --noise-sigmas 2 --refit off
     run "issue31-merge-k2-noconforming-$sc" --scene "$sc" --noise-sigmas 2 --conforming off
+  done
+fi
+
+if [[ $part == all || $part == sweep ]]; then
+  # Issue 31, third session: per scene, the uniform grid (program defaults otherwise) and
+  # merged octrees built from its very probes (--sweep-bias-budget, --sweep-noise-sigmas:
+  # every budget at every slack), into docs/results/irradiance_volume_sweep.json, tabulated
+  # by `irradiance_volume_table.py --sweep` (the share of the grid's probes at its error).
+  # The probes' noise: from the even and odd rays of one Fibonacci set (calibrated, as the
+  # second session's bias budget), from two independently turned halves, or from a repeat
+  # of the set turned at random (both measured, not calibrated). First budgets 0.25 .. 4 at
+  # the default slack (4 standard deviations), "sweep-*" (the first runs spelled
+  # --noise-estimate as --halves even-odd|independent); then budgets 0.25, 1, 4 at slacks
+  # 0 .. 8, "grid-*". About 2 minutes a run on 2 shared cores.
+  for sc in cornell cornell-box bunny living-room modern-hall sponza conference; do
+    for noise in even-odd independent; do
+      calibrate=off
+      [[ $noise == even-odd ]] && calibrate=on
+      "$bin" --scene "$sc" --mode uniform --noise-estimate "${noise/#independent/independent-halves}" \
+        --calibrate-noise "$calibrate" --sweep-bias-budget 0.25 0.5 1 2 4 --json "$out/sweep-$noise-$sc.json" 2>/dev/null | tail -7
+      python3 docs/studies/results.py add docs/results/irradiance_volume_sweep.json "sweep-$noise-$sc" "$out/sweep-$noise-$sc.json"
+    done
+  done
+  for noise in rotated-repeat even-odd; do
+    for sc in cornell cornell-box bunny living-room modern-hall sponza conference; do
+      calibrate=off
+      [[ $noise == even-odd ]] && calibrate=on
+      "$bin" --scene "$sc" --mode uniform --noise-estimate "$noise" --calibrate-noise "$calibrate" \
+        --sweep-bias-budget 0.25 1 4 --sweep-noise-sigmas 0 1 2 4 8 --json "$out/grid-$noise-$sc.json" 2>/dev/null | tail -18
+      python3 docs/studies/results.py add docs/results/irradiance_volume_sweep.json "grid-$noise-$sc" "$out/grid-$noise-$sc.json"
+    done
   done
 fi
 

@@ -20,9 +20,9 @@
 // with and without the probes' visibility (DDGI distance moments baked by Embree) and
 // reports rel_rms against the one-bounce reference over every covered pixel and over the
 // pixels within one finest cell of another surface (where walls meet floors).
-#include "/work/main/examples/common/cli_choices.hpp"
-#include "/work/main/examples/common/cli_number_checks.hpp"
-#include "/work/main/examples/common/run_program.hpp"
+#include "../common/cli_choices.hpp"
+#include "../common/cli_number_checks.hpp"
+#include "../common/run_program.hpp"
 
 #include <bounce/embree/probe_baker.hpp>
 #include <bounce/embree/probe_relocation.hpp>
@@ -35,6 +35,7 @@
 #include <bounce/study/stage_timer.hpp>
 #include <bounce/study/volume_sphere.hpp>
 #include <bounce/study/volume_surface.hpp>
+#include <bounce/study/volume_sweep.hpp>
 
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -56,6 +57,10 @@ namespace {
 enum class volume_mode { uniform, adaptive };
 const examples::choices<volume_mode> mode_names{{"uniform", volume_mode::uniform}, {"adaptive", volume_mode::adaptive}};
 const examples::choices<volume_refinement> refine_names{{"merge", volume_refinement::merge}, {"split", volume_refinement::split}};
+const examples::choices<embree::probe_noise_estimate> noise_names{
+    {"even-odd", embree::probe_noise_estimate::even_odd},
+    {"independent-halves", embree::probe_noise_estimate::independent_halves},
+    {"rotated-repeat", embree::probe_noise_estimate::rotated_repeat}};
 const examples::choices<cpu::volume_interpolation> interp_names{{"trilinear", cpu::volume_interpolation::trilinear},
                                                                 {"weighted", cpu::volume_interpolation::weighted}};
 
@@ -83,6 +88,8 @@ struct options {
     embree::probe_visibility_settings visibility;
     float self_shadow_bias = 0.3f;
     std::string relocate = "off";
+    embree::probe_noise_estimate noise = embree::probe_noise_estimate::even_odd;
+    std::vector<float> sweep, sweep_sigmas;  // merged octrees built from the same probes
 };
 
 // --surface: the volume at the camera's G-buffer, without and with visibility, against the
@@ -188,6 +195,7 @@ int run(const options& o) {
     bs.seed = o.seed;
     bs.gradient_step = o.gradient_step * std::min({finest.x, finest.y, finest.z});
     bs.gradient_noise_ratio = o.gradient_noise;
+    bs.noise = o.noise;
     std::size_t batch = 0;
     bs.progress = [&](std::size_t done, std::size_t total) {
         if (done == total || done % 64 < 4) std::fprintf(stderr, "\rbake: batch %zu, %zu / %zu probes   ", batch, done, total);
@@ -195,10 +203,12 @@ int run(const options& o) {
     };
     const embree::probe_baker baker(light, bvh, scene, bs);
     embree::relocating_probe_source relocating(baker, bvh, scene, std::min({finest.x, finest.y, finest.z}));
+    study::probe_memo memo([&](std::span<const glm::vec3> at, std::span<irradiance_probe> out) {
+        o.relocate == "on" ? relocating(at, out) : baker(at, out);
+    });  // --sweep-bias-budget builds its octrees from the same probes
     irradiance_volume_build_stats stats;
     const auto bake_start = std::chrono::steady_clock::now();
-    const irradiance_volume volume = o.relocate == "on" ? irradiance_volume::build(scene, lo, hi, vs, relocating, &stats)
-                                                        : irradiance_volume::build(scene, lo, hi, vs, baker, &stats);
+    const irradiance_volume volume = irradiance_volume::build(scene, lo, hi, vs, memo, &stats);
     const double bake_ms = study::ms_since(bake_start);
     std::fprintf(stderr, "\n");
     if (o.surface)  // the sphere path prints this line below, with the reference's popping
@@ -237,6 +247,9 @@ int run(const options& o) {
                     f.popping_excess, f.lookup_ns);
         if (name == chosen) best = std::move(f), chosen_how = how;
     }
+    irradiance_volume_settings merged = vs;  // the sweep: adaptive octrees of the same lattice
+    merged.min_depth = o.min_depth >= 0 ? o.min_depth : std::min(1, o.max_depth);
+    const auto sweep = study::bias_budget_sweep(scene, lo, hi, merged, memo, sphere, o.sweep, o.sweep_sigmas);
     std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms; reference popping %.4f\n",
                 scene.name.c_str(), examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(),
                 stats.probes_inside, volume.leaf_count(), bake_ms, sphere.reference_popping());
@@ -269,6 +282,8 @@ int run(const options& o) {
                          {"noise_sigmas", o.noise_sigmas}, {"refit", o.refit},
                          {"refine", examples::name_of(refine_names, o.refine)}, {"conforming", o.conforming},
                          {"bias_budget", o.bias_budget}, {"calibrate_noise", o.calibrate}, {"gradient_noise_ratio", o.gradient_noise},
+                         {"noise_estimate", examples::name_of(noise_names, o.noise)}, {"sweep_bias_budget", o.sweep},
+                         {"sweep_noise_sigmas", o.sweep_sigmas},
                          {"seed", o.seed}, {"threads", o.threads}};
     report.timings_ms = {{"bake", bake_ms}, {"reference", sphere.reference_ms()}};
     report.error = best.error;
@@ -286,6 +301,7 @@ int run(const options& o) {
     j["popping_reference_series"] = sphere.reference_popping_series();
     j["lookups"] = lookups;
     j["build"] = study::build_stats_json(stats);
+    if (!sweep.empty()) j["sweep"] = study::to_json(sweep);
     j["light_transport"] = "one-bounce indirect: probes and reference integrate Kd/pi * direct irradiance at the first hit";
     j["provenance"] = study::collect_provenance().to_json();
     io::write_text_file(o.json, j.dump(2, ' ', false, ojson::error_handler_t::replace) + "\n");
@@ -350,6 +366,12 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--gradient-noise", o.gradient_noise, "keep a probe's gradient only where it exceeds this times its noise "
                                                          "(0: keep all)")->check(finite_non_negative);
+    examples::add_choice(app, "--noise-estimate", o.noise, noise_names, "a probe's noise: from its rays' even and odd halves, "
+                         "from two independently turned halves, or from a repeat of its rays turned at random");
+    app.add_option("--sweep-bias-budget", o.sweep, "also build merged octrees from the same probes at these bias budgets and "
+                                                   "report their trilinear lookups under \"sweep\"")->check(finite_positive);
+    app.add_option("--sweep-noise-sigmas", o.sweep_sigmas, "the sweep's octrees at each of these --noise-sigmas too")
+        ->check(finite_non_negative);
     app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge")
         ->check(finite_positive);
     app.add_option("--seed", o.seed, "seed of the probes' and the reference's light samples, 0 .. 2^64 - 1")

@@ -21,6 +21,13 @@ bounce_cli_refusal("a --support of 1" PROGRAM irradiance_volume MATCH "--support
                    ARGS ${iv_big} --support 1)
 bounce_cli_refusal("a --path of nan" PROGRAM irradiance_volume MATCH "--path.*'nan' is not"
                    ARGS ${iv_big} --path 0.1 0.1 0.1 nan 0.5 0.5)
+# Issue 31, third session: the sweep's budgets and the noise estimate's name.
+bounce_cli_refusal("a --sweep-bias-budget of nan" PROGRAM irradiance_volume MATCH "--sweep-bias-budget.*'nan' is not"
+                   ARGS ${iv_big} --sweep-bias-budget 1 nan)
+bounce_cli_refusal("a --sweep-noise-sigmas of -1" PROGRAM irradiance_volume MATCH "--sweep-noise-sigmas.*'-1' is not"
+                   ARGS ${iv_big} --sweep-noise-sigmas -1)
+bounce_cli_refusal("a --noise-estimate not known" PROGRAM irradiance_volume MATCH "--noise-estimate.*thirds"
+                   ARGS ${iv_big} --noise-estimate thirds)
 
 # A closed box whose twelve triangles all face outwards (a room wound the wrong way), lit
 # from inside: every probe's rays hit the backs of triangles, so every probe is inside and

@@ -6,11 +6,14 @@
 
 #include <bounce/embree/probe_baker.hpp>
 #include <bounce/study/volume_sphere.hpp>
+#include <bounce/study/volume_sweep.hpp>
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <vector>
 
 using namespace bounce;
 
@@ -124,4 +127,62 @@ TEST_CASE("in a uniform environment every lookup matches the reference on the sp
         CHECK(f.lookup_ns > 0);
     }
     CHECK_THROWS_AS(study::volume_sphere_study(light, {{0, 0, 0}, {1, 0, 0}, 0.f}, ss), parameter_error);
+}
+
+TEST_CASE("a probe memo bakes each position once, and a sweep's octrees come from the grid's probes",
+          "[irradiance_volume][study]") {
+    // A lit room: a uniform grid of depth 2, then merged octrees of the same lattice from the
+    // memo: they bake nothing new, and each is the octree built from the baker directly.
+    hand_built::scene s;
+    const auto m = hand_built::add_material(s, glm::vec3(0.6f));
+    add_box(s, glm::vec3(-1.f), glm::vec3(1.f), false, m);
+    s.lights.push_back(bounce::point_light{{0.f, 0.5f, 0.f}, glm::vec3(5.f)});
+    const embree::accel bvh(s);
+    const embree::reference_integrator light(bvh, s);
+    embree::probe_baker_settings bs;
+    bs.rays = 64;
+    bs.noise = embree::probe_noise_estimate::rotated_repeat;
+    const embree::probe_baker baker(light, bvh, s, bs);
+    std::size_t calls = 0;
+    study::probe_memo memo([&](std::span<const glm::vec3> at, std::span<irradiance_probe> out) {
+        ++calls;
+        baker(at, out);
+    });
+    irradiance_volume_settings vs;
+    vs.min_depth = vs.max_depth = 2;
+    const glm::vec3 lo(-0.9f), hi(0.9f);
+    const irradiance_volume grid = irradiance_volume::build(s, lo, hi, vs, memo);
+    CHECK(memo.baked() == 125);
+    CHECK(memo.reused() == 0);
+    const std::size_t grid_calls = calls;
+    study::volume_sphere_settings ss;
+    ss.frames = 2;
+    ss.sphere_points = 16;
+    ss.popping_steps = 4;
+    ss.reference_samples = 16;
+    ss.repeat = 1;
+    const study::volume_sphere_study sphere(light, {{-0.5f, -0.3f, 0.f}, {0.5f, -0.3f, 0.f}, 0.1f}, ss);
+    vs.min_depth = 1;
+    vs.calibrate_noise = false;
+    const std::vector<float> budgets{1.f, 1000.f};
+    const auto sweep = study::bias_budget_sweep(s, lo, hi, vs, memo, sphere, budgets);
+    CHECK(memo.baked() == 125);  // every probe of the merged octrees came from memory
+    CHECK(memo.reused() == 2 * 125);
+    CHECK(calls == grid_calls);
+    REQUIRE(sweep.size() == 2);
+    vs.refinement = volume_refinement::merge;
+    vs.bias_budget = 1000.f;
+    const irradiance_volume direct = irradiance_volume::build(s, lo, hi, vs, baker);
+    CHECK(sweep[1].probes == direct.probes().size());
+    CHECK(sweep[1].leaves == direct.leaf_count());
+    CHECK(sweep[1].probes <= sweep[0].probes);  // a larger budget merges at least as much
+    CHECK(sweep[1].probes < grid.probes().size());
+    CHECK(study::to_json(sweep).size() == 2);
+    CHECK_THROWS_AS(study::bias_budget_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{-1.f}), parameter_error);
+    CHECK_THROWS_AS(study::bias_budget_sweep(s, lo, hi, vs, memo, sphere, budgets, std::vector<float>{-1.f}), parameter_error);
+    const auto by_sigmas = study::bias_budget_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{1.f}, std::vector<float>{0.f, 8.f});
+    REQUIRE(by_sigmas.size() == 2);
+    CHECK(by_sigmas[0].probes >= by_sigmas[1].probes);  // more slack merges at least as much
+    CHECK(study::to_json(by_sigmas)[1]["noise_sigmas"] == 8.f);
+    CHECK_THROWS_AS(study::probe_memo(nullptr), parameter_error);
 }

@@ -16,6 +16,7 @@
 #include <numbers>
 
 #include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 namespace bounce::embree {
 
@@ -23,9 +24,20 @@ namespace {
 
 constexpr std::uint64_t stage_probe = 0x70726f6265ull;  // "probe"
 
+constexpr std::uint64_t stage_rotation = 0x726f74ull;  // "rot"
+
 std::uint64_t position_hash(glm::vec3 p) {
     return (std::uint64_t(std::bit_cast<std::uint32_t>(p.x)) << 32) ^
            (std::uint64_t(std::bit_cast<std::uint32_t>(p.y)) << 16) ^ std::uint64_t(std::bit_cast<std::uint32_t>(p.z));
+}
+
+/// A uniformly random rotation (Shoemake 1992, "Uniform random rotations": a unit
+/// quaternion from three uniform numbers) drawn from `seed`.
+glm::dmat3 random_rotation(std::uint64_t seed) {
+    const auto u = [&](std::uint64_t k) { return double(derive_seed(seed, stage_rotation, k) >> 11) * 0x1p-53; };
+    const double u1 = u(0), u2 = 2 * std::numbers::pi * u(1), u3 = 2 * std::numbers::pi * u(2);
+    const double a = std::sqrt(1 - u1), b = std::sqrt(u1);
+    return glm::mat3_cast(glm::dquat(b * std::cos(u3), a * std::sin(u2), a * std::cos(u2), b * std::sin(u3)));
 }
 
 }  // namespace
@@ -47,11 +59,30 @@ probe_baker::probe_baker(const reference_integrator& light, const accel& bvh, co
             "must be finite and >= 0 (0: keep every gradient)");
     require(settings_.inside_fraction >= 0 && settings_.inside_fraction <= 1, "inside_fraction", "must lie in [0, 1]");
     require_match(bvh, scene);
-    directions_ = spherical_fibonacci_directions(settings_.rays);
+    if (settings_.noise == probe_noise_estimate::independent_halves && settings_.rays >= 2) {
+        directions_ = spherical_fibonacci_directions(settings_.rays / 2);
+        const auto second = spherical_fibonacci_directions(settings_.rays - settings_.rays / 2);
+        directions_.insert(directions_.end(), second.begin(), second.end());
+    } else {
+        directions_ = spherical_fibonacci_directions(settings_.rays);
+    }
 }
 
-probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t seed, cast* details) const {
-    const std::size_t n = directions_.size();
+std::vector<glm::dvec3> probe_baker::directions_at(glm::vec3 position) const {
+    std::vector<glm::dvec3> dirs = directions_;
+    if (settings_.noise != probe_noise_estimate::independent_halves || dirs.size() < 2) return dirs;
+    const std::uint64_t seed = derive_seed(settings_.seed, position_hash(position), 0);
+    const std::size_t first = dirs.size() / 2;
+    for (std::size_t h = 0; h < 2; ++h) {
+        const glm::dmat3 r = random_rotation(derive_seed(seed, stage_rotation, 16 + h));
+        for (std::size_t j = h ? first : 0; j < (h ? dirs.size() : first); ++j) dirs[j] = r * dirs[j];
+    }
+    return dirs;
+}
+
+probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t seed, std::span<const glm::dvec3> directions,
+                                          cast* details) const {
+    const std::size_t n = directions.size();
     std::vector<glm::dvec3> radiance(n);
     double inverse_distance_sum = 0;
     std::size_t back = 0;
@@ -59,7 +90,7 @@ probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t see
     for (std::size_t j = 0; j < n; ++j) {
         ray r;
         r.origin = position;
-        r.direction = glm::vec3(directions_[j]);
+        r.direction = glm::vec3(directions[j]);
         float distance = 0;
         radiance[j] = glm::dvec3(light_.incoming_radiance(r, derive_seed(seed, stage_probe, j), &distance));
         if (details && std::isfinite(distance)) {
@@ -82,11 +113,14 @@ probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t see
     };
     estimate e;
     e.all = to_float(sh_project_monte_carlo<irradiance_volume_bands, glm::dvec3>(
-        std::span<const glm::dvec3>(directions_), std::span<const glm::dvec3>(radiance), 1 / (4 * std::numbers::pi)));
-    // The two halves: even and odd rays (each a Fibonacci set of half the density).
-    for (int h = 0; h < 2 && n >= 2; ++h) {
+        directions, std::span<const glm::dvec3>(radiance), 1 / (4 * std::numbers::pi)));
+    // The two halves: the two turned sets (independent_halves), else the even and the odd
+    // rays (each a Fibonacci set of half the density).
+    const bool independent = settings_.noise == probe_noise_estimate::independent_halves;
+    for (std::size_t h = 0; h < 2 && n >= 2; ++h) {
         std::vector<glm::dvec3> dirs, values;
-        for (std::size_t j = std::size_t(h); j < n; j += 2) dirs.push_back(directions_[j]), values.push_back(radiance[j]);
+        const std::size_t begin = independent ? (h ? n / 2 : 0) : h, end = independent && !h ? n / 2 : n;
+        for (std::size_t j = begin; j < end; j += independent ? 1 : 2) dirs.push_back(directions[j]), values.push_back(radiance[j]);
         e.half[h] = to_float(sh_project_monte_carlo<irradiance_volume_bands, glm::dvec3>(
             std::span<const glm::dvec3>(dirs), std::span<const glm::dvec3>(values), 1 / (4 * std::numbers::pi)));
     }
@@ -95,12 +129,17 @@ probe_baker::estimate probe_baker::project(glm::vec3 position, std::uint64_t see
 
 namespace {
 
-/// Half the largest difference of two estimates' irradiance luminance at the axis normals.
-float probe_noise(const irradiance_probe::coefficients& a, const irradiance_probe::coefficients& b) {
+/// Half the difference of two estimates' irradiance luminance at the axis normals: the
+/// largest (`worst`), or the root mean square over the six (independent halves: its square
+/// is an unbiased estimate of the mean's variance there).
+float probe_noise(const irradiance_probe::coefficients& a, const irradiance_probe::coefficients& b, bool worst) {
     const auto ea = bounce::detail::axis_irradiance(a), eb = bounce::detail::axis_irradiance(b);
-    float worst = 0;
-    for (std::size_t k = 0; k < ea.size(); ++k) worst = std::max(worst, 0.5f * std::abs(ea[k] - eb[k]));
-    return worst;
+    double largest = 0, sum2 = 0;
+    for (std::size_t k = 0; k < ea.size(); ++k) {
+        const double d = 0.5 * std::abs(double(ea[k]) - double(eb[k]));
+        largest = std::max(largest, d), sum2 += d * d;
+    }
+    return float(worst ? largest : std::sqrt(sum2 / double(ea.size())));
 }
 
 /// Central-difference gradients from the six shifted estimates (+x -x +y -y +z -z), each
@@ -134,9 +173,21 @@ irradiance_probe probe_baker::bake(glm::vec3 position) const {
     irradiance_probe p;
     p.position = position;
     cast details;
-    const estimate centre = project(position, seed, &details);
+    const std::vector<glm::dvec3> dirs = directions_at(position);
+    const estimate centre = project(position, seed, dirs, &details);
     p.radiance = centre.all;
-    p.noise = probe_noise(centre.half[0], centre.half[1]);
+    switch (settings_.noise) {
+    case probe_noise_estimate::even_odd: p.noise = probe_noise(centre.half[0], centre.half[1], true); break;
+    case probe_noise_estimate::independent_halves: p.noise = probe_noise(centre.half[0], centre.half[1], false); break;
+    case probe_noise_estimate::rotated_repeat: {  // the same set turned at random: (a - b) / sqrt 2
+        std::vector<glm::dvec3> turned = dirs;
+        const glm::dmat3 r = random_rotation(derive_seed(seed, stage_rotation, 32));
+        for (auto& d : turned) d = r * d;
+        const estimate repeat = project(position, derive_seed(seed, stage_rotation, 33), turned, nullptr);
+        p.noise = std::sqrt(2.f) * probe_noise(centre.all, repeat.all, false);
+        break;
+    }
+    }
     p.harmonic_mean_distance = details.harmonic_mean_distance;
     p.inside = details.back_fraction > settings_.inside_fraction;
     const float step = std::min(settings_.gradient_step, settings_.nearest_fraction * details.nearest);
@@ -147,7 +198,7 @@ irradiance_probe probe_baker::bake(glm::vec3 position) const {
         for (int k = 0; k < 6; ++k) {
             glm::vec3 q = position;
             q[k / 2] += (k % 2 ? -step : step);
-            shifted[std::size_t(k)] = project(q, seed, nullptr);
+            shifted[std::size_t(k)] = project(q, seed, dirs, nullptr);
         }
         p.gradient = gated_gradient(shifted, step, settings_.gradient_noise_ratio);
     }

@@ -17,7 +17,8 @@
 /// - Harmonic mean distance: rays / sum_j 1 / d_j over the hits (misses add 0).
 /// - Noise: the probe's `noise` is half the largest difference, over the six axis normals,
 ///   between the irradiance luminance projected from the even rays and from the odd rays
-///   (the standard error of the whole estimate, from its two halves).
+///   (the standard error of the whole estimate, from its two halves); or measured without
+///   a model (probe_baker_settings::noise, probe_noise_estimate).
 /// - Inside geometry: a probe whose rays hit the back of triangles (the side opposite
 ///   their counter-clockwise normal) in more than `inside_fraction` of the cases is
 ///   flagged inside; it gets no gradient.
@@ -40,6 +41,29 @@
 
 namespace bounce::embree {
 
+/// How the probe baker finds a probe's `noise`, its standard error at the six axis normals
+/// (issue 31, third session: the merge criterion is only as good as this).
+enum class probe_noise_estimate {
+    /// Half the difference of the irradiance from the even and from the odd rays of the one
+    /// Fibonacci set, the worst of the six normals. The two halves are not independent
+    /// (together they err less than their difference says), so it overstates the error by a
+    /// factor that varies over the scene.
+    even_odd,
+    /// The rays are two Fibonacci sets of rays / 2, each turned by its own uniformly random
+    /// rotation (seeded by the probe's position, shared by its gradient's displaced probes):
+    /// independent unbiased halves a, b; the probe is their mean and `noise` the root mean
+    /// square over the six normals of (a - b) / 2, whose square is an unbiased estimate of
+    /// the mean's variance (E (a - b)^2 / 4 = var (a + b) / 2), without a model. It costs
+    /// accuracy: two turned halves err more than one set of all the rays.
+    independent_halves,
+    /// The probe is the one Fibonacci set of `rays` (as even_odd); a second projection along
+    /// the same set turned by a uniformly random rotation (seeded by the position) measures
+    /// it: `noise` is the root mean square over the six normals of their difference over
+    /// sqrt 2 (the unturned set is one draw of the turned ones: E d^2 = 2 var). One more
+    /// projection per probe (an eighth more rays with gradients).
+    rotated_repeat,
+};
+
 /// Parameters of the probe baker (unit and typical value with each).
 struct probe_baker_settings {
     /// Rays per probe (and per displaced probe of a gradient). Typical: 256-1024.
@@ -55,6 +79,8 @@ struct probe_baker_settings {
     /// this ratio times the noise, estimated as half the difference of the gradients from
     /// the even and the odd rays. Typical: 1-2; 0 keeps every gradient.
     float gradient_noise_ratio = 1.f;
+    /// How a probe's `noise` is found (probe_noise_estimate).
+    probe_noise_estimate noise = probe_noise_estimate::even_odd;
     /// Fraction of back-facing hits above which a probe is inside geometry. Typical: 0.5.
     float inside_fraction = 0.5f;
     /// Base seed of the area-light samples at the hits (unused without emitters).
@@ -76,8 +102,12 @@ public:
                 probe_baker_settings settings = {});
 
     const probe_baker_settings& settings() const noexcept { return settings_; }
-    /// The unit ray directions every probe uses.
+    /// The unit ray directions every probe uses (with independent_halves: the two halves'
+    /// unturned sets, one after the other; each probe turns each half its own way).
     const std::vector<glm::dvec3>& directions() const noexcept { return directions_; }
+    /// The directions of the probe at `position` (directions(), each half turned by the
+    /// position's own rotation with independent_halves).
+    std::vector<glm::dvec3> directions_at(glm::vec3 position) const;
 
     /// One probe at `position` (finite; throws parameter_error naming "position").
     irradiance_probe bake(glm::vec3 position) const;
@@ -96,7 +126,7 @@ public:
 
 private:
     struct cast;
-    estimate project(glm::vec3 position, std::uint64_t seed, cast* details) const;
+    estimate project(glm::vec3 position, std::uint64_t seed, std::span<const glm::dvec3> directions, cast* details) const;
 
     const reference_integrator& light_;
     const accel& bvh_;

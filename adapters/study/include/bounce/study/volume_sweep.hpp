@@ -1,0 +1,68 @@
+#pragma once
+/// \file volume_sweep.hpp
+/// Adaptive irradiance volumes against the uniform grid at equal error (issue 31, third
+/// session): every probe of the finest lattice is baked once (probe_memo), then one merged
+/// octree per bias budget (irradiance_volume_settings::bias_budget) is built from those
+/// same probes and measured on the moving sphere, so that the share of the grid's probes at
+/// the grid's error can be read off the sweep (docs/studies/irradiance_volume_table.py
+/// interpolates it).
+
+#include <bounce/scene_view.hpp>
+#include <bounce/study/volume_sphere.hpp>
+#include <bounce/volume/probe_octree.hpp>
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
+
+namespace bounce::study {
+
+/// A probe_source that bakes each position once: a later batch takes the probes already
+/// baked at the same position (bit for bit) and passes only the others to `source`.
+class probe_memo {
+public:
+    using source_type = std::function<void(std::span<const glm::vec3>, std::span<irradiance_probe>)>;
+    /// Throws parameter_error naming "source" when it is empty.
+    explicit probe_memo(source_type source);
+    /// Throws parameter_error naming "out" when its size is not the positions'.
+    void operator()(std::span<const glm::vec3> positions, std::span<irradiance_probe> out);
+    std::size_t baked() const noexcept { return baked_; }    ///< positions passed to the source
+    std::size_t reused() const noexcept { return reused_; }  ///< positions answered from memory
+
+private:
+    struct key_hash {
+        std::size_t operator()(const std::array<std::uint32_t, 3>& k) const noexcept;
+    };
+    source_type source_;
+    std::unordered_map<std::array<std::uint32_t, 3>, irradiance_probe, key_hash> memo_;
+    std::size_t baked_ = 0, reused_ = 0;
+};
+
+/// One merged octree of a sweep and its trilinear lookup on the sphere.
+struct volume_sweep_point {
+    float bias_budget = 0, noise_sigmas = 0;
+    std::size_t probes = 0, probes_inside = 0, leaves = 0;
+    volume_lookup_figures trilinear;
+};
+
+/// For every budget (> 0, finite) and every noise_sigmas (>= 0, finite; empty: settings'
+/// own), the merged octree over [lo, hi] (`settings` with refinement = merge, that
+/// bias_budget and noise_sigmas: the slack of the bias test) built from `source`, and its
+/// trilinear lookup measured on `sphere`; prints a line each ("sweep bias_budget ...").
+/// Throws parameter_error naming "budgets" or "sigmas" for a value out of range.
+std::vector<volume_sweep_point> bias_budget_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
+                                                  irradiance_volume_settings settings, probe_memo& source,
+                                                  const volume_sphere_study& sphere, std::span<const float> budgets,
+                                                  std::span<const float> sigmas = {});
+
+/// [{"bias_budget", "noise_sigmas", "probes", "probes_inside", "leaves", "rel_rms",
+/// "popping", "popping_excess"}, ...]
+nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep);
+
+}  // namespace bounce::study
