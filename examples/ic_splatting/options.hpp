@@ -87,7 +87,7 @@ struct options {
     std::uint32_t verify_rays = 8;    // verification: probe rays per pixel
     std::uint32_t verify_tile = 4;    // verification: pixels per side of a pooled tile
     float verify_k = 3.f;             // verification: standard errors of the tile's mean residual
-    float verify_tolerance = 0.1f;    // verification: and this times the cache's mean there
+    float verify_tolerance = 0.25f;   // verification: and this times the frame's mean
     cpu::scan_kind scan = cpu::scan_kind::batched;
     cpu::scan_order scan_order = cpu::scan_order::linear;  // unless given: coarse-to-fine when progressive
     std::size_t scan_batch = 0;
@@ -392,7 +392,7 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--verify-k", o.verify_k, "--verify: a tile disagrees beyond this many standard errors ...")
         ->check(examples::finite_positive)
         ->capture_default_str();
-    app.add_option("--verify-tolerance", o.verify_tolerance, "--verify: ... and beyond this times the cache's mean over the tile")
+    app.add_option("--verify-tolerance", o.verify_tolerance, "--verify: ... and beyond this times the frame's mean luminance")
         ->check(examples::finite_non_negative)
         ->capture_default_str();
     app.add_flag("--neighbour-clamp,!--no-neighbour-clamp", o.neighbour_clamp,

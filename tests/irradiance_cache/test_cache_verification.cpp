@@ -4,7 +4,8 @@
 // measured inside the strip know it (their radius is small there, as the split sphere's is
 // at the Cornell box's ceiling strip in front of the light), so the scan, whose records
 // elsewhere reach far, covers the strip with the plane's irradiance. A probe per pixel (the
-// truth with Monte Carlo-like noise of a known variance) finds it.
+// truth with Monte Carlo-like noise of a known variance; on every other pixel, as the cache
+// asks) finds it.
 #include <bounce/cache/verification.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/cache/weighting.hpp>
@@ -155,7 +156,7 @@ TEST_CASE("the verification leaves a cache that agrees with its probes alone", "
     };
     image<glm::vec3> out(64, 64);
     const cpu::cache_frame_stats s = cache.render(v.g.view(), v.cam, flat, out.view());
-    CHECK(s.verify_tiles == 256);  // one round of 16 x 16 tiles, then it stops: nothing disagreed
+    CHECK(s.verify_tiles == 256 + 289);  // 16 x 16 tiles, then 17 x 17 shifted by half a tile
     CHECK(s.verify_disagreed == 0);
     CHECK(s.verify_shrunk == 0);
 }
@@ -175,8 +176,11 @@ TEST_CASE("a tile's test pools its pixels' residuals and variances", "[irradianc
     CHECK(low.pixels == 16);
     CHECK(low.residual == Approx(-16 * 0.3).epsilon(1e-5));
     CHECK(low.variance == Approx(16 * 0.01).epsilon(1e-5));
-    CHECK(low.disagrees(o));       // mean -0.3 against a standard error of 0.025
-    CHECK_FALSE(noisy.disagrees(o));  // against 0.25: within 3 of them
+    CHECK(low.disagrees(o, 1.0));         // mean -0.3 against a standard error of 0.025
+    CHECK_FALSE(noisy.disagrees(o, 1.0));  // against 0.25: within 3 of them
+    // The tolerance is the frame's: the same 30% in a tile at a tenth of the frame's mean
+    // luminance (0.03 of the frame's scale) is not a disagreement.
+    CHECK_FALSE(low.disagrees(o, 10.0));
     // The floor: a probe that reports no spread still has (Y / 2)^2 / rays.
     const pixel_residual floored = residual_at(sum, albedo, {glm::vec3(1.f), 0.f, 4});
     CHECK(floored.variance == Approx(0.25 / 4));
@@ -186,5 +190,5 @@ TEST_CASE("a tile's test pools its pixels' residuals and variances", "[irradianc
     // Below the tolerance: a 5% bias, however certain, is not a disagreement.
     tile_residuals slight;
     for (int i = 0; i < 16; ++i) slight.add(residual_at(sum, albedo, {glm::vec3(0.95f), 1e-8f, 0}));
-    CHECK_FALSE(slight.disagrees(o));
+    CHECK_FALSE(slight.disagrees(o, 1.0));
 }

@@ -12,7 +12,9 @@
 /// probe is too noisy to judge one pixel (8 rays: a standard error near the value itself), so
 /// the residuals (probe minus cache) of a `tile` x `tile` block of pixels are pooled: the tile
 /// disagrees when the mean residual exceeds `k` of its standard errors and `tolerance` times
-/// the cache's mean there (a bias a user would see, not a rounding of the interpolation).
+/// the frame's mean (the scale the image's relative error is measured on: a gross error such
+/// as a missed feature, not the records' own noise, which is a few percent of it, nor a
+/// relative error in a dark corner that weighs nothing in the image).
 /// Where a tile disagrees, the cache measures a record at its pixel whose residual points
 /// furthest the tile's way (the scan's own record maker); with neighbour clamping the older
 /// records then shrink to it and the scan fills what they uncover (the mechanism that finds
@@ -50,7 +52,7 @@ struct verification_options {
     std::uint32_t rounds = 0;  ///< verify-and-seed passes after the scan, each followed by a scan; 0: off
     std::uint32_t tile = 4;    ///< pixels per side of the blocks whose residuals are pooled
     float k = 3.f;             ///< a tile disagrees beyond k standard errors of its mean residual ...
-    float tolerance = 0.1f;    ///< ... and beyond this times the cache's mean luminance over the tile
+    float tolerance = 0.25f;   ///< ... and beyond this times the frame's mean luminance (the cache's)
 
     bool enabled() const noexcept { return rounds > 0; }
     /// Throws parameter_error naming the first bad field.
@@ -107,13 +109,12 @@ struct tile_residuals {
         cache += r.cache;
         ++pixels;
     }
-    /// Whether the tile's mean residual exceeds k standard errors and tolerance times the
-    /// cache's mean luminance (sums over n pixels: mean = sum / n, its variance sum var / n^2,
-    /// so the test reads the same on the sums).
-    bool disagrees(const verification_options& o) const {
+    /// Whether the tile's mean residual exceeds k standard errors and tolerance times
+    /// `scale`, the frame's mean luminance (the mean is sum / n, its variance sum var / n^2).
+    bool disagrees(const verification_options& o, double scale) const {
         if (pixels == 0) return false;
-        const double d = std::abs(residual);
-        return d > double(o.k) * std::sqrt(variance) && d > double(o.tolerance) * cache;
+        const double d = std::abs(residual) / double(pixels);
+        return d > double(o.k) * std::sqrt(variance) / double(pixels) && d > double(o.tolerance) * scale;
     }
 };
 

@@ -387,7 +387,8 @@ private:
     // measures, committed in tile order), the older records within their zone of it shrunk to
     // R_new + distance (neighbour clamping towards the new record alone), and the splat and
     // scan redone on what that uncovered. Odd rounds shift the tiles by half a tile, so a
-    // feature on a tile border is pooled whole once.
+    // feature on a tile border is pooled whole once. Probes sit on a checkerboard (half the
+    // pixels: a strip one pixel wide still has every other pixel probed) at half the cost.
     template <class Sampler>
     void verify_into(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler, image_view<glm::vec4> splat,
                      const gbuffer_view<float>* record_points, cache_frame_stats& stats) {
@@ -397,8 +398,9 @@ private:
         timed(stats.verify_ms, [&] {
             tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
                 for (std::size_t x = 0; x < w; ++x)
-                    probes[y * w + x] = g.covered(x, y) ? probe_(g.position(x, y), g.normal(x, y), y * w + x)
-                                                        : probe_estimate{glm::vec3(0.f), -1.f};
+                    probes[y * w + x] = g.covered(x, y) && (x + y) % 2 == 0
+                                            ? probe_(g.position(x, y), g.normal(x, y), y * w + x)
+                                            : probe_estimate{glm::vec3(0.f), -1.f};
             });
         });
         const gbuffer_view<float>& where = record_points ? *record_points : g;
@@ -407,6 +409,16 @@ private:
         for (std::uint32_t round = 0; round < vo.rounds; ++round) {
             std::vector<pixel_xy> seeds;
             timed(stats.verify_ms, [&] {
+                // The frame's scale: the cache's mean luminance over the pixels with weight.
+                double sum = 0;
+                std::size_t count = 0;
+                for (std::size_t y = 0; y < h; ++y)
+                    for (std::size_t x = 0; x < w; ++x)
+                        if (const glm::vec4 s = splat(x, y); g.covered(x, y) && s.w > 0.f) {
+                            sum += verification_luminance(glm::vec3(s) / s.w);
+                            ++count;
+                        }
+                const double scale = count > 0 ? sum / double(count) : 0.0;
                 const std::size_t t = vo.tile, shift = (round % 2) ? t / 2 : 0;
                 const std::size_t tw = (w + shift + t - 1) / t, th = (h + shift + t - 1) / t;
                 std::vector<std::optional<pixel_xy>> found(tw * th);
@@ -418,7 +430,7 @@ private:
                         for (std::size_t y = y0; y < y1; ++y)
                             for (std::size_t x = x0; x < x1; ++x)
                                 tile.add(residual_at(splat(x, y), g.albedo(x, y), probes[y * w + x]));
-                        if (!tile.disagrees(vo)) continue;
+                        if (!tile.disagrees(vo, scale)) continue;
                         // The pixel whose residual points furthest the tile's way.
                         const double sign = tile.residual < 0 ? -1.0 : 1.0;
                         double best = -std::numeric_limits<double>::infinity();
@@ -437,7 +449,7 @@ private:
                     if (f) seeds.push_back(*f);
             });
             stats.verify_disagreed += seeds.size();
-            if (seeds.empty()) break;
+            if (seeds.empty()) continue;  // the next round pools the pixels on shifted tiles
             std::vector<std::optional<irradiance_record>> measured(seeds.size());
             timed(stats.records_ms, [&] {
                 measure(std::span<const pixel_xy>(seeds), std::span<std::optional<irradiance_record>>(measured));
