@@ -39,6 +39,7 @@ struct options {
     std::string scene = "cornell";
     std::size_t elements = 10000;     // target element count of the atlas (before subdivision)
     int block = 8;                    // shooting block side, texels (substructuring)
+    double chart_cone = atlas_options{}.cone_degrees;  // charts' cone half-angle, degrees (0: planar charts)
     visibility_kind visibility = visibility_kind::stereo;
     int resolution = 128;             // item buffer side (hemicube: per face)
     float tolerance_px = 0.25f;       // stereographic tessellation: largest edge sagitta, pixels
@@ -57,6 +58,7 @@ struct options {
     int light_samples = 4;            // the lights' shot at k x k points of each whole texel (CPU)
     int shooter_groups = 0;           // grouped shooters: at most N groups of blocks (0: off; rays only)
     int group_rays = 1;               // grouped shots: visibility rays per receiver
+    double group_near_field = 4;      // grouped shots: a group's node opens within this many half-diagonals
     int repeat = 1;                   // solves timed (medians reported)
     std::size_t width = 256, height = 256;
     bool reference = true;
@@ -77,6 +79,9 @@ inline void add_options(CLI::App& app, options& o) {
         ->capture_default_str();
     app.add_option("--elements", o.elements, "target number of elements (lightmap texels)")
         ->check(CLI::Range(std::size_t(16), std::size_t(50000000)))->capture_default_str();
+    app.add_option("--chart-cone", o.chart_cone,
+                   "charts follow surfaces within this cone of their normal, degrees (0: planar charts only)")
+        ->check(CLI::Range(0.0, 89.9));
     app.add_option("--block", o.block, "side of a shooting block in texels (substructuring; 1: shoot elements)")
         ->check(CLI::Range(1, 256))->capture_default_str();
     add_choice(app, "--visibility", o.visibility, visibility_names, "stereo | hemicube | rays")->capture_default_str();
@@ -110,6 +115,9 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--shooter-groups", o.shooter_groups,
                    "shoot groups of nearby, similarly oriented blocks across charts, at most N (0: each block; rays only)")
         ->check(CLI::Range(0, 1 << 24))->capture_default_str();
+    app.add_option("--group-near-field", o.group_near_field,
+                   "grouped shots: a node of several blocks shoots as one disc beyond this many half-diagonals")
+        ->check(examples::finite_non_negative)->capture_default_str();
     app.add_option("--group-rays", o.group_rays, "grouped shots: visibility rays per receiver, from members drawn by their light")
         ->check(CLI::Range(1, 16))->capture_default_str();
     app.add_flag("--one-sided", o.one_sided,
@@ -140,6 +148,7 @@ inline atlas_options atlas_options_for(const options& o) {
     atlas_options a;
     a.elements = o.elements;
     a.block_texels = o.block;
+    a.cone_degrees = o.chart_cone;
     a.padding = 1;
     return a;
 }
@@ -155,6 +164,7 @@ inline radiosity_options solver_options_for(const options& o) {
     r.light_samples = o.light_samples;
     r.shooter_groups = o.shooter_groups;
     r.group_visibility_samples = o.group_rays;
+    r.group_near_field = o.group_near_field;
     return r;
 }
 
@@ -215,7 +225,7 @@ inline gl::radiosity_options gl_options_for(const options& o) {
 
 /// The run's parameters as the report lists them.
 inline nlohmann::ordered_json parameters_json(const options& o) {
-    return {{"elements", o.elements}, {"block", o.block}, {"visibility", name_of(visibility_names, o.visibility)},
+    return {{"elements", o.elements}, {"block", o.block}, {"chart_cone", o.chart_cone}, {"visibility", name_of(visibility_names, o.visibility)},
             {"resolution", o.resolution}, {"tolerance_px", o.tolerance_px},
             {"adaptive", o.adaptive ? "on" : "off"}, {"max_level", o.max_level},
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
@@ -223,6 +233,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
             {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
+            {"group_near_field", o.group_near_field},
             {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 
