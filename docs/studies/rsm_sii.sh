@@ -4,7 +4,7 @@
 # technique on the Cornell box and Sponza, and adds each run's report (with its commit and
 # machine) to the study's one results file, docs/results/rsm_sii.json; then redraws the
 # figures and tables (docs/studies/rsm_sii_figures.py).
-# Usage: docs/studies/rsm_sii.sh [study|pictures|visibility|all]  (BIN=DIR/bin, RUNS=DIR for another build folder)
+# Usage: docs/studies/rsm_sii.sh [study|pictures|visibility|visibility-edges|all]  (BIN=DIR/bin, RUNS=DIR for another build folder)
 # Takes about 30 minutes on 2 shared cores; the references (4096 rays per pixel, with and
 # without indirect visibility) are computed once and cached in build/cache.
 set -euo pipefail
@@ -49,6 +49,21 @@ if [[ "$which" == visibility || "$which" == all ]]; then
     "$bin" --scene "$scene" --technique sii --vpls 1024 --pattern 4x4 --visibility rays --width "$width" \
       --height "$height" --ref-spp "$spp" --json "$runs/$name.json" --indirect-out "docs/figures/rsm_sii_${scene}_visibility.png"
     add "$name"
+  done
+fi
+
+if [[ "$which" == visibility-edges || "$which" == all ]]; then
+  # Issue 29, fourth session: SII 4x4 with the blur at 256, 1024 and 4096 VPLs, without visibility
+  # and with rays, the blur stopped by geometry alone and by its visibility edges too, on every
+  # scene, against the benchmark's references in halves (rsm_visibility_study; about 10 minutes
+  # a scene on 2 shared cores once the references are cached).
+  study_bin="${BIN:-build/bin}/rsm_visibility_study"
+  for scene in cornell cornell-box bunny conference living-room modern-hall sponza; do
+    for vpls in 256 1024 4096; do
+      name="visibility-edges-$scene-$vpls"
+      "$study_bin" --scenes "$scene" --vpls "$vpls" --configs 4x4-blur,4x4-blur-geometry-edges --json "$runs/$name.json"
+      add "$name"
+    done
   done
 fi
 
