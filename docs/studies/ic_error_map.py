@@ -7,10 +7,10 @@ bounding box and sign (cache above or below the reference), and a picture: the c
 reference and the signed error (red: cache too bright, blue: too dark).
 
     /usr/bin/python3 docs/studies/ic_error_map.py REF_A.exr REF_B.exr CACHE.exr [CACHE2.exr ...]
-        [--png OUT.png] [--rows Y0:Y1] [--regions N]
+        [--png OUT.png] [--rows Y0:Y1] [--cols X0:X1] [--regions N]
 
 With several cache images, each is reported in turn and the picture has one row per image
-(--rows crops every panel to those image rows).
+(--rows and --cols crop every panel to those image rows and columns).
 
 Reads EXRs through `oiiotool --dumpdata` (no Python binding needed). The images are the
 indirect radiance ic_splatting writes with --indirect-exr and the reference cache's
@@ -66,6 +66,7 @@ def main():
     p.add_argument("caches", nargs="+")
     p.add_argument("--png")
     p.add_argument("--rows", help="Y0:Y1, the image rows the picture keeps")
+    p.add_argument("--cols", help="X0:X1, the image columns the picture keeps")
     p.add_argument("--regions", type=int, default=8)
     o = p.parse_args()
     a, b = luminance(o.ref_a), luminance(o.ref_b)
@@ -77,7 +78,9 @@ def main():
         from PIL import Image
 
         y0, y1 = (int(v) for v in o.rows.split(":")) if o.rows else (0, a.shape[0])
-        Image.fromarray(np.concatenate([p[y0:y1] for p in panels], axis=0)).save(o.png, optimize=True)
+        x0, x1 = (int(v) for v in o.cols.split(":")) if o.cols else (0, a.shape[1])
+        rows = [np.concatenate([q[y0:y1, x0:x1] for q in p], axis=1) for p in panels]
+        Image.fromarray(np.concatenate(rows, axis=0)).save(o.png, optimize=True)
         print(f"wrote {o.png}")
 
 
@@ -121,7 +124,7 @@ def report(a, b, c, o):
         err[..., 2] = (255 * t * (d < 0)).astype(np.uint8)
         err[..., 1] = (60 * t).astype(np.uint8)
         grey = lambda x: np.repeat(tone(x)[..., None], 3, axis=2)
-        return np.concatenate([grey(c), grey(r), err], axis=1)
+        return grey(c), grey(r), err
 
 
 if __name__ == "__main__":
