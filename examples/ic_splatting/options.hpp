@@ -214,6 +214,8 @@ inline void check_combinations(const options& o, bool with_gl) {
     if (o.importance_rays && raster) throw parameter_error("--importance-rays", "needs the Embree sampler");
     if (o.importance_rays && o.adaptive_rays)
         throw parameter_error("--importance-rays", "allocates a fixed budget: not with --adaptive-rays");
+    if (o.importance_rays && o.min_record_samples > o.record_samples)
+        throw parameter_error("--min-record-samples", "importance rays: the first round must not exceed --record-samples");
     if (o.importance_rays && o.ray_rates)
         throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --importance-rays");
     if (o.filter_k > 0.f && raster)

@@ -53,9 +53,16 @@ endforeach()
 foreach(option a falloff-kappa plane-turn fill-holes record-error record-error-floor min-pixels max-pixels
                max-extrapolation front-tolerance min-weight a-sweep frames record-samples ref-spp width repeat
                scan-batch shadow-resolution min-record-samples mc-max-spp ambient-resolution max-world-ratio
-               min-mean-distance hessian-zone-cap)
+               min-mean-distance hessian-zone-cap importance-defensive)
   bounce_cli_refusal(${option}-nan PROGRAM ic_splatting MATCH "--${option}.*nan" ARGS --${option} nan)
 endforeach()
+
+# Importance-sampled records: a fixed budget, so not with the adaptive rays' target, and a
+# first round within it.
+bounce_cli_refusal(importance-with-adaptive PROGRAM ic_splatting
+  MATCH "--importance-rays.*not with --adaptive-rays" ARGS --importance-rays --adaptive-rays)
+bounce_cli_refusal(importance-first-round PROGRAM ic_splatting
+  MATCH "--min-record-samples.*must not exceed --record-samples" ARGS --importance-rays --min-record-samples 2048)
 
 # World limits: the ratio of the largest radius to the smallest is at least 1, and the
 # Hessian's zone cap means nothing to the split sphere.
