@@ -7,13 +7,14 @@
 # ways, for the scaling plot (docs/studies/radiosity_groups_figures.py). Results into
 # docs/results/radiosity_groups.json. Every solve is cut at --max-seconds 240.
 # Usage: docs/studies/radiosity_groups.sh [main|scaling] [SCENE ...]
-#   (BOUNCE_BIN: default build/bin; GROUPS: default 256)
+#   (BOUNCE_BIN: default build/bin; SHOOTER_GROUPS: default 256; ONLY=groups or ONLY=blocks: one of the two;
+#   SCALING: the element counts of the scaling runs)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bin="${BOUNCE_BIN:-build/bin}"
 out=build/runs/radiosity_groups
 results=docs/results/radiosity_groups.json
-groups="${GROUPS:-256}"
+groups="${SHOOTER_GROUPS:-256}"
 mkdir -p "$out"
 what=${1:-main}; shift || true
 run() {  # run NAME ARGS...
@@ -26,12 +27,12 @@ if [[ $what == main ]]; then
   scenes=("$@")
   [[ ${#scenes[@]} -gt 0 ]] || scenes=(cornell cornell-box modern-hall sponza bunny living-room conference)
   for s in "${scenes[@]}"; do
-    run "groups-$s" --scene "$s" --elements 100000 --shooter-groups "$groups"
-    run "blocks-$s" --scene "$s" --elements 100000 --shooter-groups 0
+    [[ ${ONLY:-groups} == blocks ]] || run "groups-$s" --scene "$s" --elements 100000 --shooter-groups "$groups"
+    [[ ${ONLY:-blocks} == groups ]] || run "blocks-$s" --scene "$s" --elements 100000 --shooter-groups 0
   done
 else
-  for n in 10000 30000 100000 200000 400000; do
-    run "scaling-groups-sponza-$n" --scene sponza --elements $n --shooter-groups "$groups" --reference off
-    run "scaling-blocks-sponza-$n" --scene sponza --elements $n --shooter-groups 0 --reference off
+  for n in ${SCALING:-10000 30000 100000 200000 400000}; do
+    [[ ${ONLY:-groups} == blocks ]] || run "scaling-groups-sponza-$n" --scene sponza --elements $n --shooter-groups "$groups" --reference off
+    [[ ${ONLY:-blocks} == groups ]] || run "scaling-blocks-sponza-$n" --scene sponza --elements $n --shooter-groups 0 --reference off
   done
 fi
