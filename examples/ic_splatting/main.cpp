@@ -90,7 +90,8 @@ adaptive_rays adaptive_settings(const options& o, const embree::accel& bvh, cons
     adaptive_rays a;
     if (o.importance_rays) {  // a fixed budget: no target, no floor
         a = {true, o.min_record_samples, o.record_samples, 1.0, 0.0,
-             o.importance_contrast ? ray_allocation::contrast : ray_allocation::radiance, double(o.importance_defensive)};
+             o.importance_contrast ? ray_allocation::contrast : ray_allocation::radiance, o.importance_cell_gradients,
+             double(o.importance_defensive)};
         a.validate();
         return a;
     }

@@ -78,6 +78,7 @@ struct options {
     float record_error_floor = 1.f;          // adaptive: irradiance floor, times the scene's mean irradiance
     bool importance_rays = false;            // record_samples rays per record, min_record_samples first, the rest by radiance
     float importance_defensive = 0.5f;       // importance: every pair's floor, times the mean first-round luminance
+    bool importance_cell_gradients = false;  // importance: gradients on the first round's grid of cell means
     bool importance_contrast = false;        // importance: by the neighbours' range of luminance, not its largest
     bool neighbour_clamp = true;
     float filter_k = 0.f;      // neighbour filter: merge within this many standard errors (0: off)
@@ -164,7 +165,8 @@ inline nlohmann::json cache_parameters(const options& o, const std::string& scen
     if (hessian && std::isfinite(limits.hessian_zone_cap)) p["hessian_zone_cap"] = limits.hessian_zone_cap;
     // Filtered records depend on the filter and on a; keyed only where on.
     if (o.filter_k > 0.f) p["record_filter"] = {o.filter_k, o.filter_reach, o.a, o.filter_soft};
-    if (o.importance_rays) p["importance_rays"] = {o.min_record_samples, o.importance_defensive, o.importance_contrast};
+    if (o.importance_rays) p["importance_rays"] = {o.min_record_samples, o.importance_defensive, o.importance_contrast,
+                                                o.importance_cell_gradients};
     return p;
 }
 
@@ -255,6 +257,7 @@ inline nlohmann::ordered_json report_parameters(const options& o, const cpu::irr
             {"record_error", o.record_error}, {"record_error_floor", o.record_error_floor},
             {"importance_rays", o.importance_rays}, {"importance_defensive", o.importance_defensive},
             {"importance_by", o.importance_contrast ? "contrast" : "radiance"},
+            {"importance_cell_gradients", o.importance_cell_gradients},
             {"neighbour_clamp", o.neighbour_clamp}, {"gradient_limit", o.gradient_limit},
             {"record_filter", o.filter_k}, {"filter_reach", o.filter_reach}, {"filter_soft", o.filter_soft},
             {"verify_rounds", o.verify_rounds}, {"verify_rays", o.verify_rays}, {"verify_tile", o.verify_tile},
@@ -321,6 +324,8 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                    "importance rays: the floor of every stratum pair's share, in units of the mean first-round luminance")
         ->check(examples::finite_non_negative)
         ->capture_default_str();
+    app.add_flag("--importance-cell-gradients", o.importance_cell_gradients,
+                 "importance rays: gradients on the first round's grid of cell means at their nearest hits, not on the fine grid");
     app.add_flag("--importance-contrast,!--importance-radiance", o.importance_contrast,
                  "importance rays: by the range of the luminance the neighbouring strata saw, not by its largest")
         ->capture_default_str();

@@ -615,7 +615,7 @@ TEST_CASE("importance-sampled hemispheres are unbiased: E, gradients, distances,
     for (const lit_ceiling c : {lit_ceiling{1.0, 0.3, 2.0, 0.4}, lit_ceiling{0.6, -0.5, 1.0, 2.0}}) {
         auto trace = [&](const glm::vec3& w) { return c.trace(w); };
         std::vector<double> e(seeds), by_count(seeds), own(seeds), grad_t(seeds), grad_r(seeds), inv_r(seeds),
-            mean_r(seeds), hxx(seeds), fixed_e(seeds), fixed_t(seeds), rays(seeds);
+            mean_r(seeds), hxx(seeds), fixed_e(seeds), fixed_t(seeds), rays(seeds), cell_t(seeds), cell_inv_r(seeds);
         const std::uint32_t fixed_m = 9, fixed_n = 28;  // 252 rays, about the same
         // The Hessian's integral from a fine midpoint grid (its estimator has no closed form here).
         double hessian_xx = 0;
@@ -652,6 +652,13 @@ TEST_CASE("importance-sampled hemispheres are unbiased: E, gradients, distances,
             inv_r[k] = 1.0 / est.harmonic_mean_distance;
             mean_r[k] = est.mean_distance;
             hxx[k] = glm::dot(c.along(), glm::dvec3(est.hessian[0] * glm::dvec2(c.along()), 0.0));
+            // The first-round grid of cell means at their nearest hits (adaptive_rays::cell_gradients).
+            hemisphere_samples cells;
+            h.cell_samples(cells);
+            const hemisphere_estimate ce = estimate_hemisphere(cells);
+            CHECK(ce.irradiance.x == Approx(est.irradiance.x).epsilon(1e-6));
+            cell_t[k] = glm::dot(ce.translation[0], c.along());
+            cell_inv_r[k] = h.mean_inverse_distance();
             by_count[k] = pi * total / double(count);
             own[k] = importance_sampled(64, 192, 0.5, 50000 + std::uint64_t(k), trace, true).irradiance().x;
             // The fixed grid of about the same rays.
@@ -673,14 +680,16 @@ TEST_CASE("importance-sampled hemispheres are unbiased: E, gradients, distances,
         }
         const moments me = moments_of(e), mc = moments_of(by_count), mo = moments_of(own), mt = moments_of(grad_t),
                       mr = moments_of(grad_r), mi = moments_of(inv_r), md = moments_of(mean_r), mh = moments_of(hxx),
-                      fe = moments_of(fixed_e), ft = moments_of(fixed_t), mrays = moments_of(rays);
+                      fe = moments_of(fixed_e), ft = moments_of(fixed_t), mrays = moments_of(rays),
+                      mct = moments_of(cell_t), mci = moments_of(cell_inv_r);
         INFO((contrast ? "contrast" : "radiance") << ", ceiling h " << c.h << " x0 " << c.x0 << ": E " << me.mean << " +- " << me.mean_se << " (spread "
                           << std::sqrt(me.variance) << ", fixed grid " << fe.mean << " spread " << std::sqrt(fe.variance)
                           << "), exact " << c.E() << "; by count " << mc.mean << ", own-sample allocation " << mo.mean
                           << "; grad_t " << mt.mean << " +- " << mt.mean_se << " (fixed " << ft.mean << ") exact " << c.dE_dx()
                           << "; grad_r " << mr.mean << " exact " << c.rot_y() << "; 1/R " << mi.mean << " exact "
                           << 2 / (3 * c.h) << "; mean r " << md.mean << " exact " << 2 * c.h << "; H_xx " << mh.mean
-                          << " +- " << mh.mean_se << " fine grid " << hessian_xx << "; rays " << mrays.mean);
+                          << " +- " << mh.mean_se << " fine grid " << hessian_xx << "; rays " << mrays.mean << "; cell grid grad_t "
+                          << mct.mean << " +- " << mct.mean_se << ", 1/R " << mci.mean);
         CHECK(mrays.mean <= 256);
         CHECK(mrays.mean >= 250);
         CHECK(agree(me.mean, me.mean_se, c.E(), 0));
@@ -691,6 +700,9 @@ TEST_CASE("importance-sampled hemispheres are unbiased: E, gradients, distances,
         CHECK(agree(mi.mean, mi.mean_se, 2 / (3 * c.h), 0));
         CHECK(agree(md.mean, md.mean_se, 2 * c.h, 0));
         CHECK(agree(mh.mean, mh.mean_se, hessian_xx, 0.03 * std::abs(hessian_xx)));
+        CHECK(agree(mci.mean, mci.mean_se, 2 / (3 * c.h), 0));
+        // On the coarse first-round grid Krivanek's bias is larger (section "Gradients").
+        CHECK(agree(mct.mean, mct.mean_se, c.dE_dx(), 0.15 * c.dE_dx()));
         // Rays to where the light changes: less spread than the fixed grid of the same rays.
         if (contrast) CHECK(me.variance < fe.variance);
     }

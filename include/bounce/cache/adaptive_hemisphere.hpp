@@ -91,6 +91,11 @@ struct adaptive_rays {
     double irradiance_floor = 0.0;
     /// Which strata the later rounds' rays go to (variance: adaptive; radiance: importance).
     ray_allocation allocation = ray_allocation::variance;
+    /// Importance allocations: the gradients (and the split sphere's harmonic mean distance)
+    /// from the first-round grid itself, each cell at its samples' mean radiance and its
+    /// nearest hit (adaptive_hemisphere::cell_samples), instead of the fine grid of
+    /// fine_samples, which is up to 16 times larger. Not with the Hessian radius.
+    bool cell_gradients = false;
     /// Radiance allocation: the floor added to every pair's importance, in units of the mean
     /// first-round luminance over the pairs, so that dark strata are still refined (the
     /// defensive part of the mixture). Non-negative; 0 gives rays to lit neighbourhoods only.
@@ -440,6 +445,33 @@ public:
         std::vector<std::uint32_t> target(cells_.size());
         for (std::size_t p = 0; p < np; ++p) target[2 * p] = target[2 * p + 1] = count[p];
         return target;
+    }
+
+    /// The first-round grid for estimate_hemisphere, each cell at its samples' mean radiance
+    /// (the unbiased cell mean), its nearest hit (the wall terms of the translation gradient
+    /// take the nearer of two cells' distances) and its first sample's direction. Throws
+    /// parameter_error if a cell is empty.
+    void cell_samples(hemisphere_samples& s) const {
+        s.rings = m_;
+        s.wedges = n_;
+        s.direction.resize(cells_.size());
+        s.radiance.resize(cells_.size());
+        s.distance.resize(cells_.size());
+        for (std::size_t i = 0; i < cells_.size(); ++i) {
+            const cell& c = cells_[i];
+            s.radiance[i] = glm::vec3(c.sum / double(nonempty(c)));
+            double nearest = 0;  // the largest inverse distance
+            for (const sample& x : c.samples) nearest = std::max(nearest, x.inverse_distance);
+            s.distance[i] = nearest > 0 ? float(1.0 / nearest) : std::numeric_limits<float>::infinity();
+            s.direction[i] = c.samples.front().direction;
+        }
+    }
+    /// The mean over the hemisphere (each cell by its measure) of the samples' inverse hit
+    /// distances, 0 for escaped rays: one over the split sphere's harmonic mean distance.
+    double mean_inverse_distance() const {
+        double sum = 0;
+        for (const cell& c : cells_) sum += c.inverse_distance / double(nonempty(c));
+        return sum / double(cells_.size());
     }
 
     /// The samples as one grid for estimate_hemisphere, fine enough for the most refined

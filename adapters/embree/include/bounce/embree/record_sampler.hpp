@@ -396,6 +396,14 @@ private:
                 cast_round(extra, round);
             }
         }
+        if (adaptive_.cell_gradients && adaptive_.allocation != ray_allocation::variance && !needs_hessian()) {
+            // Gradients on the first-round grid of cell means; R from every sample's distance.
+            h.cell_samples(w.fine);
+            hemisphere_estimate est = estimate_hemisphere(w.fine, *strata_, kind_, false);
+            const double inverse = h.mean_inverse_distance();
+            est.harmonic_mean_distance = inverse > 0 ? 1.0 / inverse : std::numeric_limits<double>::infinity();
+            return {est, std::uint32_t(used), h.variance()};
+        }
         // Directions matter to the Hessian and Ward and Heckbert's walls only.
         bounce::hemisphere_samples& fine = w.fine;
         h.fine_samples(fine, needs_hessian() || kind_ != translation_gradient_kind::krivanek_2005);
