@@ -72,11 +72,6 @@ struct comparison {
     std::size_t black_pixels(const image<glm::vec3>& v) const { return examples::black_pixels(v, reference->radiance, mask); }
 };
 
-template <class Solver>  // the back sides' radiosity lightmap of a two-sided solver, else an empty image
-image<glm::vec3> back_lightmap(const Solver& solver, int level) {
-    return solver.sides() == 2 ? solver.radiosity_lightmap(level, 1) : image<glm::vec3>{};
-}
-
 // Solves with `solver` (built after `setup_ms` of atlas and lights) as the options ask, through
 // the library's solve; with `cmp` holding a reference, the view's error at checkpoints.
 template <class Solver>
@@ -103,7 +98,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
         return true;
     };
     s.checkpoint = [&](const radiosity_progress& p) {
-        const auto v = cmp.view(solver.atlas(), solver.radiosity_lightmap(level), back_lightmap(solver, level), level, o);
+        const auto v = cmp.view(solver.atlas(), solver.radiosity_lightmap(level), back_radiosity_lightmap(solver, level), level, o);
         r.curve.push_back({p.steps, p.shots, solver.atlas().size(), setup_ms + p.elapsed_ms, p.unshot_fraction, cmp.rel_rms(v)});
     };
     if constexpr (cpu) r.report = o.adaptive ? solver.solve(s, scene, subdivision_options_for(o), std::size_t(o.subdivide_steps))
@@ -130,7 +125,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     r.base_elements = base_elements;
     std::tie(r.emitted, r.absorbed, r.escaped) = std::tuple(solver.emitted_power(), solver.absorbed_power(), solver.escaped_power());
     r.lightmap = solver.radiosity_lightmap(level);
-    r.lightmap_back = back_lightmap(solver, level);
+    r.lightmap_back = back_radiosity_lightmap(solver, level);
     const auto u = solver.unshot();
     const std::vector<glm::vec3> unshot(u.begin(), u.end());
     r.unshot = a.to_fine_texels(std::span<const glm::vec3>(unshot), level);

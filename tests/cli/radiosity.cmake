@@ -28,6 +28,8 @@ bounce_cli_refusal("a --tolerance-px no item buffer can resolve, with the floor"
 bounce_cli_refusal("a negative --seed" PROGRAM radiosity MATCH "--seed" SECONDS 10 ARGS ${quick} --seed -1)
 bounce_cli_refusal("a NaN --converge" PROGRAM radiosity MATCH "--converge" SECONDS 10 ARGS ${quick} --converge nan)
 bounce_cli_refusal("a NaN --near-field" PROGRAM radiosity MATCH "--near-field" SECONDS 10 ARGS ${quick} --near-field nan)
+bounce_cli_refusal("grouped shooters with an item buffer (they cast rays from the members)" PROGRAM radiosity
+  MATCH "--shooter-groups.*--visibility rays" SECONDS 10 ARGS ${quick} --shooter-groups 64 --visibility stereo)
 bounce_cli_refusal("a NaN --max-seconds" PROGRAM radiosity MATCH "--max-seconds" SECONDS 10 ARGS ${quick} --max-seconds nan)
 bounce_cli_refusal("an --out of an unknown image type" PROGRAM radiosity
   MATCH "--out.*\\.png or \\.exr" SECONDS 10 ARGS ${quick} --out ${CMAKE_CURRENT_BINARY_DIR}/r.unknown)

@@ -66,9 +66,20 @@ struct ray_cast_visibility {
             dist = glm::length(d);
             d /= dist;
         }
+        return segment_clear(o, d, dist, shot.chart, own);
+    }
+    // From any point (grouped shooters): the same test with `origin` on chart `origin_chart`.
+    float visible_from(const glm::vec3& origin, std::uint32_t origin_chart, const glm::vec3& position,
+                       std::uint32_t own) const {
+        const glm::dvec3 o(origin);
+        glm::dvec3 d = glm::dvec3(position) - o;
+        const double dist = glm::length(d);
+        return dist > 0 ? segment_clear(o, d / dist, dist, origin_chart, own) : 1.f;
+    }
+    float segment_clear(const glm::dvec3& o, const glm::dvec3& d, double dist, std::uint32_t from, std::uint32_t own) const {
         for (std::size_t t = 0; t < scene->triangles.size(); ++t) {
             const std::uint32_t c = atlas->chart_of_triangle[t];
-            if (c == lightmap_atlas::none || c == own || c == shot.chart) continue;
+            if (c == lightmap_atlas::none || c == own || c == from) continue;
             const auto& tri = scene->triangles[t];
             const auto hit = ray_triangle(o, d, glm::dvec3(scene->positions[tri.x]), glm::dvec3(scene->positions[tri.y]),
                                           glm::dvec3(scene->positions[tri.z]));

@@ -364,3 +364,122 @@ TEST_CASE("bad solver input raises parameter_error naming it", "[radiosity][solv
         CHECK(e.parameter() == "atlas");
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// Grouped shooters (radiosity/shooter_groups.hpp, issue 30).
+
+namespace {
+
+// The closed box of closed_box, each wall cut into n x n tiles, each tile tilted by about 2
+// degrees the other way from its neighbours (a sawtooth), so that no two tiles share a
+// plane: 6 n^2 charts, as a scene of many small triangles makes.
+owned_scene tiled_box(int n, float albedo, float radiance) {
+    owned_scene s;
+    const auto wall = s.add_material(albedo * glm::vec3(0.5f, 0.6f, 0.7f) / 0.7f);
+    const auto lamp = s.add_material(glm::vec3(0.5f), glm::vec3(radiance));
+    const float t = 1.f / float(n), tilt = 0.035f * t;
+    // The wall through `origin` spanned by u and v (u x v its inward normal).
+    const auto add_wall = [&](glm::vec3 origin, glm::vec3 u, glm::vec3 v) {
+        const glm::vec3 nrm = glm::normalize(glm::cross(u, v));
+        for (int a = 0; a < n; ++a)
+            for (int b = 0; b < n; ++b) {
+                const float sign = (a + b) % 2 == 0 ? 1.f : -1.f;
+                const auto corner = [&](int i, int j) {
+                    return origin + u * (float(a + i) * t) + v * (float(b + j) * t) + nrm * (sign * tilt * float(i) + 0.001f);
+                };
+                s.add_quad(corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1), wall);
+            }
+    };
+    add_wall({0, 0, 0}, {0, 0, 1}, {1, 0, 0});   // floor, +y
+    add_wall({0, 1, 0}, {1, 0, 0}, {0, 0, 1});   // ceiling, -y
+    add_wall({0, 0, 0}, {1, 0, 0}, {0, 1, 0});   // back, +z
+    add_wall({0, 0, 1}, {0, 1, 0}, {1, 0, 0});   // front, -z
+    add_wall({0, 0, 0}, {0, 1, 0}, {0, 0, 1});   // left, +x
+    add_wall({1, 0, 0}, {0, 0, 1}, {0, 1, 0});   // right, -x
+    const float l0 = 1.f / 3, l1 = 2.f / 3, y = 0.99f;
+    s.add_quad({l0, y, l0}, {l1, y, l0}, {l1, y, l1}, {l0, y, l1}, lamp);  // faces -y
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("grouped shooters: the converged grouped solve equals the dense solve", "[radiosity][solver][groups]") {
+    // Every node opened down to elements (a near field wider than the box), grouped shooting
+    // is block Southwell iteration on the dense system: groups of element-sides shoot their
+    // elements' exact form factors, so converged it meets the dense solve as element
+    // shooting does (1e-5 asked). Without visibility, the drawn rays are all 1. Two facing
+    // squares half their side apart: no element's form factors sum above 1, so no shot is
+    // scaled (a group's scale is its own, not its members': in a closed box's corners the
+    // element columns are scaled and groups of them are not the same system).
+    const auto box = facing_squares(1.f, 0.5f, 0.8f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 150, .block_texels = 1});
+    cpu::all_visible none;
+    const auto reference = dense_radiosity(atlas, none);
+    for (const int groups : {2, 5, 40}) {  // at least one per side's dominant axis: two here
+        cpu::progressive_radiosity<cpu::all_visible, double> solver(
+            box.view(), atlas, {}, {.shoot_blocks = false, .near_field = 1e6, .shooter_groups = groups});
+        CHECK(solver.shooters() <= std::size_t(groups));
+        solver.solve(1e-13);
+        INFO(groups << " groups, " << solver.progress().shots << " shots, " << solver.clamped_shots() << " scaled");
+        CHECK(solver.clamped_shots() == 0);
+        CHECK(worst_relative(solver, reference) < 1e-5);
+    }
+}
+
+TEST_CASE("grouped shooters keep the power balance at every step and never gain energy", "[radiosity][solver][groups][energy]") {
+    // absorbed + unshot + escaped = emitted after every step (as for blocks), the unshot power
+    // only falls, and no shot hands out more than it shot (shot_scale), with visibility drawn
+    // per receiver from a member (the Cornell box's boxes occlude, exact ray casts).
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 2000});
+    ray_cast_visibility vis{&scene, &atlas};
+    for (const int rays : {1, 4}) {
+        cpu::progressive_radiosity solver(scene.view(), atlas, vis, {.shooter_groups = 24, .group_visibility_samples = rays});
+        CHECK(solver.shooters() <= 24u);
+        double unshot = bounce::detail::channel_total(solver.unshot_power());
+        for (int s = 0; s < 60 && solver.step(); ++s) {
+            const glm::dvec3 e = solver.emitted_power();
+            const glm::dvec3 sum = solver.absorbed_power() + solver.unshot_power() + solver.escaped_power();
+            for (int c = 0; c < 3; ++c) CHECK(std::abs(sum[c] - e[c]) <= (s + 3) * 0x1p-24 * e[c] * 4);
+            const double now = bounce::detail::channel_total(solver.unshot_power());
+            CHECK(now <= unshot * (1 + 1e-6));
+            CHECK(solver.last_shot().top_share <= 1.0);
+            unshot = now;
+        }
+        CHECK(solver.unshot_fraction() < 0.2);
+        CHECK(bounce::detail::channel_total(solver.intercepted_power()) > 0);
+    }
+}
+
+TEST_CASE("grouped shooters: the steps to a fraction do not grow with the number of charts", "[radiosity][solver][groups]") {
+    // The tiled box with 4 x 4 and 16 x 16 tiles a wall (96 and 1,536 charts, 3,000 elements):
+    // one shooter a block, the steps to 80% of the power grow with the charts; 32 groups take
+    // about the same steps whatever the charts, and fewer.
+    std::size_t block_steps[2], group_steps[2];
+    for (int k = 0; k < 2; ++k) {
+        const auto box = tiled_box(k == 0 ? 4 : 16, 0.7f, 2.f);
+        const auto atlas = build_lightmap_atlas(box.view(), {.elements = 3000});
+        CHECK(atlas.charts.size() >= (k == 0 ? 97u : 1537u));
+        cpu::progressive_radiosity blocks(box.view(), atlas, cpu::all_visible{}, {.two_sided = false});
+        cpu::progressive_radiosity groups(box.view(), atlas, cpu::all_visible{}, {.two_sided = false, .shooter_groups = 32});
+        block_steps[k] = blocks.solve(0.2);
+        group_steps[k] = groups.solve(0.2);
+    }
+    INFO("blocks: " << block_steps[0] << " and " << block_steps[1] << " steps; 32 groups: " << group_steps[0] << " and "
+                    << group_steps[1]);
+    CHECK(double(block_steps[1]) > 3.0 * double(block_steps[0]));
+    CHECK(double(group_steps[1]) < 1.5 * double(group_steps[0]));
+    CHECK(double(group_steps[1]) < 0.25 * double(block_steps[1]));
+}
+
+TEST_CASE("grouped shooters refuse a visibility that renders from one point, by option name", "[radiosity][solver][groups][errors]") {
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 32}),
+                                                 {.shooter_groups = 8}),
+                      Catch::Contains("radiosity_options.shooter_groups"));
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = -1}),
+                      Catch::Contains("radiosity_options.shooter_groups"));
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = 8, .group_visibility_samples = 0}),
+                      Catch::Contains("radiosity_options.group_visibility_samples"));
+}

@@ -45,6 +45,9 @@ struct radiosity_options {
                                    ///< with visibility sampled per receiver from a member element; needs
                                    ///< a visibility with visible_from (ray casts). 0: every block-side
                                    ///< shoots alone (CPU solver; typical: 256-4096)
+    double group_near_field = 4;   ///< grouped shots: a node above the blocks (several blocks) shoots as
+                                   ///< one disc to receivers farther than this many times its half
+                                   ///< diagonal, else as its two halves (typical: 1-4)
     int group_visibility_samples = 1;  ///< grouped shots: rays per receiver, each from an element drawn
                                        ///< in proportion to its share of the receiver's light (1-16)
 
@@ -56,6 +59,8 @@ struct radiosity_options {
                 "must be finite and non-negative");
         require(light_samples >= 1 && light_samples <= 16, "radiosity_options.light_samples", "must lie in [1, 16]");
         require(shooter_groups >= 0, "radiosity_options.shooter_groups", "must be non-negative (0: off)");
+        require(group_near_field >= 0 && std::isfinite(group_near_field), "radiosity_options.group_near_field",
+                "must be finite and non-negative");
         require(group_visibility_samples >= 1 && group_visibility_samples <= 16,
                 "radiosity_options.group_visibility_samples", "must lie in [1, 16]");
     }

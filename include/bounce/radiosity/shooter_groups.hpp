@@ -56,7 +56,8 @@ struct shooter_groups {
 };
 
 /// Groups the block-sides of `atlas` (blocks given by `first`, the shooter ranges of
-/// shooter_ranges; `sides` 1 or 2) into at most `budget` groups (budget >= 1).
+/// shooter_ranges; `sides` 1 or 2) into at most `budget` groups, and at least one per
+/// non-empty normal bin (up to six), whatever the budget.
 inline shooter_groups build_shooter_groups(const lightmap_atlas& atlas, std::span<const std::uint32_t> first,
                                            std::size_t sides, std::size_t budget) {
     shooter_groups g;

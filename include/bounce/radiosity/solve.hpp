@@ -250,6 +250,13 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
 
 namespace bounce::inline radiosity {
 
+/// The back sides' radiosity lightmap of a two-sided solver (`solver.radiosity_lightmap(level,
+/// 1)`, CPU or GL), else an empty image: what embree::lightmap_view takes for back sides.
+template <class Solver>
+auto back_radiosity_lightmap(const Solver& solver, int level) -> decltype(solver.radiosity_lightmap(level, 1)) {
+    return solver.sides() == 2 ? solver.radiosity_lightmap(level, 1) : decltype(solver.radiosity_lightmap(level, 1)){};
+}
+
 /// Triangles of `scene` whose front side (counter-clockwise) and whose back side some point,
 /// spot or directional light of the scene would light, judged at each triangle's centroid
 /// with its face normal and without visibility: O(lights x triangles), no atlas needed.

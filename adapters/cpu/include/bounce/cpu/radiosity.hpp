@@ -600,7 +600,10 @@ private:
         q.position = weight > Real(0) ? (a.position * a.power + c.position * c.power) / weight
                                       : (a.position * a.area + c.position * c.area) / area;
         q.area = area;
-        q.size2 = std::max(area, Real(0.25) * Real(glm::dot(d, d)));  // the square of its half-diagonal
+        // The near-field test compares with near_field^2 size2: a block's node with its area,
+        // this node with its half-diagonal times group_near_field / near_field.
+        const double g = options_.near_field > 0 ? options_.group_near_field / options_.near_field : 0.0;
+        q.size2 = std::max(area, Real(0.25 * g * g) * Real(glm::dot(d, d)));
         q.unshot = (a.unshot * a.area + c.unshot * c.area) / area;
         q.normal = (a.normal * a.area + c.normal * c.area) / area;
         q.cone_sin = Real(sn.cone_sin);
