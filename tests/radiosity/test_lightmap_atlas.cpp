@@ -306,8 +306,8 @@ TEST_CASE("charts merge coplanar neighbours into one chart, and a curved surface
     CHECK(flat.charts.size() == 1);
     CHECK(flat.charts[0].planar);
 
-    // 24 x 20 quads around half a cylinder: 7.5 degrees a quad. Made a chart per triangle
-    // before charts followed surfaces (960 charts, at least one element each).
+    // 24 x 20 quads around half a cylinder: 7.5 degrees a quad. Planar charts (before charts
+    // followed surfaces) made 24, one per flat strip along the axis.
     const auto cyl = half_cylinder(24, 20);
     const auto atlas = build_lightmap_atlas(cyl.view(), {.elements = 2000});
     INFO("charts " << atlas.charts.size());
@@ -315,6 +315,8 @@ TEST_CASE("charts merge coplanar neighbours into one chart, and a curved surface
     CHECK(atlas.statistics.curved_charts == atlas.charts.size());
     CHECK(atlas.statistics.stretch_max > 1.0);
     CHECK(atlas.statistics.stretch_max <= 1.0 / std::cos(30.0 * std::numbers::pi / 180.0) + 1e-9);
+    // Planar charts only (cone 0): one per flat strip, as before.
+    CHECK(build_lightmap_atlas(cyl.view(), {.elements = 2000, .cone_degrees = 0}).charts.size() == 24);
 }
 
 TEST_CASE("charts stop at the cone: no triangle leaves its chart's cone", "[radiosity][atlas][charts]") {
@@ -338,7 +340,7 @@ TEST_CASE("a chart never folds over itself: a spiral ramp within the cone is cut
     const auto atlas = build_lightmap_atlas(ramp.view(), {.elements = 3000});
     INFO("charts " << atlas.charts.size() << ", refused " << atlas.statistics.overlaps_refused);
     CHECK(atlas.charts.size() >= 2);     // two turns cannot share one plane
-    CHECK(atlas.charts.size() <= 8);     // but it is not a chart per triangle (768 triangles)
+    CHECK(atlas.charts.size() <= 8);     // but not a chart per triangle or quad (768 triangles)
     CHECK(atlas.statistics.overlaps_refused > 0);
     for (std::size_t c = 0; c < atlas.charts.size(); ++c) CHECK_FALSE(chart_overlaps(ramp, atlas, c));
     // And no texel holds two layers: every element's point lies on its chart's surface.
@@ -373,8 +375,8 @@ TEST_CASE("elements of curved charts lie on their triangles and add up to the su
 
 TEST_CASE("the element budget holds within 10% on a scene of many small triangles", "[radiosity][atlas][charts]") {
     // A floor, and 60 small spheres (480 triangles each, 2 cm across) standing on it: 28,800
-    // small triangles. Before charts followed surfaces, each sphere's triangle was a chart of
-    // one element at least: 28,802 elements for any count asked below that.
+    // small triangles. Before charts followed surfaces, each flat quad of a sphere was a chart
+    // of one element at least: 14,401 elements or more for any count asked.
     owned_scene s;
     const auto m = s.add_material(glm::vec3(0.5f));
     const auto ball = s.add_material(glm::vec3(0.7f, 0.2f, 0.2f));
@@ -393,4 +395,6 @@ TEST_CASE("the element budget holds within 10% on a scene of many small triangle
         // Every chart has an element.
         for (const auto& ch : atlas.charts) CHECK(ch.element_count >= 1);
     }
+    // Planar charts only (cone 0, as before): a chart per flat quad, the budget missed.
+    CHECK(build_lightmap_atlas(s.view(), {.elements = 10000, .cone_degrees = 0}).size() > 14000);
 }

@@ -272,7 +272,9 @@ namespace bounce::detail {
 /// with their triangles and normals; returns what the growth counted.
 inline grown_charts group_into_charts(const scene_view& scene, const triangle_faces& faces,
                                       const atlas_options& options, lightmap_atlas& atlas) {
-    grown_charts g = grow_charts(scene, faces, options.cone_degrees);
+    // A cone below the coplanar tolerance is that tolerance: cone 0 gives the planar charts
+    // of before (float normals of one plane differ by rounding).
+    grown_charts g = grow_charts(scene, faces, std::max(options.cone_degrees, options.coplanar_degrees));
     const double cos_planar = std::cos(options.coplanar_degrees * std::numbers::pi / 180.0);
     for (std::size_t c = 0; c < g.triangles.size(); ++c) {
         lightmap_chart ch;
