@@ -84,7 +84,7 @@ struct options {
     float filter_k = 0.f;      // neighbour filter: merge within this many standard errors (0: off)
     float filter_reach = 2.f;  // neighbour filter: neighbours' weights at this times a
     bool filter_soft = true;   // neighbour filter: count the prediction's bias estimated from the difference
-    std::uint32_t verify_rounds = 0;  // verification passes after the scan (0: off)
+    std::uint32_t verify_rounds = 2;  // verification passes after the scan (0: off; none where it cannot run)
     std::uint32_t verify_rays = 8;    // verification: probe rays per pixel
     std::uint32_t verify_tile = 4;    // verification: pixels per side of a pooled tile
     float verify_k = 3.f;             // verification: standard errors of the tile's mean residual
@@ -388,7 +388,8 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
                  "--record-filter: also weigh the prediction's bias, estimated from the difference (default on)");
     app.add_option("--verify", o.verify_rounds,
                    "after the scan, check the image against a few-ray Monte Carlo probe per pixel pooled over tiles, "
-                   "and add records where a tile disagrees, this many rounds (0: off; docs/irradiance-splatting.md, "
+                   "and add records where a tile disagrees, this many rounds (0: off; unless given, 0 where it cannot run: "
+                   "--interp other than splat-cpu, --progressive; docs/irradiance-splatting.md, "
                    "\"Error the records cannot see\")")
         ->check(CLI::Range(0u, 16u))
         ->capture_default_str();
@@ -453,6 +454,8 @@ inline void finish_options(const CLI::App& app, options& o, const std::string& g
     // camera's pixels take its inflated zone as coverage (docs/irradiance-splatting.md,
     // "Many frames"), so a walkthrough has none unless asked.
     if (o.walkthrough > 0 && app.count("--min-pixels") == 0) o.min_pixels = 0.f;
+    // The verification pass is the default wherever it can run: a whole frame splatted on the CPU.
+    if (app.count("--verify") == 0 && (o.interp != interpolation::splat_cpu || o.progressive > 0)) o.verify_rounds = 0;
 }
 
 }  // namespace bounce::examples
