@@ -2,6 +2,7 @@
 #include "radiosity_scenes.hpp"
 
 #include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/shooters.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -317,6 +318,22 @@ TEST_CASE("charts merge coplanar neighbours into one chart, and a curved surface
     CHECK(atlas.statistics.stretch_max <= 1.0 / std::cos(30.0 * std::numbers::pi / 180.0) + 1e-9);
     // Planar charts only (cone 0): one per flat strip, as before.
     CHECK(build_lightmap_atlas(cyl.view(), {.elements = 2000, .cone_degrees = 0}).charts.size() == 24);
+}
+
+TEST_CASE("the lights' samples over a texel square are taken only where the square lies on the surface",
+          "[radiosity][atlas][charts]") {
+    // A curved chart's texel squares lie on its plane, off the surface: none of its elements is
+    // a whole texel, so the lights take their (lifted) element points. A planar chart's inner
+    // texels are whole.
+    const auto cyl = half_cylinder(24, 20);
+    const auto curved = build_lightmap_atlas(cyl.view(), {.elements = 2000});
+    const auto whole = whole_texels(curved);
+    CHECK(std::count(whole.begin(), whole.end(), std::uint8_t(1)) == 0);
+    owned_scene floor;
+    add_grid(floor, 4, 3, floor.add_material(glm::vec3(0.5f)), [](float a, float b) { return glm::vec3(4.f * a, 3.f * b, 0.f); });
+    const auto flat = build_lightmap_atlas(floor.view(), {.elements = 500});
+    const auto flat_whole = whole_texels(flat);
+    CHECK(std::count(flat_whole.begin(), flat_whole.end(), std::uint8_t(1)) > 300);
 }
 
 TEST_CASE("charts stop at the cone: no triangle leaves its chart's cone", "[radiosity][atlas][charts]") {

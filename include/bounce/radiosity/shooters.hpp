@@ -37,14 +37,16 @@ inline std::vector<std::uint32_t> shooter_ranges(const lightmap_atlas& atlas, bo
 /// Per element of `atlas`, 1 when it is a whole texel of the base grid (its overlap with its
 /// chart is the texel's full area, and its block was never subdivided): the elements whose
 /// texel square lies on the chart, so points sampled over it (light_sample_point) are on the
-/// surface. Partial texels at a chart's edge are 0 (their square leaves the chart).
+/// surface. Partial texels at a chart's edge are 0 (their square leaves the chart), and so
+/// is every element of a curved chart (its texel square lies on the chart's plane, off the
+/// surface: the lights' samples there biased the bunny's solve, 0.097 -> 0.200 rel_rms).
 inline std::vector<std::uint8_t> whole_texels(const lightmap_atlas& atlas) {
     std::vector<std::uint8_t> whole(atlas.size(), 0);
     for (std::size_t k = 0; k < atlas.blocks(); ++k) {
         if (!atlas.block_level.empty() && atlas.block_level[k] != 0) continue;
         for (std::uint32_t e = atlas.block_first[k]; e < atlas.block_first[k + 1]; ++e) {
             const lightmap_chart& ch = atlas.charts[atlas.chart[e]];
-            whole[e] = atlas.area[e] >= 0.9999f * glm::length(glm::cross(ch.axis_u, ch.axis_v)) ? 1 : 0;
+            whole[e] = ch.planar && atlas.area[e] >= 0.9999f * glm::length(glm::cross(ch.axis_u, ch.axis_v)) ? 1 : 0;
         }
     }
     return whole;
