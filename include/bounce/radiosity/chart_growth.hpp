@@ -317,3 +317,23 @@ inline grown_charts grow_charts(const scene_view& scene, const triangle_faces& f
 }
 
 }  // namespace bounce::detail
+
+namespace bounce::inline radiosity {
+
+/// What build_lightmap_atlas made (charts, texels, packing, stretch), for reports.
+struct atlas_statistics {
+    std::size_t triangles = 0, charts = 0, curved_charts = 0, one_element_charts = 0;
+    std::size_t elements = 0;
+    std::size_t chart_texels = 0;  ///< texels of the charts' rectangles (without padding)
+    std::size_t atlas_texels = 0;  ///< width x height
+    double packing_efficiency = 0; ///< elements / atlas_texels
+    std::uint32_t median_elements_per_chart = 0;
+    double stretch_mean = 1;       ///< surface area over its area on the charts' planes
+    double stretch_max = 1;        ///< the largest 1 / cos(tilt) of a triangle: a texel's side across the tilt
+    double cone_max_degrees = 0;   ///< the largest tilt of a triangle from its chart's normal
+    std::size_t seed_plane_kept = 0, overlaps_refused = 0;  ///< chart_growth.hpp
+    double texel_size = 0;         ///< h (m on the charts' planes): density 1 / h^2 texels per m^2
+    int densities_tried = 0;       ///< cut_to_element_count's iterations
+};
+
+}  // namespace bounce::radiosity
