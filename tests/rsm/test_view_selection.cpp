@@ -7,6 +7,8 @@
 #include <bounce/cpu/view_selection.hpp>
 #include <bounce/errors.hpp>
 
+#include "lit_ceiling.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -33,19 +35,11 @@ private:
 
 // A lit ceiling (y = 1, facing down) of 16 x 16 texels over [-1, 1]^2, flux growing with x,
 // above a floor seen from above by an 8 x 8 G-buffer (albedo 0.5, the corner pixel uncovered).
-struct small_scene {
-    image<glm::vec3> position{16, 16}, normal{16, 16}, flux{16, 16};
+struct small_scene : test::lit_ceiling {
     gbuffer<float> gb{8, 8};
     camera cam;
 
     small_scene() {
-        for (std::size_t y = 0; y < 16; ++y)
-            for (std::size_t x = 0; x < 16; ++x) {
-                const float u = (float(x) + 0.5f) / 8.f - 1.f, v = (float(y) + 0.5f) / 8.f - 1.f;
-                position(x, y) = {u, 1.f, v};
-                normal(x, y) = {0.f, -1.f, 0.f};
-                flux(x, y) = glm::vec3(0.01f * (1.5f + u), 0.01f, 0.005f);
-            }
         for (std::size_t y = 0; y < 8; ++y)
             for (std::size_t x = 0; x < 8; ++x) {
                 gb.view().position(x, y) = {(float(x) + 0.5f) / 4.f - 1.f, 0.f, (float(y) + 0.5f) / 4.f - 1.f};

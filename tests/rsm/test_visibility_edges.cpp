@@ -6,6 +6,8 @@
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/errors.hpp>
 
+#include "lit_ceiling.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -26,20 +28,12 @@ public:
 
 // A lit ceiling (y = 1, facing down) of 16 x 16 texels over [-1, 1]^2 above a floor (y = 0)
 // seen from above by a size x size G-buffer; the rim x = 0 falls between two columns.
-struct shadowed_floor {
+struct shadowed_floor : test::lit_ceiling {
     static constexpr std::size_t size = 40;
-    image<glm::vec3> position{16, 16}, normal{16, 16}, flux{16, 16};
     gbuffer<float> gb{size, size};
     camera cam;
 
     shadowed_floor() {
-        for (std::size_t y = 0; y < 16; ++y)
-            for (std::size_t x = 0; x < 16; ++x) {
-                const float u = (float(x) + 0.5f) / 8.f - 1.f, v = (float(y) + 0.5f) / 8.f - 1.f;
-                position(x, y) = {u, 1.f, v};
-                normal(x, y) = {0.f, -1.f, 0.f};
-                flux(x, y) = glm::vec3(0.01f * (1.5f + u), 0.01f, 0.005f);
-            }
         for (std::size_t y = 0; y < size; ++y)
             for (std::size_t x = 0; x < size; ++x) {
                 const float h = float(size) / 2.f;
