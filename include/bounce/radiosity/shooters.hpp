@@ -37,28 +37,35 @@ inline std::vector<std::uint32_t> shooter_ranges(const lightmap_atlas& atlas, bo
 /// Per element of `atlas`, 1 when it is a whole texel of the base grid (its overlap with its
 /// chart is the texel's full area, and its block was never subdivided): the elements whose
 /// texel square lies on the chart, so points sampled over it (light_sample_point) are on the
-/// surface. Partial texels at a chart's edge are 0 (their square leaves the chart), and so
-/// is every element of a curved chart (its texel square lies on the chart's plane, off the
-/// surface: the lights' samples there biased the bunny's solve, 0.097 -> 0.200 rel_rms).
+/// surface (on a curved chart, after light_sample_point's lift). Partial texels at a chart's
+/// edge are 0 (their square leaves the chart); on a curved chart, whose elements carry their
+/// surface area, a texel counts as whole from 1 / stretch of its square (stretch <= 1.155).
 inline std::vector<std::uint8_t> whole_texels(const lightmap_atlas& atlas) {
     std::vector<std::uint8_t> whole(atlas.size(), 0);
     for (std::size_t k = 0; k < atlas.blocks(); ++k) {
         if (!atlas.block_level.empty() && atlas.block_level[k] != 0) continue;
         for (std::uint32_t e = atlas.block_first[k]; e < atlas.block_first[k + 1]; ++e) {
             const lightmap_chart& ch = atlas.charts[atlas.chart[e]];
-            whole[e] = ch.planar && atlas.area[e] >= 0.9999f * glm::length(glm::cross(ch.axis_u, ch.axis_v)) ? 1 : 0;
+            whole[e] = atlas.area[e] >= 0.9999f * glm::length(glm::cross(ch.axis_u, ch.axis_v)) ? 1 : 0;
         }
     }
     return whole;
 }
 
 /// Point (a, b) of a k x k grid over element e's texel square (world): the centre of cell
-/// (a, b), cells in [0, k)^2. For whole_texels only.
+/// (a, b), cells in [0, k)^2. For whole_texels only. A curved chart's texel square lies on the
+/// chart's plane, off the surface by up to the chart's sag (points there biased the bunny's
+/// solve, 0.097 -> 0.200 rel_rms): its point moves along the chart's normal onto the element's
+/// tangent plane (its point on the surface, its mean normal), off the surface only by the
+/// surface's bend within one texel.
 inline glm::vec3 light_sample_point(const lightmap_atlas& atlas, std::uint32_t e, int a, int b, int k) {
     const lightmap_chart& ch = atlas.charts[atlas.chart[e]];
     const glm::vec2 t = glm::vec2(atlas.texel[e] - glm::uvec2(ch.atlas_x, ch.atlas_y)) +
                         (glm::vec2(float(a), float(b)) + 0.5f) / float(k);
-    return ch.origin + ch.axis_u * t.x + ch.axis_v * t.y;
+    const glm::vec3 q = ch.origin + ch.axis_u * t.x + ch.axis_v * t.y;
+    if (ch.planar) return q;
+    const glm::vec3 n = atlas.normal[e];  // within the chart's cone (30 degrees) of its normal
+    return q + ch.normal * (glm::dot(atlas.position[e] - q, n) / glm::dot(ch.normal, n));
 }
 
 /// A shooter as one disc: the area-weighted mean position of its elements [i0, i1) (world)
