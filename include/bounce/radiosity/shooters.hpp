@@ -64,7 +64,7 @@ inline glm::vec3 light_sample_point(const lightmap_atlas& atlas, std::uint32_t e
                         (glm::vec2(float(a), float(b)) + 0.5f) / float(k);
     const glm::vec3 q = ch.origin + ch.axis_u * t.x + ch.axis_v * t.y;
     if (ch.planar) return q;
-    const glm::vec3 n = atlas.normal[e];  // within the chart's cone (30 degrees) of its normal
+    const glm::vec3 n = atlas.normal[e];  // within the chart's cone (atlas_options::cone_degrees < 90) of its normal
     return q + ch.normal * (glm::dot(atlas.position[e] - q, n) / glm::dot(ch.normal, n));
 }
 
