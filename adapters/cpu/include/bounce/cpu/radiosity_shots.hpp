@@ -20,7 +20,8 @@ void progressive_radiosity<Visibility, Real>::shoot_group(std::uint32_t g) {
 }
 
 template <shot_visibility Visibility, floating Real>
-std::uint32_t progressive_radiosity<Visibility, Real>::build_group_node(std::uint32_t s, glm::dvec3& power, std::uint32_t& first_element) {
+std::uint32_t progressive_radiosity<Visibility, Real>::build_group_node(std::uint32_t s, glm::dvec3& power,
+                                                                      std::uint32_t& first_element) {
     const shooter_group_node& sn = groups_.nodes[s];
     const std::size_t blocks = first_.size() - 1, n = atlas_.size();
     if (sn.left == shooter_group_node::none) {
