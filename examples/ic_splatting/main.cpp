@@ -230,25 +230,8 @@ int run_with(const options& o) {
         if (!o.a_sweep.empty()) extra["a_sweep"] = sweep.entries;
         extra["error_debiased"] = nlohmann::ordered_json::object();
         study::add_debiased(extra["error_debiased"], last.error.debiased);
-        report.set_count("records", cache.records().size());
-        if (last.frame.measured > 0) {
-            // The batched scan's guesses: measured, and dropped because covered by then.
-            report.set_count("records_measured", last.frame.measured);
-            report.set_count("records_wasted", last.frame.wasted);
-        }
-        if (o.filter_k > 0.f) {
-            report.set_count("records_filter_merged", last.frame.filter_merged);
-            report.set_count("records_filter_refused", last.frame.filter_refused);
-        }
-        if (o.verify_rounds > 0) {
-            const cpu::cache_frame_stats& v = cache.last_stats();
-            report.set_count("verify_tiles", v.verify_tiles);
-            report.set_count("verify_disagreed", v.verify_disagreed);
-            report.set_count("verify_shrunk", v.verify_shrunk);
-            extra["verify_ms"] = v.verify_ms;
-            fmt::print("verification: {} of {} tiles disagreed, {} older records shrunk, {:.0f} ms of probes and tests\n",
-                       v.verify_disagreed, v.verify_tiles, v.verify_shrunk, v.verify_ms);
-        }
+        study::add_frame_counts(report, extra, cache.records().size(), last.frame, cache.last_stats(), o.filter_k > 0.f,
+                                o.verify_rounds > 0);
         if (o.mc_compare) extra.update(study::monte_carlo_report(measure, last, timer.median_ms("total")));
         if (o.ray_rates) extra["ray_rates"] = study::ray_rates(embree_sampler, cache.records());
         if (!o.out.empty() || !o.exr.empty()) {

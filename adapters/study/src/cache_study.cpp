@@ -296,4 +296,25 @@ void write_beside_reference(const std::filesystem::path& png, image_view<const g
     io::write_png(png, pair.view(), io::auto_exposure(reference_indirect, mask));
 }
 
+void add_frame_counts(run_report& report, nlohmann::ordered_json& extra, std::size_t records, const cache_frame& frame,
+                      const cpu::cache_frame_stats& stats, bool filter, bool verify) {
+    report.set_count("records", records);
+    if (frame.measured > 0) {
+        // The batched scan's guesses: measured, and dropped because covered by then.
+        report.set_count("records_measured", frame.measured);
+        report.set_count("records_wasted", frame.wasted);
+    }
+    if (filter) {
+        report.set_count("records_filter_merged", frame.filter_merged);
+        report.set_count("records_filter_refused", frame.filter_refused);
+    }
+    if (!verify) return;
+    report.set_count("verify_tiles", stats.verify_tiles);
+    report.set_count("verify_disagreed", stats.verify_disagreed);
+    report.set_count("verify_shrunk", stats.verify_shrunk);
+    extra["verify_ms"] = stats.verify_ms;
+    fmt::print("verification: {} of {} tiles disagreed, {} older records shrunk, {:.0f} ms of probes and tests\n",
+               stats.verify_disagreed, stats.verify_tiles, stats.verify_shrunk, stats.verify_ms);
+}
+
 }  // namespace bounce::study

@@ -23,6 +23,7 @@
 #include <bounce/study/equal_error.hpp>
 #include <bounce/study/noisy_error_report.hpp>
 #include <bounce/study/reference_cache.hpp>
+#include <bounce/study/run_report.hpp>
 #include <bounce/study/stage_timer.hpp>
 
 #include <chrono>
@@ -102,6 +103,13 @@ struct measured_frame {
     image<float> mask;
     noisy_error error;
 };
+
+/// A frame's counts into `report` (records; the batched scan's measured and wasted guesses
+/// when it measured any; the neighbour filter's merged and refused with `filter`) and, with
+/// `verify`, the verification pass's tiles, shrunk records and time (`extra["verify_ms"]`),
+/// printed as one line.
+void add_frame_counts(run_report& report, nlohmann::ordered_json& extra, std::size_t records, const cache_frame& frame,
+                      const cpu::cache_frame_stats& stats, bool filter, bool verify);
 
 /// The bookkeeping of a walkthrough (cpu::walkthrough): each step's error against its own
 /// reference, the fresh frame's, and Monte Carlo at the frame's error on every
