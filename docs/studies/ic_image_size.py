@@ -12,7 +12,7 @@ usage: ic_image_size.py TAG SIZES SPP [scenes...] [-- ic_splatting options]
   docs/studies/ic_image_size.py hess 1920x1080 2 sponza -- --radius hessian
   RESULTS=docs/results/ic_verification.jsonl docs/studies/ic_image_size.py verify 512x512 256 -- --verify 2 --mc-compare
 """
-import json, os, subprocess, sys, tempfile, time
+import json, os, resource, subprocess, sys, tempfile, time
 
 root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 args = sys.argv[1:]
@@ -35,8 +35,13 @@ with open(results, 'a') as out, tempfile.TemporaryDirectory() as tmp:
             report = os.path.join(tmp, f'{tag}-{s}-{size}.json')
             scene = s if s == 'cornell' else os.path.join(scenes_dir, s)
             cmd = [binary, '--scene', scene, '--width', w, '--height', h, '--ref-spp', spp, '--json', report] + extra
-            t0 = time.time()
+            t0, load_before = time.time(), os.getloadavg()[0]
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
             r = subprocess.run(cmd, capture_output=True, text=True)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            # CPU seconds of the whole run (setup, references from the cache, frame): less
+            # inflated by the load than wall-clock times.
+            cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
             if r.returncode != 0:
                 print(s, size, 'failed:', r.stderr[-500:], flush=True)
                 continue
@@ -44,9 +49,12 @@ with open(results, 'a') as out, tempfile.TemporaryDirectory() as tmp:
             e = j['error']
             row = {'tag': tag, 'scene': s, 'size': size, 'reference_spp': int(spp), 'records': j['records'],
                    'records_per_pixel': j['records'] / (int(w) * int(h)), 'rel_rms': e['rel_rms'],
-                   'rel_rms_debiased': e.get('rel_rms_debiased'), 'reference_noise': e.get('reference_noise_rel_rms'),
-                   'total_ms_loaded_machine': j['timings_ms']['total'], 'options': ' '.join(extra), 'commit': commit,
-                   'load_average': os.getloadavg()[0], 'cores': os.cpu_count()}
+                   'rel_rms_debiased': e.get('rel_rms_debiased'), 'rel_rms_debiased_se': e.get('rel_rms_debiased_se'),
+                   'reference_noise': e.get('reference_noise_rel_rms'), 'rays_per_record': j.get('rays_per_record'),
+                   'compute_records_ms_loaded_machine': j['timings_ms'].get('compute_records'),
+                   'total_ms_loaded_machine': j['timings_ms']['total'], 'cpu_s': cpu_s, 'options': ' '.join(extra),
+                   'commit': commit, 'load_before': load_before, 'load_average': os.getloadavg()[0],
+                   'cores': os.cpu_count()}
             # --mc-compare: Monte Carlo at equal (debiased) error and its time over the cache's.
             if 'mc_equal_error' in j:
                 row['mc_equal_error'] = j['mc_equal_error']
@@ -59,6 +67,6 @@ with open(results, 'a') as out, tempfile.TemporaryDirectory() as tmp:
             out.flush()
             deb = row['rel_rms_debiased']
             print(f"{tag} {s} {size}: {row['records']} records ({row['records_per_pixel']:.3f} per pixel), "
-                  f"debiased rel_rms {deb if deb is None else round(deb, 4)}, {time.time() - t0:.0f} s"
+                  f"debiased rel_rms {deb if deb is None else round(deb, 4)}, {time.time() - t0:.0f} s, cpu {cpu_s:.1f} s"
                   + (f", Monte Carlo {row['mc_equal_error'].get('speedup', 0):.1f}x" if 'mc_equal_error' in row else ''),
                   flush=True)
