@@ -18,6 +18,9 @@ import json
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results import monte_carlo_at_equal_error as monte_carlo  # noqa: E402
+
 root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 args = sys.argv[1:]
 path = args.pop(0) if args and args[0].endswith('.jsonl') else os.path.join(root, 'docs/results/ic_verification.jsonl')
@@ -29,17 +32,6 @@ for line in open(path):
     r = json.loads(line)
     if r['tag'] in tags:
         rows[(r['tag'], r['scene'])] = r
-
-
-def monte_carlo(r):
-    """(ratio, spp, extrapolated) of Monte Carlo at the cache's debiased error."""
-    m = r.get('mc_equal_error') or {}
-    if 'speedup' not in m:
-        return None
-    if not m.get('lower_bound'):
-        return m['speedup'], m['spp'], False
-    scale = (m['measured_rel_rms'] / m['rel_rms']) ** 2
-    return m['measured_ms'] * scale / r['total_ms_loaded_machine'], m['measured_spp'] * scale, True
 
 
 def rays(r, spp):

@@ -90,6 +90,22 @@ def runs_by_name(path):
     return {r["name"]: r for r in load(path)["runs"]}
 
 
+def monte_carlo_at_equal_error(r):
+    """(ratio, spp, extrapolated) of Monte Carlo at the cache's debiased error, from a row of
+    docs/studies/ic_image_size.py run with --mc-compare (None without one). Where the sweep
+    (--mc-max-spp) did not reach the cache's error (`lower_bound`), spp and time are
+    extrapolated from its last run with the debiased error falling as spp^-1/2 (exact for
+    independent samples: the reference's noise is taken out of the error), spp' = spp (e /
+    target)^2 and time in proportion; the ratio is against the cache run's total time."""
+    m = r.get("mc_equal_error") or {}
+    if "speedup" not in m:
+        return None
+    if not m.get("lower_bound"):
+        return m["speedup"], m["spp"], False
+    scale = (m["measured_rel_rms"] / m["rel_rms"]) ** 2
+    return m["measured_ms"] * scale / r["total_ms_loaded_machine"], m["measured_spp"] * scale, True
+
+
 def dumps(value, depth=0):
     """JSON with one key per line, but a list of plain values (a per-iteration series) on one
     line: a study's curves stay readable in a diff without a line per number."""
