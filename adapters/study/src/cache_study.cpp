@@ -99,8 +99,19 @@ void walkthrough_report::add(const cpu::walkthrough_step& step, stage_timer& tim
                                     {"ms", step.ms},
                                     {"rel_rms", err.raw.rel_rms}};
     add_debiased(entry, err.debiased);
+    // Where the frame's time went, and what the clamp and the verification did to the records.
+    entry["reclamped"] = step.frame.reclamped;
+    if (step.frame.verify_tiles > 0)
+        entry["verify"] = {{"tiles", step.frame.verify_tiles},
+                           {"disagreed", step.frame.verify_disagreed},
+                           {"shrunk", step.frame.verify_shrunk}};
+    entry["stages_ms"] = nlohmann::ordered_json::object();
+    for (const auto& [stage, ms] : step.frame.stages_ms) entry["stages_ms"][stage] = ms;
     std::string line = fmt::format("frame {:2}: {:6} records (+{:5}), {:8.1f} ms, indirect rel_rms {}", step.index,
                                    step.records, step.frame.new_records, step.ms, error_text(err));
+    if (step.frame.verify_tiles > 0)
+        line += fmt::format("; verify: {} tiles disagreed, {:.0f} ms", step.frame.verify_disagreed,
+                            step.frame.ms("verify"));
     if (step.fresh) {
         const noisy_error fresh = study_.error(*step.fresh, m.reference, study_.mask(*step.fresh, step.cam));
         entry["fresh"] = {{"records", step.fresh_records}, {"ms", step.fresh_ms}, {"rel_rms", fresh.raw.rel_rms}};

@@ -30,9 +30,16 @@ struct cache_frame {
     std::size_t wasted = 0;       ///< guesses dropped because covered by the time the scan got there
     std::size_t filter_merged = 0;   ///< new records the neighbour filter merged (cache/record_filter.hpp)
     std::size_t filter_refused = 0;  ///< new records it left alone, beyond k standard errors
+    /// Earlier records whose radius the frame's start clamped to their neighbours (the CPU frame).
+    std::size_t reclamped = 0;
+    /// The verification pass, where it ran (the CPU frame with a probe): tiles tested, tiles
+    /// that disagreed (one record measured at each, counted in new_records) and older records
+    /// shrunk to those records.
+    std::size_t verify_tiles = 0, verify_disagreed = 0, verify_shrunk = 0;
     /// The frame's stages in the order they ran, in milliseconds of wall time: "gbuffer",
-    /// ("direct",) "splat_existing", ("readback",) "scan", "compute_records", "interpolate",
-    /// "normalize" (the names in parentheses: the GL frame only).
+    /// ("direct",) "splat_existing", ("readback",) "scan", "compute_records", ("verify",)
+    /// "interpolate", "normalize" (the GL frame only has "direct" and "readback"; "verify", the
+    /// verification's probes and tests, is there when the pass ran).
     std::vector<std::pair<std::string, double>> stages_ms;
 
     /// The milliseconds of `stage`, 0 when the frame has no such stage.

@@ -38,8 +38,10 @@ concept camera_sequence = requires(const P& p, std::size_t f) {
 /// One CPU frame of `cache` seen by `cam`: the G-buffer `gbuffer_for(cam)` returns (a
 /// gbuffer<float>, e.g. embree::ray_cast_gbuffer; timed as the stage "gbuffer"), then
 /// cache.render with `sampler` as radiance, cache_frame::indirect's quantity (the stages of
-/// cache_frame_stats: splat_existing, scan, compute_records, interpolate, normalize). The
-/// frame's accuracy and policies are the cache's options.
+/// cache_frame_stats: splat_existing, scan, compute_records, verify where the verification pass
+/// ran, interpolate, normalize). The frame's accuracy and policies are the cache's options,
+/// the verification pass among them: a cache with options().verify and a probe (set_probe)
+/// verifies every frame, and the records it adds stay in the cache for the frames after.
 template <class Weight, record_sampler Sampler, class GBufferFor>
     requires std::invocable<GBufferFor&, const camera&>
 cache_frame render_frame(irradiance_cache<Weight>& cache, const camera& cam, GBufferFor&& gbuffer_for, Sampler& sampler) {
@@ -56,9 +58,14 @@ cache_frame render_frame(irradiance_cache<Weight>& cache, const camera& cam, GBu
     f.wasted = s.wasted;
     f.filter_merged = s.filter_merged;
     f.filter_refused = s.filter_refused;
+    f.reclamped = s.reclamped;
+    f.verify_tiles = s.verify_tiles;
+    f.verify_disagreed = s.verify_disagreed;
+    f.verify_shrunk = s.verify_shrunk;
     f.stages_ms.emplace_back("splat_existing", s.splat_existing_ms);
     f.stages_ms.emplace_back("scan", s.scan_ms);
     f.stages_ms.emplace_back("compute_records", s.records_ms);
+    if (s.verify_tiles > 0) f.stages_ms.emplace_back("verify", s.verify_ms);
     f.stages_ms.emplace_back("interpolate", s.interpolate_ms);
     f.stages_ms.emplace_back("normalize", s.normalize_ms);
     return f;

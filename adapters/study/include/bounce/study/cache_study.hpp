@@ -117,7 +117,10 @@ void add_frame_counts(run_report& report, nlohmann::ordered_json& extra, std::si
 class walkthrough_report {
 public:
     walkthrough_report(const cache_frame_study& study, std::size_t frames, std::size_t mc_stride);
-    /// Measures `step`, logs its line, adds its stages and its "total" to `timer`.
+    /// Measures `step`, logs its line, adds its stages and its "total" to `timer`. Its entry in
+    /// frames[]: frame, records, new_records, ms, the errors, reclamped (records the frame's
+    /// start clamped), verify (tiles, disagreed, shrunk; where the pass ran), stages_ms, and
+    /// fresh and mc_equal_error where they ran.
     void add(const cpu::walkthrough_step& step, stage_timer& timer);
     /// The run report's "walkthrough" object: frames_count, path, total_ms, mean_rel_rms,
     /// mean_rel_rms_debiased, frames_debiased_unresolved, mean_reference_noise_rel_rms,

@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""The walkthrough against Monte Carlo (issue 28: "the walkthrough at 512x512 over 16 frames: at
+equal mean per-frame error, the cache's total time at least 1.5 times its single-frame ratio
+below Monte Carlo's").
+
+usage: ic_walkthrough.py run TAG FRAMES SIZE SPP STRIDE [scenes...] [-- ic_splatting options]
+       ic_walkthrough.py table [WALK_TAG SINGLE_TAG]
+
+run: `ic_splatting --walkthrough FRAMES --walkthrough-mc-stride STRIDE` per scene at SIZE (WxH)
+with references of SPP samples per pixel in halves; appends one JSON object per scene to
+$RESULTS (docs/results/ic_walkthrough.jsonl) with the commit, the options and the machine's
+load (before and after), and the per-frame figures (records, new records, time, debiased error
+and its standard error, the verification's counts, the stages, Monte Carlo where it ran).
+The single-frame rows it is compared with come from ic_image_size.py into the same file:
+
+  RESULTS=docs/results/ic_walkthrough.jsonl docs/studies/ic_image_size.py single 512x512 128 \
+      cornell -- --mc-compare --mc-max-spp 32
+  docs/studies/ic_walkthrough.py run walk 16 512x512 128 4 cornell -- --mc-max-spp 32
+
+table: one markdown row per scene, the last walkthrough row of WALK_TAG (walk) against the last
+single-frame row of SINGLE_TAG (single). Monte Carlo at equal error: where its sweep
+(--mc-max-spp) stopped short of a frame's debiased error, its time is extrapolated from the
+last measured run with the debiased error falling as spp^-1/2, time' = time (e / target)^2 (as
+ic_verification_table.py does; marked "~"). The walkthrough's Monte Carlo total is the mean
+over the measured frames times the frames; its ratio is that total over the cache's total, at
+the frames' mean debiased error. IC_BIN: the binary (build/bin/ic_splatting); BOUNCE_CACHE,
+BOUNCE_SCENES as for ic_splatting."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+results = os.environ.get('RESULTS', os.path.join(root, 'docs/results/ic_walkthrough.jsonl'))
+order = ['cornell', 'cornell-box', 'bunny', 'sponza', 'conference', 'living-room', 'modern-hall']
+
+
+def extrapolated(m):
+    """(Monte Carlo's time at the target error, spp, extrapolated) from one mc_equal_error object."""
+    if not m.get('lower_bound'):
+        return m['ms'], m['spp'], False
+    scale = (m['measured_rel_rms'] / m['rel_rms']) ** 2
+    return m['measured_ms'] * scale, m['measured_spp'] * scale, True
+
+
+def frame_row(f):
+    keep = ('frame', 'records', 'new_records', 'ms', 'rel_rms', 'rel_rms_debiased', 'rel_rms_debiased_se',
+            'reference_noise_rel_rms', 'reclamped', 'verify', 'stages_ms', 'mc_equal_error')
+    return {k: f[k] for k in keep if k in f}
+
+
+def run(args):
+    extra = []
+    if '--' in args:
+        i = args.index('--')
+        extra, args = args[i + 1:], args[:i]
+    if len(args) < 5:
+        sys.exit(__doc__)
+    tag, frames, size, spp, stride = args[:5]
+    scenes = args[5:] or order
+    w, h = size.split('x')
+    binary = os.environ.get('IC_BIN', os.path.join(root, 'build/bin/ic_splatting'))
+    scenes_dir = os.environ.get('BOUNCE_SCENES', os.path.join(root, '../shared/scenes'))
+    commit = subprocess.run(['git', '-C', root, 'rev-parse', '--short', 'HEAD'], capture_output=True,
+                            text=True).stdout.strip()
+    with open(results, 'a') as out, tempfile.TemporaryDirectory() as tmp:
+        for s in scenes:
+            report = os.path.join(tmp, f'{tag}-{s}.json')
+            scene = s if s == 'cornell' else os.path.join(scenes_dir, s)
+            options = ['--width', w, '--height', h, '--ref-spp', spp, '--walkthrough', frames,
+                       '--walkthrough-mc-stride', stride] + extra
+            t0, load_before = time.time(), os.getloadavg()[0]
+            r = subprocess.run([binary, '--scene', scene, '--json', report] + options, capture_output=True, text=True)
+            if r.returncode != 0:
+                print(s, 'failed:', r.stderr[-500:], flush=True)
+                continue
+            j = json.load(open(report))
+            walk = j['walkthrough']
+            fr = walk['frames']
+            row = {'tag': tag, 'scene': s, 'size': size, 'reference_spp': int(spp), 'frames_count': int(frames),
+                   'mc_stride': int(stride), 'records': j['records'],
+                   'total_ms_loaded_machine': walk['total_ms'], 'mean_rel_rms': walk['mean_rel_rms'],
+                   'mean_rel_rms_debiased': walk['mean_rel_rms_debiased'],
+                   'frames_debiased_unresolved': walk['frames_debiased_unresolved'],
+                   'reference_noise': walk['mean_reference_noise_rel_rms'], 'mc_equal_error': walk.get('mc_equal_error'),
+                   'frames': [frame_row(f) for f in fr], 'options': ' '.join(options),
+                   'parameters': j.get('parameters'), 'commit': commit, 'load_before': load_before,
+                   'load_average': os.getloadavg()[0], 'cores': os.cpu_count(), 'wall_s': time.time() - t0}
+            out.write(json.dumps(row) + '\n')
+            out.flush()
+            ratio = walkthrough_ratio(row)
+            print(f"{tag} {s}: {row['records']} records, {row['total_ms_loaded_machine'] / 1000:.1f} s over {frames} "
+                  f"frames, mean debiased {row['mean_rel_rms_debiased']:.4f}, Monte Carlo "
+                  f"{'~' if ratio[2] else ''}{ratio[0]:.1f}x, {time.time() - t0:.0f} s wall, load "
+                  f"{load_before:.1f} -> {row['load_average']:.1f}", flush=True)
+
+
+def walkthrough_ratio(row):
+    """(ratio, Monte Carlo's total ms, any frame extrapolated) over the frames Monte Carlo measured."""
+    measured = [extrapolated(f['mc_equal_error']) for f in row['frames']
+                if 'speedup' in (f.get('mc_equal_error') or {})]
+    if not measured:
+        return float('nan'), float('nan'), False
+    total = sum(m[0] for m in measured) / len(measured) * row['frames_count']
+    return total / row['total_ms_loaded_machine'], total, any(m[2] for m in measured)
+
+
+def single_ratio(row):
+    m = row.get('mc_equal_error') or {}
+    if 'speedup' not in m:
+        return float('nan'), False
+    ms, _, extra = extrapolated(m)
+    return ms / row['total_ms_loaded_machine'], extra
+
+
+def table(args):
+    walk_tag, single_tag = (args + ['walk', 'single'])[:2] if len(args) != 1 else (args[0], 'single')
+    walks, singles = {}, {}
+    for line in open(results):
+        r = json.loads(line)
+        if r['tag'] == walk_tag and 'frames' in r:
+            walks[r['scene']] = r
+        elif r['tag'] == single_tag:
+            singles[r['scene']] = r
+    print('| scene | single frame: records | debiased rel_rms | time | Monte Carlo | walkthrough: records | new per '
+          'frame (1-15) | verify ms per frame (1-15) | mean debiased rel_rms (se) | time | Monte Carlo | walk / '
+          'single | load |')
+    print('|---|' + '---|' * 12)
+    for s in order:
+        w, one = walks.get(s), singles.get(s)
+        if w is None and one is None:
+            continue
+        cells = [s]
+        if one:
+            r1, x1 = single_ratio(one)
+            cells += [f"{one['records']:,}", f"{one['rel_rms_debiased']:.4f}",
+                      f"{one['total_ms_loaded_machine'] / 1000:.1f} s", f"{'~' if x1 else ''}{r1:.1f}x"]
+        else:
+            cells += ['not run', '', '', '']
+        if w:
+            fr = w['frames']
+            later = fr[1:] or fr
+            new = sum(f['new_records'] for f in later) / len(later)
+            verify = sum((f.get('stages_ms') or {}).get('verify', 0.0) for f in later) / len(later)
+            se = (sum(f.get('rel_rms_debiased_se', 0.0) ** 2 for f in fr)) ** 0.5 / len(fr)
+            rw, _, xw = walkthrough_ratio(w)
+            cells += [f"{w['records']:,}", f"{new:,.0f}", f"{verify:,.0f}",
+                      f"{w['mean_rel_rms_debiased']:.4f} ({se:.4f})", f"{w['total_ms_loaded_machine'] / 1000:.1f} s",
+                      f"{'~' if xw else ''}{rw:.1f}x", f"{rw / r1:.2f}" if one else '']
+        else:
+            cells += ['not run', '', '', '', '', '', '']
+        load = ' / '.join(f"{r['load_average']:.0f}" for r in (one, w) if r)
+        print('| ' + ' | '.join(cells + [load]) + ' |')
+
+
+if __name__ == '__main__':
+    if len(sys.argv) < 2 or sys.argv[1] not in ('run', 'table'):
+        sys.exit(__doc__)
+    (run if sys.argv[1] == 'run' else table)(sys.argv[2:])
