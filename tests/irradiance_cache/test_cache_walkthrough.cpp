@@ -7,6 +7,7 @@
 #include <bounce/cpu/cache_walkthrough.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/irradiance_probe.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/embree/reference.hpp>
@@ -182,6 +183,60 @@ TEST_CASE("a walkthrough's frames are the cache's frames camera by camera, with 
             CHECK(s.fresh_records == empty.records().size());
         }
     }
+}
+
+TEST_CASE("a walkthrough verifies every frame of a cache with the pass and a probe, and keeps the pass's records",
+          "[irradiance_cache][walkthrough][verification]") {
+    auto& f = fixture();
+    // The pass as ic_splatting runs it by default (two rounds, 8-ray probes), with a test loose
+    // enough (k = 1, no floor on the frame's scale) that tiles disagree on 32 x 32 pixels.
+    const embree::irradiance_probe probe(f.integrator, 8);
+    const auto verified_cache = [&] {
+        auto c = f.cache();
+        auto o = c.options();
+        o.verify = {2, 4, 1.f, 0.f};
+        c.set_options(o);
+        c.set_probe(std::cref(probe));
+        return c;
+    };
+    // By hand: the cache's render camera by camera, with the pass.
+    auto hand = verified_cache();
+    std::vector<image<glm::vec3>> images;
+    std::vector<std::vector<irradiance_record>> records;
+    std::vector<cpu::cache_frame_stats> stats;
+    for (std::size_t k = 0; k < f.path.frames(); ++k) {
+        const camera cam = f.path.at(k);
+        gbuffer<float> g = f.ray_cast(cam);
+        image<glm::vec3> indirect(width, height);
+        stats.push_back(hand.render(g.view(), cam, f.sampler, indirect.view(), output_quantity::radiance));
+        images.push_back(std::move(indirect));
+        records.push_back(hand.records());
+    }
+    auto cache = verified_cache();
+    std::size_t disagreed = 0;
+    cpu::walkthrough(cache, f.path, [&](const camera& c) { return f.ray_cast(c); }, f.sampler, {},
+                     [&](cpu::walkthrough_step&& s) {
+                         const std::size_t k = s.index;
+                         CAPTURE(k);
+                         CHECK(same_image(s.frame.indirect, images[k]));
+                         CHECK(same_records(cache.records(), records[k]));
+                         // Every frame ran the pass (both rounds over every tile) and says so.
+                         CHECK(s.frame.verify_tiles == stats[k].verify_tiles);
+                         CHECK(s.frame.verify_tiles >= 2 * (width / 4) * (height / 4));
+                         CHECK(s.frame.verify_disagreed == stats[k].verify_disagreed);
+                         CHECK(s.frame.verify_shrunk == stats[k].verify_shrunk);
+                         CHECK(s.frame.reclamped == stats[k].reclamped);
+                         CHECK(s.frame.ms("verify") > 0.0);
+                         disagreed += s.frame.verify_disagreed;
+                         // The records of the frames before are kept (radii may shrink, nothing moves).
+                         if (k > 0)
+                             for (std::size_t i = 0; i < records[k - 1].size(); ++i)
+                                 CHECK(cache.records()[i].position == records[k - 1][i].position);
+                     });
+    REQUIRE(disagreed > 0);
+    // The pass's records change the walk: a cache without it ends elsewhere.
+    const by_hand plain = frames_by_hand(f);
+    CHECK(cache.records().size() != plain.records.back().size());
 }
 
 TEST_CASE("the cache's generation changes when its records are replaced or shrunk, and only then",
