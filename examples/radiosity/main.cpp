@@ -15,7 +15,6 @@
 // the above and the solvers' bookkeeping, the checkpoints' error measurements left out),
 // and, outside total, lightmap_view (rendering the view from the lightmap) and reference.
 #include <bounce/cpu/radiosity.hpp>
-#include <bounce/embree/lightmap_view.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/image_io.hpp>
@@ -36,6 +35,7 @@
 #include "holes.hpp"
 #include "memory.hpp"
 #include "options.hpp"
+#include "oracle.hpp"
 #include "report.hpp"
 
 #include <fmt/core.h>
@@ -60,11 +60,10 @@ struct comparison {
     const io::scene& scene;
     std::optional<embree::multi_bounce_image> reference;
     image<float> mask;
-    // The view from the front's lightmap and, for two-sided solves, the back's (else empty).
-    image<glm::vec3> view(const lightmap_atlas& atlas, const image<glm::vec3>& front, const image<glm::vec3>& back,
-                          int level, const options& o) const {
-        return embree::lightmap_view(bvh, scene, atlas, front.view(), back.width() ? back.view() : front.view(), level,
-                                     scene.camera, o.width, o.height);
+    // The view --view asks for (view.hpp), of both sides for two-sided solves.
+    template <class Solver>
+    image<glm::vec3> view(const Solver& solver, int level, const options& o) const {
+        return render_view(bvh, scene, scene.camera, solver, level, o.view, o.width, o.height);
     }
     double rel_rms(const image<glm::vec3>& v) const {
         return study::compare_luminance(v.view(), reference->radiance.view(), mask.view()).rel_rms;
@@ -98,7 +97,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
         return true;
     };
     s.checkpoint = [&](const radiosity_progress& p) {
-        const auto v = cmp.view(solver.atlas(), solver.radiosity_lightmap(level), back_radiosity_lightmap(solver, level), level, o);
+        const auto v = cmp.view(solver, level, o);
         r.curve.push_back({p.steps, p.shots, solver.atlas().size(), setup_ms + p.elapsed_ms, p.unshot_fraction, cmp.rel_rms(v)});
     };
     if constexpr (cpu) r.report = o.adaptive ? solver.solve(s, scene, subdivision_options_for(o), std::size_t(o.subdivide_steps))
@@ -129,11 +128,13 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     const auto u = solver.unshot();
     const std::vector<glm::vec3> unshot(u.begin(), u.end());
     r.unshot = a.to_fine_texels(std::span<const glm::vec3>(unshot), level);
-    timer.time("lightmap_view", [&] { r.view = cmp.view(a, r.lightmap, r.lightmap_back, level, o); });
+    timer.time("lightmap_view", [&] { r.view = cmp.view(solver, level, o); });
     if (cmp.reference) r.black_pixels = cmp.black_pixels(r.view);
     if (cmp.reference && !o.holes_out.empty())
         write_holes(o.holes_out, cmp.bvh, a, r.lightmap, r.lightmap_back.width() ? r.lightmap_back : r.lightmap,
                     cmp.scene.camera, r.view, cmp.reference->radiance, cmp.mask, level);
+    if (cmp.reference && !o.oracle_out.empty())  // (check_options refused it on GL and with --adaptive)
+        write_oracle(o.oracle_out, cmp.bvh, scene, solver, reference_settings_for(o), *cmp.reference, cmp.mask, r.view, o.width, o.height);
     return r;
 }
 
@@ -167,7 +168,8 @@ solve_result solve_once(const options& o, const io::scene& scene, const embree::
 // Everything the run is asked for is checked here, before any work: outputs, the comparison
 // file, option combinations, the cache, the tolerance against the scene and the memory.
 std::optional<image<glm::vec3>> check_before_work(const options& o, const io::scene& scene) {
-    if (!o.json.empty()) io::check_output_file("--json", o.json);
+    for (const auto& [name, file] : {std::pair{"--json", o.json}, std::pair{"--oracle-out", o.oracle_out}})
+        if (!file.empty()) io::check_output_file(name, file);
     for (const auto& [name, file] : {std::pair{"--out", o.out}, std::pair{"--reference-out", o.reference_out}}) {
         if (file.empty()) continue;
         if (file.extension() != ".png" && file.extension() != ".exr")

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include "../common/cli_choices.hpp"
 #include "../common/cli_number_checks.hpp"
+#include "view.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -66,7 +67,8 @@ struct options {
     std::uint64_t seed = 1;           // the reference's base seed
     int curve_points = 16;            // error checkpoints along the solve (0: none)
     bool quiet = false;
-    std::filesystem::path json, out, lightmaps, versus, reference_out, holes_out;
+    view_kind view = view_kind::lightmap;  // the camera's view: the lightmap, or the lights' direct light per pixel
+    std::filesystem::path json, out, lightmaps, versus, reference_out, holes_out, oracle_out;
 };
 
 inline void add_options(CLI::App& app, options& o) {
@@ -113,8 +115,9 @@ inline void add_options(CLI::App& app, options& o) {
                    "point, spot and directional lights taken at k x k points of each whole texel (1: its element's point)")
         ->check(CLI::Range(1, 16))->capture_default_str();
     app.add_option("--shooter-groups", o.shooter_groups,
-                   "shoot groups of nearby, similarly oriented blocks across charts, at most N (0: each block; rays only)")
-        ->check(CLI::Range(0, 1 << 24))->capture_default_str();
+                   "shoot groups of nearby, similarly oriented blocks across charts, at most N (0: each block; -1: as "
+                   "many as the scene makes worth it; rays only)")
+        ->check(CLI::Range(-1, 1 << 24))->capture_default_str();
     app.add_option("--group-near-field", o.group_near_field,
                    "grouped shots: a node of several blocks shoots as one disc beyond this many half-diagonals")
         ->check(examples::finite_non_negative)->capture_default_str();
@@ -139,6 +142,10 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--out", o.out, "write the rendered view here (.png or .exr)");
     app.add_option("--lightmaps", o.lightmaps, "write the lightmaps (EXR) into this folder");
     app.add_option("--holes-out", o.holes_out, "write a CSV of the view's black pixels where the reference is lit (holes.hpp)");
+    add_choice(app, "--view", o.view, view_names,
+               "lightmap (B / pi looked up) | direct+indirect (the lights' direct light per pixel, the rest looked up)")
+        ->capture_default_str();
+    app.add_option("--oracle-out", o.oracle_out, "write the error's split and the best lightmap's error (JSON, oracle.hpp)");
     app.add_option("--reference-out", o.reference_out, "write the reference view here (.png or .exr)");
     app.add_option("--versus", o.versus, "also compare the view with this EXR view of another run (same size)");
 }
@@ -187,10 +194,14 @@ inline void check_options(const options& o) {
     if (o.visibility == visibility_kind::hemicube && o.resolution % 2 != 0)
         throw parameter_error("--resolution", "a hemicube needs an even resolution");
     check_backend_built(o.backend);
-    if (o.shooter_groups > 0 && o.visibility != visibility_kind::rays)
+    if (o.shooter_groups != 0 && o.visibility != visibility_kind::rays)
         throw parameter_error("--shooter-groups", "needs --visibility rays: a group's rays leave from its members, and "
                                                   "an item buffer renders from one point per shot");
+    if (!o.oracle_out.empty() && (o.adaptive || o.backend == backend::gl))
+        throw parameter_error("--oracle-out", "needs the CPU backend without --adaptive (base texels, the direct deposit apart)");
     if (o.backend != backend::gl) return;
+    if (o.view == view_kind::direct_indirect)
+        throw parameter_error("--view", "'direct+indirect' needs the CPU backend (its solver keeps the lights' direct deposit apart)");
     // What the GL solver does not offer (docs/radiosity-gl.md).
     if (o.visibility == visibility_kind::rays)
         throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
@@ -234,7 +245,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
             {"group_near_field", o.group_near_field},
-            {"reference_paths", o.reference_paths}, {"seed", o.seed}};
+            {"view", name_of(view_names, o.view)}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 
 /// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),
