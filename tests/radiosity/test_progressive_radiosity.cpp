@@ -472,13 +472,53 @@ TEST_CASE("grouped shooters: the steps to a fraction do not grow with the number
     CHECK(double(group_steps[1]) < 0.25 * double(block_steps[1]));
 }
 
+TEST_CASE("grouped shooters: the derived budget follows the scene's shape, not its units nor its charts", "[radiosity][solver][groups]") {
+    // Budget 0 (radiosity_options::shooter_groups = -1): the widest group is split while a
+    // receiver takes more than cut.discs discs per group shot on average. The cut meets that
+    // bound and is the coarsest the greedy order gives (one merge back would exceed it); the
+    // same box in millimetres gives the same groups (within rounding); 16 times the charts give about as many
+    // groups; the solve takes fewer steps than one shooter a block.
+    std::size_t derived[2];
+    for (int k = 0; k < 2; ++k) {
+        auto box = tiled_box(k == 0 ? 4 : 16, 0.7f, 2.f);
+        const auto atlas = build_lightmap_atlas(box.view(), {.elements = 3000});
+        const auto first = shooter_ranges(atlas, true);
+        const shooter_groups g = build_shooter_groups(atlas, first, 1, 0);
+        INFO(atlas.charts.size() << " charts, " << first.size() - 1 << " blocks: " << g.size() << " groups, " << g.discs << " discs");
+        CHECK(g.discs <= 2.0);
+        CHECK(g.discs > 0.5);
+        CHECK(g.size() < first.size() - 1);
+        // One group fewer (the cut of a smaller fixed budget) takes more discs than allowed.
+        const shooter_groups fewer = build_shooter_groups(atlas, first, 1, g.size() - 1);
+        const std::vector<double> mean = group_mean_discs(atlas, fewer, {});
+        double sum = 0;
+        for (const std::uint32_t r : fewer.roots) sum += mean[r];
+        CHECK(sum > 2.0 * double(fewer.size()));
+        derived[k] = g.size();
+        for (glm::vec3& p : box.positions) p *= 1000.f;
+        const auto mm = build_lightmap_atlas(box.view(), {.elements = 3000});
+        const shooter_groups gm = build_shooter_groups(mm, shooter_ranges(mm, true), 1, 0, {.near_field = 4, .group_near_field = 4});
+        CHECK(std::abs(double(gm.size()) - double(g.size())) <= 0.02 * double(g.size()));  // float rounding at 1000x
+        if (k == 1) {
+            cpu::progressive_radiosity blocks(box.view(), mm, cpu::all_visible{}, {.two_sided = false});
+            cpu::progressive_radiosity groups(box.view(), mm, cpu::all_visible{}, {.two_sided = false, .shooter_groups = -1});
+            CHECK(groups.shooters() == g.size());
+            const std::size_t block_steps = blocks.solve(0.2), group_steps = groups.solve(0.2);
+            INFO(block_steps << " steps with blocks, " << group_steps << " with the derived groups");
+            CHECK(double(group_steps) < 0.5 * double(block_steps));
+        }
+    }
+    INFO("derived groups: " << derived[0] << " (4 x 4 tiles), " << derived[1] << " (16 x 16)");
+    CHECK(double(derived[1]) < 2.0 * double(derived[0]));
+}
+
 TEST_CASE("grouped shooters refuse a visibility that renders from one point, by option name", "[radiosity][solver][groups][errors]") {
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
     CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 32}),
                                                  {.shooter_groups = 8}),
                       Catch::Contains("radiosity_options.shooter_groups"));
-    CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = -1}),
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = -2}),
                       Catch::Contains("radiosity_options.shooter_groups"));
     CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = 8, .group_visibility_samples = 0}),
                       Catch::Contains("radiosity_options.group_visibility_samples"));

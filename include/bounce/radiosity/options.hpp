@@ -44,7 +44,8 @@ struct radiosity_options {
                                    ///< similarly oriented blocks across charts, each shooting as one
                                    ///< with visibility sampled per receiver from a member element; needs
                                    ///< a visibility with visible_from (ray casts). 0: every block-side
-                                   ///< shoots alone (CPU solver; typical: 256-4096)
+                                   ///< shoots alone; -1: as many as the scene's shape and blocks make
+                                   ///< worth it (the budget derived in shooter_groups.hpp; CPU solver)
     double group_near_field = 4;   ///< grouped shots: a node above the blocks (several blocks) shoots as
                                    ///< one disc to receivers farther than this many times its half
                                    ///< diagonal, else as its two halves (typical: 1-4)
@@ -58,7 +59,7 @@ struct radiosity_options {
         require(near_field >= 0 && std::isfinite(near_field), "radiosity_options.near_field",
                 "must be finite and non-negative");
         require(light_samples >= 1 && light_samples <= 16, "radiosity_options.light_samples", "must lie in [1, 16]");
-        require(shooter_groups >= 0, "radiosity_options.shooter_groups", "must be non-negative (0: off)");
+        require(shooter_groups >= -1, "radiosity_options.shooter_groups", "must be -1 (derived), 0 (off) or a budget");
         require(group_near_field >= 0 && std::isfinite(group_near_field), "radiosity_options.group_near_field",
                 "must be finite and non-negative");
         require(group_visibility_samples >= 1 && group_visibility_samples <= 16,

@@ -17,6 +17,17 @@
 /// radiosity's grouped shot). Nodes keep what does not change from shot to shot: their leaves
 /// (a contiguous range of `leaves`), their bounding box (of the members' block discs), area,
 /// area-weighted normal sum and normal cone.
+///
+/// The budget derived from the scene (budget 0, group_cut::discs): a grouped shot costs per
+/// receiver one visibility ray plus the discs it takes (one per node it does not open), and
+/// its steps to a fraction of the power grow with the groups. The split of the widest group
+/// goes on while the mean over receivers and groups of the discs a receiver takes from a
+/// group's hierarchy exceeds `discs` (a block's shot takes about one); receivers sampled
+/// evenly over the elements, every leaf taken as holding power, the near-field and cone tests
+/// of the grouped shot. Large groups are opened by every receiver near them (the near field
+/// is group_near_field half-diagonals), so the cut stops where the groups are small against
+/// the distances between the scene's surfaces: set by the scene's shape and its blocks, not
+/// by a fixed count.
 
 #include <bounce/radiosity/lightmap_atlas.hpp>
 
@@ -52,14 +63,51 @@ struct shooter_groups {
     std::vector<shooter_group_node> nodes;       ///< the forest, children before parents
     std::vector<std::uint32_t> roots;            ///< per group, its node
     std::vector<std::uint32_t> group_of_leaf;    ///< per block-side, its group
+    double discs = 0;                            ///< the cut's mean discs per receiver and group (derived budget; else 0)
     std::size_t size() const noexcept { return roots.size(); }
 };
 
+/// How a derived budget cuts the forest (build_shooter_groups with budget 0; file comment).
+struct group_cut {
+    double discs = 2;               ///< the mean discs a receiver takes per group shot, at most
+    double near_field = 4;          ///< radiosity_options::near_field (a block's node opens within it times its side)
+    double group_near_field = 4;    ///< radiosity_options::group_near_field (half-diagonals)
+    std::size_t receivers = 256;    ///< receivers sampled (evenly over the elements)
+};
+
+/// Per node of `g`, the mean over `receivers` sampled elements of the discs a receiver takes
+/// from the node's hierarchy (the grouped shot's near-field and cone tests; a leaf is one
+/// disc, or none when it faces away).
+inline std::vector<double> group_mean_discs(const lightmap_atlas& atlas, const shooter_groups& g, const group_cut& cut) {
+    std::vector<double> mean(g.nodes.size(), 0.0);
+    const std::size_t n = atlas.size(), count = std::min(cut.receivers, n);
+    std::vector<double> d(g.nodes.size());
+    const double near2 = cut.near_field * cut.near_field, half = 0.5 * cut.group_near_field;
+    for (std::size_t k = 0; k < count; ++k) {
+        const glm::vec3 p = atlas.position[(k * n + n / 2) / count];
+        for (std::size_t j = 0; j < g.nodes.size(); ++j) {  // children before parents
+            const shooter_group_node& node = g.nodes[j];
+            const glm::vec3 c = 0.5f * (node.lo + node.hi), e = node.hi - node.lo, r = p - c;
+            const double d2 = glm::dot(r, r);
+            const bool leaf = node.left == shooter_group_node::none;
+            if (!leaf && d2 < std::max(near2 * node.area, half * half * double(glm::dot(e, e)))) {
+                d[j] = d[node.left] + d[node.right];
+                continue;
+            }
+            const double len = std::sqrt(double(glm::dot(node.normal_sum, node.normal_sum)) * d2);
+            d[j] = len > 0 && double(glm::dot(node.normal_sum, r)) / len < -double(node.cone_sin) ? 0.0 : 1.0;
+        }
+        for (std::size_t j = 0; j < d.size(); ++j) mean[j] += d[j] / double(count);
+    }
+    return mean;
+}
+
 /// Groups the block-sides of `atlas` (blocks given by `first`, the shooter ranges of
 /// shooter_ranges; `sides` 1 or 2) into at most `budget` groups, and at least one per
-/// non-empty normal bin (up to six), whatever the budget.
+/// non-empty normal bin (up to six), whatever the budget; budget 0: as many as `cut` derives
+/// from the scene (the file comment).
 inline shooter_groups build_shooter_groups(const lightmap_atlas& atlas, std::span<const std::uint32_t> first,
-                                           std::size_t sides, std::size_t budget) {
+                                           std::size_t sides, std::size_t budget, const group_cut& cut = {}) {
     shooter_groups g;
     const std::size_t blocks = first.size() - 1, leaves = blocks * sides;
     struct leaf_geometry {
@@ -129,17 +177,28 @@ inline shooter_groups build_shooter_groups(const lightmap_atlas& atlas, std::spa
     };
     using entry = std::pair<float, std::uint32_t>;  // (bounding-box diagonal squared, node)
     std::priority_queue<entry> open;
-    std::vector<std::uint32_t> done;
+    std::vector<std::uint32_t> done, bins;
     for (std::uint32_t lo = 0; lo < leaves;) {
         std::uint32_t hi = lo;
         while (hi < leaves && bin_of[g.leaves[hi]] == bin_of[g.leaves[lo]]) ++hi;
         const std::uint32_t root = build(build, lo, hi);
         const glm::vec3 d = g.nodes[root].hi - g.nodes[root].lo;
         open.push({glm::dot(d, d), root});
+        bins.push_back(root);
         lo = hi;
     }
-    // Split the widest group while the budget allows (a split adds one group).
-    while (!open.empty() && open.size() + done.size() < std::max<std::size_t>(budget, 1)) {
+    // Split the widest group while the budget allows (a split adds one group), or, derived,
+    // while the groups' mean discs per receiver exceed cut.discs.
+    const bool derived = budget == 0;
+    const std::vector<double> discs = derived ? group_mean_discs(atlas, g, cut) : std::vector<double>{};
+    double sum = 0;
+    if (derived)
+        for (const std::uint32_t b : bins) sum += discs[b];
+    const auto more = [&] {
+        const std::size_t groups = open.size() + done.size();
+        return derived ? sum > cut.discs * double(groups) : groups < budget;
+    };
+    while (!open.empty() && more()) {
         const std::uint32_t k = open.top().second;
         open.pop();
         const shooter_group_node& n = g.nodes[k];
@@ -147,6 +206,7 @@ inline shooter_groups build_shooter_groups(const lightmap_atlas& atlas, std::spa
             done.push_back(k);
             continue;
         }
+        if (derived) sum += discs[n.left] + discs[n.right] - discs[k];
         for (const std::uint32_t c : {n.left, n.right}) {
             const glm::vec3 d = g.nodes[c].hi - g.nodes[c].lo;
             open.push({glm::dot(d, d), c});
@@ -155,6 +215,7 @@ inline shooter_groups build_shooter_groups(const lightmap_atlas& atlas, std::spa
     while (!open.empty()) done.push_back(open.top().second), open.pop();
     std::sort(done.begin(), done.end(), [&](std::uint32_t a, std::uint32_t b) { return g.nodes[a].first < g.nodes[b].first; });
     g.roots = std::move(done);
+    if (derived) g.discs = sum / double(std::max<std::size_t>(g.roots.size(), 1));
     g.group_of_leaf.assign(leaves, 0);
     for (std::size_t k = 0; k < g.roots.size(); ++k) {
         const shooter_group_node& n = g.nodes[g.roots[k]];

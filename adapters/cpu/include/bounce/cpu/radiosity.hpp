@@ -364,8 +364,9 @@ private:
             centre_[k] = disc.centre;
             shooter_area_[k] = Real(disc.area);
         }
-        if (options_.shooter_groups > 0)
-            groups_ = build_shooter_groups(atlas_, first_, sides_, std::size_t(options_.shooter_groups));
+        if (options_.shooter_groups != 0)  // -1: the budget derived from the scene (shooter_groups.hpp)
+            groups_ = build_shooter_groups(atlas_, first_, sides_, std::size_t(std::max(options_.shooter_groups, 0)),
+                                           {.near_field = options_.near_field, .group_near_field = options_.group_near_field});
         refresh_powers();
     }
     static double ms_since(clock::time_point t) {
