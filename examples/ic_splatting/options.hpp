@@ -228,8 +228,8 @@ inline void check_combinations(const options& o, bool with_gl) {
         throw parameter_error("--ray-rates", "times the fixed grid's rays: not with --adaptive-rays");
     if (o.adaptive_rays && !o.a_sweep.empty())
         throw parameter_error("--a-sweep", "adaptive rays aim at a standard error tied to a: sweep a over separate runs");
-    if (o.verify_rounds > 0 && o.interp != interpolation::splat_cpu)
-        throw parameter_error("--verify", "runs in the CPU splat frame only (--interp splat-cpu)");
+    if (o.verify_rounds > 0 && o.interp != interpolation::splat_cpu && o.interp != interpolation::splat_gl)
+        throw parameter_error("--verify", "runs in the splat frames only (--interp splat-cpu or splat-gl)");
     if (o.verify_rounds > 0 && o.progressive > 0)
         throw parameter_error("--verify", "checks a whole frame: not with --progressive's record budget");
     if (o.ray_rates && raster) throw parameter_error("--ray-rates", "applies to --sampler embree only");
@@ -389,7 +389,7 @@ inline void add_options(CLI::App& app, options& o, std::string& gradients) {
     app.add_option("--verify", o.verify_rounds,
                    "after the scan, check the image against a few-ray Monte Carlo probe per pixel pooled over tiles, "
                    "and add records where a tile disagrees, this many rounds (0: off; unless given, 0 where it cannot run: "
-                   "--interp other than splat-cpu, --progressive; docs/irradiance-splatting.md, "
+                   "--interp other than splat-cpu and splat-gl, --progressive; docs/irradiance-splatting.md, "
                    "\"Error the records cannot see\")")
         ->check(CLI::Range(0u, 16u))
         ->capture_default_str();
@@ -454,8 +454,9 @@ inline void finish_options(const CLI::App& app, options& o, const std::string& g
     // camera's pixels take its inflated zone as coverage (docs/irradiance-splatting.md,
     // "Many frames"), so a walkthrough has none unless asked.
     if (o.walkthrough > 0 && app.count("--min-pixels") == 0) o.min_pixels = 0.f;
-    // The verification pass is the default wherever it can run: a whole frame splatted on the CPU.
-    if (app.count("--verify") == 0 && (o.interp != interpolation::splat_cpu || o.progressive > 0)) o.verify_rounds = 0;
+    // The verification pass is the default wherever it can run: a whole frame splatted (CPU or GL).
+    const bool splats = o.interp == interpolation::splat_cpu || o.interp == interpolation::splat_gl;
+    if (app.count("--verify") == 0 && (!splats || o.progressive > 0)) o.verify_rounds = 0;
 }
 
 }  // namespace bounce::examples

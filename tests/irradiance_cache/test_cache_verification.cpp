@@ -1,11 +1,8 @@
 // Error the records cannot see (issue 28, third session): the verification pass after the
-// scan (cache/verification.hpp, cpu::irradiance_cache's options().verify with set_probe).
-// A plane whose irradiance dips in a strip two pixels wide; only records
-// measured inside the strip know it (their radius is small there, as the split sphere's is
-// at the Cornell box's ceiling strip in front of the light), so the scan, whose records
-// elsewhere reach far, covers the strip with the plane's irradiance. A probe per pixel (the
-// truth with Monte Carlo-like noise of a known variance; on every other pixel, as the cache
-// asks) finds it.
+// scan (cache/verification.hpp, cpu::irradiance_cache's options().verify with set_probe) on
+// the strip plane of strip_plane.hpp (the probes on every other pixel, as the cache asks).
+#include "strip_plane.hpp"
+
 #include <bounce/cache/verification.hpp>
 #include <bounce/cpu/irradiance_cache.hpp>
 #include <bounce/cache/weighting.hpp>
@@ -22,56 +19,9 @@
 #include <vector>
 
 using namespace bounce;
+using namespace bounce::strip_test;
 
 namespace {
-
-constexpr float strip_x = 0.1f, strip_half = 0.015f;  // pixels are about 0.013 wide at 64 x 64: two columns
-
-bool in_strip(const glm::vec3& p) { return std::abs(p.x - strip_x) < strip_half; }
-float truth(const glm::vec3& p) { return in_strip(p) ? 0.4f : 1.f; }
-
-// The plane z = 0 seen from (0, 0, 1): every pixel's point, normal +z, grey albedo.
-struct plane_view {
-    camera cam;
-    gbuffer<float> g;
-    explicit plane_view(std::size_t size) : g(size, size) {
-        for (std::size_t y = 0; y < size; ++y)
-            for (std::size_t x = 0; x < size; ++x) {
-                const glm::vec3 d = cam.direction(float(x) + 0.5f, float(y) + 0.5f, size, size);
-                g.position(x, y) = cam.position + d;  // d's component along the view axis is 1: z = 0
-                g.normal(x, y) = glm::vec3(0, 0, 1);
-                g.albedo(x, y) = glm::vec3(0.5f);
-                g.depth(x, y) = 1.f;
-            }
-    }
-};
-
-// Records with the truth at their point; radius 0.5 (a zone of 15 pixels at a = 0.4) except
-// inside the strip, where a record sees what makes the strip dark nearby.
-struct strip_sampler {
-    std::size_t calls = 0;
-    void operator()(std::span<const glm::vec3> points, std::span<const glm::vec3> normals, std::span<const double>,
-                    std::span<std::optional<irradiance_record>> out) {
-        for (std::size_t k = 0; k < points.size(); ++k) {
-            irradiance_record r;
-            r.position = points[k];
-            r.normal = normals[k];
-            r.irradiance = glm::vec3(truth(points[k]));
-            r.radius = in_strip(points[k]) ? 0.003f : 0.5f;
-            out[k] = r;
-            ++calls;
-        }
-    }
-};
-
-// A probe: the truth plus Gaussian noise of a relative spread 0.3 per ray over 8 rays, the
-// variance it reports the true one; deterministic per pixel.
-probe_estimate noisy_probe(glm::vec3 p, glm::vec3, std::size_t pixel) {
-    std::mt19937 rng(std::uint32_t(pixel) * 2654435761u + 7u);
-    std::normal_distribution<float> z(0.f, 1.f);
-    const float e = truth(p), sd = 0.3f * e / std::sqrt(8.f);
-    return {glm::vec3(e + sd * z(rng)), sd * sd, 8};
-}
 
 struct strip_result {
     double strip_error = 0, rest_error = 0;  // mean |cache - truth| over the strip's pixels and the others'
@@ -80,35 +30,18 @@ struct strip_result {
 };
 
 strip_result render_strip(std::uint32_t rounds) {
-    plane_view v(64);
-    cpu::irradiance_cache_options o;
-    o.splat.a = 0.4f;
-    o.splat.gradients = false;
-    o.neighbour_clamp = true;
-    o.verify.rounds = rounds;
-    cpu::irradiance_cache<ward_smooth_weight> cache(glm::vec3(-1.f), glm::vec3(1.f), o);
+    plane_view v;
+    cpu::irradiance_cache<ward_smooth_weight> cache(glm::vec3(-1.f), glm::vec3(1.f), strip_options(rounds));
     cache.set_probe(noisy_probe);
     strip_sampler sampler;
-    image<glm::vec3> out(64, 64);
+    image<glm::vec3> out(size, size);
     strip_result r;
     r.stats = cache.render(v.g.view(), v.cam, sampler, out.view());
     r.records = cache.records().size();
-    std::size_t strip = 0, rest = 0;
-    for (std::size_t y = 0; y < 64; ++y)
-        for (std::size_t x = 0; x < 64; ++x) {
-            const glm::vec3 p = v.g.position(x, y);
-            const double e = std::abs(double(out(x, y).x) - truth(p));
-            if (in_strip(p)) {
-                r.strip_error += e;
-                ++strip;
-            } else {
-                r.rest_error += e;
-                ++rest;
-            }
-        }
-    REQUIRE(strip == 128);  // two columns of pixels
-    r.strip_error /= double(strip);
-    r.rest_error /= double(rest);
+    const strip_errors e = errors_of(v.g, out);
+    REQUIRE(e.strip_pixels == 128);  // two columns of pixels
+    r.strip_error = e.strip;
+    r.rest_error = e.rest;
     return r;
 }
 
@@ -132,7 +65,7 @@ TEST_CASE("the scan covers a strip no record sampled with its surroundings' irra
 }
 
 TEST_CASE("the verification leaves a cache that agrees with its probes alone", "[irradiance_cache][verification]") {
-    plane_view v(64);
+    plane_view v;
     cpu::irradiance_cache_options o;
     o.splat.a = 0.4f;
     o.verify.rounds = 2;

@@ -4,6 +4,7 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <span>
@@ -44,14 +45,30 @@ void irradiance_splatter::splat_existing(const gbuffer_textures& g, const camera
         splat_ = image<glm::vec4>(w, h);
     }
     read_gbuffer(g, gbuffer_.view());
+    // The scan's copy weighs as the GPU does: an albedo of pi for irradiance (splatted(g)),
+    // so that the verification's residuals divide the splat by the albedo it holds.
+    if (output_ == output_quantity::irradiance)
+        std::fill(gbuffer_.albedo.data(), gbuffer_.albedo.data() + w * h, glm::vec3(std::numbers::pi_v<float>));
     splats_.read_splat(splat_.view());
     stats.readback_ms = ms_since(t0);
 }
 
+void irradiance_splatter::resplat(const gbuffer_textures& g, const camera& cam,
+                                  const std::vector<irradiance_record>& records, image_view<glm::vec4> splat) {
+    g.validate();
+    require(splat.width() == g.width() && splat.height() == g.height(), "splat", "size differs from the G-buffer");
+    splats_.upload(records);
+    on_gpu_ = records.size();
+    wide_on_gpu_ = 0;  // radii changed: the wide splat's copy uploads again
+    splats_.clear(g.width(), g.height());
+    splats_.splat(splatted(g), cam, options_.splat, options_.weighting);
+    splats_.read_splat(splat);
+}
+
 void irradiance_splatter::splat_new(const gbuffer_textures& g, const camera& cam,
-                                    const std::vector<irradiance_record>& records, std::size_t before,
-                                    splatter_frame_stats& stats) {
+                                    const std::vector<irradiance_record>& records, splatter_frame_stats& stats) {
     auto t0 = clock::now();
+    const std::size_t before = on_gpu_;
     splats_.append(std::span(records).subspan(before));
     on_gpu_ = records.size();
     const gbuffer_textures sg = splatted(g);

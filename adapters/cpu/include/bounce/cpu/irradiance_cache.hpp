@@ -37,6 +37,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <concepts>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -248,7 +249,11 @@ public:
         if (options_.interpolation == cache_interpolation::splat) {
             timed(stats.splat_existing_ms, [&] { splat_records<Weight>(g, cam, records_, sp, splat.view()); });
             scan_into(g, cam, sampler, splat.view(), record_points, stats);
-            if (options_.verify.enabled() && probe_) verify_into(g, cam, sampler, splat.view(), record_points, stats);
+            if (options_.verify.enabled() && probe_)
+                verify_into(g, cam, sampler, splat.view(), record_points, stats, [&](image_view<glm::vec4> s) {
+                    std::fill(s.data(), s.data() + s.width() * s.height(), glm::vec4(0.f));
+                    splat_records<Weight>(g, cam, records_, sp, s);
+                });
             // Step 5: the image comes from splatting every record into a clean buffer.
             timed(stats.interpolate_ms, [&] {
                 std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
@@ -282,6 +287,24 @@ public:
                 "a scan on a splat buffer needs splatting");
         cache_frame_stats stats;
         scan_into(g, cam, sampler, splat, record_points, stats);
+        return stats;
+    }
+
+    /// scan() and then, with options().verify and a probe (set_probe), the verification pass
+    /// on `splat`, for a backend that splats elsewhere (gl::irradiance_splatter::frame): where
+    /// the CPU frame splats every record again after a round shrank some, `resplat(splat)` must
+    /// leave in `splat` every record of the cache splatted over `g` (the GL frame splats them
+    /// on the GPU and reads the buffer back); the round's scan follows. `g`'s albedo must be
+    /// the one the splat weighs (pi for irradiance), as the residuals divide by it. Returns
+    /// what it did, which last_stats() also holds. Splatting only.
+    template <record_sampler Sampler, class Resplat>
+        requires std::invocable<Resplat&, image_view<glm::vec4>>
+    cache_frame_stats scan_and_verify(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler,
+                                      image_view<glm::vec4> splat, Resplat&& resplat,
+                                      const gbuffer_view<float>* record_points = nullptr) {
+        cache_frame_stats stats = scan(g, cam, sampler, splat, record_points);
+        if (options_.verify.enabled() && probe_) verify_into(g, cam, sampler, splat, record_points, stats, resplat);
+        last_ = stats;
         return stats;
     }
 
@@ -389,21 +412,23 @@ private:
     // scan redone on what that uncovered. Odd rounds shift the tiles by half a tile, so a
     // feature on a tile border is pooled whole once. Probes sit on a checkerboard (half the
     // pixels: a strip one pixel wide still has every other pixel probed) at half the cost.
-    template <class Sampler>
+    // Probes start where records are measured (record_points when given). `resplat(splat)`
+    // splats every record again into the cleared buffer (the backend's splat).
+    template <class Sampler, class Resplat>
     void verify_into(const gbuffer_view<float>& g, const camera& cam, Sampler& sampler, image_view<glm::vec4> splat,
-                     const gbuffer_view<float>* record_points, cache_frame_stats& stats) {
+                     const gbuffer_view<float>* record_points, cache_frame_stats& stats, Resplat&& resplat) {
         const verification_options& vo = options_.verify;
         const std::size_t w = g.width(), h = g.height();
+        const gbuffer_view<float>& where = record_points ? *record_points : g;
         std::vector<probe_estimate> probes(w * h);
         timed(stats.verify_ms, [&] {
             tbb::parallel_for(std::size_t(0), h, [&](std::size_t y) {
                 for (std::size_t x = 0; x < w; ++x)
                     probes[y * w + x] = g.covered(x, y) && (x + y) % 2 == 0
-                                            ? probe_(g.position(x, y), g.normal(x, y), y * w + x)
+                                            ? probe_(where.position(x, y), where.normal(x, y), y * w + x)
                                             : probe_estimate{glm::vec3(0.f), -1.f};
             });
         });
-        const gbuffer_view<float>& where = record_points ? *record_points : g;
         auto measure = batch_measurer(where, cam, sampler);
         auto commit = committer(stats);
         for (std::uint32_t round = 0; round < vo.rounds; ++round) {
@@ -463,8 +488,7 @@ private:
                 stats.new_records += 1;
             }
             stats.verify_shrunk += shrink_to(first);
-            std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
-            splat_records<Weight>(g, cam, records_, options_.splat, splat);
+            resplat(splat);
             stats.scan_ms += ms_since(t0);
             scan_into(g, cam, sampler, splat, record_points, stats);
         }

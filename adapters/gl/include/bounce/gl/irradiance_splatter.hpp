@@ -7,7 +7,10 @@
 ///      grows: only new ones travel);
 ///   2. read the splat buffer and the G-buffer back;
 ///   3. the cache-miss scan, on the CPU, by the caller's `scan` (cpu::irradiance_cache::scan:
-///      it appends records and splats them into the read-back buffer);
+///      it appends records and splats them into the read-back buffer), and with it the
+///      verification pass where the cache has one (cpu::irradiance_cache::scan_and_verify:
+///      its rounds' records shrink older ones, so every record is splatted again on the GPU
+///      and read back, `resplat`, before the round's scan);
 ///   4. upload the new records and splat them on top of step 1's buffer;
 ///   5. normalize (and, with a budget, fill holes from a wider splat) into `indirect()`:
 ///      irradiance E by default, or radiance rho/pi * E with the G-buffer's albedo
@@ -16,9 +19,16 @@
 /// restores the GL state it changes (as splat_pass and compose_pass do).
 ///
 /// `frame` is a whole frame as a renderer runs it: its G-buffer (gl::gbuffer_pass), its
-/// direct light (gl::direct_light), the steps above with a cpu::irradiance_cache's scan and
-/// any record sampler, and the indirect and composed images read back, as a
-/// bounce::cache_frame (what cpu::walkthrough and the cache studies take).
+/// direct light (gl::direct_light), the steps above with a cpu::irradiance_cache's scan (and
+/// its verification pass: the CPU frame's defaults are the GL frame's) and any record
+/// sampler, and the indirect and composed images read back, as a bounce::cache_frame (what
+/// cpu::walkthrough and the cache studies take).
+///
+/// Why the verification's residual test reads the splat buffer back instead of running as a
+/// shader: its probes are ray-traced on the CPU (as the records are), and the scan that
+/// follows each round reads the whole splat buffer anyway, so a shader would add an upload
+/// of the probes (a frame-sized buffer) and save no read-back; what stays on the GPU is the
+/// splat, the per-round cost that grows with the records (docs/gl-splatting.md).
 
 #include <bounce/cache/frame.hpp>
 #include <bounce/camera.hpp>
@@ -109,12 +119,21 @@ public:
         stats.scan_ms = ms_since(t0);
         require(records.size() >= before, "records", "the scan may only append records");
         stats.new_records = records.size() - before;
-        splat_new(g, cam, records, before, stats);
+        splat_new(g, cam, records, stats);
         return stats;
     }
 
+    /// Within render()'s scan, after the caller shrank records (as the verification pass's
+    /// rounds do: the `resplat` of cpu::irradiance_cache::scan_and_verify): every record of
+    /// `records` (the list render() was given) uploaded and splatted again over `g` (render()'s
+    /// textures) seen by `cam`, and the splat buffer read back into `splat` (the scan's
+    /// buffer); render() then splats only the records added after this on top. Throws
+    /// parameter_error on bad textures or sizes.
+    void resplat(const gbuffer_textures& g, const camera& cam, const std::vector<irradiance_record>& records,
+                 image_view<glm::vec4> splat);
+
     /// A whole frame of `cache` (a cpu::irradiance_cache with splatting: any type with its
-    /// options(), records(), generation(), clamp_to_neighbours() and scan()) seen by `cam` at
+    /// options(), records(), generation(), clamp_to_neighbours() and scan_and_verify()) seen by `cam` at
     /// `width` x `height`:
     ///   - the splatter takes the cache's splat parameters and hole filling (its a included;
     ///     the weighting stays this splatter's, which must be the cache's Weight), clamps the
@@ -122,14 +141,18 @@ public:
     ///     when the cache replaced or shrank them (its generation changed) or is another cache
     ///     (told apart by address: call reset() when a new cache takes a destroyed one's place);
     ///   - passes.gbuffer renders the G-buffer of passes.mesh, passes.light its direct light;
-    ///   - render() with cache.scan(g, cam, sampler, splat) as the scan, as radiance (the
-    ///     quantity of cache_frame::indirect). `record_points(points)`
+    ///   - render() with cache.scan_and_verify(g, cam, sampler, splat, resplat) as the scan
+    ///     (the verification pass where the cache has one: options().verify and a probe; its
+    ///     rounds splat every record again here, resplat()), as radiance (the quantity of
+    ///     cache_frame::indirect). `record_points(points)`
     ///     may first move the read-back G-buffer's points to where `sampler` should measure the
     ///     records (a ray tracer's own hits of the pixels: embree::snap_to_ray_hits); its time
-    ///     counts as record computation;
+    ///     counts as record computation, and the verification's probes start there too;
     ///   - the indirect image and direct + indirect (compose) are read back.
     /// The frame's stages (cache_frame::stages_ms): gbuffer, direct, splat_existing,
-    /// readback, scan, compute_records, interpolate, normalize (the read-backs and compose).
+    /// readback, scan, compute_records, verify (where the pass ran: its probes and tests; its
+    /// records count in compute_records, its splats and scans in scan), interpolate,
+    /// normalize (the read-backs and compose).
     /// Stage times are the GPU's only with options().time_stages. Throws parameter_error as
     /// render() and the cache's scan do.
     template <class Cache, record_sampler Sampler, class RecordPoints = raster_record_points>
@@ -146,33 +169,40 @@ public:
         passes.light.render(tex);
         if (options_.time_stages) finish();
         f.stages_ms.emplace_back("direct", ms_since(t0));
-        double scan_ms = 0, records_ms = 0;
+        double scan_ms = 0, records_ms = 0, verify_ms = 0;
+        const auto resplat = [&](image_view<glm::vec4> s) { this->resplat(tex, cam, cache.records(), s); };
         const splatter_frame_stats st =
             render(tex, cam, cache.records(), [&](gbuffer_view<float> g, image_view<glm::vec4> splat) {
                 const auto took = [&](const auto& s) {
                     scan_ms += s.scan_ms;
                     records_ms += s.records_ms;
+                    verify_ms += s.verify_ms;
                     f.measured = s.measured;
                     f.wasted = s.wasted;
                     f.filter_merged = s.filter_merged;
                     f.filter_refused = s.filter_refused;
+                    f.verify_tiles = s.verify_tiles;
+                    f.verify_disagreed = s.verify_disagreed;
+                    f.verify_shrunk = s.verify_shrunk;
                 };
                 if constexpr (std::is_same_v<std::remove_cvref_t<RecordPoints>, raster_record_points>) {
-                    took(cache.scan(g, cam, sampler, splat));
+                    took(cache.scan_and_verify(g, cam, sampler, splat, resplat));
                 } else {
                     const auto t1 = clock::now();
                     gbuffer<float> points = gbuffer_;
                     record_points(points.view());
                     records_ms += ms_since(t1);
                     const gbuffer_view<float> where = points.view();
-                    took(cache.scan(g, cam, sampler, splat, &where));
+                    took(cache.scan_and_verify(g, cam, sampler, splat, resplat, &where));
                 }
             }, output_quantity::radiance);
+        generation_ = cache.generation();  // the GPU's copy holds the radii the verification left
         f.new_records = st.new_records;
         f.stages_ms.emplace_back("splat_existing", st.splat_existing_ms);
         f.stages_ms.emplace_back("readback", st.readback_ms);
         f.stages_ms.emplace_back("scan", scan_ms);
         f.stages_ms.emplace_back("compute_records", records_ms);
+        if (f.verify_tiles > 0) f.stages_ms.emplace_back("verify", verify_ms);
         f.stages_ms.emplace_back("interpolate", st.interpolate_ms);
         t0 = clock::now();
         f.indirect = image<glm::vec3>(width, height);
@@ -184,7 +214,8 @@ public:
         return f;
     }
 
-    /// The G-buffer and the splat buffer the last frame's scan saw (row 0 at the top).
+    /// The G-buffer the last frame's scan saw (row 0 at the top; for irradiance, render()'s
+    /// default, with an albedo of pi everywhere: what the splat weighs, as the CPU cache does).
     const gbuffer<float>& scanned_gbuffer() const noexcept { return gbuffer_; }
     /// The last frame's indirect light as render() was asked for it (RGBA32F, rgb; alpha 1).
     const texture& indirect() const { return compose_.result(); }
@@ -222,8 +253,9 @@ private:
     }
     void splat_existing(const gbuffer_textures& g, const camera& cam, const std::vector<irradiance_record>& records,
                         splatter_frame_stats& stats);
+    // The records from on_gpu_ on (those the scan added since the last splat of all) on top.
     void splat_new(const gbuffer_textures& g, const camera& cam, const std::vector<irradiance_record>& records,
-                   std::size_t before, splatter_frame_stats& stats);
+                   splatter_frame_stats& stats);
     // g as the splat passes read it: for irradiance, its albedo replaced by pi everywhere
     // (the splat kernel weighs rho/pi * E).
     gbuffer_textures splatted(const gbuffer_textures& g);
