@@ -56,15 +56,21 @@ using options = examples::volume_options;
 using examples::volume_mode;
 using examples::mode_names, examples::refine_names, examples::noise_names, examples::interp_names;
 
+study::volume_surface_settings surface_settings(const options& o) {
+    study::volume_surface_settings s;
+    s.width = s.height = o.surface_size;
+    s.reference_samples = std::max(2u, o.sphere.reference_samples);
+    s.seed = o.sphere.seed;
+    return s;
+}
+
 // --surface: the volume at the camera's G-buffer, without and with visibility, against the
 // one-bounce reference at the same points; printed, and written to --json.
 int run_surface(const options& o, const io::scene& scene, const embree::accel& bvh, const embree::reference_integrator& light,
                 const irradiance_volume& volume, std::span<const glm::vec3> baked_at, glm::vec3 extent, ojson report) {
     study::probe_visibility_report_settings s;
     s.visibility = o.visibility;
-    s.surface.width = s.surface.height = o.surface_size;
-    s.surface.reference_samples = std::max(2u, o.sphere.reference_samples);
-    s.surface.seed = o.sphere.seed;
+    s.surface = surface_settings(o);
     const glm::vec3 cell = extent / float(1 << o.max_depth);
     s.wall_distance = std::min({cell.x, cell.y, cell.z});
     s.self_shadow_bias = o.self_shadow_bias;
@@ -151,6 +157,7 @@ int run(const options& o) {
     vs.refinement = o.refine;
     vs.conforming_corners = o.conforming == "on";
     vs.bias_budget = o.bias_budget;
+    vs.bias_tolerance = o.bias_tolerance;
     vs.calibrate_noise = o.calibrate == "on";
     vs.memory_limit_bytes = study::available_memory_bytes();
     const glm::vec3 finest = extent / float(1 << o.max_depth);
@@ -213,7 +220,12 @@ int run(const options& o) {
     }
     irradiance_volume_settings merged = vs;  // the sweep: adaptive octrees of the same lattice
     merged.min_depth = o.min_depth >= 0 ? o.min_depth : std::min(1, o.max_depth);
-    const auto sweep = study::bias_budget_sweep(scene, lo, hi, merged, memo, sphere, o.sweep, o.sweep_sigmas);
+    std::optional<study::volume_surface_study> surface;  // --sweep-surface: wall distance = the finest cell
+    if (o.sweep_surface) surface.emplace(light, bvh, scene, scene.camera, std::min({finest.x, finest.y, finest.z}), surface_settings(o));
+    const auto sweep = o.sweep_depths.empty()
+                           ? study::bias_budget_sweep(scene, lo, hi, merged, memo, sphere, o.sweep, o.sweep_sigmas, surface ? &*surface : nullptr)
+                           : study::volume_depth_sweep(scene, lo, hi, merged, memo, sphere, o.sweep_depths, o.sweep,
+                                                       o.sweep_tolerances, o.sweep_sigmas, surface ? &*surface : nullptr);
     std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms; reference popping %.4f\n",
                 scene.name.c_str(), examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(),
                 stats.probes_inside, volume.leaf_count(), bake_ms, sphere.reference_popping());
@@ -245,9 +257,10 @@ int run(const options& o) {
                          {"cull_tolerance", o.cull}, {"prediction_tolerance", o.prediction_tolerance},
                          {"noise_sigmas", o.noise_sigmas}, {"refit", o.refit},
                          {"refine", examples::name_of(refine_names, o.refine)}, {"conforming", o.conforming},
-                         {"bias_budget", o.bias_budget}, {"calibrate_noise", o.calibrate}, {"gradient_noise_ratio", o.gradient_noise},
+                         {"bias_budget", o.bias_budget}, {"bias_tolerance", o.bias_tolerance}, {"calibrate_noise", o.calibrate}, {"gradient_noise_ratio", o.gradient_noise},
                          {"noise_estimate", examples::name_of(noise_names, o.noise)}, {"sweep_bias_budget", o.sweep},
-                         {"sweep_noise_sigmas", o.sweep_sigmas},
+                         {"sweep_noise_sigmas", o.sweep_sigmas}, {"sweep_depths", o.sweep_depths}, {"sweep_bias_tolerance", o.sweep_tolerances},
+                         {"sweep_surface", o.sweep_surface}, {"surface_size", o.surface_size},
                          {"seed", o.seed}, {"threads", o.threads}};
     report.timings_ms = {{"bake", bake_ms}, {"reference", sphere.reference_ms()}};
     report.error = best.error;

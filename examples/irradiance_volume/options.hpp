@@ -48,14 +48,16 @@ struct volume_options {
     int threads = 0;
     bool sh_study = false, surface = false;
     std::string refit = "on", conforming = "on", calibrate = "on";
-    float bias_budget = 0.f;
+    float bias_budget = 0.f, bias_tolerance = 0.f;
     volume_refinement refine = volume_refinement::merge;
     std::size_t surface_size = 128;
     embree::probe_visibility_settings visibility;
     float self_shadow_bias = 0.3f;
     std::string relocate = "off";
     embree::probe_noise_estimate noise = embree::probe_noise_estimate::even_odd;
-    std::vector<float> sweep, sweep_sigmas;  // merged octrees built from the same probes
+    std::vector<float> sweep, sweep_sigmas, sweep_tolerances;  // merged octrees built from the same probes
+    std::vector<int> sweep_depths;           // ... and uniform grids, at these finest depths
+    bool sweep_surface = false;              // ... measured at the camera's surface points too
 };
 
 /// Every option of the program, with its checks, on `app`, setting `o`.
@@ -105,6 +107,8 @@ inline void add_volume_options(CLI::App& app, volume_options& o) {
         ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--bias-budget", o.bias_budget, "merge: the bias a merge may add, fraction of the noise it removes "
                                                    "(0: the per-probe test)")->check(finite_non_negative);
+    app.add_option("--bias-tolerance", o.bias_tolerance, "merge: the bias a merge may add, fraction of the finest grid's mean "
+                                                         "light, in place of --bias-budget (0: off)")->check(finite_non_negative);
     app.add_option("--calibrate-noise", o.calibrate, "on: scale the probes' noise to the finest grid's second differences")
         ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--gradient-noise", o.gradient_noise, "keep a probe's gradient only where it exceeds this times its noise "
@@ -115,8 +119,16 @@ inline void add_volume_options(CLI::App& app, volume_options& o) {
                                                    "report their trilinear lookups under \"sweep\"")->check(finite_positive);
     app.add_option("--sweep-noise-sigmas", o.sweep_sigmas, "the sweep's octrees at each of these --noise-sigmas too")
         ->check(finite_non_negative);
-    app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge")
-        ->check(finite_positive);
+    app.add_option("--sweep-bias-tolerance", o.sweep_tolerances, "the sweep's octrees at these --bias-tolerance values too "
+                                                                 "(with --sweep-depths)")->check(finite_positive);
+    app.add_option("--sweep-depths", o.sweep_depths, "also the uniform grid of each of these depths (<= --max-depth: from the "
+                                                     "same probes), and the sweep's octrees merged from each of them")
+        ->check(CLI::Range(0, irradiance_volume::depth_limit));
+    app.add_flag("--sweep-surface", o.sweep_surface, "also measure the sweep's octrees at the camera's surface points "
+                                                     "(--surface-size, --ref-samples)");
+    app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge (0: no "
+                                                       "gradients; trilinear lookups and merging do not use them)")
+        ->check(finite_non_negative);
     app.add_option("--seed", o.seed, "seed of the probes' and the reference's light samples, 0 .. 2^64 - 1")
         ->check(seed_u64);
     app.add_option("--repeat", o.sphere.repeat, "lookup timing repeats (median)")->check(CLI::Range(1, 1000));

@@ -184,5 +184,22 @@ TEST_CASE("a probe memo bakes each position once, and a sweep's octrees come fro
     REQUIRE(by_sigmas.size() == 2);
     CHECK(by_sigmas[0].probes >= by_sigmas[1].probes);  // more slack merges at least as much
     CHECK(study::to_json(by_sigmas)[1]["noise_sigmas"] == 8.f);
+    // Grids and merges at several depths of the same lattice bake nothing new (a point of
+    // depth 1 is one of depth 2), grids first, then each depth's budgets and tolerances.
+    const std::vector<int> depths{1, 2};
+    const auto by_depth = study::volume_depth_sweep(s, lo, hi, vs, memo, sphere, depths, std::vector<float>{1.f},
+                                                    std::vector<float>{0.05f, 10.f});
+    CHECK(memo.baked() == 125);
+    REQUIRE(by_depth.size() == 2 + 2 * 3);
+    CHECK((by_depth[0].uniform && by_depth[0].max_depth == 1 && by_depth[0].probes == 27));
+    CHECK((by_depth[1].uniform && by_depth[1].max_depth == 2 && by_depth[1].probes == 125));
+    CHECK(by_depth[1].trilinear.error.rel_rms == Approx(sphere.measure(grid, "t", cpu::volume_lookup{}).error.rel_rms));
+    CHECK((by_depth[5].max_depth == 2 && by_depth[5].bias_budget == 1.f && by_depth[5].bias_tolerance == 0.f));
+    CHECK((by_depth[7].bias_tolerance == 10.f && by_depth[7].bias_budget == 0.f && by_depth[7].max_depth == 2));
+    CHECK(by_depth[7].probes <= by_depth[6].probes);
+    CHECK(by_depth[7].probes < 125);  // a tolerance of ten times the light merges
+    CHECK(study::to_json(by_depth)[7]["bias_tolerance"] == 10.f);
+    CHECK_THROWS_AS(study::volume_depth_sweep(s, lo, hi, vs, memo, sphere, std::vector<int>{11}, {}, {}), parameter_error);
+    CHECK_THROWS_AS(study::bias_tolerance_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{0.f}), parameter_error);
     CHECK_THROWS_AS(study::probe_memo(nullptr), parameter_error);
 }

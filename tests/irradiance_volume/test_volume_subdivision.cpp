@@ -227,3 +227,35 @@ TEST_CASE("merging: a change of the light keeps the finest cells it crosses, fla
         CHECK(std::abs(v.trilinear({x, 0.1f, 0.1f}, {0, 0, 1}).x - exact) < 0.15f * exact);
     }
 }
+
+TEST_CASE("merging by an error target: a gentle bend merges, a step stays fine, whatever the noise", "[irradiance_volume]") {
+    const auto scene = test::far_triangle();
+    // Nearly noiseless probes (0.01% a half) of a gentle bend (x^2 / 10, at most 2.5% of the
+    // light across a depth-1 cell) left of x = 0 and a step of 3 at x = 0.5.
+    const noisy_field field{[](glm::vec3 p) { return 2 + 0.1f * p.x * p.x + 3 / (1 + std::exp(-(p.x - 0.5f) / 0.02f)); }, 1e-4f,
+                            true};
+    auto s = merge_settings();
+    s.min_depth = 1;
+    s.calibrate_noise = false;
+    s.bias_tolerance = 0.02f;  // 2% of the grid's mean light
+    const auto target = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, field);
+    // The bias budget bounds the bias by the (tiny) noise: the same bend keeps finer cells.
+    s.bias_tolerance = 0;
+    s.bias_budget = 1;
+    const auto budget = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, field);
+    for (const float y : {-0.6f, 0.4f})
+        for (const float z : {-0.3f, 0.7f}) {
+            INFO("y " << y << " z " << z);
+            CHECK(target.nodes()[target.find_leaf({-0.6f, y, z})].depth == 1);
+            CHECK(budget.nodes()[budget.find_leaf({-0.6f, y, z})].depth > 1);
+            CHECK(target.nodes()[target.find_leaf({0.5f, y, z})].depth == 4);
+        }
+    CHECK(target.probes().size() < budget.probes().size());
+    s.bias_tolerance = -0.1f;
+    try {
+        (void)irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, field);
+        FAIL("a negative bias tolerance was accepted");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "settings.bias_tolerance");
+    }
+}

@@ -2,9 +2,11 @@
 
 #include <bounce/errors.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <utility>
 
 namespace bounce::study {
@@ -45,44 +47,124 @@ void probe_memo::operator()(std::span<const glm::vec3> positions, std::span<irra
     }
 }
 
-std::vector<volume_sweep_point> bias_budget_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
-                                                  irradiance_volume_settings settings, probe_memo& source,
-                                                  const volume_sphere_study& sphere, std::span<const float> budgets,
-                                                  std::span<const float> sigmas) {
-    for (const float b : budgets) require(std::isfinite(b) && b > 0, "budgets", "every bias budget must be positive and finite");
+namespace {
+
+// The octree's figures: trilinear on the sphere, and at the surface points when given.
+volume_sweep_point measure_point(const irradiance_volume& volume, const irradiance_volume_build_stats& stats,
+                                 const volume_sphere_study& sphere, const volume_surface_study* surface) {
+    volume_sweep_point p;
+    p.max_depth = volume.depth();
+    p.probes = volume.probes().size();
+    p.probes_inside = stats.probes_inside;
+    p.leaves = volume.leaf_count();
+    p.trilinear = sphere.measure(volume, "trilinear", cpu::volume_lookup{});
+    if (surface) p.surface = surface->measure(volume, nullptr, cpu::volume_lookup{});
+    return p;
+}
+
+void print_point(const char* what, const volume_sweep_point& p) {
+    std::printf("%s depth %d bias_budget %-6.3g tolerance %-6.3g sigmas %-4.3g %6zu probes, %6zu leaves  rel_rms %.4f  popping %.4f (excess %.4f)",
+                what, p.max_depth, double(p.bias_budget), double(p.bias_tolerance), double(p.noise_sigmas), p.probes, p.leaves, p.trilinear.error.rel_rms,
+                p.trilinear.popping, p.trilinear.popping_excess);
+    if (p.surface) std::printf("  surface %.4f (debiased %.4f)", p.surface->all.rel_rms, p.surface->all.rel_rms_debiased);
+    std::printf("\n");
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+namespace {
+
+// The merged octree of every value (set by `set`) at every slack, measured.
+template <class Set>
+std::vector<volume_sweep_point> merge_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi, irradiance_volume_settings settings,
+                                            probe_memo& source, const volume_sphere_study& sphere, std::span<const float> values,
+                                            std::span<const float> sigmas, const volume_surface_study* surface, Set set) {
     for (const float k : sigmas) require(std::isfinite(k) && k >= 0, "sigmas", "every noise_sigmas must be finite and >= 0");
     settings.refinement = volume_refinement::merge;
     const std::vector<float> ks = sigmas.empty() ? std::vector<float>{settings.noise_sigmas}
                                                  : std::vector<float>(sigmas.begin(), sigmas.end());
     std::vector<volume_sweep_point> out;
-    for (const float b : budgets) {
+    for (const float v : values) {
         for (const float k : ks) {
-            settings.bias_budget = b;
+            set(settings, v);
             settings.noise_sigmas = k;
             irradiance_volume_build_stats stats;
             const irradiance_volume volume = irradiance_volume::build(scene, lo, hi, settings, source, &stats);
-            volume_sweep_point p;
-            p.bias_budget = b;
+            volume_sweep_point p = measure_point(volume, stats, sphere, surface);
+            p.max_depth = settings.max_depth;  // the lattice merged from (the octree may be shallower)
+            p.bias_budget = settings.bias_budget;
+            p.bias_tolerance = settings.bias_tolerance;
             p.noise_sigmas = k;
-            p.probes = volume.probes().size();
-            p.probes_inside = stats.probes_inside;
-            p.leaves = volume.leaf_count();
-            p.trilinear = sphere.measure(volume, "trilinear", cpu::volume_lookup{});
-            std::printf("sweep bias_budget %-6.3g sigmas %-4.3g %5zu probes, %5zu leaves  rel_rms %.4f  popping %.4f (excess %.4f)\n",
-                        double(b), double(k), p.probes, p.leaves, p.trilinear.error.rel_rms, p.trilinear.popping,
-                        p.trilinear.popping_excess);
+            print_point("sweep", p);
             out.push_back(std::move(p));
         }
     }
     return out;
 }
 
+}  // namespace
+
+std::vector<volume_sweep_point> bias_budget_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
+                                                  irradiance_volume_settings settings, probe_memo& source,
+                                                  const volume_sphere_study& sphere, std::span<const float> budgets,
+                                                  std::span<const float> sigmas, const volume_surface_study* surface) {
+    for (const float b : budgets) require(std::isfinite(b) && b > 0, "budgets", "every bias budget must be positive and finite");
+    settings.bias_tolerance = 0;
+    return merge_sweep(scene, lo, hi, settings, source, sphere, budgets, sigmas, surface,
+                       [](irradiance_volume_settings& s, float b) { s.bias_budget = b; });
+}
+
+std::vector<volume_sweep_point> bias_tolerance_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
+                                                     irradiance_volume_settings settings, probe_memo& source,
+                                                     const volume_sphere_study& sphere, std::span<const float> tolerances,
+                                                     std::span<const float> sigmas, const volume_surface_study* surface) {
+    for (const float t : tolerances)
+        require(std::isfinite(t) && t > 0, "tolerances", "every bias tolerance must be positive and finite");
+    settings.bias_budget = 0;
+    return merge_sweep(scene, lo, hi, settings, source, sphere, tolerances, sigmas, surface,
+                       [](irradiance_volume_settings& s, float t) { s.bias_tolerance = t; });
+}
+
+std::vector<volume_sweep_point> volume_depth_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
+                                                   const irradiance_volume_settings& settings, probe_memo& source,
+                                                   const volume_sphere_study& sphere, std::span<const int> depths,
+                                                   std::span<const float> budgets, std::span<const float> tolerances,
+                                                   std::span<const float> sigmas, const volume_surface_study* surface) {
+    for (const int d : depths)
+        require(d >= 0 && d <= irradiance_volume::depth_limit, "depths", "every depth must be within 0 .. depth_limit");
+    std::vector<volume_sweep_point> out;
+    for (const int d : depths) {
+        irradiance_volume_settings grid = settings;
+        grid.min_depth = grid.max_depth = d;
+        irradiance_volume_build_stats stats;
+        volume_sweep_point p = measure_point(irradiance_volume::build(scene, lo, hi, grid, source, &stats), stats, sphere, surface);
+        p.uniform = true;
+        print_point("grid", p);
+        out.push_back(std::move(p));
+    }
+    for (const int d : depths) {
+        irradiance_volume_settings merged = settings;
+        merged.max_depth = d;
+        merged.min_depth = std::min(merged.min_depth, d);
+        for (auto points : {bias_budget_sweep(scene, lo, hi, merged, source, sphere, budgets, sigmas, surface),
+                            bias_tolerance_sweep(scene, lo, hi, merged, source, sphere, tolerances, sigmas, surface)})
+            out.insert(out.end(), std::make_move_iterator(points.begin()), std::make_move_iterator(points.end()));
+    }
+    return out;
+}
+
 nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep) {
     nlohmann::ordered_json j = nlohmann::ordered_json::array();
-    for (const auto& p : sweep)
-        j.push_back({{"bias_budget", p.bias_budget}, {"noise_sigmas", p.noise_sigmas}, {"probes", p.probes}, {"probes_inside", p.probes_inside},
-                     {"leaves", p.leaves}, {"rel_rms", p.trilinear.error.rel_rms}, {"popping", p.trilinear.popping},
-                     {"popping_excess", p.trilinear.popping_excess}});
+    for (const auto& p : sweep) {
+        nlohmann::ordered_json e = {{"max_depth", p.max_depth}, {"uniform", p.uniform}, {"bias_budget", p.bias_budget},
+                                    {"bias_tolerance", p.bias_tolerance},
+                                    {"noise_sigmas", p.noise_sigmas}, {"probes", p.probes}, {"probes_inside", p.probes_inside},
+                                    {"leaves", p.leaves}, {"rel_rms", p.trilinear.error.rel_rms}, {"popping", p.trilinear.popping},
+                                    {"popping_excess", p.trilinear.popping_excess}};
+        if (p.surface) e["surface"] = p.surface->to_json();
+        j.push_back(std::move(e));
+    }
     return j;
 }
 

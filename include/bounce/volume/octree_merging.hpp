@@ -66,11 +66,13 @@ std::array<std::uint64_t, 8> lattice_corner_keys(const Lattice& lattice, const l
 /// stays below bias_budget times the noise variance merging removes from a point of the
 /// finest grid (8/27 sigma^2, the mean of sum w^2 over a cell), with noise_sigmas standard
 /// deviations of that estimate (sqrt(2 / probes) of the expected variance) as slack so that
-/// noise alone merges, and differences below 0.1% of the light ignored.
+/// noise alone merges, and differences below 0.1% of the light ignored. With
+/// bias_tolerance > 0 the bound is (bias_tolerance * scene_level)^2 instead (scene_level:
+/// the finest grid's mean light, absolute_floor_level at 1).
 template <class Lattice>
 bool cell_bias_within_budget(const Lattice& lattice, const std::array<std::uint32_t, 8>& corner, const parent_prediction& parent,
                              const std::vector<std::uint32_t>& tested, float sigma2, float noise_scale2,
-                             const irradiance_volume_settings& s) {
+                             const irradiance_volume_settings& s, float scene_level = 0) {
     const auto& all = lattice.probes();
     const glm::vec3 lo = all[corner[0]].position, size = all[corner[7]].position - lo;
     double miss2 = 0, expected = 0, expected2 = 0, level = 0;
@@ -103,7 +105,9 @@ bool cell_bias_within_budget(const Lattice& lattice, const std::array<std::uint3
     // sqrt(2 sum var^2) over the probes (the 6 normals of a probe counted as one).
     const double bias2 = (miss2 - expected) / double(n), slack = s.noise_sigmas * std::sqrt(2 * expected2 * 6) / double(n);
     const double floor2 = std::pow(1e-3 * (level / double(n) + parent.floor_level), 2);
-    return bias2 <= s.bias_budget * (8.0 / 27.0) * noise_scale2 * sigma2 + slack + floor2;
+    const double bound = s.bias_tolerance > 0 ? std::pow(double(s.bias_tolerance) * scene_level, 2)
+                                              : s.bias_budget * (8.0 / 27.0) * noise_scale2 * sigma2;
+    return bias2 <= bound + slack + floor2;
 }
 
 /// The scale of the probes' reported noise variance the finest grid supports: the median
@@ -149,7 +153,7 @@ float noise_scale2(const Lattice& lattice, int max_depth) {
 
 template <class Lattice>
 bool cell_predicts_finest(const Lattice& lattice, const lattice_cell& c, float floor_level, float tolerance,
-                          const irradiance_volume_settings& s, float noise_scale2 = 1) {
+                          const irradiance_volume_settings& s, float noise_scale2 = 1, float scene_level = 0) {
     const auto& all = lattice.probes();
     const auto keys = lattice_corner_keys(lattice, c);
     parent_prediction parent;
@@ -174,8 +178,9 @@ bool cell_predicts_finest(const Lattice& lattice, const lattice_cell& c, float f
                 if (std::find(corner.begin(), corner.end(), idx) == corner.end()) tested.push_back(idx);
             }
     if (usable == 0) return true;
-    if (s.bias_budget > 0)
-        return cell_bias_within_budget(lattice, corner, parent, tested, float(noise2 / double(usable)), noise_scale2, s);
+    if (s.bias_budget > 0 || s.bias_tolerance > 0)
+        return cell_bias_within_budget(lattice, corner, parent, tested, float(noise2 / double(usable)), noise_scale2, s,
+                                       scene_level);
     parent.noise = family_sigmas(s.noise_sigmas, 6 * tested.size()) * float(std::sqrt(noise2 / double(usable)));
     const glm::vec3 lo = all[corner[0]].position, size = all[corner[7]].position - lo;
     for (const std::uint32_t idx : tested)
@@ -194,8 +199,9 @@ std::vector<std::vector<bool>> merge_from_finest(const Lattice& lattice, float f
     std::vector<std::vector<bool>> whole(std::size_t(s.max_depth) + 1);
     const auto cells = [](int d) { return std::uint64_t(1) << d; };
     whole[std::size_t(s.max_depth)].assign(cells(s.max_depth) * cells(s.max_depth) * cells(s.max_depth), true);
-    const float scale2 = s.bias_budget > 0 && s.calibrate_noise ? noise_scale2(lattice, s.max_depth) : 1.f;
+    const float scale2 = (s.bias_budget > 0 || s.bias_tolerance > 0) && s.calibrate_noise ? noise_scale2(lattice, s.max_depth) : 1.f;
     stats.noise_scale = std::sqrt(scale2);
+    const float scene_level = s.bias_tolerance > 0 ? absolute_floor_level(lattice.probes(), 1.f) : 0.f;
     for (int d = s.max_depth - 1; d >= s.min_depth; --d) {
         const std::uint64_t n = cells(d), st = lattice.step(d);
         whole[std::size_t(d)].assign(n * n * n, false);
@@ -203,7 +209,7 @@ std::vector<std::vector<bool>> merge_from_finest(const Lattice& lattice, float f
             for (std::uint64_t y = 0; y < n; ++y)
                 for (std::uint64_t x = 0; x < n; ++x) {
                     if (!cell_predicts_finest(lattice, {x * st, y * st, z * st, d}, floor_level, s.prediction_tolerance, s,
-                                              scale2))
+                                              scale2, scene_level))
                         continue;
                     whole[std::size_t(d)][x + n * (y + n * z)] = true;
                     ++stats.merged;

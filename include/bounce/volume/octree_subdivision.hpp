@@ -131,7 +131,15 @@ struct irradiance_volume_settings {
     /// expected noise) stays below this fraction of the noise variance merging removes
     /// (cell_bias_within_budget). 1: break-even with the refit's noise reduction.
     float bias_budget = 0.f;
-    /// With bias_budget: scale the probes' reported noise to what the finest grid's second
+    /// Merging by an error target instead (issue 31, fourth session), when > 0: a cell
+    /// merges while the bias its interpolation adds (the same estimate, noise taken out,
+    /// noise_sigmas standard deviations of slack) stays below (bias_tolerance * L)^2, L the
+    /// mean band-0 irradiance luminance of the finest grid's probes outside geometry: one
+    /// bound in units of the scene's light for every cell, whatever its noise, so cells
+    /// stay fine where the light departs from trilinear and merge where it does not.
+    /// Replaces bias_budget's bound. Typical: 0.01-0.1.
+    float bias_tolerance = 0.f;
+    /// With bias_budget or bias_tolerance: scale the probes' reported noise to what the finest grid's second
     /// differences support (noise_scale2).
     bool calibrate_noise = true;
     /// Absolute floor added to the denominators above, as a fraction of the mean

@@ -345,6 +345,8 @@ inline void validate_volume_build(const scene_view& scene, glm::vec3 lo, glm::ve
     threshold(s.prediction_tolerance, "settings.prediction_tolerance");
     threshold(s.noise_sigmas, "settings.noise_sigmas");
     threshold(s.absolute_floor, "settings.absolute_floor");
+    threshold(s.bias_budget, "settings.bias_budget");
+    threshold(s.bias_tolerance, "settings.bias_tolerance");
 }
 
 /// The root cell over [lo, hi] with the scene's triangles that overlap it.

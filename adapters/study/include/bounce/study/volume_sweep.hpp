@@ -5,15 +5,20 @@
 /// octree per bias budget (irradiance_volume_settings::bias_budget) is built from those
 /// same probes and measured on the moving sphere, so that the share of the grid's probes at
 /// the grid's error can be read off the sweep (docs/studies/irradiance_volume_table.py
-/// interpolates it).
+/// interpolates it). Fourth session: the same at several finest depths and the uniform grid
+/// of each depth (volume_depth_sweep), so that octrees merged from a lattice deeper than the
+/// grid (refined deeper where the light changes, fewer probes elsewhere) meet the grid at
+/// equal probes, optionally measured at the camera's surface points as well.
 
 #include <bounce/scene_view.hpp>
 #include <bounce/study/volume_sphere.hpp>
+#include <bounce/study/volume_surface.hpp>
 #include <bounce/volume/probe_octree.hpp>
 
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <unordered_map>
 #include <vector>
@@ -44,25 +49,54 @@ private:
     std::size_t baked_ = 0, reused_ = 0;
 };
 
-/// One merged octree of a sweep and its trilinear lookup on the sphere.
+/// One octree of a sweep (merged, or the uniform grid of max_depth) and its trilinear lookup
+/// on the sphere, and at the surface points of a view when the sweep was given them.
 struct volume_sweep_point {
-    float bias_budget = 0, noise_sigmas = 0;
+    int max_depth = 0;     ///< the lattice it was built on (merged from, or the grid's depth)
+    bool uniform = false;  ///< the uniform grid (bias_budget and noise_sigmas then 0)
+    float bias_budget = 0, bias_tolerance = 0, noise_sigmas = 0;
     std::size_t probes = 0, probes_inside = 0, leaves = 0;
     volume_lookup_figures trilinear;
+    std::optional<volume_surface_figures> surface;  ///< trilinear, no visibility
 };
 
 /// For every budget (> 0, finite) and every noise_sigmas (>= 0, finite; empty: settings'
 /// own), the merged octree over [lo, hi] (`settings` with refinement = merge, that
 /// bias_budget and noise_sigmas: the slack of the bias test) built from `source`, and its
 /// trilinear lookup measured on `sphere`; prints a line each ("sweep bias_budget ...").
-/// Throws parameter_error naming "budgets" or "sigmas" for a value out of range.
+/// Throws parameter_error naming "budgets" or "sigmas" for a value out of range. With
+/// `surface`, each octree is measured at its points too (volume_sweep_point::surface).
 std::vector<volume_sweep_point> bias_budget_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
                                                   irradiance_volume_settings settings, probe_memo& source,
                                                   const volume_sphere_study& sphere, std::span<const float> budgets,
-                                                  std::span<const float> sigmas = {});
+                                                  std::span<const float> sigmas = {},
+                                                  const volume_surface_study* surface = nullptr);
 
-/// [{"bias_budget", "noise_sigmas", "probes", "probes_inside", "leaves", "rel_rms",
-/// "popping", "popping_excess"}, ...]
+/// The same with settings.bias_tolerance (an error target in units of the scene's light)
+/// set to each of `tolerances` (> 0, finite; parameter_error naming "tolerances") in place
+/// of bias_budget.
+std::vector<volume_sweep_point> bias_tolerance_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
+                                                     irradiance_volume_settings settings, probe_memo& source,
+                                                     const volume_sphere_study& sphere, std::span<const float> tolerances,
+                                                     std::span<const float> sigmas = {},
+                                                     const volume_surface_study* surface = nullptr);
+
+/// For every depth of `depths` (0 .. irradiance_volume::depth_limit), the uniform grid of that
+/// depth over [lo, hi] built from `source` (a lattice point of depth d is one of depth d + 1:
+/// after the deepest, the others bake nothing new), then, for every depth, the merged
+/// octrees of bias_budget_sweep and of bias_tolerance_sweep with settings.max_depth = that
+/// depth (none for an empty list); grids first, then merges by depth, as given. Prints a line each ("grid depth
+/// ...", "sweep depth ..."). Throws parameter_error naming "depths" for a depth out of range.
+std::vector<volume_sweep_point> volume_depth_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
+                                                   const irradiance_volume_settings& settings, probe_memo& source,
+                                                   const volume_sphere_study& sphere, std::span<const int> depths,
+                                                   std::span<const float> budgets, std::span<const float> tolerances,
+                                                   std::span<const float> sigmas = {},
+                                                   const volume_surface_study* surface = nullptr);
+
+/// [{"max_depth", "uniform", "bias_budget", "bias_tolerance", "noise_sigmas", "probes", "probes_inside",
+/// "leaves", "rel_rms", "popping", "popping_excess"[, "surface": volume_surface_figures::
+/// to_json()]}, ...]
 nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep);
 
 }  // namespace bounce::study
