@@ -12,7 +12,7 @@ bounce_cli_refusal("a depth whose grid exceeds memory" PROGRAM irradiance_volume
                    ARGS --max-depth 10)
 bounce_cli_refusal("a --seed of -1" PROGRAM irradiance_volume MATCH "--seed.*'-1' is not a whole number"
                    ARGS ${iv_big} --seed -1)
-foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull --prediction-tolerance --noise-sigmas --gradient-noise --self-shadow-bias --bias-budget)
+foreach(option --radius --b --support --margin --gradient-step --distance-ratio --cull --prediction-tolerance --noise-sigmas --gradient-noise --self-shadow-bias --bias-budget --bias-tolerance)
   bounce_cli_refusal("${option} nan" PROGRAM irradiance_volume MATCH "${option}.*'nan' is not" ARGS ${iv_big} ${option} nan)
 endforeach()
 # --support must exceed 1; the refusal prints the open bound as such, "(1, 16]", not 1.000001
@@ -26,6 +26,11 @@ bounce_cli_refusal("a --sweep-bias-budget of nan" PROGRAM irradiance_volume MATC
                    ARGS ${iv_big} --sweep-bias-budget 1 nan)
 bounce_cli_refusal("a --sweep-noise-sigmas of -1" PROGRAM irradiance_volume MATCH "--sweep-noise-sigmas.*'-1' is not"
                    ARGS ${iv_big} --sweep-noise-sigmas -1)
+# Fourth session: the sweep's tolerances and depths.
+bounce_cli_refusal("a --sweep-bias-tolerance of nan" PROGRAM irradiance_volume MATCH "--sweep-bias-tolerance.*'nan' is not"
+                   ARGS ${iv_big} --sweep-bias-tolerance 0.1 nan)
+bounce_cli_refusal("a --sweep-depths of 11" PROGRAM irradiance_volume MATCH "--sweep-depths.*11"
+                   ARGS ${iv_big} --sweep-depths 4 11)
 bounce_cli_refusal("a --noise-estimate not known" PROGRAM irradiance_volume MATCH "--noise-estimate.*thirds"
                    ARGS ${iv_big} --noise-estimate thirds)
 
