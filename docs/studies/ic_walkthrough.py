@@ -18,13 +18,17 @@ The single-frame rows it is compared with come from ic_image_size.py into the sa
   docs/studies/ic_walkthrough.py run walk 16 512x512 128 4 cornell -- --mc-max-spp 32
 
 table: one markdown row per scene, the last walkthrough row of WALK_TAG (walk) against the last
-single-frame row of SINGLE_TAG (single). Monte Carlo at equal error: where its sweep
-(--mc-max-spp) stopped short of a frame's debiased error, its time is extrapolated from the
-last measured run with the debiased error falling as spp^-1/2, time' = time (e / target)^2 (as
-ic_verification_table.py does; marked "~"). The walkthrough's Monte Carlo total is the mean
-over the measured frames times the frames; its ratio is that total over the cache's total, at
-the frames' mean debiased error. IC_BIN: the binary (build/bin/ic_splatting); BOUNCE_CACHE,
-BOUNCE_SCENES as for ic_splatting."""
+single-frame row of SINGLE_TAG (single). Monte Carlo at equal error: its time at error E is
+taken from the last run of its sweep (--mc-max-spp) with the debiased error falling as
+spp^-1/2 (exact for independent samples: the reference's noise is taken out of the error),
+time' = time (e / E)^2, as ic_verification_table.py does ("~": extrapolated beyond the sweep).
+The walkthrough's E is the mean of the frames' debiased errors (the issue's "equal mean
+per-frame error"): each measured frame's Monte Carlo time at E, their mean times the frames,
+over the cache's total. Matching each frame's own error instead is unstable: a frame whose
+debiased error is within its standard error of 0 asks for an unbounded Monte Carlo time. The
+table also gives the walkthrough's first frame (an empty cache, the same references and load)
+as a single frame. IC_BIN: the binary (build/bin/ic_splatting); BOUNCE_CACHE, BOUNCE_SCENES as
+for ic_splatting."""
 import json
 import os
 import subprocess
@@ -37,12 +41,10 @@ results = os.environ.get('RESULTS', os.path.join(root, 'docs/results/ic_walkthro
 order = ['cornell', 'cornell-box', 'bunny', 'sponza', 'conference', 'living-room', 'modern-hall']
 
 
-def extrapolated(m):
-    """(Monte Carlo's time at the target error, spp, extrapolated) from one mc_equal_error object."""
-    if not m.get('lower_bound'):
-        return m['ms'], m['spp'], False
-    scale = (m['measured_rel_rms'] / m['rel_rms']) ** 2
-    return m['measured_ms'] * scale, m['measured_spp'] * scale, True
+def monte_carlo_ms(m, target):
+    """(Monte Carlo's time at debiased error `target`, extrapolated beyond its sweep) from one
+    mc_equal_error object."""
+    return m['measured_ms'] * (m['measured_rel_rms'] / target) ** 2, target < m['measured_rel_rms']
 
 
 def frame_row(f):
@@ -92,27 +94,38 @@ def run(args):
             out.flush()
             ratio = walkthrough_ratio(row)
             print(f"{tag} {s}: {row['records']} records, {row['total_ms_loaded_machine'] / 1000:.1f} s over {frames} "
-                  f"frames, mean debiased {row['mean_rel_rms_debiased']:.4f}, Monte Carlo "
+                  f"frames, mean debiased {row['mean_rel_rms_debiased']:.4f}, Monte Carlo at that error "
                   f"{'~' if ratio[2] else ''}{ratio[0]:.1f}x, {time.time() - t0:.0f} s wall, load "
                   f"{load_before:.1f} -> {row['load_average']:.1f}", flush=True)
 
 
 def walkthrough_ratio(row):
-    """(ratio, Monte Carlo's total ms, any frame extrapolated) over the frames Monte Carlo measured."""
-    measured = [extrapolated(f['mc_equal_error']) for f in row['frames']
-                if 'speedup' in (f.get('mc_equal_error') or {})]
-    if not measured:
+    """(ratio, Monte Carlo's total ms, extrapolated) at the frames' mean debiased error."""
+    target = row['mean_rel_rms_debiased']
+    measured = [monte_carlo_ms(f['mc_equal_error'], target) for f in row['frames']
+                if 'measured_ms' in (f.get('mc_equal_error') or {})]
+    if not measured or not target > 0:
         return float('nan'), float('nan'), False
     total = sum(m[0] for m in measured) / len(measured) * row['frames_count']
-    return total / row['total_ms_loaded_machine'], total, any(m[2] for m in measured)
+    return total / row['total_ms_loaded_machine'], total, any(m[1] for m in measured)
 
 
 def single_ratio(row):
+    """(ratio, extrapolated) of a single-frame row (ic_image_size.py with --mc-compare)."""
     m = row.get('mc_equal_error') or {}
-    if 'speedup' not in m:
+    if 'measured_ms' not in m:
         return float('nan'), False
-    ms, _, extra = extrapolated(m)
+    ms, extra = monte_carlo_ms(m, m['rel_rms'])
     return ms / row['total_ms_loaded_machine'], extra
+
+
+def first_frame_ratio(row):
+    """(ratio, debiased error) of the walkthrough's first frame alone."""
+    f = row['frames'][0]
+    m = f.get('mc_equal_error') or {}
+    if 'measured_ms' not in m:
+        return float('nan'), f['rel_rms_debiased']
+    return monte_carlo_ms(m, m['rel_rms'])[0] / f['ms'], f['rel_rms_debiased']
 
 
 def table(args):
@@ -124,31 +137,37 @@ def table(args):
             walks[r['scene']] = r
         elif r['tag'] == single_tag:
             singles[r['scene']] = r
-    print('| scene | single frame: records | debiased rel_rms | time | Monte Carlo | walkthrough: records | new per '
-          'frame (1-15) | verify ms per frame (1-15) | mean debiased rel_rms (se) | time | Monte Carlo | walk / '
-          'single | load |')
+    print('| scene | single frame: records | debiased rel_rms (se) | time | Monte Carlo | walkthrough: records | '
+          'mean debiased rel_rms (se) | time | Monte Carlo | walk / single | first frame: rel_rms, Monte Carlo | '
+          'later frames: new records, s, of which clamp + splat, verify | load |')
     print('|---|' + '---|' * 12)
     for s in order:
         w, one = walks.get(s), singles.get(s)
         if w is None and one is None:
             continue
         cells = [s]
+        r1 = float('nan')
         if one:
             r1, x1 = single_ratio(one)
-            cells += [f"{one['records']:,}", f"{one['rel_rms_debiased']:.4f}",
-                      f"{one['total_ms_loaded_machine'] / 1000:.1f} s", f"{'~' if x1 else ''}{r1:.1f}x"]
+            cells += [f"{one['records']:,}", f"{one['rel_rms_debiased']:.4f} ({one.get('rel_rms_debiased_se', 0):.4f})",
+                      f"{one['total_ms_loaded_machine'] / 1000:.1f} s", f"{'~' if x1 else ''}{r1:.0f}x"]
         else:
             cells += ['not run', '', '', '']
         if w:
             fr = w['frames']
             later = fr[1:] or fr
-            new = sum(f['new_records'] for f in later) / len(later)
-            verify = sum((f.get('stages_ms') or {}).get('verify', 0.0) for f in later) / len(later)
+            n = len(later)
+            new = sum(f['new_records'] for f in later) / n
+            ms = sum(f['ms'] for f in later) / n
+            splat = sum(f['stages_ms'].get('splat_existing', 0.0) for f in later) / n
+            verify = sum(f['stages_ms'].get('verify', 0.0) for f in later) / n
             se = (sum(f.get('rel_rms_debiased_se', 0.0) ** 2 for f in fr)) ** 0.5 / len(fr)
             rw, _, xw = walkthrough_ratio(w)
-            cells += [f"{w['records']:,}", f"{new:,.0f}", f"{verify:,.0f}",
-                      f"{w['mean_rel_rms_debiased']:.4f} ({se:.4f})", f"{w['total_ms_loaded_machine'] / 1000:.1f} s",
-                      f"{'~' if xw else ''}{rw:.1f}x", f"{rw / r1:.2f}" if one else '']
+            r0, e0 = first_frame_ratio(w)
+            cells += [f"{w['records']:,}", f"{w['mean_rel_rms_debiased']:.4f} ({se:.4f})",
+                      f"{w['total_ms_loaded_machine'] / 1000:.1f} s", f"{'~' if xw else ''}{rw:.0f}x",
+                      f"{rw / r1:.2f}" if one else '', f"{e0:.4f}, {r0:.0f}x",
+                      f"{new:,.0f}, {ms / 1000:.1f} s, {splat / 1000:.1f} s, {verify / 1000:.1f} s"]
         else:
             cells += ['not run', '', '', '', '', '', '']
         load = ' / '.join(f"{r['load_average']:.0f}" for r in (one, w) if r)
