@@ -259,6 +259,12 @@ def figure(scene, index, path):
         for t in techniques_of(scene):
             tech = str(t.get("technique"))
             marker, colour = STYLE.get(tech, ("*", "tab:gray"))
+            own = [s for s in (t.get("monte_carlo") or []) if isinstance(s, dict)] if t.get("quantity") == q else []
+            own = sorted(((num(s.get("ms")) or 0) / 1000, num(s.get("rel_rms_debiased")) or 0) for s in own)
+            own = [p for p in own if p[0] > 0 and p[1] > 0]
+            if own:  # a merged row's own sweep (benchmark_merge.py)
+                ax.plot([p[0] for p in own], [p[1] for p in own], color=colour, linestyle=":", linewidth=1,
+                        label=f"Monte Carlo ({tech}'s run)")
             for err, hollow, suffix in ((t.get("error"), False, ""), (t.get("error_unoccluded"), True, " (vs unoccluded)")):
                 target_q = "unoccluded" if hollow else t.get("quantity")
                 if target_q != q or not isinstance(err, dict) or "failed" in t:
@@ -294,6 +300,9 @@ def figure(scene, index, path):
 
 # ---- the page --------------------------------------------------------------------------------------
 
+MERGED_MARK = "†"
+
+
 def provenance_lines(results):
     prov = results.get("provenance") or {}
     lines = ["## Provenance and settings", ""]
@@ -316,6 +325,15 @@ def provenance_lines(results):
             elif isinstance(v, bool):
                 v = json.dumps(v)
             lines.append(f"  - {k}: {v}")
+    for m in prov.get("merged") or []:  # runs of some techniques merged in (benchmark_merge.py)
+        if not isinstance(m, dict):
+            continue
+        techs = sorted({str(e).split("/", 1)[-1] for e in m.get("entries") or []})
+        use = m.get("machine_use") or {}
+        lines.append(f"- merged run ({', '.join(techs) or DASH}; rows marked {MERGED_MARK}): commit {m.get('commit', DASH)}, "
+                     f"date {m.get('date', DASH)}, command `{m.get('command', DASH)}`, wall {fmt(num(use.get('wall_s')))} s, "
+                     f"load average {fmt(num(use.get('load_average_start')))} -> {fmt(num(use.get('load_average_end')))}"
+                     + (f"; {m['note']}" if m.get("note") else ""))
     return lines + [""]
 
 
@@ -372,8 +390,12 @@ def scene_lines(scene, index, figure_path, left_off, md_dir):
     lines += ["| technique | quantity | time | rel_rms (debiased ± se) | SSIM | Monte Carlo at equal rel_rms | speed-up "
               "| Monte Carlo at equal SSIM | speed-up | against the unoccluded reference: rel_rms, SSIM, speed-up | counts |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
+    merged_rows = False
     for t in techniques_of(scene):
         tech = cell(t.get("technique", DASH))
+        if isinstance(t.get("merged_run"), int):
+            tech += " " + MERGED_MARK
+            merged_rows = True
         if "failed" in t:
             lines.append(f"| {tech} | {cell(t.get('quantity', DASH))} | failed: {cell(t['failed'])} |"
                          + f" {DASH} |" * 8)
@@ -388,6 +410,9 @@ def scene_lines(scene, index, figure_path, left_off, md_dir):
                      f"{fmt_fixed(get(err, 'ssim'), 3)} | {fmt_mc(mc.get('rel_rms'))} | {fmt_speedup(mc.get('rel_rms'))} | "
                      f"{fmt_mc(mc.get('ssim'))} | {fmt_speedup(mc.get('ssim'))} | {unocc} | {fmt_counts(t.get('counts'))} |")
     lines.append("")
+    if merged_rows:
+        lines += [f"{MERGED_MARK} from a later run of that technique alone (provenance above), its speed-ups against that "
+                  "run's own Monte Carlo sweep (the dotted line in the figure).", ""]
     visibility = [v for v in scene.get("visibility") or [] if isinstance(v, dict)]
     if visibility:
         lines += ["What indirect visibility adds (issue 29's headline, at most 1.2): each RSM technique's debiased "

@@ -171,7 +171,54 @@ def main(script, workdir):
                           "--figures", os.path.join(workdir, "bad")], capture_output=True, text=True, timeout=60)
     if run.returncode == 0 or "scenes" not in run.stderr:
         fail(f"a results file without scenes gave exit {run.returncode}: {run.stderr}")
-    print("benchmark report: page, tables, figures and verdicts as the fixture says")
+    check_merge(script, workdir, results)
+    print("benchmark report: page, tables, figures and verdicts as the fixture says; a merged run marked")
+
+
+def check_merge(script, workdir, results):
+    """benchmark_merge.py: a run of the cache alone replaces its rows, keeps its own sweep, is marked."""
+    merge = os.path.join(os.path.dirname(script), "benchmark_merge.py")
+    partial = {"provenance": dict(FIXTURE["provenance"], commit="4567def", command="benchmark --techniques x",
+                                  machine_use={"wall_s": 12.0, "load_average_start": 3.5, "load_average_end": 4.5}),
+               "scenes": [{"scene": "cornell",
+                           "techniques": [technique("irradiance_cache", "one_bounce", 246.0, 0.021, 0.95, 9.25, 2.4)],
+                           "monte_carlo": {"one_bounce": mc_sweep(0.5)}}]}
+    part_path, merged = os.path.join(workdir, "partial.json"), os.path.join(workdir, "merged.json")
+    with open(part_path, "w") as f:
+        json.dump(partial, f)
+    run = subprocess.run([sys.executable, merge, results, part_path, "--out", merged, "--note", "loaded machine"],
+                         capture_output=True, text=True, timeout=60)
+    if run.returncode != 0:
+        fail(f"the merge exited {run.returncode}: {run.stderr}")
+    with open(merged) as f:
+        m = json.load(f)
+    cache = m["scenes"][0]["techniques"][0]
+    if cache.get("ms") != 246.0 or cache.get("merged_run") != 0 or len(cache.get("monte_carlo") or []) != 6:
+        fail(f"the merged row is not the partial run's with its sweep: {cache}")
+    if m["scenes"][0]["techniques"][1] != FIXTURE["scenes"][0]["techniques"][1] or \
+            m["scenes"][1] != FIXTURE["scenes"][1] or m["scenes"][0]["monte_carlo"] != FIXTURE["scenes"][0]["monte_carlo"]:
+        fail("the merge changed rows or sweeps of the base run")
+    md = os.path.join(workdir, "merged", "benchmark.md")
+    run = subprocess.run([sys.executable, script, merged, "--md", md, "--figures", os.path.join(workdir, "merged")],
+                         capture_output=True, text=True, timeout=120)
+    if run.returncode != 0:
+        fail(f"the report script exited {run.returncode} on the merged file: {run.stderr}")
+    with open(md) as f:
+        text = f.read()
+    for needle in ("| irradiance_cache † | one_bounce | 246 ms |", "9.2x", "merged run (irradiance_cache; rows marked †): "
+                   "commit 4567def", "load average 3.50 -> 4.50; loaded machine", "† from a later run"):
+        if needle not in text:
+            fail(f"{needle!r} is not on the merged page")
+    if "| irradiance_cache † | one_bounce | 2.50 s" in text:
+        fail("the second scene's cache row, not in the partial run, is marked merged")
+    # Runs of another size or reference are not merged.
+    partial["provenance"]["settings"] = dict(partial["provenance"]["settings"], width=128)
+    with open(part_path, "w") as f:
+        json.dump(partial, f)
+    run = subprocess.run([sys.executable, merge, results, part_path, "--out", merged], capture_output=True, text=True,
+                         timeout=60)
+    if run.returncode == 0 or "not comparable" not in run.stderr:
+        fail(f"a run of another size was merged (exit {run.returncode}): {run.stderr}")
 
 
 if __name__ == "__main__":
