@@ -75,3 +75,7 @@ bounce_cli_refusal(hessian-zone-cap-split-sphere PROGRAM ic_splatting
 bounce_cli_refusal(interp-unknown PROGRAM ic_splatting
   MATCH "--interp: splat-vulkan not in .splat-cpu,splat-gl,octree,octree-lanes." ARGS --interp splat-vulkan)
 bounce_cli_refusal(sampler-number PROGRAM ic_splatting MATCH "--sampler: 1 not in .embree,raster." ARGS --sampler 1)
+
+# The verification pass runs in both splat frames (CPU and GL), not with the octree.
+bounce_cli_refusal(verify-octree PROGRAM ic_splatting
+  MATCH "--verify.*splat-cpu or splat-gl" ARGS --verify 2 --interp octree)
