@@ -99,6 +99,22 @@ def main():
         row = ", ".join(f"{p['bias_tolerance']:g}: {100 * p['probes'] / n4:.0f}% {err(p, 'path'):.4f}/{err(p, 'surface'):.4f}"
                         for p in family(r, 5, "tolerance"))
         print(f"- {sc}: {row}")
+    print()
+    print("One tolerance for every scene: scenes where it is within the depth-4 grid's error with at most 40% of its "
+          "probes (path / surface), merged from 4 and from 5")
+    for d in (4, 5):
+        tols = sorted({p["bias_tolerance"] for sc in scenes for p in family(runs[sc], d, "tolerance")})
+        for t in tols:
+            hits = {"path": [], "surface": []}
+            for sc in scenes:
+                r = runs[sc]
+                g4 = grid(r, 4)
+                p = next(p for p in family(r, d, "tolerance") if p["bias_tolerance"] == t)
+                for m in hits:
+                    if p["probes"] <= 0.4 * g4["probes"] and err(p, m) <= err(g4, m):
+                        hits[m].append(sc)
+            print(f"- from {d}, tolerance {t:g}: path {len(hits['path'])} ({', '.join(hits['path'])}), "
+                  f"surface {len(hits['surface'])} ({', '.join(hits['surface'])})")
     if picture:
         figure(runs, scenes, picture)
 

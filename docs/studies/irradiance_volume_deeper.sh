@@ -21,7 +21,7 @@ scenes=("$@")
 for sc in "${scenes[@]}"; do
   "$bin" --scene "$sc" --mode uniform --max-depth 5 --noise-estimate rotated-repeat --calibrate-noise off \
     --gradient-step 0 --sweep-depths 3 4 5 --sweep-bias-budget 1 16 64 256 \
-    --sweep-bias-tolerance 0.01 0.02 0.04 0.06 0.08 0.1 0.12 0.16 0.24 0.32 --sweep-surface \
+    --sweep-bias-tolerance 0.01 0.02 0.04 0.06 0.08 0.1 0.12 0.16 0.24 0.32 0.48 0.64 1 1.5 2 3 --sweep-surface \
     --json "$out/deeper-$sc.json" 2>/dev/null | grep -E "^(grid|sweep|$sc)"
   python3 docs/studies/results.py add "$results" "deeper-$sc" "$out/deeper-$sc.json"
 done

@@ -199,6 +199,7 @@ TEST_CASE("a probe memo bakes each position once, and a sweep's octrees come fro
     CHECK(by_depth[7].probes <= by_depth[6].probes);
     CHECK(by_depth[7].probes < 125);  // a tolerance of ten times the light merges
     CHECK(study::to_json(by_depth)[7]["bias_tolerance"] == 10.f);
+    CHECK((by_depth[1].hanging == 0 && by_depth[7].hanging < by_depth[7].probes));
     CHECK_THROWS_AS(study::volume_depth_sweep(s, lo, hi, vs, memo, sphere, std::vector<int>{11}, {}, {}), parameter_error);
     CHECK_THROWS_AS(study::bias_tolerance_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{0.f}), parameter_error);
     CHECK_THROWS_AS(study::probe_memo(nullptr), parameter_error);

@@ -57,6 +57,7 @@ volume_sweep_point measure_point(const irradiance_volume& volume, const irradian
     p.probes = volume.probes().size();
     p.probes_inside = stats.probes_inside;
     p.leaves = volume.leaf_count();
+    p.hanging = stats.hanging_corners;
     p.trilinear = sphere.measure(volume, "trilinear", cpu::volume_lookup{});
     if (surface) p.surface = surface->measure(volume, nullptr, cpu::volume_lookup{});
     return p;
@@ -160,7 +161,8 @@ nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep) {
         nlohmann::ordered_json e = {{"max_depth", p.max_depth}, {"uniform", p.uniform}, {"bias_budget", p.bias_budget},
                                     {"bias_tolerance", p.bias_tolerance},
                                     {"noise_sigmas", p.noise_sigmas}, {"probes", p.probes}, {"probes_inside", p.probes_inside},
-                                    {"leaves", p.leaves}, {"rel_rms", p.trilinear.error.rel_rms}, {"popping", p.trilinear.popping},
+                                    {"leaves", p.leaves}, {"hanging", p.hanging}, {"rel_rms", p.trilinear.error.rel_rms},
+                                    {"popping", p.trilinear.popping},
                                     {"popping_excess", p.trilinear.popping_excess}};
         if (p.surface) e["surface"] = p.surface->to_json();
         j.push_back(std::move(e));

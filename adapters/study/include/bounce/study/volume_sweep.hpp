@@ -56,6 +56,7 @@ struct volume_sweep_point {
     bool uniform = false;  ///< the uniform grid (bias_budget and noise_sigmas then 0)
     float bias_budget = 0, bias_tolerance = 0, noise_sigmas = 0;
     std::size_t probes = 0, probes_inside = 0, leaves = 0;
+    std::size_t hanging = 0;  ///< stored probes at T-junctions, the coarser leaf's interpolation (conforming corners)
     volume_lookup_figures trilinear;
     std::optional<volume_surface_figures> surface;  ///< trilinear, no visibility
 };
@@ -95,7 +96,7 @@ std::vector<volume_sweep_point> volume_depth_sweep(const scene_view& scene, glm:
                                                    const volume_surface_study* surface = nullptr);
 
 /// [{"max_depth", "uniform", "bias_budget", "bias_tolerance", "noise_sigmas", "probes", "probes_inside",
-/// "leaves", "rel_rms", "popping", "popping_excess"[, "surface": volume_surface_figures::
+/// "leaves", "hanging", "rel_rms", "popping", "popping_excess"[, "surface": volume_surface_figures::
 /// to_json()]}, ...]
 nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep);
 
