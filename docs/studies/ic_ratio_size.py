@@ -8,6 +8,8 @@ the image's pixels on a log axis).
 Rows: docs/results/ic_ratio_size.jsonl (docs/studies/ic_image_size.py with the defaults and
 --mc-compare) and the 512x512 rows of docs/results/ic_verification.jsonl tagged
 `quiet-verify` (the same defaults on a quiet machine); the last row of each (scene, size).
+Records without the verification pass: the rows tagged `records-noverify` (--verify 0), else
+the `base` rows of docs/results/ic_image_size.jsonl (the defaults before the pass existed).
 Monte Carlo at equal error is that of results.monte_carlo_at_equal_error: past the sweep
 (--mc-max-spp) extrapolated as spp ~ err^-2, marked "~". The cache and its Monte Carlo are
 timed in the same run, so the ratio is comparable across loads only as far as the load stayed
@@ -32,17 +34,24 @@ def pixels(size):
 
 
 def load_rows(paths):
-    """{(scene, size): row}, the last of each; the verification file's `quiet-verify` only."""
-    rows = {}
+    """({(scene, size): row}, the last of each with Monte Carlo, the verification file's
+    `quiet-verify` only; {(scene, size): records} of the runs tagged `records-noverify`)."""
+    rows, records = {}, {}
     for path in paths:
         for line in open(path):
             r = json.loads(line)
-            if 'mc_equal_error' not in r:
+            if r['tag'] == 'records-noverify':
+                records[(r['scene'], r['size'])] = r['records']
+            # Before --verify existed: ic_image_size.jsonl's defaults (tag `base`), equal to the
+            # records-noverify counts wherever both were measured.
+            if os.path.basename(path) == 'ic_image_size.jsonl' and r['tag'] == 'base' and not r['options']:
+                records.setdefault((r['scene'], r['size']), r['records'])
+            if 'mc_equal_error' not in r or os.path.basename(path) == 'ic_image_size.jsonl':
                 continue
             if os.path.basename(path) == 'ic_verification.jsonl' and r['tag'] != 'quiet-verify':
                 continue
             rows[(r['scene'], r['size'])] = r
-    return rows
+    return rows, records
 
 
 def target(scene, size):
@@ -51,7 +60,7 @@ def target(scene, size):
     return TARGETS.get(size)
 
 
-def table(rows):
+def table(rows, records):
     print('| scene | size | records | per pixel | debiased rel_rms (se) | cache | Monte Carlo at equal error '
           '| ratio | target | load before / after |')
     print('|---|---|---|---|---|---|---|---|---|---|')
@@ -68,12 +77,17 @@ def table(rows):
             print(f"| {s} | {size} | {r['records']:,} | {r['records_per_pixel']:.3f} | {err} | {cache_s:.1f} s "
                   f"| {'~' if extrapolated else ''}{ratio * cache_s:.0f} s ({spp:.0f} spp) | {'~' if extrapolated else ''}{ratio:.1f}x | {mark} | {load} |")
     print()
-    print('| scene | records 1920x1080 / 512x512 |')
-    print('|---|---|')
+    print('| scene | records 512x512 | 1920x1080 | ratio | without verification: 512x512 | 1920x1080 | ratio '
+          '| verification\'s records 512x512 | 1920x1080 |')
+    print('|---|---|---|---|---|---|---|---|---|')
     for s in ORDER:
         a, b = rows.get((s, '512x512')), rows.get((s, '1920x1080'))
-        if a and b:
-            print(f"| {s} | {b['records'] / a['records']:.2f}x ({b['records']:,} / {a['records']:,}) |")
+        c, d = records.get((s, '512x512')), records.get((s, '1920x1080'))
+        a, b = a and a['records'], b and b['records']
+        cells = [f"{a:,}" if a else '', f"{b:,}" if b else '', f"{b / a:.2f}x" if a and b else '',
+                 f"{c:,}" if c else '', f"{d:,}" if d else '', f"{d / c:.2f}x" if c and d else '',
+                 f"{a - c:,} ({(a - c) / a:.0%})" if a and c else '', f"{b - d:,} ({(b - d) / b:.0%})" if b and d else '']
+        print(f"| {s} | " + ' | '.join(cells) + ' |')
 
 
 def plot(rows, out):
@@ -89,7 +103,10 @@ def plot(rows, out):
         sizes = sorted({k[1] for k in rows if k[0] == s}, key=pixels)
         px = [pixels(z) for z in sizes]
         mc = [monte_carlo_at_equal_error(rows[(s, z)]) for z in sizes]
-        ax.plot(px, [m[0] for m in mc], 'o-', color='C0')
+        ax.plot(px, [m[0] for m in mc], '-', color='C0')
+        for x, z, m in zip(px, sizes, mc):
+            quiet = rows[(s, z)]['load_average'] < 3  # filled: quiet machine; open: loaded
+            ax.plot([x], [m[0]], 'o', color='C0', markerfacecolor='C0' if quiet else 'white')
         for x, z, m in zip(px, sizes, mc):
             ax.annotate(f"{m[0]:.0f}x", (x, m[0]), textcoords='offset points', xytext=(0, 5), ha='center', fontsize=7)
         for z, t in ((z, target(s, z)) for z in ('512x512', '1920x1080')):
@@ -105,7 +122,8 @@ def plot(rows, out):
         ax.grid(True, which='major', color='0.9')
     axes[0][0].set_ylabel('Monte Carlo time / cache time')
     fig.suptitle('Cache against Monte Carlo at equal debiased error, defaults (red: the issue\'s target; '
-                 'loaded 2-core machine, ratio from one run)', fontsize=10)
+                 'filled: quiet machine, open: loaded 2-core machine, load 2-24; cache and Monte Carlo timed in one run)',
+                 fontsize=9)
     fig.tight_layout()
     fig.savefig(out, dpi=80)
     print(f"wrote {out} ({os.path.getsize(out) // 1024} KB)", file=sys.stderr)
@@ -113,7 +131,8 @@ def plot(rows, out):
 
 if __name__ == '__main__':
     paths = sys.argv[1:] or [os.path.join(root, 'docs/results/ic_verification.jsonl'),
-                             os.path.join(root, 'docs/results/ic_ratio_size.jsonl')]
-    rows = load_rows(paths)
-    table(rows)
+                             os.path.join(root, 'docs/results/ic_ratio_size.jsonl'),
+                             os.path.join(root, 'docs/results/ic_image_size.jsonl')]
+    rows, records = load_rows(paths)
+    table(rows, records)
     plot(rows, os.path.join(root, 'docs/figures/ic-ratio-size.png'))
