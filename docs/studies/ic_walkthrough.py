@@ -54,10 +54,8 @@ def frame_row(f):
 
 
 def run(args):
-    extra = []
-    if '--' in args:
-        i = args.index('--')
-        extra, args = args[i + 1:], args[:i]
+    sep = args.index('--') if '--' in args else len(args)
+    args, extra = args[:sep], args[sep + 1:]
     if len(args) < 5:
         sys.exit(__doc__)
     tag, frames, size, spp, stride = args[:5]
@@ -128,6 +126,27 @@ def first_frame_ratio(row):
     return monte_carlo_ms(m, m['rel_rms'])[0] / f['ms'], f['rel_rms_debiased']
 
 
+RAYS_PER_RECORD = 1026  # the default 32 x 32 grid and its two gradient rays (ic_verification_table.py)
+
+
+def rays_ratio(row, frames, target):
+    """Monte Carlo's rays at debiased error `target` over the cache's, for `frames` frames of
+    `row` (a walkthrough row: its measured frames; a single-frame row: itself): spp times
+    pixels against the records' rays plus the verification's probes (8 rays on half the
+    pixels: an upper bound); the scan's wasted guesses and the splats left out. The machine's
+    load does not move it."""
+    w, h = (int(v) for v in row['size'].split('x'))
+    verified = 'verify_tiles' in row or any('verify' in f for f in row.get('frames', []))
+    probes = w * h // 2 * 8 if verified else 0
+    if 'frames' in row:
+        ms = [f['mc_equal_error'] for f in row['frames'] if 'measured_ms' in (f.get('mc_equal_error') or {})]
+        records = sum(f['new_records'] for f in row['frames'])
+    else:
+        ms, records = [row['mc_equal_error']], row['records']
+    spp = sum(m['measured_spp'] * (m['measured_rel_rms'] / target) ** 2 for m in ms) / len(ms)
+    return spp * w * h * frames / (records * RAYS_PER_RECORD + probes * frames)
+
+
 def table(args):
     walk_tag, single_tag = (args + ['walk', 'single'])[:2] if len(args) != 1 else (args[0], 'single')
     walks, singles = {}, {}
@@ -138,7 +157,7 @@ def table(args):
         elif r['tag'] == single_tag:
             singles[r['scene']] = r
     print('| scene | single frame: records | debiased rel_rms (se) | time | Monte Carlo | walkthrough: records | '
-          'mean debiased rel_rms (se) | time | Monte Carlo | walk / single | first frame: rel_rms, Monte Carlo | '
+          'mean debiased rel_rms (se) | time | Monte Carlo | walk / single (by rays) | first frame: rel_rms, Monte Carlo | '
           'later frames: new records, s, of which clamp + splat, verify | load |')
     print('|---|' + '---|' * 12)
     for s in order:
@@ -166,7 +185,8 @@ def table(args):
             r0, e0 = first_frame_ratio(w)
             cells += [f"{w['records']:,}", f"{w['mean_rel_rms_debiased']:.4f} ({se:.4f})",
                       f"{w['total_ms_loaded_machine'] / 1000:.1f} s", f"{'~' if xw else ''}{rw:.0f}x",
-                      f"{rw / r1:.2f}" if one else '', f"{e0:.4f}, {r0:.0f}x",
+                      f"{rw / r1:.2f} ({rays_ratio(w, 16, w['mean_rel_rms_debiased']) / rays_ratio(one, 1, one['rel_rms_debiased']):.2f})"
+                      if one else '', f"{e0:.4f}, {r0:.0f}x",
                       f"{new:,.0f}, {ms / 1000:.1f} s, {splat / 1000:.1f} s, {verify / 1000:.1f} s"]
         else:
             cells += ['not run', '', '', '', '', '', '']
