@@ -68,30 +68,39 @@ def row(r, name=None):
 
 
 def table():
+    """The doc's tables: the pairs (derived against blocks), then Sponza's scaling."""
     runs = results.runs_by_name(RESULTS)
-    print("| run | elements | charts | shooters | steps | converged (indirect) | solve s | total s | solve ms per step "
-          "| rel_rms | load before |")
-    print("|" + "---|" * 11)
-    for name, r in runs.items():
-        if not re.search(r"-r[0-9]+$", name):
-            print(row(r, name))
-    print()
-    print("Repeated pairs (run in turn, the -rK suffix):")
-    for name, r in runs.items():
-        if re.search(r"-r[0-9]+$", name):
-            print(f"  {name}: {solve_ms(r) / 1000:.1f} s, {r['iterations']} steps, {r['shooters']} shooters")
-    print()
-    print("| scene, elements | steps derived / blocks | solve s derived / blocks | ratio | rel_rms derived / blocks |")
-    print("|---|---|---|---|---|")
+    print("| scene, elements | shooters derived / blocks | steps derived / blocks | solve s derived / blocks "
+          "| ratio | rel_rms derived / blocks | load before |")
+    print("|---|---|---|---|---|---|---|")
     for s in SCENES:
         for n in (10000, 30000, 100000):
             d, b = runs.get(f"derived-{s}-{n}"), runs.get(f"blocks-{s}-{n}")
             if not d or not b:
                 continue
             ed, eb = (d.get("error") or {}).get("rel_rms"), (b.get("error") or {}).get("rel_rms")
-            cut = "" if b["stopped"] == "converged" else f" ({b['stopped']})"
-            print(f"| {s}, {n // 1000}k | {d['iterations']} / {b['iterations']}{cut} | {solve_ms(d) / 1000:.1f} / "
-                  f"{solve_ms(b) / 1000:.1f} | {solve_ms(d) / solve_ms(b):.2f} | {ed:.4f} / {eb:.4f} |")
+            def cut(r):
+                return "" if r["stopped"] == "converged" else f" (cut at {100 * (1 - r['indirect_unshot_fraction']):.1f}%)"
+            print(f"| {s}, {d['elements']:,} | {d['shooters']:,} / {b['shooters']:,} | {d['iterations']:,}{cut(d)} / "
+                  f"{b['iterations']:,}{cut(b)} | {solve_ms(d) / 1000:.1f} / {solve_ms(b) / 1000:.1f} | "
+                  f"{solve_ms(d) / solve_ms(b):.2f} | {ed:.4f} / {eb:.4f} | {d['load_before'][0]:.0f}, "
+                  f"{b['load_before'][0]:.0f} |")
+    print()
+    print("| Sponza, shooters | elements | shooters | steps | converged (indirect) | solve s | solve ms per step "
+          "| load before |")
+    print("|---|---|---|---|---|---|---|---|")
+    for mode in ("derived", "blocks"):
+        for n in (10000, 30000, 100000, 300000, 1000000):
+            r = runs.get(f"{mode}-sponza-{n}")
+            if r:
+                print(f"| {mode} | {r['elements']:,} | {r['shooters']:,} | {r['iterations']:,} | "
+                      f"{100 * (1 - r['indirect_unshot_fraction']):.1f}% ({r['stopped']}) | {solve_ms(r) / 1000:.1f} | "
+                      f"{solve_ms(r) / max(r['iterations'], 1):.0f} | {r['load_before'][0]:.0f} |")
+    print()
+    print("Repeated pairs (run in turn, the -rK suffix):")
+    for name, r in runs.items():
+        if re.search(r"-r[0-9]+$", name):
+            print(f"  {name}: {solve_ms(r) / 1000:.1f} s, {r['iterations']} steps, {r['shooters']} shooters")
 
 
 def plot():
