@@ -6,8 +6,11 @@
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/cpu/radiosity_item_buffer.hpp>
+#include <bounce/embree/lightmap_view.hpp>
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
+#include <bounce/luminance.hpp>
+#include <bounce/output.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/sampling.hpp>
 
@@ -362,4 +365,75 @@ TEST_CASE("a floor running around a column's base is lit: its element's point li
     o.converge = 0.999;
     solver.solve(o);
     CHECK(solver.radiosity(0)[floor.first_element].y > 1.f);
+}
+
+namespace {
+
+// A view's luminance error against `ref` over the pixels that see geometry: rms / rms.
+double view_error(const image<glm::vec3>& v, const image<glm::vec3>& ref) {
+    double d = 0, r = 0;
+    for (std::size_t y = 0; y < ref.height(); ++y)
+        for (std::size_t x = 0; x < ref.width(); ++x) {
+            const double a = rec709_luminance<double, glm::dvec3>(glm::dvec3(v(x, y)));
+            const double b = rec709_luminance<double, glm::dvec3>(glm::dvec3(ref(x, y)));
+            d += (a - b) * (a - b);
+            r += b * b;
+        }
+    return std::sqrt(d / r);
+}
+
+}  // namespace
+
+TEST_CASE("the direct+indirect view draws a sun strip narrower than a texel, which the lightmap's lookup blurs",
+          "[radiosity][embree][view]") {
+    // The room's 5 cm sun strip on the floor (x in [0, 0.67], z in [1.975, 2.025]) crosses
+    // texels about 17 cm wide: looked up in the lightmap it is spread over them (at most about
+    // a third of its radiance), drawn per pixel with shadow rays it is exact. A camera 1 m
+    // above the strip, 64 x 64 pixels of 8.4 mm.
+    const auto scene = room_with_slit(0.05f);
+    const lightmap_atlas atlas = build_lightmap_atlas(scene.view(), {.elements = 3000});
+    cpu::progressive_radiosity solver(scene.view(), atlas, embree_visibility(scene, atlas),
+                                      {.two_sided = true, .light_samples = 4});
+    radiosity_solve_options o;
+    o.converge = 0.999;
+    solver.solve(o);
+    std::vector<image<glm::vec3>> b, rest;
+    for (int side = 0; side < 2; ++side) {
+        std::vector<glm::vec3> r(solver.display_radiosity(side));
+        const auto d = solver.output(output_quantity::irradiance, light_paths::direct, side);
+        for (std::size_t i = 0; i < r.size(); ++i) r[i] -= atlas.albedo[i] * d[i];  // B less rho E_d
+        b.push_back(solver.radiosity_lightmap(0, side));
+        rest.push_back(atlas.to_fine_texels(std::span<const glm::vec3>(r), 0, glm::vec3(0.f), true));
+    }
+    const embree::accel bvh(scene.view());
+    camera cam;
+    cam.position = {0.35f, 1.f, 2.f};
+    cam.look_at = {0.35f, 0.f, 2.f};
+    cam.up = {1.f, 0.f, 0.f};
+    cam.fov_y_deg = 30.f;
+    const std::size_t n = 64;
+    const auto lookup = embree::lightmap_view(bvh, scene.view(), atlas, b[0].view(), b[1].view(), 0, cam, n, n);
+    const auto direct = embree::lightmap_direct_view(bvh, scene.view(), atlas, rest[0].view(), rest[1].view(), 0, cam, n, n);
+    // The sun's radiance off the floor: rho / pi * 20 * cos, cos = 0.45 / |(1, 0.45, 0)|.
+    const float sun = 0.6f / float(std::numbers::pi) * 20.f * 0.45f / std::sqrt(1.f + 0.45f * 0.45f);
+    const glm::vec3 rest_centre = direct(n / 2, n / 2) - sun;
+    INFO("direct+indirect " << direct(n / 2, n / 2).y << ", lookup " << lookup(n / 2, n / 2).y << ", sun " << sun);
+    CHECK(rest_centre.y >= 0.f);
+    CHECK(rest_centre.y < 0.1f * sun);  // the rest is what the floor gets bounced
+    CHECK(lookup(n / 2, n / 2).y < 0.6f * sun);
+    // 12 pixels (10 cm) off the strip the floor is in the wall's shadow, lit only by the
+    // bounces; the lookup spreads the strip's light into it.
+    CHECK(direct(n / 2 + 12, n / 2).y > 0.f);
+    CHECK(direct(n / 2 + 12, n / 2).y < 0.5f * lookup(n / 2 + 12, n / 2).y);
+    embree::multi_bounce_settings settings;
+    settings.paths = 64;
+    const auto ref = embree::multi_bounce_reference(bvh, scene.view(), settings).render(cam, n, n);
+    const double e_lookup = view_error(lookup, ref.radiance), e_direct = view_error(direct, ref.radiance);
+    INFO("rel_rms: lookup " << e_lookup << ", direct+indirect " << e_direct);
+    CHECK(e_direct < 0.5 * e_lookup);
+    // With no rest, the view is the lights' direct light alone: the sun where the strip is.
+    const image<glm::vec3> zero(rest[0].width(), rest[0].height(), glm::vec3(0.f));
+    const auto sun_only = embree::lightmap_direct_view(bvh, scene.view(), atlas, zero.view(), zero.view(), 0, cam, n, n);
+    CHECK(sun_only(n / 2, n / 2).y == Approx(sun).epsilon(1e-4));
+    CHECK(sun_only(n / 2 + 12, n / 2).y == 0.f);
 }
