@@ -121,7 +121,7 @@ def plot():
                                    fontsize=7)
         other = [r for r in runs if r["mode"] == mode and r["stopped"] == "converged"]
         ax[2].scatter([r["charts"] for r in other], [r["iterations"] for r in other], color=colour, s=14,
-                      label=f"{mode} (every scene, 10k-1M)")
+                      label=f"{mode} (every scene and count, converged runs)")
     x = sorted({r["elements"] for r in runs if r["scene"] == "sponza"})
     if x:
         ax[1].plot(x, [x0 / x[0] * min(solve_ms(r) / r["iterations"] for r in runs if r["scene"] == "sponza"
