@@ -67,7 +67,7 @@ struct options {
     std::uint64_t seed = 1;           // the reference's base seed
     int curve_points = 16;            // error checkpoints along the solve (0: none)
     bool quiet = false;
-    view_kind view = view_kind::lightmap;  // the camera's view: the lightmap, or the lights' direct light per pixel
+    view_kind view = view_kind::automatic;  // the camera's view: the lightmap, or the lights' direct light per pixel
     std::filesystem::path json, out, lightmaps, versus, reference_out, holes_out, oracle_out;
 };
 
@@ -143,7 +143,8 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--lightmaps", o.lightmaps, "write the lightmaps (EXR) into this folder");
     app.add_option("--holes-out", o.holes_out, "write a CSV of the view's black pixels where the reference is lit (holes.hpp)");
     add_choice(app, "--view", o.view, view_names,
-               "lightmap (B / pi looked up) | direct+indirect (the lights' direct light per pixel, the rest looked up)")
+               "lightmap (B / pi looked up) | direct+indirect (the lights' direct light per pixel, the rest looked up) | "
+               "auto (direct+indirect on the CPU backend, lightmap on GL)")
         ->capture_default_str();
     app.add_option("--oracle-out", o.oracle_out, "write the error's split and the best lightmap's error (JSON, oracle.hpp)");
     app.add_option("--reference-out", o.reference_out, "write the reference view here (.png or .exr)");
@@ -245,7 +246,8 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
             {"group_near_field", o.group_near_field},
-            {"view", name_of(view_names, o.view)}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
+            {"view", name_of(view_names, o.view != view_kind::automatic ? o.view
+                                         : o.backend == backend::gl ? view_kind::lightmap : view_kind::direct_indirect)}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 
 /// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),

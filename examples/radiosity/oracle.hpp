@@ -1,8 +1,8 @@
 #pragma once
 // Where the view's error is (issue 30, --oracle-out): the error of the solve's view split into
 // the lights' direct light and the rest, and the best any lightmap of this atlas could do (an
-// "oracle" lightmap: each texel the multi-bounce reference integrator's mean radiance over 2 x 2
-// points of its texel square, or at its element's point for partial texels, on each side the
+// "oracle" lightmap: each texel the multi-bounce reference integrator's mean radiance over 4 x 4
+// points of its texel square (planar charts' whole texels), else at its element's point, on each side the
 // view sees, through the same bilinear lookup), against the reference and a second one of
 // another seed (their difference taking the references' noise out), and the oracle's own
 // noise from two oracles of different seeds. Every error is relative to the reference's
@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -38,13 +39,26 @@ struct oracle_lightmaps {
 
 inline oracle_lightmaps oracle_values(const embree::accel& bvh, const scene_view& scene, const lightmap_atlas& atlas,
                                       const std::vector<std::uint8_t>& seen, std::uint32_t paths, std::uint64_t seed) {
-    constexpr int k = 2;  // k x k points over a whole texel
+    constexpr int k = 4;  // k x k points over a whole texel of a planar chart, as the lights' shot takes
     embree::multi_bounce_settings whole, partial;
     whole.paths = std::max<std::uint32_t>(1, paths / (k * k));
     partial.paths = paths;
     whole.seed = partial.seed = seed;
     const embree::multi_bounce_reference at_whole(bvh, scene, whole), at_partial(bvh, scene, partial);
-    const std::vector<std::uint8_t> is_whole = whole_texels(atlas);
+    std::vector<std::uint8_t> is_whole = whole_texels(atlas);
+    for (std::size_t e = 0; e < atlas.size(); ++e)  // a curved chart's texel square leaves its surface
+        is_whole[e] = is_whole[e] && atlas.charts[atlas.chart[e]].planar;
+    // Per chart, the triangle whose albedo's least channel is largest: the reference shades
+    // with a triangle's albedo, rescaled below to the texel's (the mean over the chart).
+    std::vector<std::uint32_t> shade(atlas.charts.size());
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+        const lightmap_chart& ch = atlas.charts[c];
+        float best = -1.f;
+        for (std::uint32_t t = ch.first_triangle; t < ch.first_triangle + ch.triangle_count; ++t) {
+            const glm::vec3 rho = scene.materials[scene.material_of[atlas.chart_triangles[t]]].albedo;
+            if (std::min({rho.x, rho.y, rho.z}) > best) best = std::min({rho.x, rho.y, rho.z}), shade[c] = atlas.chart_triangles[t];
+        }
+    }
     const std::size_t n = atlas.size();
     oracle_lightmaps out{std::vector<glm::vec3>(2 * n, glm::vec3(0.f)), std::vector<glm::vec3>(2 * n, glm::vec3(0.f))};
     const float pi = float(std::numbers::pi);
@@ -52,8 +66,7 @@ inline oracle_lightmaps oracle_values(const embree::accel& bvh, const scene_view
         const auto e = std::uint32_t(i % n);
         const int side = int(i / n);
         if (!seen[2 * atlas.chart[e] + std::size_t(side)]) return;
-        const lightmap_chart& ch = atlas.charts[atlas.chart[e]];
-        const std::uint32_t tri = atlas.chart_triangles[ch.first_triangle];
+        const std::uint32_t tri = shade[atlas.chart[e]];
         const glm::vec3 n_side = side ? -atlas.normal[e] : atlas.normal[e];
         std::vector<glm::dvec3> bounces;
         glm::dvec3 total(0.0);
@@ -167,7 +180,7 @@ void write_split(const std::filesystem::path& file, const embree::accel& bvh, co
                    {"direct", part_error(da, direct, direct, ta, tb, mask, &db)},
                    {"indirect", part_error(ira, ia, ib, ta, tb, mask, &irb)},
                    {"black_pixels", black_pixels(va, ta, mask)},
-                   {"paths_per_texel", settings.paths}, {"points_per_whole_texel", 4}};
+                   {"paths_per_texel", settings.paths}, {"points_per_whole_texel", 16}};
     j["elements"] = atlas.size();
     j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     io::write_text_file(file, j.dump(2) + "\n");

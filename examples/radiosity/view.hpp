@@ -14,8 +14,11 @@
 
 namespace bounce::examples {
 
-enum class view_kind { lightmap, direct_indirect };
-inline const choices<view_kind> view_names{{"lightmap", view_kind::lightmap},
+// automatic: direct+indirect where the solver keeps the direct deposit apart (the CPU
+// solver), else the lightmap (the GL solver); measured lower on every shared scene
+// (docs/radiosity.md, "Where the error is").
+enum class view_kind { automatic, lightmap, direct_indirect };
+inline const choices<view_kind> view_names{{"auto", view_kind::automatic}, {"lightmap", view_kind::lightmap},
                                            {"direct+indirect", view_kind::direct_indirect}};
 
 // Whether the solver keeps its lights' direct deposit apart per side (the CPU solver).
@@ -48,7 +51,7 @@ image<glm::vec3> split_lightmap(const Solver& solver, int level, int side, bool 
 template <class Solver>
 image<glm::vec3> render_view(const embree::accel& bvh, const scene_view& scene, const bounce::camera& cam, const Solver& solver,
                              int level, view_kind kind, std::size_t width, std::size_t height) {
-    if (kind == view_kind::lightmap) {
+    if (kind == view_kind::lightmap || (kind == view_kind::automatic && !splits_direct<Solver>)) {
         const image<glm::vec3> front = solver.radiosity_lightmap(level), back = back_radiosity_lightmap(solver, level);
         return embree::lightmap_view(bvh, scene, solver.atlas(), front.view(), back.width() ? back.view() : front.view(),
                                      level, cam, width, height);
