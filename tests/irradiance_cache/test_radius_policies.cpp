@@ -126,6 +126,51 @@ TEST_CASE("a frame from a second camera starts by clamping the first camera's re
     CHECK(worst <= 4 * std::numeric_limits<float>::epsilon());
 }
 
+TEST_CASE("clamping only what changed since the last clamp equals clamping the whole cache, frame after frame",
+          "[irradiance_cache][neighbour_clamp]") {
+    // Each frame adds records from another camera; before each clamp the expected radii are
+    // the whole pass over a copy of the cache (the linear loop, every record against every
+    // other with the radii before the pass). Old records must shrink to new ones (a clamp of
+    // the new records alone would leave them), and the records the previous clamp shrank
+    // must act on the rest.
+    const io::scene scene = io::cornell_box();
+    const embree::accel bvh(scene);
+    const embree::reference_integrator integrator(bvh, scene, {});
+    const embree::record_sampler sampler(integrator, embree::hemisphere_grid_for(64), radius_limits{});
+    cpu::irradiance_cache_options o;
+    o.splat.a = 0.3f;
+    o.neighbour_clamp = true;
+    const auto [lo, hi] = scene.bounds();
+    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, o);
+    std::size_t old_shrunk = 0, frames = 0;
+    for (const float step : {0.f, 0.3f, -0.2f, 0.45f, 0.1f}) {
+        camera cam = scene.camera;
+        cam.position += step * (cam.look_at - cam.position);
+        cam.look_at.x += 0.5f * step;
+        const std::size_t before = cache.records().size();
+        auto g = embree::ray_cast_gbuffer(bvh, scene, cam, 40, 40);
+        image<glm::vec3> indirect(40, 40);
+        cache.render(g.view(), cam, sampler, indirect.view());
+        const std::vector<irradiance_record> snapshot = cache.records();
+        if (snapshot.size() == before) continue;
+        ++frames;
+        const std::size_t shrunk = cache.clamp_to_neighbours();
+        const std::vector<irradiance_record>& recs = cache.records();
+        REQUIRE(recs.size() == snapshot.size());
+        std::size_t mismatched = 0, changed = 0;
+        for (std::size_t i = 0; i < recs.size(); ++i) {
+            const float expected = neighbour_clamped_radius(snapshot[i], snapshot);
+            mismatched += recs[i].radius != expected;
+            changed += expected < snapshot[i].radius;
+            old_shrunk += i < before && expected < snapshot[i].radius;
+        }
+        CHECK(mismatched == 0);
+        CHECK(shrunk == changed);
+    }
+    CHECK(frames >= 4);
+    CHECK(old_shrunk > 0);
+}
+
 TEST_CASE("the occlusion Hessian vanishes under uniform radiance however near the geometry is",
           "[irradiance_gradients][hessian]") {
     // A closed box of uniform radiance: E = pi L wherever the point moves, so its Hessian is 0.

@@ -194,6 +194,12 @@ public:
     /// another camera, the pixel centres move off the small records' sub-pixel zones and
     /// the old large records cover them with the wrong irradiance, so the miss test finds
     /// nothing to fix (a grown Sponza cache got worse with every frame of a walkthrough).
+    /// Only what can change is evaluated, with the result bitwise the whole pass's: the last
+    /// pass left R_i <= R_j + |p_i - p_j| (the same float sum) for every j whose radius it saw
+    /// and that has not changed since, so only the `sources` (records added since, and records
+    /// whose radius differs from what the last pass saw or left) can lower a record: each
+    /// source is clamped against every record, and every other record against the sources
+    /// whose distance is below its radius (the index's covering query).
     /// A no-op (returns 0) without neighbour_clamp or when no record was added since the
     /// last call; otherwise returns how many radii shrank. render() calls it at the start
     /// of every frame; a caller that splats elsewhere (gl::irradiance_splatter) calls it
@@ -202,15 +208,34 @@ public:
         if (!options_.neighbour_clamp || settled_ == records_.size()) return 0;
         neighbour_index index(lo_, hi_);
         index.sync(records_);
-        std::vector<float> radius(records_.size());
-        tbb::parallel_for(std::size_t(0), records_.size(),
-                          [&](std::size_t i) { radius[i] = index.clamped_radius(records_[i]); });
+        const std::size_t n = records_.size();
+        std::vector<float> radius(n);
+        std::vector<char> is_source(n, 1);
+        std::vector<std::size_t> sources;
+        for (std::size_t i = 0; i < n; ++i) {
+            radius[i] = records_[i].radius;
+            if (i < settled_) is_source[i] = radius[i] != seen_[i] || radius[i] != left_[i];
+            if (is_source[i]) sources.push_back(i);
+        }
+        tbb::parallel_for(std::size_t(0), sources.size(),
+                          [&](std::size_t k) { radius[sources[k]] = index.clamped_radius(records_[sources[k]]); });
+        for (const std::size_t j : sources)
+            index.for_each_covering(records_[j].position, 1.f, [&](std::size_t i) {
+                if (is_source[i]) return;
+                const float d = glm::length(records_[i].position - records_[j].position);
+                radius[i] = std::min(radius[i], records_[j].radius + d);
+            });
+        seen_.resize(n);
+        left_.resize(n);
         std::size_t shrunk = 0;
-        for (std::size_t i = 0; i < records_.size(); ++i)
+        for (std::size_t i = 0; i < n; ++i) {
+            seen_[i] = records_[i].radius;
+            left_[i] = radius[i];
             if (radius[i] < records_[i].radius) {
                 records_[i].radius = radius[i];
                 ++shrunk;
             }
+        }
         if (shrunk == 0) {
             clamp_ = std::move(index);
         } else {
@@ -218,7 +243,7 @@ public:
             clamp_.sync(records_);
             ++generation_;
         }
-        settled_ = records_.size();
+        settled_ = n;
         return shrunk;
     }
 
@@ -573,6 +598,7 @@ private:
     irradiance_probe probe_;
     cache_frame_stats last_;
     std::size_t settled_ = 0;  // records_.size() at the last clamp_to_neighbours
+    std::vector<float> seen_, left_;  // the radii that clamp saw and left (clamp_to_neighbours)
     std::uint64_t generation_ = 0;
     std::vector<std::uint32_t> order_;
     std::pair<std::size_t, std::size_t> order_size_{0, 0};
