@@ -47,6 +47,7 @@ struct options {
     std::vector<std::string> configs;
     bool flat_normals = false;
     float sigmas = discontinuity_params{}.visibility_sigmas;
+    float complete_below = 0.5f;  // the 4x4-blur-complete configs
 };
 
 /// `s` with every triangle's corners its own vertices carrying the triangle's geometric normal
@@ -100,6 +101,20 @@ image<glm::vec3> blurred_reference(const gbuffer_view<float>& g, image_view<cons
     cpu::discontinuity_buffer(g, o.discontinuity, edges.view());
     cpu::geometry_aware_blur(e.view(), edges.view(), g.depth, o.pattern, scratch.view(), out.view());
     apply_output(output_quantity::radiance, image_view<const glm::vec3>(g.albedo), out.view());
+    return out;
+}
+
+/// How many of the pattern's sub-buffers the blur of geometry alone reaches at each pixel
+/// (cpu::reached_sub_buffers: 16 inside a surface at 4x4, fewer where depth or normal edges
+/// cut the tent short), in every channel, for --dump.
+image<glm::vec3> reached_sub_buffers(const gbuffer_view<float>& g, const indirect_options& o) {
+    image<glm::vec2> edges(g.width(), g.height());
+    image<float> reached(g.width(), g.height());
+    cpu::discontinuity_buffer(g, o.discontinuity, edges.view());
+    cpu::reached_sub_buffers(edges.view(), g.depth, o.pattern, reached.view());
+    image<glm::vec3> out(g.width(), g.height());
+    for (std::size_t y = 0; y < g.height(); ++y)
+        for (std::size_t x = 0; x < g.width(); ++x) out(x, y) = glm::vec3(reached(x, y));
     return out;
 }
 
@@ -158,6 +173,8 @@ int run(const options& o) {
         {  // The blur's bias on the true light.
             indirect_options b = base;
             b.pattern = p44;
+            if (!o.dump.empty())
+                dump_image(o, scene.name, "reached_sub_buffers", reached_sub_buffers(s.g.view(), b).view());
             for (const bool vis : {false, true}) {
                 const bench::halves_reference& ref = vis ? occluded : unoccluded;
                 const image<glm::vec3> blurred = blurred_reference(s.g.view(), ref.mean.view(), b);
@@ -180,6 +197,7 @@ int run(const options& o) {
             bool view = true;  // with rays: VPLs chosen by the view (the library's default)
             indirect_technique technique = indirect_technique::sii;
             float sigmas = -1.f;  // visibility edges of the blur; -1: --sigmas
+            bool complete = false;  // isolated pixels completed (discontinuity_params::complete_below)
         };
         const std::vector<config> configs = {{"plain-footprint", p11, false, true},
                                              {"plain-fixed", p11, false, false},
@@ -190,7 +208,9 @@ int run(const options& o) {
                                              {"4x4-blur-noview", p44, true, false, false},
                                              {"gather", p11, false, false, true, indirect_technique::rsm_gather},
                                              {"4x4-blur-geometry-edges", p44, true, false, true,
-                                              indirect_technique::sii, 0.f}};
+                                              indirect_technique::sii, 0.f},
+                                             {"4x4-blur-complete", p44, true, false, true, indirect_technique::sii,
+                                              -1.f, true}};
         for (const auto& c : configs) {
             if (!o.configs.empty() && std::find(o.configs.begin(), o.configs.end(), c.name) == o.configs.end())
                 continue;
@@ -205,6 +225,7 @@ int run(const options& o) {
                 opt.light.footprint_scale = c.footprint ? 1.f : 0.f;
                 if (!c.view) opt.view_selection.candidates = 1;
                 opt.discontinuity.visibility_sigmas = c.sigmas < 0.f ? o.sigmas : c.sigmas;
+                if (c.complete) opt.discontinuity.complete_below = o.complete_below;
                 image<glm::vec3> e(s.g.width(), s.g.height());
                 const auto f0 = std::chrono::steady_clock::now();
                 renderer.render(opt, s.g.view(), scene.camera, caster.views(), e.view(), output_quantity::radiance);
@@ -223,6 +244,7 @@ int run(const options& o) {
                                             {"vpls", o.vpls},
                                             {"pattern", c.pattern.cells() > 1 ? "4x4" : "1x1"},
                                             {"blur", c.blur},
+                                            {"complete_below", opt.discontinuity.complete_below},
                                             {"view_selection", rays_on && c.view},
                                             {"visibility_sigmas",
                                              rays_on && c.blur ? opt.discontinuity.visibility_sigmas : 0.f},
@@ -249,10 +271,14 @@ int main(int argc, char** argv) {
     app.add_option("--seed", o.seed, "seed of the VPLs");
     app.add_option("--width", o.width, "image width")->check(CLI::Range(1, 4096));
     app.add_option("--height", o.height, "image height")->check(CLI::Range(1, 4096));
-    app.add_option("--configs", o.configs, "only these: plain-footprint, plain-fixed, 4x4-noblur, 4x4-blur")
+    app.add_option("--configs", o.configs,
+                   "only these: plain-footprint, plain-fixed, 4x4-noblur, 4x4-blur, 4x4-blur-complete, gather, ...")
         ->delimiter(',');
     app.add_option("--sigmas", o.sigmas, "the blur's visibility edges (discontinuity_params::visibility_sigmas)")
         ->check(CLI::Range(0.f, 100.f));
+    app.add_option("--complete-below", o.complete_below,
+                   "4x4-blur-complete: share of sub-buffers below which a pixel gets every VPL")
+        ->check(CLI::Range(0.f, 1.f));
     app.add_flag("--flat-normals", o.flat_normals, "every triangle shaded with its own geometric normal");
     app.add_option("--json", o.json, "write the frames' errors here (docs/studies/results.py adds it)");
     app.add_option("--dump", o.dump, "write every image as raw float32 into this folder");

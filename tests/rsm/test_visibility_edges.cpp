@@ -5,6 +5,7 @@
 // of geometry alone spreads the lit side into the shadow.
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/errors.hpp>
+#include <bounce/sampling.hpp>
 
 #include "lit_ceiling.hpp"
 
@@ -131,4 +132,86 @@ TEST_CASE("a bad visibility_sigmas is refused by its name", "[rsm][blur]") {
             CHECK(std::string(e.what()).find("visibility_sigmas") != std::string::npos);
         }
     }
+}
+
+// Isolated pixels (issue 29, fifth session; cpu::reached_sub_buffers, complete_isolated_pixels).
+
+TEST_CASE("reached_sub_buffers counts the sub-buffers the blur itself averages", "[rsm][blur]") {
+    // Random edges: the count at each pixel equals the number of sub-buffers whose indicator
+    // image the blur carries to that pixel.
+    const std::size_t w = 37, h = 29;
+    const interleave_pattern p{4, 3};
+    image<glm::vec2> edges(w, h);
+    image<float> depth(w, h, 1.f), reached(w, h);
+    pcg32 rng(7, 3);
+    for (std::size_t y = 0; y < h; ++y)
+        for (std::size_t x = 0; x < w; ++x)
+            edges(x, y) = glm::vec2(rng.next_double() < 0.25 ? 1.f : 0.f, rng.next_double() < 0.25 ? 1.f : 0.f);
+    // A pixel without geometry, cut off on every side as discontinuity_buffer marks it.
+    depth(5, 5) = std::numeric_limits<float>::infinity();
+    edges(5, 5) = glm::vec2(1.f);
+    edges(4, 5).x = 1.f;
+    edges(5, 4).y = 1.f;
+    cpu::reached_sub_buffers(edges.view(), depth.view(), p, reached.view());
+    image<float> count(w, h);
+    image<glm::vec3> one(w, h), scratch(w, h), blurred(w, h);
+    for (int j = 0; j < p.m; ++j)
+        for (int i = 0; i < p.n; ++i) {
+            for (std::size_t y = 0; y < h; ++y)
+                for (std::size_t x = 0; x < w; ++x)
+                    one(x, y) = glm::vec3(int(x) % p.n == i && int(y) % p.m == j ? 1.f : 0.f);
+            cpu::geometry_aware_blur(one.view(), edges.view(), depth.view(), p, scratch.view(), blurred.view());
+            for (std::size_t y = 0; y < h; ++y)
+                for (std::size_t x = 0; x < w; ++x) count(x, y) += blurred(x, y).x > 0.f ? 1.f : 0.f;
+        }
+    std::size_t isolated = 0;
+    for (std::size_t y = 0; y < h; ++y)
+        for (std::size_t x = 0; x < w; ++x) {
+            if (x == 5 && y == 5) {
+                CHECK(reached(x, y) == float(p.cells()));  // no geometry: copied, never completed
+                continue;
+            }
+            CHECK(reached(x, y) == count(x, y));
+            isolated += reached(x, y) < float(p.cells()) ? 1 : 0;
+        }
+    CHECK(isolated > w * h / 4);  // the edges do cut: the case is not trivial
+}
+
+TEST_CASE("a pixel the blur isolates is completed with every VPL, as the plain frame has it", "[rsm][blur]") {
+    shadowed_floor s;
+    const left_half_shadow shadow;
+    // Two pixels with their own depth (a post seen end-on): edges all round, so the blur keeps
+    // only their own sub-buffer's VPLs at 16 times the weight. One is lit, one in the shadow.
+    const std::size_t lit_x = 30, dark_x = 9, row = 17;
+    s.gb.view().depth(lit_x, row) = 2.f;
+    s.gb.view().depth(dark_x, row) = 2.f;
+    const image<glm::vec3> plain = s.frame(shadow_options(1, 3.f), shadow);
+    const image<glm::vec3> blurred = s.frame(shadow_options(4, 3.f), shadow);
+    indirect_options o = shadow_options(4, 3.f);
+    o.discontinuity.complete_below = 0.5f;
+    const image<glm::vec3> completed = s.frame(o, shadow);
+    REQUIRE(brightness(plain(lit_x, row)) > 0.0);
+    // Without completion the lit pixel is its sub-buffer's 64 VPLs at 16 times the weight.
+    CHECK(std::abs(brightness(blurred(lit_x, row)) / brightness(plain(lit_x, row)) - 1.0) > 0.01);
+    for (int c = 0; c < 3; ++c) {
+        CHECK(completed(lit_x, row)[c] == Approx(plain(lit_x, row)[c]).epsilon(1e-5));
+        CHECK(completed(dark_x, row)[c] == 0.f);  // visibility holds for the completed pixel too
+    }
+    std::size_t changed = 0;
+    for (std::size_t y = 0; y < shadowed_floor::size; ++y)
+        for (std::size_t x = 0; x < shadowed_floor::size; ++x)
+            if (!(y == row && (x == lit_x || x == dark_x)))
+                changed += completed(x, y) == blurred(x, y) ? 0 : 1;
+    CHECK(changed == 0);  // every other pixel reaches at least 8 of the 16 sub-buffers: unchanged
+}
+
+TEST_CASE("a bad complete_below is refused by its name, and with imperfect shadow maps", "[rsm][blur]") {
+    indirect_options o;
+    for (const float bad : {-0.1f, 1.5f, std::numeric_limits<float>::quiet_NaN()}) {
+        o.discontinuity.complete_below = bad;
+        CHECK_THROWS_WITH(o.validate(), Catch::Contains("complete_below"));
+    }
+    o.discontinuity.complete_below = 0.5f;
+    o.visibility = indirect_visibility::ism;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("complete_below"));
 }

@@ -79,6 +79,12 @@ struct discontinuity_params {
     /// (visibility_discontinuity; docs section 15, "Issue 29, fourth session"); 0: no
     /// visibility edges (the blur of geometry alone). Typical: 3.
     float visibility_sigmas = 3.f;
+    /// Interleaved SII (no imperfect shadow maps): a pixel whose blur reaches fewer than this
+    /// share of the pattern's sub-buffers (edges all round it: a thin ledge, a crease) is
+    /// completed with the sum of every VPL of the frame at the pixel itself, the plain
+    /// estimate, instead of its few sub-buffers' share at N M times the weight
+    /// (cpu::complete_isolated_pixels; docs section 15, fifth session). In [0, 1]; 0: off.
+    float complete_below = 0.f;
 
     bool operator==(const discontinuity_params&) const = default;
 
@@ -88,6 +94,8 @@ struct discontinuity_params {
                 "must lie in [-1, 1]");
         require(std::isfinite(visibility_sigmas) && visibility_sigmas >= 0.f, "visibility_sigmas",
                 "must be finite and >= 0");
+        require(std::isfinite(complete_below) && complete_below >= 0.f && complete_below <= 1.f, "complete_below",
+                "must lie in [0, 1]");
     }
 };
 
@@ -172,6 +180,8 @@ struct indirect_options {
                 "applies to the RSM gather only");
         upsample.validate();
         view_selection.validate();
+        require(discontinuity.complete_below == 0.f || visibility != indirect_visibility::ism,
+                "discontinuity.complete_below", "completes with none or rays, not with ism");
         if (visibility == indirect_visibility::ism) {
             require(technique == indirect_technique::sii, "visibility",
                     "ism applies to SII only (the RSM gather's disc samples have no maps of their own)");

@@ -206,6 +206,12 @@ private:
         if (visibility_edges())
             add_visibility_edges(b.stats.view(), options_.discontinuity.visibility_sigmas, b.edges.view());
         geometry_aware_blur(b.gathered.view(), b.edges.view(), gb.depth, p, b.scratch.view(), out);
+        if (options_.technique == indirect_technique::sii && options_.discontinuity.complete_below > 0.f) {
+            image<float> reached(w, h);  // the pixels the blur isolates get every VPL (sii_splat.hpp)
+            reached_sub_buffers(b.edges.view(), gb.depth, p, reached.view());
+            complete_isolated_pixels(gb, reached.view(), options_.discontinuity.complete_below * float(p.cells()),
+                                     vpls_, options_.light, out, occlusion());
+        }
         t.blur_ms += ms_since(start);
     }
 

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -193,6 +194,52 @@ void tent_blur(image_view<const glm::vec3> in, image_view<const glm::vec2> edges
     tent_pass<R, true>(scratch, edges, depth, p.m, out);
 }
 }  // namespace detail
+
+/// How many of the pattern's sub-buffers geometry_aware_blur reaches at each pixel with these
+/// `edges` (the count its weights are shared among; N M inside a surface, fewer where edges
+/// cut the tent short on every side), written to `reached`; pixels that see no geometry
+/// (infinite depth, copied by the blur) get N M. `edges` as discontinuity_buffer makes them
+/// (a pixel that sees no geometry is cut off on every side). At most 64 sub-buffers a row.
+inline void reached_sub_buffers(image_view<const glm::vec2> edges, image_view<const float> depth,
+                                const interleave_pattern& p, image_view<float> reached) {
+    p.validate();
+    require(edges.width() == depth.width() && edges.height() == depth.height() &&
+                reached.width() == depth.width() && reached.height() == depth.height(),
+            "edges/reached", "size differs from the depth");
+    const std::ptrdiff_t w = std::ptrdiff_t(depth.width()), h = std::ptrdiff_t(depth.height());
+    // Tap k steps along an axis is reached when no edge lies between it and the centre and k < n.
+    const auto span = [](std::ptrdiff_t at, std::ptrdiff_t size, int n, auto&& cut) {
+        std::ptrdiff_t lo = 0, hi = 0;
+        while (lo + 1 < n && at - lo - 1 >= 0 && !(cut(at - lo - 1) > 0.f)) ++lo;
+        while (hi + 1 < n && at + hi + 1 < size && !(cut(at + hi) > 0.f)) ++hi;
+        return std::pair{lo, hi};
+    };
+    // Residues mod n the horizontal pass reaches at each pixel, as a bit mask.
+    std::vector<std::uint64_t> row_mask(std::size_t(w * h));
+    tbb::parallel_for(std::ptrdiff_t(0), h, [&](std::ptrdiff_t y) {
+        for (std::ptrdiff_t x = 0; x < w; ++x) {
+            const auto [lo, hi] = span(x, w, p.n, [&](std::ptrdiff_t t) { return edges(std::size_t(t), std::size_t(y)).x; });
+            std::uint64_t m = 0;
+            for (std::ptrdiff_t t = x - lo; t <= x + hi; ++t) m |= std::uint64_t(1) << std::size_t(t % p.n);
+            row_mask[std::size_t(y * w + x)] = m;
+        }
+    });
+    tbb::parallel_for(std::ptrdiff_t(0), h, [&](std::ptrdiff_t y) {
+        std::vector<std::uint64_t> by_row(std::size_t(p.m));
+        for (std::ptrdiff_t x = 0; x < w; ++x) {
+            if (!(depth(std::size_t(x), std::size_t(y)) < std::numeric_limits<float>::infinity())) {
+                reached(std::size_t(x), std::size_t(y)) = float(p.cells());
+                continue;
+            }
+            const auto [lo, hi] = span(y, h, p.m, [&](std::ptrdiff_t t) { return edges(std::size_t(x), std::size_t(t)).y; });
+            std::fill(by_row.begin(), by_row.end(), 0);
+            for (std::ptrdiff_t t = y - lo; t <= y + hi; ++t) by_row[std::size_t(t % p.m)] |= row_mask[std::size_t(t * w + x)];
+            int count = 0;
+            for (const std::uint64_t m : by_row) count += std::popcount(m);
+            reached(std::size_t(x), std::size_t(y)) = float(count);
+        }
+    });
+}
 
 /// The separable geometry-aware blur (step 6): a tent of radius n - 1 along x, then of
 /// radius m - 1 along y (interleave_tent_weight), each stopping at the first discontinuity

@@ -192,6 +192,52 @@ inline void splat_vpls(const gbuffer_view<float>& gb, const interleave_maps& map
     });
 }
 
+/// Completes the pixels of a blurred interleaved SII frame that its blur isolates: where
+/// `reached` (reached_sub_buffers) is below `min_reached`, the pixel of `out` (image order,
+/// irradiance) becomes the sum of every one of `vpls` at the pixel itself, each at its own
+/// weight (1 / (N M) of the interleaved one; its area likewise for the clamp), with an
+/// occlusion ray per term that is not 0 when `occlusion` is given: the plain frame's estimate
+/// there. Unbiased as the blurred value is (the union of the sub-buffers' VPLs is the plain
+/// frame's sample), with the variance of all the VPLs instead of the few reached sub-buffers'
+/// share at N M times the weight (docs section 15, fifth session). The splat's cutoff is not
+/// applied (every VPL counts in full). `gb` is the image's G-buffer. Returns the pixels completed.
+inline std::size_t complete_isolated_pixels(const gbuffer_view<float>& gb, image_view<const float> reached,
+                                            float min_reached, std::span<const vpl> vpls,
+                                            const pixel_light_params& lp, image_view<glm::vec3> out,
+                                            const occlusion_query* occlusion = nullptr) {
+    lp.validate();
+    require(reached.width() == gb.width() && reached.height() == gb.height() && out.width() == gb.width() &&
+                out.height() == gb.height(),
+            "reached/out", "size differs from the G-buffer");
+    std::vector<std::array<std::size_t, 2>> pixels;
+    for (std::size_t y = 0; y < gb.height(); ++y)
+        for (std::size_t x = 0; x < gb.width(); ++x)
+            if (gb.covered(x, y) && reached(x, y) < min_reached) pixels.push_back({x, y});
+    tbb::enumerable_thread_specific<detail::visible_splat_scratch> scratches;
+    tbb::parallel_for(std::size_t(0), pixels.size(), [&](std::size_t i) {
+        const auto [u, v] = pixels[i];
+        detail::visible_splat_scratch& s = scratches.local();
+        s.segments.clear();
+        s.terms.clear();
+        const glm::vec3 x = gb.position(u, v), n = gb.normal(u, v);
+        for (const vpl& l : vpls) {
+            if (!(glm::dot(l.normal, x - (l.position - l.normal * lp.offset)) > 0.f)) continue;
+            const glm::vec3 e = pixel_light_irradiance<float, glm::vec3>(x, n, l.position, l.normal, l.flux,
+                                                                         lp.offset, lp.min_distance2_for(l.area));
+            if (e.x == 0.f && e.y == 0.f && e.z == 0.f) continue;
+            s.segments.push_back({x, n, l.position, l.normal});
+            s.terms.push_back(e);
+        }
+        s.blocked.assign(s.terms.size(), 0);
+        if (occlusion && !s.terms.empty()) occlusion->occluded(s.segments, s.blocked);
+        glm::vec3 sum(0.f);
+        for (std::size_t k = 0; k < s.terms.size(); ++k)
+            if (!s.blocked[k]) sum += s.terms[k];
+        out(u, v) = sum;
+    });
+    return pixels.size();
+}
+
 /// The plain splat (no interleaving): every VPL, in index order, over the G-buffer `gb`
 /// (the image itself), added to `out`.
 inline void splat_vpls(const gbuffer_view<float>& gb, const camera& cam, std::span<const vpl> vpls,
