@@ -495,6 +495,7 @@ TEST_CASE("grouped shooters: the derived budget follows the scene's shape, not i
         for (const std::uint32_t r : fewer.roots) sum += mean[r];
         CHECK(sum > 2.0 * double(fewer.size()));
         derived[k] = g.size();
+        CHECK(build_shooter_groups(atlas, first, 1, 0, {.discs = 4}).size() < g.size());  // a looser bound: coarser
         for (glm::vec3& p : box.positions) p *= 1000.f;
         const auto mm = build_lightmap_atlas(box.view(), {.elements = 3000});
         const shooter_groups gm = build_shooter_groups(mm, shooter_ranges(mm, true), 1, 0, {.near_field = 4, .group_near_field = 4});
@@ -520,6 +521,8 @@ TEST_CASE("grouped shooters refuse a visibility that renders from one point, by 
                       Catch::Contains("radiosity_options.shooter_groups"));
     CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = -2}),
                       Catch::Contains("radiosity_options.shooter_groups"));
+    CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = -1, .group_discs = 0}),
+                      Catch::Contains("radiosity_options.group_discs"));
     CHECK_THROWS_WITH(cpu::progressive_radiosity(scene.view(), atlas, cpu::all_visible{}, {.shooter_groups = 8, .group_visibility_samples = 0}),
                       Catch::Contains("radiosity_options.group_visibility_samples"));
 }

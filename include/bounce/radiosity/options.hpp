@@ -51,6 +51,9 @@ struct radiosity_options {
                                    ///< diagonal, else as its two halves (typical: 1-4)
     int group_visibility_samples = 1;  ///< grouped shots: rays per receiver, each from an element drawn
                                        ///< in proportion to its share of the receiver's light (1-16)
+    double group_discs = 2;        ///< the derived budget (shooter_groups -1): groups are split while a
+                                   ///< receiver takes more discs than this per group shot on average
+                                   ///< (group_cut::discs; > 0, typical: 2-8)
 
     /// Throws parameter_error naming the option ("radiosity_options.near_field" ...).
     void validate() const {
@@ -62,6 +65,7 @@ struct radiosity_options {
         require(shooter_groups >= -1, "radiosity_options.shooter_groups", "must be -1 (derived), 0 (off) or a budget");
         require(group_near_field >= 0 && std::isfinite(group_near_field), "radiosity_options.group_near_field",
                 "must be finite and non-negative");
+        require(group_discs > 0 && std::isfinite(group_discs), "radiosity_options.group_discs", "must be finite and positive");
         require(group_visibility_samples >= 1 && group_visibility_samples <= 16,
                 "radiosity_options.group_visibility_samples", "must lie in [1, 16]");
     }

@@ -366,7 +366,7 @@ private:
         }
         if (options_.shooter_groups != 0)  // -1: the budget derived from the scene (shooter_groups.hpp)
             groups_ = build_shooter_groups(atlas_, first_, sides_, std::size_t(std::max(options_.shooter_groups, 0)),
-                                           {.near_field = options_.near_field, .group_near_field = options_.group_near_field});
+                                           {options_.group_discs, options_.near_field, options_.group_near_field});
         refresh_powers();
     }
     static double ms_since(clock::time_point t) {
