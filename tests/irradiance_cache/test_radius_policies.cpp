@@ -50,6 +50,27 @@ hemisphere_samples hemisphere_of(std::uint32_t m, std::uint32_t n, Radiance radi
     return s;
 }
 
+// The built-in box and a cache with neighbour clamping, rendered camera after camera.
+struct box_walk {
+    static cpu::irradiance_cache_options options() {
+        cpu::irradiance_cache_options o;
+        o.splat.a = 0.3f;
+        o.neighbour_clamp = true;
+        return o;
+    }
+    io::scene scene = io::cornell_box();
+    embree::accel bvh{scene};
+    embree::reference_integrator integrator{bvh, scene, {}};
+    embree::record_sampler sampler{integrator, embree::hemisphere_grid_for(64), radius_limits{}};
+    cpu::irradiance_cache<ward_smooth_weight> cache{scene.bounds().first, scene.bounds().second, options()};
+
+    cpu::cache_frame_stats render(const camera& cam, std::uint32_t size) {
+        auto g = embree::ray_cast_gbuffer(bvh, scene, cam, size, size);
+        image<glm::vec3> indirect(size, size);
+        return cache.render(g.view(), cam, sampler, indirect.view());
+    }
+};
+
 }  // namespace
 
 TEST_CASE("clamping the whole cache makes its radius field 1-Lipschitz and only ever shrinks radii",
@@ -94,22 +115,14 @@ TEST_CASE("without neighbour clamping the cache's radii are left as measured", "
 
 TEST_CASE("a frame from a second camera starts by clamping the first camera's records to the ones made since",
           "[irradiance_cache][neighbour_clamp]") {
-    const io::scene scene = io::cornell_box();
-    const embree::accel bvh(scene);
-    const embree::reference_integrator integrator(bvh, scene, {});
-    const embree::record_sampler sampler(integrator, embree::hemisphere_grid_for(64), radius_limits{});
-    cpu::irradiance_cache_options o;
-    o.splat.a = 0.3f;
-    o.neighbour_clamp = true;
-    const auto [lo, hi] = scene.bounds();
-    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, o);
+    box_walk box;
+    const io::scene& scene = box.scene;
+    auto& cache = box.cache;
     camera second = scene.camera;
     second.position += 0.3f * (second.look_at - second.position);
     std::size_t reclamped_total = 0;
     for (const camera& cam : {scene.camera, second, scene.camera}) {
-        auto g = embree::ray_cast_gbuffer(bvh, scene, cam, 32, 32);
-        image<glm::vec3> indirect(32, 32);
-        reclamped_total += cache.render(g.view(), cam, sampler, indirect.view()).reclamped;
+        reclamped_total += box.render(cam, 32).reclamped;
     }
     // The second camera's records shrank some of the first's, and the third frame's start
     // some of the second's; one more clamp (as the next frame would start) settles the
@@ -133,24 +146,16 @@ TEST_CASE("clamping only what changed since the last clamp equals clamping the w
     // other with the radii before the pass). Old records must shrink to new ones (a clamp of
     // the new records alone would leave them), and the records the previous clamp shrank
     // must act on the rest.
-    const io::scene scene = io::cornell_box();
-    const embree::accel bvh(scene);
-    const embree::reference_integrator integrator(bvh, scene, {});
-    const embree::record_sampler sampler(integrator, embree::hemisphere_grid_for(64), radius_limits{});
-    cpu::irradiance_cache_options o;
-    o.splat.a = 0.3f;
-    o.neighbour_clamp = true;
-    const auto [lo, hi] = scene.bounds();
-    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, o);
+    box_walk box;
+    const io::scene& scene = box.scene;
+    auto& cache = box.cache;
     std::size_t old_shrunk = 0, frames = 0;
     for (const float step : {0.f, 0.3f, -0.2f, 0.45f, 0.1f}) {
         camera cam = scene.camera;
         cam.position += step * (cam.look_at - cam.position);
         cam.look_at.x += 0.5f * step;
         const std::size_t before = cache.records().size();
-        auto g = embree::ray_cast_gbuffer(bvh, scene, cam, 40, 40);
-        image<glm::vec3> indirect(40, 40);
-        cache.render(g.view(), cam, sampler, indirect.view());
+        box.render(cam, 40);
         const std::vector<irradiance_record> snapshot = cache.records();
         if (snapshot.size() == before) continue;
         ++frames;
