@@ -19,7 +19,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from results import monte_carlo_at_equal_error  # noqa: E402
+from results import monte_carlo_at_equal_error, monte_carlo_rays_ratio  # noqa: E402
 
 root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ORDER = ['cornell', 'cornell-box', 'bunny', 'sponza', 'conference', 'living-room', 'modern-hall']
@@ -62,8 +62,8 @@ def target(scene, size):
 
 def table(rows, records):
     print('| scene | size | records | per pixel | debiased rel_rms (se) | cache | Monte Carlo at equal error '
-          '| ratio | target | load before / after |')
-    print('|---|---|---|---|---|---|---|---|---|---|')
+          '| ratio | rays | target | load before / after |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|')
     for s in ORDER:
         for size in sorted({k[1] for k in rows if k[0] == s}, key=pixels):
             r = rows[(s, size)]
@@ -75,7 +75,7 @@ def table(rows, records):
             mark = '' if t is None else (f"{t:.0f}x " + ('met' if ratio >= t else '**missed**'))
             load = f"{r['load_before']:.1f} / {r['load_average']:.1f}" if 'load_before' in r else f"{r['load_average']:.1f}"
             print(f"| {s} | {size} | {r['records']:,} | {r['records_per_pixel']:.3f} | {err} | {cache_s:.1f} s "
-                  f"| {'~' if extrapolated else ''}{ratio * cache_s:.0f} s ({spp:.0f} spp) | {'~' if extrapolated else ''}{ratio:.1f}x | {mark} | {load} |")
+                  f"| {'~' if extrapolated else ''}{ratio * cache_s:.0f} s ({spp:.0f} spp) | {'~' if extrapolated else ''}{ratio:.1f}x | {monte_carlo_rays_ratio(r, spp):.0f}x | {mark} | {load} |")
     print()
     print('| scene | records 512x512 | 1920x1080 | ratio | without verification: 512x512 | 1920x1080 | ratio '
           '| verification\'s records 512x512 | 1920x1080 |')

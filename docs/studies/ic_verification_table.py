@@ -19,7 +19,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from results import monte_carlo_at_equal_error as monte_carlo  # noqa: E402
+from results import monte_carlo_at_equal_error as monte_carlo, monte_carlo_rays_ratio as rays  # noqa: E402
 
 root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 args = sys.argv[1:]
@@ -32,12 +32,6 @@ for line in open(path):
     r = json.loads(line)
     if r['tag'] in tags:
         rows[(r['tag'], r['scene'])] = r
-
-
-def rays(r, spp):
-    w, h = (int(v) for v in r['size'].split('x'))
-    cache = r['records'] * 1026 + (w * h // 2 * 8 if 'verify_tiles' in r else 0)
-    return spp * w * h / cache
 
 
 def cell(r):

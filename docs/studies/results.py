@@ -106,6 +106,15 @@ def monte_carlo_at_equal_error(r):
     return m["measured_ms"] * scale / r["total_ms_loaded_machine"], m["measured_spp"] * scale, True
 
 
+def monte_carlo_rays_ratio(r, spp):
+    """Monte Carlo's rays at `spp` over the cache's, which the machine's load does not move:
+    spp times the pixels against the records' 1,026 rays each plus, with --verify, the probes'
+    8 rays on half the pixels (an upper bound: pixels that see nothing are not probed)."""
+    w, h = (int(v) for v in r["size"].split("x"))
+    cache = r["records"] * 1026 + (w * h // 2 * 8 if "verify_tiles" in r else 0)
+    return spp * w * h / cache
+
+
 def dumps(value, depth=0):
     """JSON with one key per line, but a list of plain values (a per-iteration series) on one
     line: a study's curves stay readable in a diff without a line per number."""
