@@ -54,6 +54,13 @@ def load_rows(paths):
     return rows, records
 
 
+def resolved(r):
+    """False where the debiased error's standard error is over half the error: the reference's
+    noise hides the cache's error, and Monte Carlo at that error means nothing."""
+    se = r.get('rel_rms_debiased_se')
+    return se is None or se <= 0.5 * r['rel_rms_debiased']
+
+
 def target(scene, size):
     if size == '1920x1080' and scene in ('cornell', 'cornell-box'):
         return CORNELL_1080
@@ -68,6 +75,11 @@ def table(rows, records):
         for size in sorted({k[1] for k in rows if k[0] == s}, key=pixels):
             r = rows[(s, size)]
             ratio, spp, extrapolated = monte_carlo_at_equal_error(r)
+            if not resolved(r):
+                print(f"| {s} | {size} | {r['records']:,} | {r['records_per_pixel']:.3f} | {r['rel_rms_debiased']:.4f} "
+                      f"({r['rel_rms_debiased_se']:.4f}) | | not resolved: the error's standard error is over half the error "
+                      f"| | | | {r['load_before']:.1f} / {r['load_average']:.1f} |")
+                continue
             cache_s = r['total_ms_loaded_machine'] / 1000
             se = r.get('rel_rms_debiased_se')
             err = f"{r['rel_rms_debiased']:.4f}" + (f" ({se:.4f})" if se is not None else '')
@@ -100,7 +112,7 @@ def plot(rows, out):
     for ax in axes.flat[len(scenes):]:
         ax.axis('off')
     for ax, s in zip(axes.flat, scenes):
-        sizes = sorted({k[1] for k in rows if k[0] == s}, key=pixels)
+        sizes = sorted({k[1] for k in rows if k[0] == s and resolved(rows[k])}, key=pixels)
         px = [pixels(z) for z in sizes]
         mc = [monte_carlo_at_equal_error(rows[(s, z)]) for z in sizes]
         ax.plot(px, [m[0] for m in mc], '-', color='C0')
