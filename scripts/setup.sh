@@ -13,7 +13,7 @@ packages=(
   libglm-dev libembree-dev libtbb-dev
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev
   catch2 libopenimageio-dev openimageio-tools libtinyobjloader-dev libcli11-dev nlohmann-json3-dev libfmt-dev
-  libtinygltf-dev glslang-tools spirv-tools libvulkan-dev mesa-vulkan-drivers
+  libtinygltf-dev glslang-tools glslang-dev spirv-tools libvulkan-dev mesa-vulkan-drivers
   python3 python3-matplotlib
 )
 [ "$preset" = clang ] && packages+=(clang)
