@@ -23,6 +23,8 @@
 #include <bounce/light.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/direct_light.hpp>
+#include <bounce/image.hpp>
+#include <bounce/output.hpp>
 #include <bounce/radiosity/options.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -32,6 +34,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <span>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -255,6 +258,34 @@ namespace bounce::inline radiosity {
 template <class Solver>
 auto back_radiosity_lightmap(const Solver& solver, int level) -> decltype(solver.radiosity_lightmap(level, 1)) {
     return solver.sides() == 2 ? solver.radiosity_lightmap(level, 1) : decltype(solver.radiosity_lightmap(level, 1)){};
+}
+
+/// Whether a solver keeps its lights' direct deposit apart per side (the CPU solver does, the
+/// GL solver does not): what a view that computes the direct light per pixel needs.
+template <class Solver>
+concept splits_direct = requires(const Solver& s) {
+    s.display_radiosity(0);
+    s.output(output_quantity::irradiance, light_paths::direct, 0);
+};
+
+/// Per element of `side`, the lights' direct deposit rho E_d (W/m^2): the part of B that a
+/// view computing the direct light per pixel replaces.
+template <splits_direct Solver>
+std::vector<glm::vec3> direct_deposit(const Solver& solver, int side) {
+    std::vector<glm::vec3> d = solver.output(output_quantity::irradiance, light_paths::direct, side);
+    for (std::size_t i = 0; i < d.size(); ++i) d[i] *= solver.atlas().albedo[i];
+    return d;
+}
+
+/// The lightmap of `side` at `level` with the lights' direct deposit taken out (B - rho E_d):
+/// the bounced light alone, what embree::lightmap_direct_view (or a renderer's own direct
+/// lighting) adds its per-pixel direct light to.
+template <splits_direct Solver>
+image<glm::vec3> bounced_radiosity_lightmap(const Solver& solver, int level, int side) {
+    std::vector<glm::vec3> b = solver.display_radiosity(side);
+    const std::vector<glm::vec3> d = direct_deposit(solver, side);
+    for (std::size_t i = 0; i < b.size(); ++i) b[i] -= d[i];
+    return solver.atlas().to_fine_texels(std::span<const glm::vec3>(b), level, glm::vec3(0.f), true);
 }
 
 /// Triangles of `scene` whose front side (counter-clockwise) and whose back side some point,
