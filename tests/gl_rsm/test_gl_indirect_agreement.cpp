@@ -319,6 +319,11 @@ TEST_CASE("the GL indirect renderer refuses bad input by name", "[gl][rsm]") {
         o.visibility = indirect_visibility::rays;
         throws_naming([&] { gl::indirect_renderer bad(o); }, "visibility");
     }
+    SECTION("completing isolated pixels, which runs on the CPU only") {
+        indirect_options o;
+        o.discontinuity.complete_below = 0.5f;
+        throws_naming([&] { gl::indirect_renderer bad(o); }, "complete_below");
+    }
     SECTION("output of another size") {
         gl::texture small(gl::texel_format::rgba32f, 15, 12);
         throws_naming([&] { r.render(gb.textures(), s.cam, maps, small); }, "irradiance");

@@ -437,6 +437,8 @@ void indirect_renderer::validate_options(const indirect_options& options) {
     options.validate();
     require(options.visibility != indirect_visibility::rays, "visibility",
             "rays run on the CPU only (cpu::indirect_renderer with embree::occlusion_rays); GL offers ism");
+    require(options.discontinuity.complete_below == 0.f, "discontinuity.complete_below",
+            "completing isolated pixels runs on the CPU only (cpu::indirect_renderer)");
 }
 
 indirect_renderer::~indirect_renderer() = default;
