@@ -33,6 +33,7 @@ RESULTS = os.path.join(ROOT, "docs", "results", "radiosity_scaling.json")
 FIGURE = os.path.join(ROOT, "docs", "figures", "radiosity_scaling.png")
 SCENES = ["cornell", "cornell-box", "bunny", "sponza", "conference", "living-room", "modern-hall"]
 MODES = {"derived": "-1", "blocks": "0"}
+PER_STEP = ("converged_fraction", "iteration_ms")  # left out of the results file
 
 
 def run(name, scene, elements, mode, max_seconds, reference=True):
@@ -51,6 +52,8 @@ def run(name, scene, elements, mode, max_seconds, reference=True):
     r["load_before"] = list(load)
     r["load_after"] = list(os.getloadavg())
     r["mode"] = mode
+    for series in PER_STEP:  # thousands of numbers a run, which no table or plot here reads
+        r.pop(series, None)
     results.add(RESULTS, "radiosity_scaling", name, r)
     print(row(r, name), flush=True)
 
