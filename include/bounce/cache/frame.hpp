@@ -48,6 +48,19 @@ struct cache_frame {
             if (name == stage) return ms;
         return 0.0;
     }
+
+    /// The counts of a frame's scan and verification (`s`: cpu::irradiance_cache's
+    /// cache_frame_stats) into this frame: what the CPU and the GL frame both report.
+    template <class ScanStats>
+    void take_scan_counts(const ScanStats& s) {
+        measured = s.measured;
+        wasted = s.wasted;
+        filter_merged = s.filter_merged;
+        filter_refused = s.filter_refused;
+        verify_tiles = s.verify_tiles;
+        verify_disagreed = s.verify_disagreed;
+        verify_shrunk = s.verify_shrunk;
+    }
 };
 
 }  // namespace bounce::cache

@@ -54,14 +54,8 @@ cache_frame render_frame(irradiance_cache<Weight>& cache, const camera& cam, GBu
     // cache_frame holds radiance: the image a renderer shows (and the GL frame composes).
     const cache_frame_stats s = cache.render(f.g.view(), cam, sampler, f.indirect.view(), output_quantity::radiance);
     f.new_records = s.new_records;
-    f.measured = s.measured;
-    f.wasted = s.wasted;
-    f.filter_merged = s.filter_merged;
-    f.filter_refused = s.filter_refused;
+    f.take_scan_counts(s);
     f.reclamped = s.reclamped;
-    f.verify_tiles = s.verify_tiles;
-    f.verify_disagreed = s.verify_disagreed;
-    f.verify_shrunk = s.verify_shrunk;
     f.stages_ms.emplace_back("splat_existing", s.splat_existing_ms);
     f.stages_ms.emplace_back("scan", s.scan_ms);
     f.stages_ms.emplace_back("compute_records", s.records_ms);

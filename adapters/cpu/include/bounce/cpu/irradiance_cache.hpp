@@ -274,15 +274,15 @@ public:
         if (options_.interpolation == cache_interpolation::splat) {
             timed(stats.splat_existing_ms, [&] { splat_records<Weight>(g, cam, records_, sp, splat.view()); });
             scan_into(g, cam, sampler, splat.view(), record_points, stats);
+            const auto splat_all = [&](image_view<glm::vec4> s) {  // every record into a clean buffer
+                std::fill(s.data(), s.data() + s.width() * s.height(), glm::vec4(0.f));
+                splat_records<Weight>(g, cam, records_, sp, s);
+            };
             if (options_.verify.enabled() && probe_)
-                verify_into(g, cam, sampler, splat.view(), record_points, stats, [&](image_view<glm::vec4> s) {
-                    std::fill(s.data(), s.data() + s.width() * s.height(), glm::vec4(0.f));
-                    splat_records<Weight>(g, cam, records_, sp, s);
-                });
+                verify_into(g, cam, sampler, splat.view(), record_points, stats, splat_all);
             // Step 5: the image comes from splatting every record into a clean buffer.
             timed(stats.interpolate_ms, [&] {
-                std::fill(splat.data(), splat.data() + splat.width() * splat.height(), glm::vec4(0.f));
-                splat_records<Weight>(g, cam, records_, sp, splat.view());
+                splat_all(splat.view());
                 if (options_.fills_holes()) {
                     splat_params wide_sp = sp;
                     wide_sp.a = sp.a * options_.fill_holes;

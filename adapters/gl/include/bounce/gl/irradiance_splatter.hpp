@@ -177,13 +177,7 @@ public:
                     scan_ms += s.scan_ms;
                     records_ms += s.records_ms;
                     verify_ms += s.verify_ms;
-                    f.measured = s.measured;
-                    f.wasted = s.wasted;
-                    f.filter_merged = s.filter_merged;
-                    f.filter_refused = s.filter_refused;
-                    f.verify_tiles = s.verify_tiles;
-                    f.verify_disagreed = s.verify_disagreed;
-                    f.verify_shrunk = s.verify_shrunk;
+                    f.take_scan_counts(s);
                 };
                 if constexpr (std::is_same_v<std::remove_cvref_t<RecordPoints>, raster_record_points>) {
                     took(cache.scan_and_verify(g, cam, sampler, splat, resplat));
