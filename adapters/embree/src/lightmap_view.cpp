@@ -23,6 +23,17 @@ void check_atlas(const accel& bvh, const scene_view& scene, const lightmap_atlas
             "was not built from this scene (triangle counts differ)");
 }
 
+// The level and both lightmaps' sizes; returns 2^level, the texels per atlas texel side.
+std::size_t check_lightmaps(const lightmap_atlas& atlas, image_view<const glm::vec3> front,
+                            image_view<const glm::vec3> back, int level) {
+    require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
+    const std::size_t f = std::size_t(1) << level;
+    for (const auto& lightmap : {front, back})
+        require(lightmap.width() == std::size_t(atlas.width) * f && lightmap.height() == std::size_t(atlas.height) * f,
+                "lightmap", "must be the atlas's size times 2^level");
+    return f;
+}
+
 // Runs f(y) for every row, rows in parallel.
 template <class F>
 void for_rows(std::size_t height, F&& f) {
@@ -73,11 +84,7 @@ image<glm::vec3> lightmap_view(const std::vector<lightmap_hit>& hits, std::size_
                                const lightmap_atlas& atlas, image_view<const glm::vec3> front,
                                image_view<const glm::vec3> back, int level) {
     require(hits.size() == width * height, "hits", "must hold width x height pixels");
-    require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
-    const std::size_t f = std::size_t(1) << level;
-    for (const auto& lightmap : {front, back})
-        require(lightmap.width() == std::size_t(atlas.width) * f && lightmap.height() == std::size_t(atlas.height) * f,
-                "lightmap", "must be the atlas's size times 2^level");
+    const std::size_t f = check_lightmaps(atlas, front, back, level);
     image<glm::vec3> out(width, height, glm::vec3(0.f));
     const float scale = float(f);
     const float inv_pi = float(1.0 / std::numbers::pi);
@@ -113,11 +120,7 @@ image<glm::vec3> lightmap_view(const accel& bvh, const scene_view& scene, const 
                                image_view<const glm::vec3> front, image_view<const glm::vec3> back, int level,
                                const bounce::camera& cam, std::size_t width, std::size_t height) {
     check_atlas(bvh, scene, atlas);
-    require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
-    const std::size_t f = std::size_t(1) << level;
-    for (const auto& lightmap : {front, back})
-        require(lightmap.width() == std::size_t(atlas.width) * f && lightmap.height() == std::size_t(atlas.height) * f,
-                "lightmap", "must be the atlas's size times 2^level");
+    check_lightmaps(atlas, front, back, level);  // before any ray
     return lightmap_view(lightmap_hits(bvh, scene, atlas, cam, width, height), width, height, atlas, front, back, level);
 }
 
