@@ -3,8 +3,11 @@
 #include "room.hpp"
 
 #include <bounce/cpu/irradiance_cache.hpp>
+#include <bounce/embree/irradiance_probe.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/record_sampler.hpp>
+
+#include <functional>
 
 int main() {
     const room r;
@@ -16,7 +19,11 @@ int main() {
     const embree::reference_integrator shading(bvh, scene);           // shades the rays' hits
     const embree::record_sampler sampler(shading, embree::hemisphere_grid_for(256), radius_limits{});
     const auto [lo, hi] = scene.bounds();
-    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi);          // keep it across frames
+    cpu::irradiance_cache_options options;
+    options.verify.rounds = 2;                                        // check the image against 8-ray probes
+    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, options); // keep it across frames
+    const embree::irradiance_probe probe(shading, 8);                 // the verification's probe
+    cache.set_probe(std::cref(probe));                                // must outlive the cache's frames
     gbuffer<float> g = embree::ray_cast_gbuffer(bvh, scene, cam, 64, 48);  // or your own G-buffer
     image<glm::vec3> e(64, 48);
     cache.render(g.view(), cam, sampler, e.view());                   // indirect irradiance, W/m^2
