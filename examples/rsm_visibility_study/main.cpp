@@ -26,6 +26,8 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -48,6 +50,7 @@ struct options {
     bool flat_normals = false;
     float sigmas = discontinuity_params{}.visibility_sigmas;
     float complete_below = 0.5f;  // the 4x4-blur-complete configs
+    view_selection_params view;    // with rays: the view's choice of VPLs (candidates 1: off)
 };
 
 /// `s` with every triangle's corners its own vertices carrying the triangle's geometric normal
@@ -127,7 +130,11 @@ int run(const options& o) {
                                        {"width", o.width},
                                        {"height", o.height},
                                        {"flat_normals", o.flat_normals},
+                                       {"occlusion", o.occlusion},
                                        {"rsm_resolution", 256},
+                                       {"view_candidates", o.view.candidates},
+                                       {"view_receivers", o.view.receivers},
+                                       {"view_defensive", o.view.defensive},
                                        {"visibility_sigmas", o.sigmas}}},
                                      {"frames", nlohmann::ordered_json::array()},
                                      {"blurred_references", nlohmann::ordered_json::array()}};
@@ -161,7 +168,7 @@ int run(const options& o) {
         rs.resolution = 256;
         embree::rsm_ray_caster caster(bvh, scene, rs);
         caster.render();
-        const embree::occlusion_rays rays(bvh);
+        const diagnostic_occlusion rays(bvh, scene, o.occlusion);
         cpu::indirect_renderer renderer({}, &rays);
 
         indirect_options base;
@@ -223,6 +230,7 @@ int run(const options& o) {
                 opt.visibility = vis;
                 opt.light = default_pixel_light(scene.view(), c.pattern);
                 opt.light.footprint_scale = c.footprint ? 1.f : 0.f;
+                opt.view_selection = o.view;
                 if (!c.view) opt.view_selection.candidates = 1;
                 opt.discontinuity.visibility_sigmas = c.sigmas < 0.f ? o.sigmas : c.sigmas;
                 if (c.complete) opt.discontinuity.complete_below = o.complete_below;
@@ -256,6 +264,7 @@ int run(const options& o) {
                 dump_image(o, scene.name, c.name + (rays_on ? "-rays" : "-none"), e.view());
             }
         }
+        rays.report(scene.name);
     }
     if (!o.json.empty()) io::write_text_file(o.json, report.dump(2) + "\n");
     return 0;
@@ -279,6 +288,11 @@ int main(int argc, char** argv) {
     app.add_option("--complete-below", o.complete_below,
                    "4x4-blur-complete: share of sub-buffers below which a pixel gets every VPL")
         ->check(CLI::Range(0.f, 1.f));
+    app.add_option("--candidates", o.view.candidates, "view_selection.candidates (1: VPLs by flux alone)")
+        ->check(CLI::Range(1, 64));
+    app.add_option("--receivers", o.view.receivers, "view_selection.receivers")->check(CLI::Range(1, 1 << 20));
+    app.add_option("--defensive", o.view.defensive, "view_selection.defensive")->check(CLI::Range(0.001f, 1.f));
+    app.add_option("--occlusion", o.occlusion, "diagnostic occlusion query: rays (the library's), geometric, shortened");
     app.add_flag("--flat-normals", o.flat_normals, "every triangle shaded with its own geometric normal");
     app.add_option("--json", o.json, "write the frames' errors here (docs/studies/results.py adds it)");
     app.add_option("--dump", o.dump, "write every image as raw float32 into this folder");
