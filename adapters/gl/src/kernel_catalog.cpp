@@ -14,6 +14,7 @@
 #include <bounce/indirect/rsm_sampling.hpp>
 #include <bounce/radiosity/kernels.hpp>
 #include <bounce/radiosity/shooters.hpp>
+#include <bounce/radiosity/sides.hpp>
 #include <bounce/radiosity/stereographic_tessellation.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/shadow_mapping.hpp>
@@ -151,6 +152,8 @@ void radiosity(catalog& c) {
         .add("radiosity parallel", "radiosity_parallel_coords", BOUNCE_KERNEL(parallel_item_coords<f32, vec3, vec2>))
         .add("radiosity shot", "radiosity_form_factor", BOUNCE_KERNEL(element_form_factor<f32, vec3>))
         .add("radiosity shot", "radiosity_near_field", BOUNCE_KERNEL(near_field_opens<f32, vec3>))
+        .add("radiosity shot", "radiosity_receiving_side", BOUNCE_KERNEL(receiving_side<f32, vec3>))
+        .add("radiosity shot", "radiosity_side_normal", BOUNCE_KERNEL(side_normal<f32, vec3>))
         .add("radiosity direct", "radiosity_light_side", BOUNCE_KERNEL(light_hemisphere_side<f32, vec3>))
         .add("radiosity direct", "radiosity_point_irradiance", BOUNCE_KERNEL(point_light_irradiance<f32, vec3>))
         .add("radiosity direct", "radiosity_directional_irradiance", BOUNCE_KERNEL(directional_light_irradiance<f32, vec3>))
