@@ -2,7 +2,8 @@
 // is unbiased for every sub-buffer (its mean over seeds against the candidates' own sum, and
 // a frame's mean over seeds against the frame of every texel, with visibility, within a
 // tolerance from the seeds' spread), and the weights stay finite where the camera sees no
-// candidate or no receiver sees anything.
+// candidate or no receiver sees anything; a candidate hidden from the whole view is drawn with
+// the defensive share alone.
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/cpu/view_selection.hpp>
 #include <bounce/errors.hpp>
@@ -11,6 +12,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -195,6 +197,60 @@ TEST_CASE("where the camera sees no candidate the draw is uniform and every weig
     r.render(gb.view(), s.cam, std::span<const rsm_view>(&map, 1), frame.view());
     for (std::size_t y = 0; y < 8; ++y)
         for (std::size_t x = 0; x < 8; ++x) CHECK(frame(x, y) == glm::vec3(0.f));
+}
+
+// Blocks every segment whose sender lies at z > 0: that half of the ceiling is hidden from
+// the whole view.
+class hidden_senders final : public occlusion_query {
+public:
+    void occluded(std::span<const visibility_segment> segments, std::span<std::uint8_t> blocked) const override {
+        for (std::size_t i = 0; i < segments.size(); ++i) blocked[i] = segments[i].sender.z > 0.f ? 1 : 0;
+    }
+};
+
+TEST_CASE("a VPL the view cannot see is drawn with the defensive share alone", "[rsm][view_selection]") {
+    // Each drawn VPL's flux is its candidate's times 1 / (cells n_s P): a hidden candidate
+    // has P = defensive / M exactly, a seen one more; over seeds the hidden half of the
+    // candidates gets count x (hidden / M) x defensive draws, within the seeds' spread.
+    const small_scene s;
+    const rsm_view map = s.map();
+    const hidden_senders occluder;
+    const std::size_t count = 16, cells = 4;
+    const indirect_options base = options(2, count);
+    const double m = double(count) * base.view_selection.candidates, a = base.view_selection.defensive;
+    const int seeds = 400;
+    double drawn = 0, expected = 0, sum2 = 0;
+    for (int seed = 1; seed <= seeds; ++seed) {
+        indirect_options o = base;
+        o.seed = std::uint64_t(seed);
+        gbuffer<float> gb = s.gb;
+        const std::vector<vpl> v =
+            cpu::select_vpls_for_view(std::span<const rsm_view>(&map, 1), o, gb.view(), &occluder, int(cells));
+        const std::vector<vpl> candidates =
+            select_vpls(std::span<const rsm_view>(&map, 1), std::size_t(m), o.selection, o.seed);
+        REQUIRE(v.size() == count);
+        double hidden_candidates = 0, hidden_draws = 0;
+        for (const vpl& c : candidates) hidden_candidates += c.position.z > 0.f ? 1 : 0;
+        for (const vpl& l : v) {
+            const auto c = std::find_if(candidates.begin(), candidates.end(),
+                                        [&](const vpl& x) { return x.position == l.position; });
+            REQUIRE(c != candidates.end());
+            const double p = double(c->flux.y) / (double(l.flux.y) * double(count));  // 1 / (cells n_s factor)
+            if (l.position.z > 0.f) {
+                CHECK(p == Approx(a / m).epsilon(1e-5));
+                hidden_draws += 1;
+            } else {
+                CHECK(p > 1.5 * a / m);
+            }
+        }
+        const double want = double(count) * hidden_candidates / m * a;
+        drawn += hidden_draws;
+        expected += want;
+        sum2 += (hidden_draws - want) * (hidden_draws - want);
+    }
+    INFO("hidden draws " << drawn << " against " << expected);
+    CHECK(expected > 0.5 * seeds);  // hidden candidates in most seeds
+    CHECK(std::abs(drawn - expected) <= 4.5 * std::sqrt(sum2) + 1e-9);
 }
 
 TEST_CASE("bad view selection parameters are refused by name", "[rsm][view_selection]") {
