@@ -51,6 +51,71 @@ struct options {
     float sigmas = discontinuity_params{}.visibility_sigmas;
     float complete_below = 0.5f;  // the 4x4-blur-complete configs
     view_selection_params view;    // with rays: the view's choice of VPLs (candidates 1: off)
+    std::string occlusion = "rays";
+};
+
+/// The occlusion queries --occlusion compares (the RSM gather's bias with rays, issue 29):
+/// "rays" answers as embree::occlusion_rays (each end moved off its surface along the given,
+/// shading, normal); "geometric" moves each end along its triangle's geometric normal instead
+/// (found by a probe ray back along the shading normal); "shortened" keeps the receiver's end
+/// and stops the ray 2 epsilon before the sender itself, whatever the sender's normal says.
+/// Each counts where blocked segments meet their first surface: within 3, 30 or 300 epsilon
+/// of the receiver's end, of the sender's, or further from both.
+class diagnostic_occlusion final : public occlusion_query {
+public:
+    diagnostic_occlusion(const embree::accel& bvh, const io::scene& scene, std::string mode)
+        : bvh_(bvh), scene_(scene), mode_(std::move(mode)), eps_(bvh.ray_epsilon()) {
+        if (mode_ != "rays" && mode_ != "geometric" && mode_ != "shortened")
+            throw parameter_error("--occlusion", "must be rays, geometric or shortened");
+    }
+    void occluded(std::span<const visibility_segment> segments, std::span<std::uint8_t> blocked) const override {
+        thread_local std::vector<embree::ray> rays;
+        thread_local std::vector<embree::hit> hits;
+        rays.resize(segments.size());
+        hits.resize(segments.size());
+        for (std::size_t i = 0; i < segments.size(); ++i) {
+            const visibility_segment& s = segments[i];
+            const bool geo = mode_ == "geometric";
+            const glm::vec3 rn = geo ? geometric_normal(s.receiver, s.receiver_normal) : s.receiver_normal;
+            const glm::vec3 sn = geo ? geometric_normal(s.sender, s.sender_normal) : s.sender_normal;
+            const glm::vec3 from = segment_end(s.receiver, rn, s.sender, eps_);
+            const glm::vec3 to = mode_ == "shortened" ? s.sender : segment_end(s.sender, sn, s.receiver, eps_);
+            const float len = glm::length(to - from);
+            rays[i] = {from, to - from, 0.f, mode_ == "shortened" ? std::max(0.f, 1.f - 2.f * eps_ / len) : 1.f};
+        }
+        bvh_.intersect(rays, hits);
+        for (std::size_t i = 0; i < segments.size(); ++i) {
+            blocked[i] = hits[i].found() ? 1 : 0;
+            if (!hits[i].found()) continue;
+            const float len = glm::length(rays[i].direction);
+            const float near = hits[i].t * len / eps_, far = (1.f - hits[i].t) * len / eps_;
+            const std::size_t end = near <= far ? 0 : 1;
+            const float d = std::min(near, far);
+            counts_[end][d < 3.f ? 0 : d < 30.f ? 1 : d < 300.f ? 2 : 3] += 1;
+        }
+        total_ += segments.size();
+    }
+    void report(const std::string& scene) const {
+        fmt::print("{} occlusion {}: {} segments; blocked within 3/30/300/more eps of the receiver {} {} {} {}, "
+                   "of the sender {} {} {} {}\n",
+                   scene, mode_, total_.load(), counts_[0][0].load(), counts_[0][1].load(), counts_[0][2].load(),
+                   counts_[0][3].load(), counts_[1][0].load(), counts_[1][1].load(), counts_[1][2].load(),
+                   counts_[1][3].load());
+    }
+
+private:
+    glm::vec3 geometric_normal(const glm::vec3& p, const glm::vec3& n) const {
+        const float probe = 4.f * eps_;
+        const embree::ray r{p + n * probe, -n, 0.f, 2.f * probe};
+        const embree::hit h = bvh_.intersect(r);
+        return h.found() ? embree::surface_at(scene_.view(), r, h).geometric_normal : n;
+    }
+    embree::accel bvh_;
+    const io::scene& scene_;
+    std::string mode_;
+    float eps_;
+    mutable std::array<std::array<std::atomic<std::uint64_t>, 4>, 2> counts_{};
+    mutable std::atomic<std::uint64_t> total_{0};
 };
 
 /// `s` with every triangle's corners its own vertices carrying the triangle's geometric normal
