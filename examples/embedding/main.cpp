@@ -3,6 +3,7 @@
 // adds one-bounce indirect light by irradiance splatting (docs/embedding.md walks through it).
 //   build/bin/embedding --out embedding.png
 #include <bounce/cpu/irradiance_cache.hpp>
+#include <bounce/embree/irradiance_probe.hpp>
 #include <bounce/embree/record_sampler.hpp>
 #include <bounce/gl/direct_light.hpp>
 #include <bounce/gl/irradiance_splatter.hpp>
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -144,13 +146,22 @@ int main(int argc, char** argv) {
     const embree::reference_integrator shading(bvh, scene);
     const embree::record_sampler sampler(shading, embree::hemisphere_grid_for(512), radius_limits{});
     const auto [lo, hi] = scene.bounds();
-    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi);
+    // The verification pass (as ic_splatting's default): the image checked against 8-ray probes,
+    // records added where it disagrees; its rounds splat every record again on the GPU (resplat).
+    cpu::irradiance_cache_options options;
+    options.verify.rounds = 2;
+    cpu::irradiance_cache<ward_smooth_weight> cache(lo, hi, options);
+    const embree::irradiance_probe probe(shading, 8);
+    cache.set_probe(std::cref(probe));
     gl::irradiance_splatter splatter;
     const gl::gbuffer_textures g{gl::texture_ref::of(tex[0]), gl::texture_ref::of(tex[1]), gl::texture_ref::of(tex[2])};
+    const auto resplat = [&](image_view<glm::vec4> splat) { splatter.resplat(g, cam, cache.records(), splat); };
     // Radiance rho/pi * E with the G-buffer's albedo, since compose adds it to the direct radiance.
     const auto stats = splatter.render(
         g, cam, cache.records(),
-        [&](gbuffer_view<float> gv, image_view<glm::vec4> splat) { cache.scan(gv, cam, sampler, splat); },
+        [&](gbuffer_view<float> gv, image_view<glm::vec4> splat) {
+            cache.scan_and_verify(gv, cam, sampler, splat, resplat);
+        },
         output_quantity::radiance);
     const gl::scene_mesh mesh(scene);
     gl::direct_light direct(scene, mesh);
