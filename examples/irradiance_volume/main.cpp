@@ -141,24 +141,7 @@ int run(const options& o) {
         return 0;
     }
 
-    irradiance_volume_settings vs;  // the bake
-    vs.max_depth = o.max_depth;
-    vs.min_depth = o.mode == volume_mode::uniform ? o.max_depth
-                   : o.min_depth >= 0            ? o.min_depth
-                                                 : std::min(1, o.max_depth);
-    vs.distance_ratio = o.distance_ratio;
-    vs.neighbour_change = o.neighbour_change;
-    vs.geometry_triangles = o.geometry_triangles;
-    vs.gradient_ratio = o.gradient_ratio;
-    vs.cull_tolerance = o.cull;
-    vs.prediction_tolerance = o.prediction_tolerance;
-    vs.noise_sigmas = o.noise_sigmas;
-    vs.refit_culled = o.refit == "on";
-    vs.refinement = o.refine;
-    vs.conforming_corners = o.conforming == "on";
-    vs.bias_budget = o.bias_budget;
-    vs.bias_tolerance = o.bias_tolerance;
-    vs.calibrate_noise = o.calibrate == "on";
+    irradiance_volume_settings vs = examples::volume_settings(o);  // the bake
     vs.memory_limit_bytes = study::available_memory_bytes();
     const glm::vec3 finest = extent / float(1 << o.max_depth);
     embree::probe_baker_settings bs;
@@ -212,6 +195,7 @@ int run(const options& o) {
     study::volume_lookup_figures best;
     cpu::volume_lookup chosen_how;
     for (const auto& [name, how] : variants) {
+        if (name != chosen && !volume.hanging_corners().empty()) continue;  // only trilinear computes hanging corners
         auto f = sphere.measure(volume, name, how);
         lookups[name] = f.to_json();
         std::printf("%-20s rel_rms %.4f  popping %.4f (excess %.4f)  lookup %.0f ns\n", name.c_str(), f.error.rel_rms, f.popping,
@@ -222,10 +206,17 @@ int run(const options& o) {
     merged.min_depth = o.min_depth >= 0 ? o.min_depth : std::min(1, o.max_depth);
     std::optional<study::volume_surface_study> surface;  // --sweep-surface: wall distance = the finest cell
     if (o.sweep_surface) surface.emplace(light, bvh, scene, scene.camera, std::min({finest.x, finest.y, finest.z}), surface_settings(o));
+    study::volume_rebake rebake{[&](std::uint32_t rays, std::span<const glm::vec3> at, std::span<irradiance_probe> out) {
+        embree::probe_baker_settings more = bs;  // --sweep-equal-rays: the same probes with more rays
+        more.rays = rays, more.progress = {};
+        embree::probe_baker(light, bvh, scene, more)(at, out);
+    }, std::uint64_t(irradiance_volume::uniform_probe_count(std::max(0, o.sweep_equal_rays))) * o.rays};
+    const auto* rebaking = o.sweep_equal_rays >= 0 ? &rebake : nullptr;
     const auto sweep = o.sweep_depths.empty()
-                           ? study::bias_budget_sweep(scene, lo, hi, merged, memo, sphere, o.sweep, o.sweep_sigmas, surface ? &*surface : nullptr)
+                           ? study::bias_budget_sweep(scene, lo, hi, merged, memo, sphere, o.sweep, o.sweep_sigmas,
+                                                      surface ? &*surface : nullptr, rebaking)
                            : study::volume_depth_sweep(scene, lo, hi, merged, memo, sphere, o.sweep_depths, o.sweep,
-                                                       o.sweep_tolerances, o.sweep_sigmas, surface ? &*surface : nullptr);
+                                                       o.sweep_tolerances, o.sweep_sigmas, surface ? &*surface : nullptr, rebaking);
     std::printf("%s %s depth %d: %zu probes (%zu inside), %zu leaves, bake %.0f ms; reference popping %.4f\n",
                 scene.name.c_str(), examples::name_of(mode_names, o.mode).c_str(), volume.depth(), volume.probes().size(),
                 stats.probes_inside, volume.leaf_count(), bake_ms, sphere.reference_popping());
@@ -260,7 +251,9 @@ int run(const options& o) {
                          {"bias_budget", o.bias_budget}, {"bias_tolerance", o.bias_tolerance}, {"calibrate_noise", o.calibrate}, {"gradient_noise_ratio", o.gradient_noise},
                          {"noise_estimate", examples::name_of(noise_names, o.noise)}, {"sweep_bias_budget", o.sweep},
                          {"sweep_noise_sigmas", o.sweep_sigmas}, {"sweep_depths", o.sweep_depths}, {"sweep_bias_tolerance", o.sweep_tolerances},
-                         {"sweep_surface", o.sweep_surface}, {"surface_size", o.surface_size},
+                         {"sweep_surface", o.sweep_surface}, {"sweep_equal_rays", o.sweep_equal_rays},
+                         {"hanging_corners", examples::name_of(examples::hanging_names, o.hanging)},
+                         {"bias_tolerance_unit", examples::name_of(examples::tolerance_unit_names, o.tolerance_unit)}, {"surface_size", o.surface_size},
                          {"seed", o.seed}, {"threads", o.threads}};
     report.timings_ms = {{"bake", bake_ms}, {"reference", sphere.reference_ms()}};
     report.error = best.error;

@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -27,6 +28,10 @@ inline const choices<embree::probe_noise_estimate> noise_names{
     {"even-odd", embree::probe_noise_estimate::even_odd},
     {"independent-halves", embree::probe_noise_estimate::independent_halves},
     {"rotated-repeat", embree::probe_noise_estimate::rotated_repeat}};
+inline const choices<hanging_corner_storage> hanging_names{{"stored", hanging_corner_storage::stored},
+                                                           {"computed", hanging_corner_storage::computed}};
+inline const choices<bias_tolerance_unit> tolerance_unit_names{{"light", bias_tolerance_unit::scene_light},
+                                                               {"noise", bias_tolerance_unit::probe_noise}};
 inline const choices<cpu::volume_interpolation> interp_names{{"trilinear", cpu::volume_interpolation::trilinear},
                                                                 {"weighted", cpu::volume_interpolation::weighted}};
 
@@ -58,6 +63,9 @@ struct volume_options {
     std::vector<float> sweep, sweep_sigmas, sweep_tolerances;  // merged octrees built from the same probes
     std::vector<int> sweep_depths;           // ... and uniform grids, at these finest depths
     bool sweep_surface = false;              // ... measured at the camera's surface points too
+    int sweep_equal_rays = -1;               // ... and rebaked with the rays of the grid of this depth
+    hanging_corner_storage hanging = hanging_corner_storage::stored;
+    bias_tolerance_unit tolerance_unit = bias_tolerance_unit::scene_light;
 };
 
 /// Every option of the program, with its checks, on `app`, setting `o`.
@@ -126,6 +134,14 @@ inline void add_volume_options(CLI::App& app, volume_options& o) {
         ->check(CLI::Range(0, irradiance_volume::depth_limit));
     app.add_flag("--sweep-surface", o.sweep_surface, "also measure the sweep's octrees at the camera's surface points "
                                                      "(--surface-size, --ref-samples)");
+    app.add_option("--sweep-equal-rays", o.sweep_equal_rays, "also measure each of the sweep's octrees with its probes baked "
+                                                             "again with the total rays of the uniform grid of this depth "
+                                                             "(needs --hanging-corners computed)")
+        ->check(CLI::Range(0, irradiance_volume::depth_limit));
+    add_choice(app, "--hanging-corners", o.hanging, hanging_names,
+               "adaptive: a probe at each T-junction corner (stored), or none, interpolated by the trilinear lookup");
+    add_choice(app, "--bias-tolerance-unit", o.tolerance_unit, tolerance_unit_names,
+               "--bias-tolerance in units of the finest grid's mean light or of its probes' median noise");
     app.add_option("--gradient-step", o.gradient_step, "central-difference step, fraction of the finest cell edge (0: no "
                                                        "gradients; trilinear lookups and merging do not use them)")
         ->check(finite_non_negative);
@@ -145,6 +161,31 @@ inline void add_volume_options(CLI::App& app, volume_options& o) {
         ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--self-shadow-bias", o.self_shadow_bias, "visibility test's self-shadow bias (fraction of 0.75 cell)")
         ->check(detail::number_in(0, 4, true, "a bias"));
+}
+
+/// The build's settings from the options (memory_limit_bytes left to the caller).
+inline irradiance_volume_settings volume_settings(const volume_options& o) {
+    irradiance_volume_settings vs;
+    vs.max_depth = o.max_depth;
+    vs.min_depth = o.mode == volume_mode::uniform ? o.max_depth
+                   : o.min_depth >= 0            ? o.min_depth
+                                                 : std::min(1, o.max_depth);
+    vs.distance_ratio = o.distance_ratio;
+    vs.neighbour_change = o.neighbour_change;
+    vs.geometry_triangles = o.geometry_triangles;
+    vs.gradient_ratio = o.gradient_ratio;
+    vs.cull_tolerance = o.cull;
+    vs.prediction_tolerance = o.prediction_tolerance;
+    vs.noise_sigmas = o.noise_sigmas;
+    vs.refit_culled = o.refit == "on";
+    vs.refinement = o.refine;
+    vs.conforming_corners = o.conforming == "on";
+    vs.bias_budget = o.bias_budget;
+    vs.bias_tolerance = o.bias_tolerance;
+    vs.tolerance_unit = o.tolerance_unit;
+    vs.hanging_corners = o.hanging;
+    vs.calibrate_noise = o.calibrate == "on";
+    return vs;
 }
 
 }  // namespace bounce::examples

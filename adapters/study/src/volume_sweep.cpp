@@ -58,14 +58,16 @@ volume_sweep_point measure_point(const irradiance_volume& volume, const irradian
     p.probes_inside = stats.probes_inside;
     p.leaves = volume.leaf_count();
     p.hanging = stats.hanging_corners;
+    p.hanging_computed = !volume.hanging_corners().empty();
+    p.scene_light = stats.scene_light, p.median_noise = stats.median_noise;
     p.trilinear = sphere.measure(volume, "trilinear", cpu::volume_lookup{});
     if (surface) p.surface = surface->measure(volume, nullptr, cpu::volume_lookup{});
     return p;
 }
 
 void print_point(const char* what, const volume_sweep_point& p) {
-    std::printf("%s depth %d bias_budget %-6.3g tolerance %-6.3g sigmas %-4.3g %6zu probes, %6zu leaves  rel_rms %.4f  popping %.4f (excess %.4f)",
-                what, p.max_depth, double(p.bias_budget), double(p.bias_tolerance), double(p.noise_sigmas), p.probes, p.leaves, p.trilinear.error.rel_rms,
+    std::printf("%s rays %u depth %d bias_budget %-6.3g tolerance %-6.3g sigmas %-4.3g %6zu probes, %6zu leaves  rel_rms %.4f  popping %.4f (excess %.4f)",
+                what, p.rays_per_probe, p.max_depth, double(p.bias_budget), double(p.bias_tolerance), double(p.noise_sigmas), p.probes, p.leaves, p.trilinear.error.rel_rms,
                 p.trilinear.popping, p.trilinear.popping_excess);
     if (p.surface) std::printf("  surface %.4f (debiased %.4f)", p.surface->all.rel_rms, p.surface->all.rel_rms_debiased);
     std::printf("\n");
@@ -80,7 +82,8 @@ namespace {
 template <class Set>
 std::vector<volume_sweep_point> merge_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi, irradiance_volume_settings settings,
                                             probe_memo& source, const volume_sphere_study& sphere, std::span<const float> values,
-                                            std::span<const float> sigmas, const volume_surface_study* surface, Set set) {
+                                            std::span<const float> sigmas, const volume_surface_study* surface,
+                                            const volume_rebake* rebake, Set set) {
     for (const float k : sigmas) require(std::isfinite(k) && k >= 0, "sigmas", "every noise_sigmas must be finite and >= 0");
     settings.refinement = volume_refinement::merge;
     const std::vector<float> ks = sigmas.empty() ? std::vector<float>{settings.noise_sigmas}
@@ -98,7 +101,16 @@ std::vector<volume_sweep_point> merge_sweep(const scene_view& scene, glm::vec3 l
             p.bias_tolerance = settings.bias_tolerance;
             p.noise_sigmas = k;
             print_point("sweep", p);
-            out.push_back(std::move(p));
+            out.push_back(p);
+            if (!rebake || !rebake->bake || volume.stored_hanging_corners() > 0) continue;
+            irradiance_volume again = volume;  // the same layout, its probes baked with the total rays
+            const auto rays = std::uint32_t(std::max<std::uint64_t>(1, rebake->total_rays / std::max<std::size_t>(1, volume.probes().size())));
+            again.rebake([&](std::span<const glm::vec3> at, std::span<irradiance_probe> baked) { rebake->bake(rays, at, baked); });
+            volume_sweep_point q = measure_point(again, stats, sphere, surface);
+            q.max_depth = p.max_depth, q.bias_budget = p.bias_budget, q.bias_tolerance = p.bias_tolerance, q.noise_sigmas = k;
+            q.rays_per_probe = rays;
+            print_point("rebaked", q);
+            out.push_back(std::move(q));
         }
     }
     return out;
@@ -109,21 +121,23 @@ std::vector<volume_sweep_point> merge_sweep(const scene_view& scene, glm::vec3 l
 std::vector<volume_sweep_point> bias_budget_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
                                                   irradiance_volume_settings settings, probe_memo& source,
                                                   const volume_sphere_study& sphere, std::span<const float> budgets,
-                                                  std::span<const float> sigmas, const volume_surface_study* surface) {
+                                                  std::span<const float> sigmas, const volume_surface_study* surface,
+                                                  const volume_rebake* rebake) {
     for (const float b : budgets) require(std::isfinite(b) && b > 0, "budgets", "every bias budget must be positive and finite");
     settings.bias_tolerance = 0;
-    return merge_sweep(scene, lo, hi, settings, source, sphere, budgets, sigmas, surface,
+    return merge_sweep(scene, lo, hi, settings, source, sphere, budgets, sigmas, surface, rebake,
                        [](irradiance_volume_settings& s, float b) { s.bias_budget = b; });
 }
 
 std::vector<volume_sweep_point> bias_tolerance_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
                                                      irradiance_volume_settings settings, probe_memo& source,
                                                      const volume_sphere_study& sphere, std::span<const float> tolerances,
-                                                     std::span<const float> sigmas, const volume_surface_study* surface) {
+                                                     std::span<const float> sigmas, const volume_surface_study* surface,
+                                                     const volume_rebake* rebake) {
     for (const float t : tolerances)
         require(std::isfinite(t) && t > 0, "tolerances", "every bias tolerance must be positive and finite");
     settings.bias_budget = 0;
-    return merge_sweep(scene, lo, hi, settings, source, sphere, tolerances, sigmas, surface,
+    return merge_sweep(scene, lo, hi, settings, source, sphere, tolerances, sigmas, surface, rebake,
                        [](irradiance_volume_settings& s, float t) { s.bias_tolerance = t; });
 }
 
@@ -131,7 +145,8 @@ std::vector<volume_sweep_point> volume_depth_sweep(const scene_view& scene, glm:
                                                    const irradiance_volume_settings& settings, probe_memo& source,
                                                    const volume_sphere_study& sphere, std::span<const int> depths,
                                                    std::span<const float> budgets, std::span<const float> tolerances,
-                                                   std::span<const float> sigmas, const volume_surface_study* surface) {
+                                                   std::span<const float> sigmas, const volume_surface_study* surface,
+                                                   const volume_rebake* rebake) {
     for (const int d : depths)
         require(d >= 0 && d <= irradiance_volume::depth_limit, "depths", "every depth must be within 0 .. depth_limit");
     std::vector<volume_sweep_point> out;
@@ -148,8 +163,8 @@ std::vector<volume_sweep_point> volume_depth_sweep(const scene_view& scene, glm:
         irradiance_volume_settings merged = settings;
         merged.max_depth = d;
         merged.min_depth = std::min(merged.min_depth, d);
-        for (auto points : {bias_budget_sweep(scene, lo, hi, merged, source, sphere, budgets, sigmas, surface),
-                            bias_tolerance_sweep(scene, lo, hi, merged, source, sphere, tolerances, sigmas, surface)})
+        for (auto points : {bias_budget_sweep(scene, lo, hi, merged, source, sphere, budgets, sigmas, surface, rebake),
+                            bias_tolerance_sweep(scene, lo, hi, merged, source, sphere, tolerances, sigmas, surface, rebake)})
             out.insert(out.end(), std::make_move_iterator(points.begin()), std::make_move_iterator(points.end()));
     }
     return out;
@@ -161,7 +176,9 @@ nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep) {
         nlohmann::ordered_json e = {{"max_depth", p.max_depth}, {"uniform", p.uniform}, {"bias_budget", p.bias_budget},
                                     {"bias_tolerance", p.bias_tolerance},
                                     {"noise_sigmas", p.noise_sigmas}, {"probes", p.probes}, {"probes_inside", p.probes_inside},
-                                    {"leaves", p.leaves}, {"hanging", p.hanging}, {"rel_rms", p.trilinear.error.rel_rms},
+                                    {"leaves", p.leaves}, {"hanging", p.hanging}, {"hanging_computed", p.hanging_computed},
+                                    {"rays_per_probe", p.rays_per_probe}, {"scene_light", p.scene_light},
+                                    {"median_noise", p.median_noise}, {"rel_rms", p.trilinear.error.rel_rms},
                                     {"popping", p.trilinear.popping},
                                     {"popping_excess", p.trilinear.popping_excess}};
         if (p.surface) e["surface"] = p.surface->to_json();

@@ -112,6 +112,19 @@ std::pair<V, T> trilinear_probe_accumulate(const V& sum, const T& weight_sum, co
     return {sum + sh_irradiance<L, T, V>(c, n) * w, weight_sum + w};
 }
 
+/// One term of a computed hanging corner (volume/hanging_corners.hpp): acc + weight * c per
+/// coefficient. The lookup sums a corner's terms (stored probes and their weights: the
+/// coarser leaf's interpolation) from zero, then weighs the sum as a corner
+/// (trilinear_probe_accumulate); irradiance is linear in the coefficients, so this equals
+/// a stored probe holding that interpolation.
+template <int L, real T, vec3_of<T> V>
+std::array<V, sh_count(L)> probe_combination_add(const std::array<V, sh_count(L)>& acc, const T& weight,
+                                                 const std::array<V, sh_count(L)>& c) {
+    std::array<V, sh_count(L)> out = acc;
+    for (std::size_t i = 0; i < sh_count(L); ++i) out[i] = acc[i] + c[i] * weight;
+    return out;
+}
+
 /// The average sum / weight_sum, and 0 where no probe contributed (weight_sum = 0).
 template <real T, vec3_of<T> V>
 V probe_average(const V& sum, const T& weight_sum) {

@@ -151,6 +151,16 @@ float noise_scale2(const Lattice& lattice, int max_depth) {
     return n > 0 ? float(std::min(1.0, r / n)) : 1.f;
 }
 
+/// The median noise of the probes outside geometry (0 when there is none).
+inline float median_noise(const std::vector<irradiance_probe>& probes) {
+    std::vector<float> noise;
+    for (const auto& p : probes)
+        if (!p.inside) noise.push_back(p.noise);
+    if (noise.empty()) return 0.f;
+    std::nth_element(noise.begin(), noise.begin() + std::ptrdiff_t(noise.size() / 2), noise.end());
+    return noise[noise.size() / 2];
+}
+
 template <class Lattice>
 bool cell_predicts_finest(const Lattice& lattice, const lattice_cell& c, float floor_level, float tolerance,
                           const irradiance_volume_settings& s, float noise_scale2 = 1, float scene_level = 0) {
@@ -201,7 +211,12 @@ std::vector<std::vector<bool>> merge_from_finest(const Lattice& lattice, float f
     whole[std::size_t(s.max_depth)].assign(cells(s.max_depth) * cells(s.max_depth) * cells(s.max_depth), true);
     const float scale2 = (s.bias_budget > 0 || s.bias_tolerance > 0) && s.calibrate_noise ? noise_scale2(lattice, s.max_depth) : 1.f;
     stats.noise_scale = std::sqrt(scale2);
-    const float scene_level = s.bias_tolerance > 0 ? absolute_floor_level(lattice.probes(), 1.f) : 0.f;
+    float scene_level = 0;
+    if (s.bias_tolerance > 0) {
+        stats.scene_light = absolute_floor_level(lattice.probes(), 1.f);
+        stats.median_noise = median_noise(lattice.probes()) * stats.noise_scale;
+        scene_level = s.tolerance_unit == bias_tolerance_unit::probe_noise ? stats.median_noise : stats.scene_light;
+    }
     for (int d = s.max_depth - 1; d >= s.min_depth; --d) {
         const std::uint64_t n = cells(d), st = lattice.step(d);
         whole[std::size_t(d)].assign(n * n * n, false);

@@ -8,6 +8,7 @@
 #include <bounce/errors.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/scene_view.hpp>
+#include <bounce/volume/hanging_corners.hpp>
 #include <bounce/volume/kernels.hpp>
 #include <bounce/volume/triangle_box_overlap.hpp>
 
@@ -67,6 +68,12 @@ enum class volume_refinement {
     /// is not predicted (prediction_tolerance, noise_sigmas); with prediction_tolerance 0,
     /// Oat's heuristics split and cull_tolerance culls.
     split,
+};
+
+/// The unit of irradiance_volume_settings::bias_tolerance.
+enum class bias_tolerance_unit {
+    scene_light,  ///< L: the mean band-0 irradiance luminance of the finest grid's probes outside geometry
+    probe_noise,  ///< sigma: the median of those probes' noise (its standard error, times the calibration's scale)
 };
 
 /// The octree's shape and Oat's subdivision heuristics. A heuristic is off when its
@@ -139,6 +146,14 @@ struct irradiance_volume_settings {
     /// stay fine where the light departs from trilinear and merge where it does not.
     /// Replaces bias_budget's bound. Typical: 0.01-0.1.
     float bias_tolerance = 0.f;
+    /// The unit of bias_tolerance (issue 31, fifth session): the scene's light L, or the
+    /// median noise sigma of the finest grid's probes (the bound is then (t sigma)^2: an
+    /// error target relative to what the probes resolve, derived from the bake).
+    bias_tolerance_unit tolerance_unit = bias_tolerance_unit::scene_light;
+    /// Where hanging corners live (with conforming_corners): a stored probe each, or none,
+    /// computed by the trilinear lookup from the coarser leaf's corners (the same values;
+    /// the weighted lookup, the visibility test and flatten() (GL) then refuse the volume).
+    hanging_corner_storage hanging_corners = hanging_corner_storage::stored;
     /// With bias_budget or bias_tolerance: scale the probes' reported noise to what the finest grid's second
     /// differences support (noise_scale2).
     bool calibrate_noise = true;
@@ -162,6 +177,8 @@ struct irradiance_volume_build_stats {
     std::size_t merged = 0;          ///< cells merged from their children (refinement merge)
     std::size_t hanging_corners = 0; ///< leaf corners set from a coarser leaf (conforming_corners)
     float noise_scale = 1;           ///< scale applied to the probes' noise (calibrate_noise)
+    float scene_light = 0;           ///< L of bias_tolerance_unit (merging by bias_tolerance)
+    float median_noise = 0;          ///< sigma of bias_tolerance_unit, noise_scale applied (merging by bias_tolerance)
     std::size_t inside_cells = 0;    ///< cells not split because every corner is inside geometry
     std::size_t probes_baked = 0;    ///< probes the source computed, culled ones included
     std::size_t probes_inside = 0;   ///< probes of the final volume flagged inside

@@ -173,8 +173,30 @@ public:
     /// The smallest reach of a usable probe (the `ref` scale of the weights).
     float reference_reach() const noexcept { return reference_reach_; }
 
-    /// Nodes and probes as std430 buffers.
+    /// Nodes and probes as std430 buffers. Throws parameter_error naming "volume" when it
+    /// computes its hanging corners (the GL lookup reads a probe at every corner).
     irradiance_volume_gpu_layout flatten() const;
+
+    /// The computed hanging corners (settings.hanging_corners = computed; empty otherwise):
+    /// a leaf corner c with c & 0x80000000 is hanging_corners()[c & 0x7fffffff], whose terms
+    /// (stored probes and weights, hanging_terms()) sum to the coarser leaf's interpolation.
+    const std::vector<hanging_corner>& hanging_corners() const noexcept { return hanging_.corners; }
+    const std::vector<hanging_term>& hanging_terms() const noexcept { return hanging_.terms; }
+    /// Hanging corners stored as probes (conforming corners with hanging_corners = stored).
+    std::size_t stored_hanging_corners() const noexcept { return stored_hanging_; }
+    /// Throws parameter_error naming "volume" when the volume computes hanging corners:
+    /// `what` (a lookup other than trilinear) needs a probe at every corner.
+    void require_stored_corners(const char* what) const;
+
+    /// Bakes every stored probe again from `source` at its position and takes its light
+    /// (radiance, gradients, harmonic mean distance, noise), keeping the layout: leaves,
+    /// inside flags, reaches and the computed hanging corners' weights. With more rays per
+    /// probe than the bake that decided the layout it compares layouts at equal total rays.
+    /// Throws parameter_error naming "volume" when hanging corners are stored (their values
+    /// would no longer be their coarser leaf's interpolation), "probes" when the source
+    /// returns a non-finite probe or moves one.
+    template <probe_source Source>
+    void rebake(Source&& source);
 
     /// Cap on the weight at a probe, in units of its reach (see weighted_probe_accumulate).
     static constexpr float min_relative_distance = 1e-4f;
@@ -184,6 +206,8 @@ private:
     std::vector<irradiance_probe> probes_;
     std::vector<std::uint32_t> owner_;
     float reference_reach_ = 1.f;
+    detail::hanging_table hanging_;
+    std::size_t stored_hanging_ = 0;
 };
 
 // ---- implementation ------------------------------------------------------------------------
@@ -347,6 +371,8 @@ inline void validate_volume_build(const scene_view& scene, glm::vec3 lo, glm::ve
     threshold(s.absolute_floor, "settings.absolute_floor");
     threshold(s.bias_budget, "settings.bias_budget");
     threshold(s.bias_tolerance, "settings.bias_tolerance");
+    require(s.hanging_corners == hanging_corner_storage::stored || s.conforming_corners, "settings.hanging_corners",
+            "computed hanging corners are the coarser leaf's interpolation: they need conforming_corners on");
 }
 
 /// The root cell over [lo, hi] with the scene's triangles that overlap it.
@@ -413,29 +439,6 @@ std::vector<octree_cell> grow_level(const scene_view& scene, const std::vector<o
     return children;
 }
 
-/// The probes some leaf uses, renumbered in order of first use, and every node's corners
-/// renumbered to them (inner nodes keep a corner only where its probe survived, else 0).
-inline std::vector<irradiance_probe> used_probes(const std::vector<irradiance_probe>& all,
-                                                 std::vector<irradiance_volume::node>& nodes) {
-    std::vector<irradiance_probe> used;
-    std::vector<std::uint32_t> remap(all.size(), std::numeric_limits<std::uint32_t>::max());
-    for (auto& nd : nodes) {
-        if (!nd.leaf()) continue;
-        for (auto& idx : nd.corner) {
-            if (remap[idx] == std::numeric_limits<std::uint32_t>::max()) {
-                remap[idx] = std::uint32_t(used.size());
-                used.push_back(all[idx]);
-            }
-            idx = remap[idx];
-        }
-    }
-    for (auto& nd : nodes) {
-        if (nd.leaf()) continue;
-        for (auto& idx : nd.corner) idx = remap[idx] == std::numeric_limits<std::uint32_t>::max() ? 0u : remap[idx];
-    }
-    return used;
-}
-
 /// Sets each probe's reach (half the diagonal of the largest leaf it is a corner of) and
 /// owner (that leaf; the first in node order among equals); returns the smallest reach.
 inline float set_reach_and_owners(const std::vector<irradiance_volume::node>& nodes,
@@ -447,7 +450,7 @@ inline float set_reach_and_owners(const std::vector<irradiance_volume::node>& no
         if (!nd.leaf()) continue;
         const float half_diagonal = 0.5f * glm::length(nd.size);
         for (std::uint32_t idx : nd.corner)
-            if (half_diagonal > probes[idx].reach) probes[idx].reach = half_diagonal, owner[idx] = i;
+            if ((idx & hanging_flag) == 0 && half_diagonal > probes[idx].reach) probes[idx].reach = half_diagonal, owner[idx] = i;
     }
     float smallest = std::numeric_limits<float>::infinity();
     for (const auto& p : probes) smallest = std::min(smallest, p.reach);
@@ -496,8 +499,15 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
         samples = std::move(constraints.samples);  // the culled splits' probes are among them
     }
     if (s.refit_culled && !samples.empty()) lattice.refit(samples, 16);
-    if (s.conforming_corners) lattice.set_hanging(constraints.hanging), stats.hanging_corners = constraints.hanging.size();
-    v.probes_ = detail::used_probes(lattice.probes(), v.nodes_);
+    stats.hanging_corners = s.conforming_corners ? constraints.hanging.size() : 0;
+    if (s.conforming_corners && s.hanging_corners == hanging_corner_storage::computed) {
+        const auto expanded = detail::expand_hanging(constraints.hanging);
+        v.probes_ = detail::used_probes(lattice.probes(), v.nodes_, &expanded, &v.hanging_);
+    } else {
+        if (s.conforming_corners) lattice.set_hanging(constraints.hanging);
+        v.stored_hanging_ = stats.hanging_corners;
+        v.probes_ = detail::used_probes(lattice.probes(), v.nodes_);
+    }
     for (const auto& p : v.probes_) stats.probes_inside += p.inside ? 1 : 0;
     if (stats.probes_inside == v.probes_.size())
         throw parameter_error("scene", "every one of the " + std::to_string(v.probes_.size()) +
@@ -507,6 +517,27 @@ irradiance_volume irradiance_volume::build(const scene_view& scene, glm::vec3 lo
     v.reference_reach_ = detail::set_reach_and_owners(v.nodes_, v.probes_, v.owner_);
     if (stats_out) *stats_out = stats;
     return v;
+}
+
+template <probe_source Source>
+void irradiance_volume::rebake(Source&& source) {
+    if (stored_hanging_ > 0)
+        throw parameter_error("volume", "its " + std::to_string(stored_hanging_) +
+                                            " stored hanging corners would no longer interpolate their coarser leaf; build it "
+                                            "with settings.hanging_corners = computed");
+    std::vector<glm::vec3> positions;
+    for (const auto& p : probes_) positions.push_back(p.position);
+    std::vector<irradiance_probe> baked(positions.size());
+    source(std::span<const glm::vec3>(positions), std::span<irradiance_probe>(baked));
+    const float scale = glm::length(hi() - lo());
+    for (std::size_t i = 0; i < baked.size(); ++i) {
+        require(detail::finite_probe(baked[i]), "probes", "the probe source returned a non-finite probe");
+        require(glm::length(baked[i].position - positions[i]) <= 1e-5f * scale, "probes",
+                "the probe source moved a probe away from its position");
+        irradiance_probe& p = probes_[i];
+        p.radiance = baked[i].radiance, p.gradient = baked[i].gradient;
+        p.harmonic_mean_distance = baked[i].harmonic_mean_distance, p.noise = baked[i].noise;
+    }
 }
 
 inline std::size_t irradiance_volume::leaf_count() const noexcept {
@@ -536,15 +567,34 @@ inline glm::vec3 irradiance_volume::trilinear(glm::vec3 p, glm::vec3 n) const {
     const auto w = trilinear_weights<float, glm::vec3>(p, leaf.lo, leaf.size);
     glm::vec3 sum(0.f);
     float wsum = 0.f;
-    for (int k = 0; k < 8; ++k) {
-        const irradiance_probe& pr = probes_[leaf.corner[std::size_t(k)]];
-        std::tie(sum, wsum) = trilinear_probe_accumulate<irradiance_volume_bands, float, glm::vec3>(
-            sum, wsum, n, w[std::size_t(k)], pr.inside ? 0.f : 1.f, pr.radiance);
+    for (std::size_t k = 0; k < 8; ++k) {
+        const std::uint32_t idx = leaf.corner[k];
+        if ((idx & detail::hanging_flag) == 0) {
+            const irradiance_probe& pr = probes_[idx];
+            std::tie(sum, wsum) = trilinear_probe_accumulate<irradiance_volume_bands, float, glm::vec3>(
+                sum, wsum, n, w[k], pr.inside ? 0.f : 1.f, pr.radiance);
+            continue;
+        }
+        const hanging_corner& h = hanging_.corners[idx & ~detail::hanging_flag];
+        irradiance_probe::coefficients c{};
+        for (std::uint32_t t = h.first; t < h.first + h.count; ++t)
+            c = probe_combination_add<irradiance_volume_bands, float, glm::vec3>(c, hanging_.terms[t].weight,
+                                                                                 probes_[hanging_.terms[t].probe].radiance);
+        std::tie(sum, wsum) = trilinear_probe_accumulate<irradiance_volume_bands, float, glm::vec3>(sum, wsum, n, w[k], h.valid, c);
     }
     return probe_average<float, glm::vec3>(sum, wsum);
 }
 
+inline void irradiance_volume::require_stored_corners(const char* what) const {
+    if (!hanging_.corners.empty())
+        throw parameter_error("volume", std::string(what) + " needs a probe at every corner, and this volume computes its " +
+                                            std::to_string(hanging_.corners.size()) +
+                                            " hanging corners in the trilinear lookup; build it with "
+                                            "settings.hanging_corners = stored");
+}
+
 inline void irradiance_volume::weighted_candidates(glm::vec3 p, float support, std::vector<std::uint32_t>& out) const {
+    require_stored_corners("the weighted lookup");
     out.clear();
     std::uint32_t stack[8 * depth_limit + 8];
     int top = 0;
@@ -582,6 +632,7 @@ inline glm::vec3 irradiance_volume::weighted(glm::vec3 p, glm::vec3 n, const wei
 }
 
 inline irradiance_volume_gpu_layout irradiance_volume::flatten() const {
+    require_stored_corners("flatten (the GL lookup)");
     irradiance_volume_gpu_layout out;
     out.max_depth = depth();
     out.nodes.reserve(nodes_.size());

@@ -148,11 +148,12 @@ inline void filter_ray_distances(std::span<const glm::vec3> directions, std::spa
 /// how.self_shadow_bias times the leaf's shortest edge; renormalized over the usable
 /// corners, 0 if none is. With how.mode = none it is `volume.trilinear(p, n)`. Throws
 /// parameter_error naming "visibility" when `vis` does not hold one map per probe of
-/// `volume`, "self_shadow_bias" when negative or not finite.
+/// `volume`, "volume" when it computes its hanging corners (irradiance_volume::require_stored_corners), "self_shadow_bias" when negative or not finite.
 inline glm::vec3 trilinear_visible(const irradiance_volume& volume, const probe_visibility& vis, glm::vec3 p, glm::vec3 n,
                                    glm::vec3 view, const visibility_lookup& how) {
     require(std::isfinite(how.self_shadow_bias) && how.self_shadow_bias >= 0, "self_shadow_bias", "must be finite and >= 0");
     if (how.mode == volume_visibility::none) return volume.trilinear(p, n);
+    volume.require_stored_corners("the visibility test");
     require(vis.probe_count() == volume.probes().size(), "visibility", "one distance map per probe of the volume");
     const irradiance_volume::node& leaf = volume.nodes()[volume.find_leaf(p)];
     const auto w = trilinear_weights<float, glm::vec3>(p, leaf.lo, leaf.size);

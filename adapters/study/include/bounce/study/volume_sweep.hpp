@@ -56,9 +56,22 @@ struct volume_sweep_point {
     bool uniform = false;  ///< the uniform grid (bias_budget and noise_sigmas then 0)
     float bias_budget = 0, bias_tolerance = 0, noise_sigmas = 0;
     std::size_t probes = 0, probes_inside = 0, leaves = 0;
-    std::size_t hanging = 0;  ///< stored probes at T-junctions, the coarser leaf's interpolation (conforming corners)
+    std::size_t hanging = 0;  ///< T-junction corners, the coarser leaf's interpolation (conforming corners)
+    bool hanging_computed = false;  ///< hanging corners computed by the lookup, not among `probes`
+    /// 0: the probes of the lattice's bake (equal rays per probe); else every stored probe
+    /// baked again with this many rays, the sweep's total over the probes (volume_rebake)
+    std::uint32_t rays_per_probe = 0;
+    float scene_light = 0, median_noise = 0;  ///< the units of bias_tolerance (irradiance_volume_build_stats)
     volume_lookup_figures trilinear;
     std::optional<volume_surface_figures> surface;  ///< trilinear, no visibility
+};
+
+/// Equal total rays: each merged octree (built with settings.hanging_corners = computed) is
+/// measured a second time with its stored probes baked again by `bake(rays, positions, out)`
+/// with rays = total_rays / its probes (irradiance_volume::rebake), its layout unchanged.
+struct volume_rebake {
+    std::function<void(std::uint32_t, std::span<const glm::vec3>, std::span<irradiance_probe>)> bake;
+    std::uint64_t total_rays = 0;  ///< e.g. the uniform grid's probes times its rays per probe
 };
 
 /// For every budget (> 0, finite) and every noise_sigmas (>= 0, finite; empty: settings'
@@ -66,12 +79,14 @@ struct volume_sweep_point {
 /// bias_budget and noise_sigmas: the slack of the bias test) built from `source`, and its
 /// trilinear lookup measured on `sphere`; prints a line each ("sweep bias_budget ...").
 /// Throws parameter_error naming "budgets" or "sigmas" for a value out of range. With
-/// `surface`, each octree is measured at its points too (volume_sweep_point::surface).
+/// `surface`, each octree is measured at its points too (volume_sweep_point::surface); with
+/// `rebake`, each is measured again at equal total rays (a second point, rays_per_probe > 0).
 std::vector<volume_sweep_point> bias_budget_sweep(const scene_view& scene, glm::vec3 lo, glm::vec3 hi,
                                                   irradiance_volume_settings settings, probe_memo& source,
                                                   const volume_sphere_study& sphere, std::span<const float> budgets,
                                                   std::span<const float> sigmas = {},
-                                                  const volume_surface_study* surface = nullptr);
+                                                  const volume_surface_study* surface = nullptr,
+                                                  const volume_rebake* rebake = nullptr);
 
 /// The same with settings.bias_tolerance (an error target in units of the scene's light)
 /// set to each of `tolerances` (> 0, finite; parameter_error naming "tolerances") in place
@@ -80,7 +95,8 @@ std::vector<volume_sweep_point> bias_tolerance_sweep(const scene_view& scene, gl
                                                      irradiance_volume_settings settings, probe_memo& source,
                                                      const volume_sphere_study& sphere, std::span<const float> tolerances,
                                                      std::span<const float> sigmas = {},
-                                                     const volume_surface_study* surface = nullptr);
+                                                     const volume_surface_study* surface = nullptr,
+                                                  const volume_rebake* rebake = nullptr);
 
 /// For every depth of `depths` (0 .. irradiance_volume::depth_limit), the uniform grid of that
 /// depth over [lo, hi] built from `source` (a lattice point of depth d is one of depth d + 1:
@@ -93,10 +109,11 @@ std::vector<volume_sweep_point> volume_depth_sweep(const scene_view& scene, glm:
                                                    const volume_sphere_study& sphere, std::span<const int> depths,
                                                    std::span<const float> budgets, std::span<const float> tolerances,
                                                    std::span<const float> sigmas = {},
-                                                   const volume_surface_study* surface = nullptr);
+                                                   const volume_surface_study* surface = nullptr,
+                                                  const volume_rebake* rebake = nullptr);
 
 /// [{"max_depth", "uniform", "bias_budget", "bias_tolerance", "noise_sigmas", "probes", "probes_inside",
-/// "leaves", "hanging", "rel_rms", "popping", "popping_excess"[, "surface": volume_surface_figures::
+/// "leaves", "hanging", "hanging_computed", "rays_per_probe", "scene_light", "median_noise", "rel_rms", "popping", "popping_excess"[, "surface": volume_surface_figures::
 /// to_json()]}, ...]
 nlohmann::ordered_json to_json(std::span<const volume_sweep_point> sweep);
 
