@@ -1,9 +1,9 @@
 // sh_study: the SH toolkit measured.
 //  1. Speed: SH projection (3 bands, RGB) of a probe bake's worth of 6 x size^2 cube maps
-//     back to back with cpu::cube_map_sh_projector, beside a plain read (a sum) of the same
-//     data in the same run, the same projection on cache-resident data (compute alone), the
-//     portable path, binary16 texels, and the one-off table construction
-//     (cpu::benchmark_sh_projection).
+//     back to back with cpu::cube_map_sh_projector, float and binary16 texels, on 1 thread and
+//     on --threads, each beside a streaming read of the same bytes (the memory ceiling), the
+//     same projection on cache-resident data (compute alone), the AVX2 and portable paths,
+//     and the one-off table construction (cpu::benchmark_sh_projection).
 //  2. Accuracy per order (1 .. 8): radiance truncation error (Parseval) and irradiance error
 //     (max and mean over the sphere, relative to the peak) for a directional light, a uniform
 //     sky and a cone light, from the closed-form coefficients and through a rasterized cube
@@ -40,49 +40,37 @@ struct options {
 
 void print_speed(const cpu::sh_projection_benchmark_result& r, const options& o, int threads) {
     const auto per_s = [](double count, double ms) { return count / (ms * 1e-3); };
-    fmt::print("SH projection, 3 bands RGB, {} maps of 6 x {}^2 texels ({:.0f} MB), {} threads, {} path\n", o.maps, o.size,
-               r.float_bytes / 1e6, threads, r.path);
+    fmt::print("SH projection, 3 bands RGB, {} maps of 6 x {}^2 texels ({:.0f} MB of float texels), up to {} threads, {} path\n",
+               o.maps, o.size, r.texels * 12 / 1e6, threads, r.path);
     fmt::print("  load average {:.2f} before, {:.2f} after (other processes share the cores: compare CPU time)\n",
                r.load_before, r.load_after);
-    fmt::print("  {:<32} {:>9} {:>9} {:>9} {:>7} {:>13}\n", "", "wall ms", "Gtexel/s", "GB/s", "CPU ms", "Gtexel/CPU-s");
-    auto line = [&](const char* what, const cpu::benchmark_timing& t, double bytes) {
-        fmt::print("  {:<32} {:>9.2f} {:>9.3f} {:>9.2f} {:>7.1f} {:>13.3f}\n", what, t.wall_ms, per_s(r.texels, t.wall_ms) / 1e9,
-                   per_s(bytes, t.wall_ms) / 1e9, t.cpu_ms, per_s(r.texels, t.cpu_ms) / 1e9);
-    };
-    line("plain read (sum)", r.read, r.float_bytes);
-    line("SH projection", r.project, r.float_bytes);
-    line("SH projection, data in cache", r.resident, r.float_bytes);
-    line("SH projection, portable path", r.portable, r.float_bytes);
-    line("plain read, half texels (sum)", r.half_read, r.half_bytes);
-    line("SH projection, half texels", r.half_project, r.half_bytes);
-    fmt::print("  table construction (once per size): {:.2f} ms, {:.1f} MB\n", r.table.wall_ms, double(r.table_bytes) / 1e6);
-    fmt::print("  checksums: sum {:.6g}, half sum {:.6g}, c00 of map 0 {:.6g}\n\n", r.checksum, r.half_checksum,
-               r.first_coefficient);
+    fmt::print("  best of {} runs (median in brackets); Gtexel/CPU-s from the best run's own CPU time\n", o.repeat);
+    fmt::print("  {:<24} {:>3} {:>17} {:>17} {:>8} {:>8} {:>12}\n", "", "thr", "wall ms", "Gtexel/s", "GB/s", "CPU ms",
+               "Gtexel/CPU-s");
+    for (const auto& f : r.figures) {
+        const auto& t = f.timing;
+        fmt::print("  {:<24} {:>3} {:>7.2f} [{:>7.2f}] {:>7.3f} [{:>7.3f}] {:>8.2f} {:>8.1f} {:>12.3f}\n", f.name, f.threads,
+                   t.best_wall_ms, t.wall_ms, per_s(r.texels, t.best_wall_ms) / 1e9, per_s(r.texels, t.wall_ms) / 1e9,
+                   per_s(f.bytes, t.best_wall_ms) / 1e9, t.best_cpu_ms, per_s(r.texels, t.best_cpu_ms) / 1e9);
+    }
+    fmt::print("  table construction (once per size): {:.2f} ms, {:.2f} MB\n", r.table_ms, double(r.table_bytes) / 1e6);
+    fmt::print("  checksums: read {:.6g}, c00 of map 0 {:.6g}\n\n", r.checksum, r.first_coefficient);
 }
 
 json speed_json(const cpu::sh_projection_benchmark_result& r) {
     const auto per_s = [](double count, double ms) { return count / (ms * 1e-3); };
-    return {
-        {"timings_ms", {{"table", r.table.wall_ms}, {"plain_read", r.read.wall_ms}, {"projection", r.project.wall_ms},
-                        {"projection_cache_resident", r.resident.wall_ms}, {"projection_portable", r.portable.wall_ms},
-                        {"plain_read_half", r.half_read.wall_ms}, {"projection_half", r.half_project.wall_ms}}},
-        {"cpu_ms", {{"plain_read", r.read.cpu_ms}, {"projection", r.project.cpu_ms},
-                    {"projection_cache_resident", r.resident.cpu_ms}, {"projection_portable", r.portable.cpu_ms},
-                    {"plain_read_half", r.half_read.cpu_ms}, {"projection_half", r.half_project.cpu_ms}}},
-        {"throughput", {{"projection_texels_per_s", per_s(r.texels, r.project.wall_ms)},
-                        {"projection_gb_per_s", per_s(r.float_bytes, r.project.wall_ms) / 1e9},
-                        {"plain_read_texels_per_s", per_s(r.texels, r.read.wall_ms)},
-                        {"plain_read_gb_per_s", per_s(r.float_bytes, r.read.wall_ms) / 1e9},
-                        {"cache_resident_texels_per_s", per_s(r.texels, r.resident.wall_ms)},
-                        {"portable_texels_per_s", per_s(r.texels, r.portable.wall_ms)},
-                        {"projection_texels_per_cpu_s", per_s(r.texels, r.project.cpu_ms)},
-                        {"plain_read_texels_per_cpu_s", per_s(r.texels, r.read.cpu_ms)},
-                        {"cache_resident_texels_per_cpu_s", per_s(r.texels, r.resident.cpu_ms)},
-                        {"half_projection_texels_per_s", per_s(r.texels, r.half_project.wall_ms)},
-                        {"half_plain_read_texels_per_s", per_s(r.texels, r.half_read.wall_ms)},
-                        {"half_projection_texels_per_cpu_s", per_s(r.texels, r.half_project.cpu_ms)}}},
-        {"load_average", {{"before", r.load_before}, {"after", r.load_after}}},
-    };
+    json figures = json::array();
+    for (const auto& f : r.figures) {
+        const auto& t = f.timing;
+        figures.push_back({{"name", f.name}, {"threads", f.threads}, {"bytes", f.bytes},
+                           {"wall_ms", {{"best", t.best_wall_ms}, {"median", t.wall_ms}}},
+                           {"cpu_ms", {{"of_best", t.best_cpu_ms}, {"median", t.cpu_ms}}},
+                           {"texels_per_s", {{"best", per_s(r.texels, t.best_wall_ms)}, {"median", per_s(r.texels, t.wall_ms)}}},
+                           {"gb_per_s_best", per_s(f.bytes, t.best_wall_ms) / 1e9},
+                           {"texels_per_cpu_s_best", per_s(r.texels, t.best_cpu_ms)}});
+    }
+    return {{"texels", r.texels}, {"table_ms", r.table_ms}, {"table_bytes", r.table_bytes}, {"figures", figures},
+            {"load_average", {{"before", r.load_before}, {"after", r.load_after}}}};
 }
 
 void print_accuracy(const study::sh_environment& env, const json& rows, std::size_t size) {
@@ -111,6 +99,7 @@ int run(const options& o) {
     bs.maps = o.maps;
     bs.size = o.size;
     bs.repeat = o.repeat;
+    bs.threads = threads;
     bs.memory_limit_bytes = study::available_memory_bytes();
     const auto speed = cpu::benchmark_sh_projection(bs);
     print_speed(speed, o, threads);
@@ -147,7 +136,7 @@ int main(int argc, char** argv) {
     options o;
     app.add_option("--maps", o.maps, "cube maps projected back to back (a probe bake)")->check(CLI::Range(1, 100000));
     app.add_option("--size", o.size, "texels per cube-face edge")->check(CLI::Range(1, 1024));
-    app.add_option("--repeat", o.repeat, "timed runs per figure (the median is reported)")->check(CLI::Range(1, 1000));
+    app.add_option("--repeat", o.repeat, "timed runs per figure (the best and the median are reported)")->check(CLI::Range(1, 1000));
     app.add_option("--threads", o.threads, "TBB threads (0: all)")->check(CLI::Range(0, 1024));
     app.add_option("--json", o.json_path, "write the figures and provenance to this file");
     CLI11_PARSE(app, argc, argv);

@@ -73,7 +73,7 @@ double error_bound(const cube_set& set, std::size_t map, std::size_t i, int chan
 TEST_CASE("batch cube-map projection matches the double reference within the float summation bound", "[sh][cpu]") {
     for (const std::size_t n : {64u, 13u}) {
         const cube_set set(n, 5, 40 + n);
-        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::portable}) {
+        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::avx2, cpu::sh_projection_path::portable}) {
             const cpu::cube_map_sh_projector<L> projector(n, path);
             std::vector<sh_coefficients<L, glm::vec3>> out(set.views.size());
             projector.project(set.views, out);
@@ -91,7 +91,7 @@ TEST_CASE("batch cube-map projection matches the double reference within the flo
 
 TEST_CASE("batch cube-map projection is bitwise the same for any thread count and batching", "[sh][cpu]") {
     const cube_set set(32, 40, 7);
-    const auto path = GENERATE(cpu::sh_projection_path::automatic, cpu::sh_projection_path::portable);
+    const auto path = GENERATE(cpu::sh_projection_path::automatic, cpu::sh_projection_path::avx2, cpu::sh_projection_path::portable);
     const cpu::cube_map_sh_projector<L> projector(32, path);
     INFO("path " << projector.path_name());
     std::vector<sh_coefficients<L, glm::vec3>> one_thread(set.views.size()), two_threads(set.views.size());
@@ -187,7 +187,7 @@ TEST_CASE("half-float maps project as their decoded float values do, on both pat
                 half_views[k].faces[std::size_t(f)] = h.view();
                 decoded_views[k].faces[std::size_t(f)] = d.view();
             }
-        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::portable}) {
+        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::avx2, cpu::sh_projection_path::portable}) {
             const cpu::cube_map_sh_projector<L> projector(n, path);
             std::vector<sh_coefficients<L, glm::vec3>> from_half(half_views.size()), from_float(half_views.size());
             projector.project(half_views, from_half);

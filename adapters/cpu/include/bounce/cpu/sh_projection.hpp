@@ -38,12 +38,15 @@
 #include <bounce/image.hpp>
 #include <bounce/sh/basis.hpp>
 #include <bounce/sh/projection.hpp>
+#include <bounce/sh/quadrature.hpp>
 
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -101,100 +104,210 @@ constexpr std::uint16_t float_to_half(float f) noexcept {
     return std::uint16_t(sign | h);
 }
 
-/// Which row-product code `cube_map_sh_projector` runs.
+/// An allocator on 64-byte boundaries (cache lines: whole-line 512-bit loads).
+template <class T>
+struct line_allocator {
+    using value_type = T;
+    static constexpr std::align_val_t alignment{64};
+    line_allocator() noexcept = default;
+    template <class U>
+    line_allocator(const line_allocator<U>&) noexcept {}
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), alignment)); }
+    void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, alignment); }
+    template <class U>
+    bool operator==(const line_allocator<U>&) const noexcept { return true; }
+};
+
+/// Which code `cube_map_sh_projector` runs.
 enum class sh_projection_path {
-    automatic,  ///< AVX2 + FMA + F16C where the CPU has them, else portable
+    automatic,  ///< the widest of avx512 / avx2 the CPU has (checked at run time), else portable
+    avx2,       ///< AVX2 + FMA + F16C where the CPU has them, else portable (for comparison and testing)
     portable,   ///< plain loops only (for comparison and testing)
 };
 
-/// Projects RGB cube maps of a fixed size (glm::vec3 texels, packed rows) onto bands
-/// 0 .. L - 1. Construct once per size (it computes 6 size^2 L^2 table entries), then call
+/// Projects RGB cube maps of a fixed size (glm::vec3 or half_rgb texels) onto bands
+/// 0 .. L - 1. Construct once per size (it tabulates size^2 L^2 weights), then call
 /// `project` for each batch of maps.
 template <int L>
 class cube_map_sh_projector {
 public:
     static constexpr std::size_t coefficients = sh_count(L);
-    static constexpr std::size_t rows_per_block = 16;  ///< face rows projected per table block
-    static constexpr std::size_t maps_per_task = 16;  ///< maps one TBB task projects together
+    /// Texels summed in float before the sums go into double: a float accumulator lane adds
+    /// at most chunk_texels / 8 products, whatever the size (the error bound of tests/sh).
+    static constexpr std::size_t chunk_texels = 4096;
+    static constexpr std::size_t maps_per_task = 4;  ///< maps one TBB task projects (one after the other)
+    /// How far ahead of the texel being multiplied the AVX paths ask for texels (bytes).
+    static constexpr std::size_t prefetch_bytes = 4096;
 
     /// Tables for size x size faces (typical: 64; 1 to 4096). Throws parameter_error naming
     /// "size" outside that range.
     explicit cube_map_sh_projector(std::size_t size, sh_projection_path path = sh_projection_path::automatic)
-        : size_(size), avx2_(path == sh_projection_path::automatic && cpu_has_avx2_fma()) {
+        : size_(size), face_texels_(size * size), stride_((size * size + 15) / 16 * 16), kind_(choose(path)) {
         static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "texel rows are read as packed floats");
         require(size >= 1 && size <= 4096, "size", "cube-map size must be 1 to 4096 texels");
-        // 8 floats of padding: a block whose texel count is not a multiple of 8 reads up
-        // to 7 weights past its end, multiplied by the zero padding of the planar texels.
-        table_.assign(6 * coefficients * size_ * size_ + 8, 0.f);
-        for (int f = 0; f < 6; ++f)
-            for (std::size_t y = 0; y < size_; ++y)
-                for (std::size_t x = 0; x < size_; ++x) {
-                    const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face(f), size_, x, y));
-                    const double dw = cube_texel_solid_angle(size_, x, y);
-                    for (std::size_t i = 0; i < coefficients; ++i) table_[table_row(std::size_t(f), y, i) + x] = float(basis[i] * dw);
-                }
+        // Each coefficient's weights start on a 64-byte boundary (whole-line vector loads);
+        // 16 floats of padding: the vector loops read up to 15 weights past a run's end (times
+        // zero texels).
+        table_.assign(coefficients * stride_ + 16, 0.f);
+        for (std::size_t y = 0; y < size_; ++y)
+            for (std::size_t x = 0; x < size_; ++x) {
+                const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face::positive_z, size_, x, y));
+                const double dw = cube_texel_solid_angle(size_, x, y);
+                for (std::size_t j = 0; j < coefficients; ++j) table_[j * stride_ + y * size_ + x] = float(basis[j] * dw);
+            }
+        face_mix_ = face_mixing_matrices();
     }
 
     std::size_t size() const noexcept { return size_; }
-    /// The row product that runs: "avx2" or "portable".
-    const char* path_name() const noexcept { return avx2_ ? "avx2" : "portable"; }
-    /// Bytes of the table (4 x 6 size^2 L^2).
+    /// The code that runs: "avx512", "avx2" or "portable".
+    const char* path_name() const noexcept { return kind_ == kind::avx512 ? "avx512" : kind_ == kind::avx2 ? "avx2" : "portable"; }
+    /// Bytes of the table (4 size^2 L^2: one face's, shared by the six).
     std::size_t table_bytes() const noexcept { return table_.size() * sizeof(float); }
 
     /// SH coefficients of every map of `maps` into `out` (one per map), in parallel over
-    /// groups of maps. Throws parameter_error naming "out" when the counts differ and
-    /// "maps" when a map is not a cube of this projector's size.
+    /// maps. Throws parameter_error naming "out" when the counts differ and "maps" when a
+    /// map is not a cube of this projector's size.
     void project(std::span<const cube_map_view<const glm::vec3>> maps, std::span<sh_coefficients<L, glm::vec3>> out) const {
-        require(out.size() == maps.size(), "out", "one coefficient set per map");
-        for (const auto& m : maps) {
-            require_cube_map(m, "maps");
-            require(m.size() == size_, "maps", "a map's size differs from the projector's");
-        }
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, maps.size(), maps_per_task),
-                          [&](const tbb::blocked_range<std::size_t>& r) { project_group(maps, out, r.begin(), r.end()); });
+        project_all(maps, out);
     }
 
     /// `project` for half-float maps.
     void project(std::span<const cube_map_view<const half_rgb>> maps, std::span<sh_coefficients<L, glm::vec3>> out) const {
-        require(out.size() == maps.size(), "out", "one coefficient set per map");
-        for (const auto& m : maps) {
-            require_cube_map(m, "maps");
-            require(m.size() == size_, "maps", "a map's size differs from the projector's");
-        }
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, maps.size(), maps_per_task),
-                          [&](const tbb::blocked_range<std::size_t>& r) { project_group(maps, out, r.begin(), r.end()); });
+        project_all(maps, out);
     }
 
     /// The coefficients of one map (no parallelism).
     sh_coefficients<L, glm::vec3> project(const cube_map_view<const glm::vec3>& map) const {
         require_cube_map(map, "map");
         require(map.size() == size_, "map", "the map's size differs from the projector's");
-        sh_coefficients<L, glm::vec3> out{};
-        const std::array<cube_map_view<const glm::vec3>, 1> one{map};
-        project_group(std::span<const cube_map_view<const glm::vec3>>(one), std::span<sh_coefficients<L, glm::vec3>>(&out, 1), 0, 1);
-        return out;
+        return project_map(map);
     }
 
 private:
-    // Accumulators per coefficient: 8 lanes of red, 8 of green, 8 of blue.
-    static constexpr std::size_t acc_stride = 24;
+    enum class kind { portable, avx2, avx512 };
+    // Moment sums of one run, m[3 j + c] (coefficient j of the shared table, channel c).
+    using moments = std::array<double, 3 * coefficients>;
 
-    static bool cpu_has_avx2_fma() noexcept {
+    static kind choose(sh_projection_path path) noexcept {
 #if BOUNCE_SH_PROJECTION_AVX2
-        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+        if (path == sh_projection_path::portable) return kind::portable;
+        const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+        if (avx2 && path == sh_projection_path::automatic && __builtin_cpu_supports("avx512f") &&
+            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
+            return kind::avx512;
+        return avx2 ? kind::avx2 : kind::portable;
 #else
-        return false;
+        (void)path;
+        return kind::portable;
 #endif
     }
 
-    // Table layout [face][coefficient][row][size]: one coefficient's rows follow each
-    // other, so a block of rows is one contiguous run of weights.
-    std::size_t table_row(std::size_t face, std::size_t y, std::size_t i) const noexcept {
-        return ((face * coefficients + i) * size_ + y) * size_;
+    // The six faces share the +z face's table: face f looks along R_f (u, -v, 1), R_f a
+    // signed permutation (sh/projection.hpp), and each band of SH is closed under it, so
+    // Y_i(R_f w) = sum_j M_f[i][j] Y_j(w) with M_f[i][j] = int Y_i(R_f w) Y_j(w) dw,
+    // integrated exactly (to rounding) by a sphere rule of bands < L + 1.
+    static std::array<std::array<double, coefficients * coefficients>, 6> face_mixing_matrices() {
+        std::array<std::array<double, coefficients * coefficients>, 6> mix{};
+        const auto rule = sphere_quadrature(L + 1, 2 * L + 2);
+        for (int f = 0; f < 6; ++f) {
+            const glm::dvec3 centre = cube_face_direction(cube_face(f), 0, 0);
+            const glm::dvec3 along_u = cube_face_direction(cube_face(f), 1, 0) - centre;
+            const glm::dvec3 along_v = centre - cube_face_direction(cube_face(f), 0, 1);  // local y is -v
+            for (const auto& q : rule) {
+                const auto local = sh_basis<L, double, glm::dvec3>(q.d);
+                const auto world = sh_basis<L, double, glm::dvec3>(q.d.x * along_u + q.d.y * along_v + q.d.z * centre);
+                for (std::size_t i = 0; i < coefficients; ++i)
+                    for (std::size_t j = 0; j < coefficients; ++j) mix[std::size_t(f)][i * coefficients + j] += q.w * world[i] * local[j];
+            }
+            for (double& m : mix[std::size_t(f)]) m = std::abs(m) < 1e-12 ? 0.0 : m;  // exact zeros: rounding only
+        }
+        return mix;
     }
 
-    // The block's texels as three planes (r, g, b), each `stride` floats apart, zero-padded
-    // to a multiple of 8 texels.
+    template <class Texel>
+    void project_all(std::span<const cube_map_view<const Texel>> maps, std::span<sh_coefficients<L, glm::vec3>> out) const {
+        require(out.size() == maps.size(), "out", "one coefficient set per map");
+        for (const auto& m : maps) {
+            require_cube_map(m, "maps");
+            require(m.size() == size_, "maps", "a map's size differs from the projector's");
+        }
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, maps.size(), maps_per_task), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t k = r.begin(); k < r.end(); ++k) out[k] = project_map(maps[k]);
+        });
+    }
+
+    // One map: per face, the moments against the shared table over runs of at most
+    // chunk_texels (the whole packed face, or row by row), mixed into the coefficients.
+    template <class Texel>
+    sh_coefficients<L, glm::vec3> project_map(const cube_map_view<const Texel>& map) const {
+        moments total{};
+        for (std::size_t f = 0; f < 6; ++f) {
+            const auto& face = map.faces[f];
+            moments m{};
+            const bool packed = face.stride() == size_;
+            const std::size_t runs = packed ? 1 : size_, run = packed ? face_texels_ : size_;
+            for (std::size_t y = 0; y < runs; ++y)
+                for (std::size_t x = 0; x < run; x += chunk_texels)
+                    accumulate(&face(0, y) + x, std::min(chunk_texels, run - x), table_.data() + y * size_ + x, m);
+            const auto& mix = face_mix_[f];
+            for (std::size_t i = 0; i < coefficients; ++i)
+                for (std::size_t j = 0; j < coefficients; ++j)
+                    if (const double a = mix[i * coefficients + j]; a != 0)
+                        for (std::size_t c = 0; c < 3; ++c) total[3 * i + c] += a * m[3 * j + c];
+        }
+        sh_coefficients<L, glm::vec3> out{};
+        for (std::size_t i = 0; i < coefficients; ++i)
+            for (std::size_t c = 0; c < 3; ++c) out[i][int(c)] = float(total[3 * i + c]);
+        return out;
+    }
+
+    template <class Texel>
+    void accumulate(const Texel* src, std::size_t texels, const float* w, moments& m) const {
+        accumulate_planar(src, texels, w, m);
+    }
+
+    // The run is split into r, g, b planes `plane_texels` at a time (a streaming pass
+    // that leaves them in L1), multiplied by the table in float lanes per channel (16 with
+    // AVX-512, 8 otherwise), the lanes added in double at the end of the run. (Splitting in
+    // registers and multiplying in the same pass measured 1.7x slower from memory: 27
+    // accumulators, three channels and the permutations' indices overflow the registers.)
+    static constexpr std::size_t plane_texels = 512;
+    static constexpr std::size_t acc_stride = 48;  // per coefficient: 16 lanes of r, of g, of b
+
+    template <class Texel>
+    void accumulate_planar(const Texel* src, std::size_t texels, const float* w, moments& m) const {
+        alignas(64) float planes[3 * plane_texels];
+        alignas(64) float acc[coefficients * acc_stride] = {};
+        for (std::size_t x0 = 0; x0 < texels; x0 += plane_texels) {
+            const std::size_t n = std::min(plane_texels, texels - x0), padded = (n + 15) / 16 * 16;
+            float *r = planes, *g = planes + plane_texels, *b = planes + 2 * plane_texels;
+            switch (kind_) {
+#if BOUNCE_SH_PROJECTION_AVX2
+                case kind::avx512: deinterleave_avx512(src + x0, n, r, g, b); break;
+                case kind::avx2: deinterleave_avx2(src + x0, n, r, g, b); break;
+#endif
+                default: deinterleave_portable(src + x0, n, r, g, b);
+            }
+            std::fill(r + n, r + padded, 0.f);
+            std::fill(g + n, g + padded, 0.f);
+            std::fill(b + n, b + padded, 0.f);
+            switch (kind_) {
+#if BOUNCE_SH_PROJECTION_AVX2
+                case kind::avx512: accumulate_avx512<0>(planes, padded, w + x0, acc); break;
+                case kind::avx2: accumulate_avx2(planes, padded, w + x0, acc); break;
+#endif
+                default: accumulate_portable(planes, padded, w + x0, acc);
+            }
+        }
+        for (std::size_t j = 0; j < coefficients; ++j)
+            for (std::size_t c = 0; c < 3; ++c) {
+                double s = 0;
+                for (std::size_t lane = 0; lane < 16; ++lane) s += double(acc[j * acc_stride + 16 * c + lane]);
+                m[3 * j + c] += s;
+            }
+    }
+
+    // The planes of `texels` texels (r, g, b, each plane_texels floats apart).
     template <class Texel>
     static void deinterleave_portable(const Texel* src, std::size_t texels, float* r, float* g, float* b) {
         for (std::size_t x = 0; x < texels; ++x) {
@@ -210,19 +323,19 @@ private:
         }
     }
 
-    // acc[i][c][lane] += sum over x = lane (mod 8) of w_i[x] plane_c[x] over `padded` texels.
-    void accumulate_portable(const float* planes, std::size_t stride, std::size_t padded, std::size_t face, std::size_t y0,
-                             float* acc) const {
-        for (std::size_t i = 0; i < coefficients; ++i) {
-            const float* w = table_.data() + table_row(face, y0, i);
+    // acc[j][c][lane] += sum over x = lane (mod 8) of w_j[x] plane_c[x] over `padded` texels
+    // (lanes 0-7 of each channel's 16).
+    void accumulate_portable(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        for (std::size_t j = 0; j < coefficients; ++j) {
+            const float* w = w0 + j * stride_;
             // Local accumulators: through `acc` the compiler must assume they alias the
             // table and the planes, and would load and store them every step.
-            float a[acc_stride];
-            std::copy_n(acc + i * acc_stride, acc_stride, a);
+            float a[3][8];
+            for (std::size_t c = 0; c < 3; ++c) std::copy_n(acc + j * acc_stride + 16 * c, 8, a[c]);
             for (std::size_t x = 0; x < padded; x += 8)
                 for (std::size_t c = 0; c < 3; ++c)
-                    for (std::size_t lane = 0; lane < 8; ++lane) a[8 * c + lane] += w[x + lane] * planes[c * stride + x + lane];
-            std::copy_n(a, acc_stride, acc + i * acc_stride);
+                    for (std::size_t lane = 0; lane < 8; ++lane) a[c][lane] += w[x + lane] * planes[c * plane_texels + x + lane];
+            for (std::size_t c = 0; c < 3; ++c) std::copy_n(a[c], 8, acc + j * acc_stride + 16 * c);
         }
     }
 
@@ -244,6 +357,8 @@ private:
                                                                            float* g, float* b) {
         std::size_t x = 0;
         for (; x + 8 <= texels; x += 8) {
+            const char* ahead = reinterpret_cast<const char*>(src + x) + prefetch_bytes;
+            for (std::size_t line = 0; line < 8 * sizeof(Texel); line += 64) _mm_prefetch(ahead + line, _MM_HINT_T0);
             if constexpr (std::is_same_v<Texel, half_rgb>) {
                 const auto* h = reinterpret_cast<const __m128i*>(src + x);
                 deinterleave8(_mm256_cvtph_ps(_mm_loadu_si128(h)), _mm256_cvtph_ps(_mm_loadu_si128(h + 1)),
@@ -259,18 +374,17 @@ private:
     // The products with 256-bit FMAs, G coefficients at a time: 3 G accumulators, the three
     // planes and one weight vector in registers (13 of 16 for G = 3).
     template <std::size_t G>
-    __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const float* planes, std::size_t stride,
-                                                                         std::size_t padded, std::size_t face, std::size_t y0,
+    __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const float* planes, std::size_t padded, const float* w0,
                                                                          std::size_t first, float* acc) const {
         __m256 a[G][3];
         const float* w[G];
         for (std::size_t g = 0; g < G; ++g) {
-            w[g] = table_.data() + table_row(face, y0, first + g);
-            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm256_loadu_ps(acc + (first + g) * acc_stride + 8 * c);
+            w[g] = w0 + (first + g) * stride_;
+            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm256_loadu_ps(acc + (first + g) * acc_stride + 16 * c);
         }
         for (std::size_t x = 0; x < padded; x += 8) {
-            const __m256 r = _mm256_loadu_ps(planes + x), gr = _mm256_loadu_ps(planes + stride + x),
-                         b = _mm256_loadu_ps(planes + 2 * stride + x);
+            const __m256 r = _mm256_loadu_ps(planes + x), gr = _mm256_loadu_ps(planes + plane_texels + x),
+                         b = _mm256_loadu_ps(planes + 2 * plane_texels + x);
             for (std::size_t g = 0; g < G; ++g) {
                 const __m256 weight = _mm256_loadu_ps(w[g] + x);
                 a[g][0] = _mm256_fmadd_ps(weight, r, a[g][0]);
@@ -279,89 +393,86 @@ private:
             }
         }
         for (std::size_t g = 0; g < G; ++g)
-            for (std::size_t c = 0; c < 3; ++c) _mm256_storeu_ps(acc + (first + g) * acc_stride + 8 * c, a[g][c]);
+            for (std::size_t c = 0; c < 3; ++c) _mm256_storeu_ps(acc + (first + g) * acc_stride + 16 * c, a[g][c]);
     }
 
-    void accumulate_avx2(const float* planes, std::size_t stride, std::size_t padded, std::size_t face, std::size_t y0,
-                         float* acc) const {
-        std::size_t i = 0;
-        for (; i + 3 <= coefficients; i += 3) accumulate_group_avx2<3>(planes, stride, padded, face, y0, i, acc);
-        if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(planes, stride, padded, face, y0, i, acc);
-        if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(planes, stride, padded, face, y0, i, acc);
+    void accumulate_avx2(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        std::size_t j = 0;
+        for (; j + 3 <= coefficients; j += 3) accumulate_group_avx2<3>(planes, padded, w0, j, acc);
+        if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(planes, padded, w0, j, acc);
+        if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(planes, padded, w0, j, acc);
     }
-#endif
 
+    // AVX-512: 16 texels a step split with two two-source permutations per channel, the
+    // tail by the portable loop.
     template <class Texel>
-    void project_group(std::span<const cube_map_view<const Texel>> maps, std::span<sh_coefficients<L, glm::vec3>> out,
-                       std::size_t begin, std::size_t end) const {
-        const std::size_t count = end - begin;
-        std::vector<float> acc(count * coefficients * acc_stride);
-        std::vector<double> sums(count * coefficients * 3, 0.0);
-        // One block's texels as planes, padded to whole vectors with zeros.
-        const std::size_t stride = (rows_per_block * size_ + 7) / 8 * 8;
-        std::vector<float> planes(3 * stride, 0.f);
-        for (std::size_t face = 0; face < 6; ++face) {
-            std::fill(acc.begin(), acc.end(), 0.f);
-            for (std::size_t y0 = 0; y0 < size_; y0 += rows_per_block) {
-                const std::size_t y1 = std::min(size_, y0 + rows_per_block), texels = (y1 - y0) * size_;
-                const std::size_t padded = (texels + 7) / 8 * 8;
-                // A face's last block can be shorter than the others: zero its padding, which
-                // still holds texels of the block before.
-                for (std::size_t c = 0; c < 3; ++c)
-                    std::fill(planes.begin() + std::ptrdiff_t(c * stride + texels), planes.begin() + std::ptrdiff_t(c * stride + padded), 0.f);
-                for (std::size_t k = 0; k < count; ++k) {
-                    const auto& face_view = maps[begin + k].faces[face];
-                    float* a = acc.data() + k * coefficients * acc_stride;
-                    // The next map's rows are a separate stream the hardware prefetcher has
-                    // not seen yet: ask for them while this map's rows are multiplied.
-                    if (k + 1 < count)
-                        for (std::size_t y = y0; y < y1; ++y) {
-                            const char* next = reinterpret_cast<const char*>(&maps[begin + k + 1].faces[face](0, y));
-                            for (std::size_t b = 0; b < sizeof(Texel) * size_; b += 64) __builtin_prefetch(next + b);
-                        }
-                    // Packed rows (stride = width) are one run; otherwise row by row.
-                    const std::size_t run = face_view.stride() == size_ ? y1 - y0 : 1;
-                    for (std::size_t y = y0; y < y1; y += run) {
-                        const std::size_t at = (y - y0) * size_;
-                        float* r = planes.data() + at;
-#if BOUNCE_SH_PROJECTION_AVX2
-                        if (avx2_) {
-                            deinterleave_avx2(&face_view(0, y), run * size_, r, r + stride, r + 2 * stride);
-                            continue;
-                        }
-#endif
-                        deinterleave_portable(&face_view(0, y), run * size_, r, r + stride, r + 2 * stride);
-                    }
-#if BOUNCE_SH_PROJECTION_AVX2
-                    if (avx2_) {
-                        accumulate_avx2(planes.data(), stride, padded, face, y0, a);
-                        continue;
-                    }
-#endif
-                    accumulate_portable(planes.data(), stride, padded, face, y0, a);
-                }
+    __attribute__((target("avx512f,avx512bw,avx512vl,avx2,fma,f16c"))) static void deinterleave_avx512(const Texel* src,
+                                                                                                    std::size_t texels, float* r,
+                                                                                                    float* g, float* b) {
+        alignas(64) static constexpr int from_ab[3][16] = {{0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0},
+                                                           {1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0},
+                                                           {2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0}};
+        alignas(64) static constexpr int from_tc[3][16] = {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29},
+                                                           {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30},
+                                                           {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31}};
+        float* out[3] = {r, g, b};
+        std::size_t x = 0;
+        for (; x + 16 <= texels; x += 16) {
+            const char* ahead = reinterpret_cast<const char*>(src + x) + prefetch_bytes;
+            for (std::size_t line = 0; line < 16 * sizeof(Texel); line += 64) _mm_prefetch(ahead + line, _MM_HINT_T0);
+            __m512 v[3];
+            for (std::size_t k = 0; k < 3; ++k) {
+                if constexpr (std::is_same_v<Texel, half_rgb>)  // maskz: GCC 12's plain form reads an undefined register
+                    v[k] = _mm512_maskz_cvtph_ps(0xffff, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(src[x].bits + 16 * k)));
+                else
+                    v[k] = _mm512_loadu_ps(&src[x].x + 16 * k);
             }
-            // Lanes [8c, 8c + 8) hold channel c.
-            for (std::size_t k = 0; k < count; ++k)
-                for (std::size_t i = 0; i < coefficients; ++i) {
-                    const float* a = acc.data() + (k * coefficients + i) * acc_stride;
-                    double* sum = sums.data() + (k * coefficients + i) * 3;
-                    for (std::size_t c = 0; c < 3; ++c) {
-                        double s = 0;
-                        for (std::size_t lane = 0; lane < 8; ++lane) s += double(a[8 * c + lane]);
-                        sum[c] += s;
-                    }
-                }
+            for (std::size_t c = 0; c < 3; ++c)
+                _mm512_storeu_ps(out[c] + x, _mm512_permutex2var_ps(_mm512_permutex2var_ps(v[0], _mm512_load_si512(from_ab[c]), v[1]),
+                                                                    _mm512_load_si512(from_tc[c]), v[2]));
         }
-        for (std::size_t k = 0; k < count; ++k)
-            for (std::size_t i = 0; i < coefficients; ++i)
-                for (std::size_t c = 0; c < 3; ++c)
-                    out[begin + k][i][int(c)] = float(sums[(k * coefficients + i) * 3 + c]);
+        deinterleave_portable(src + x, texels - x, r + x, g + x, b + x);
     }
 
-    std::size_t size_;
-    bool avx2_;
-    std::vector<float> table_;
+    // The products, G <= 9 coefficients a pass: 3 G accumulators, the three planes in
+    // registers and the weights as memory operands (30 of 32 registers for G = 9).
+    template <std::size_t First>
+    void accumulate_avx512(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        accumulate_group_avx512<First, std::min<std::size_t>(9, coefficients - First)>(planes, padded, w0, acc);
+        if constexpr (First + 9 < coefficients) accumulate_avx512<First + 9>(planes, padded, w0, acc);
+    }
+
+    template <std::size_t First, std::size_t G>
+    __attribute__((target("avx512f,avx512bw,avx512vl,avx2,fma,f16c"))) void
+    accumulate_group_avx512(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        __m512 a[G][3];
+#pragma GCC unroll 9
+        for (std::size_t g = 0; g < G; ++g)
+#pragma GCC unroll 3
+            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm512_load_ps(acc + (First + g) * acc_stride + 16 * c);
+        const float* w = w0 + First * stride_;
+        for (std::size_t x = 0; x < padded; x += 16) {
+            const __m512 r = _mm512_load_ps(planes + x), gr = _mm512_load_ps(planes + plane_texels + x),
+                         b = _mm512_load_ps(planes + 2 * plane_texels + x);
+#pragma GCC unroll 9
+            for (std::size_t g = 0; g < G; ++g) {
+                const __m512 weight = _mm512_loadu_ps(w + g * stride_ + x);
+                a[g][0] = _mm512_fmadd_ps(weight, r, a[g][0]);
+                a[g][1] = _mm512_fmadd_ps(weight, gr, a[g][1]);
+                a[g][2] = _mm512_fmadd_ps(weight, b, a[g][2]);
+            }
+        }
+#pragma GCC unroll 9
+        for (std::size_t g = 0; g < G; ++g)
+#pragma GCC unroll 3
+            for (std::size_t c = 0; c < 3; ++c) _mm512_store_ps(acc + (First + g) * acc_stride + 16 * c, a[g][c]);
+    }
+#endif
+
+    std::size_t size_, face_texels_, stride_;  // stride_: floats from one coefficient's weights to the next
+    kind kind_;
+    std::vector<float, line_allocator<float>> table_;  // [coefficient][texel of the +z face]
+    std::array<std::array<double, coefficients * coefficients>, 6> face_mix_;
 };
 
 }  // namespace bounce::cpu
