@@ -1,6 +1,9 @@
 // The table-driven batch projection of cpu/sh_projection.hpp against the core's double
-// reference (within a recursive-summation bound), bitwise the same for any thread count and
-// any batching, on sizes with and without a partial 8-texel period, on both code paths.
+// reference (within a recursive-summation bound derived from the count of float terms),
+// bitwise the same for any thread count and any batching, on sizes with and without a
+// partial vector, an odd size (a middle row that is its own mirror), a face larger than one
+// float chunk, strided faces and more than 9 coefficients of one parity (L = 5), on every
+// code path.
 #include "sphere_quadrature.hpp"
 
 #include <bounce/cpu/sh_projection.hpp>
@@ -14,6 +17,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <numbers>
 #include <vector>
 
 using namespace bounce;
@@ -28,14 +32,15 @@ struct cube_set {
     std::vector<std::array<image<glm::vec3>, 6>> storage;
     std::vector<cube_map_view<const glm::vec3>> views;
 
-    // `count` maps of a smooth random RGB function plus a bright lobe (a sun), different per map.
-    cube_set(std::size_t n, std::size_t count, std::uint64_t seed) : size(n), storage(count) {
+    // `count` maps of a smooth random RGB function plus a bright lobe (a sun), different per
+    // map; with `pad` > 0 each face is a view into an image `pad` texels wider (strided rows).
+    cube_set(std::size_t n, std::size_t count, std::uint64_t seed, std::size_t pad = 0) : size(n), storage(count) {
         pcg32 rng(seed);
         for (auto& faces : storage) {
             const glm::dvec3 sun = glm::normalize(glm::dvec3(rng.next_double() - 0.5, rng.next_double() - 0.5, 0.3));
             const glm::dvec3 tint(rng.next_double(), rng.next_double(), rng.next_double());
             for (int f = 0; f < 6; ++f) {
-                faces[std::size_t(f)] = image<glm::vec3>(n, n);
+                faces[std::size_t(f)] = image<glm::vec3>(n + pad, n, glm::vec3(1e30f));  // the padding must not be read
                 for (std::size_t y = 0; y < n; ++y)
                     for (std::size_t x = 0; x < n; ++x) {
                         const glm::dvec3 d = cube_texel_direction(cube_face(f), n, x, y);
@@ -46,47 +51,55 @@ struct cube_set {
         }
         for (auto& faces : storage) {
             cube_map_view<const glm::vec3> v;
-            for (int f = 0; f < 6; ++f) v.faces[std::size_t(f)] = faces[std::size_t(f)].view();
+            for (int f = 0; f < 6; ++f) v.faces[std::size_t(f)] = faces[std::size_t(f)].view().subview(0, 0, n, n);
             views.push_back(v);
         }
     }
 };
 
-// Recursive summation of m float products has error at most (m + 1) u sum |t f|
-// (Higham, Accuracy and Stability, Eq. 4.4, plus one rounding per product), u = 2^-24;
-// the table entries are themselves rounded (u relative) and the lanes' partial sums are added
-// in double. m = the terms one lane sums over a face: size rows x ceil(3 size / 24) periods.
-double error_bound(const cube_set& set, std::size_t map, std::size_t i, int channel) {
-    const std::size_t n = set.size, m = n * ((3 * n + 23) / 24);
+// The projector sums, per face, float terms w_j(t) (f(t) +- f(t')) over texel pairs t, t'
+// (a row and its mirror) against the shared table, in float lanes that each add at most
+// m = chunk_texels / 8 terms before going into double, then mixes the face's moments by an
+// orthogonal matrix M_f (rows of norm 1). Recursive summation of m terms has error at most
+// (m - 1) u sum |terms| (Higham, Accuracy and Stability, Eq. 4.4), plus one rounding each for
+// the product, the pair's sum and the table entry: (m + 3) u. By Cauchy-Schwarz and the
+// addition theorem, sum_j |M_f[i][j] Y_j| <= sqrt((2 l + 1) / 4 pi) over band l, so
+//   |error| <= (m + 3) u sum over texels of sqrt((2 l + 1) / 4 pi) dw |f| + rounding to float.
+template <int L>
+double error_bound(const cube_set& set, std::size_t map, std::size_t i, int channel, double result) {
+    const std::size_t n = set.size, m = cpu::cube_map_sh_projector<L>::chunk_texels / 8;
+    const double band = sh_band(i), scale = std::sqrt((2 * band + 1) / (4 * std::numbers::pi));
     double magnitude = 0;
     for (int f = 0; f < 6; ++f)
         for (std::size_t y = 0; y < n; ++y)
-            for (std::size_t x = 0; x < n; ++x) {
-                const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face(f), n, x, y));
-                magnitude += std::abs(basis[i] * cube_texel_solid_angle(n, x, y) * set.views[map].faces[std::size_t(f)](x, y)[channel]);
-            }
-    return double(m + 3) * 0x1p-24 * magnitude + 0x1p-24 * 4;  // + rounding the result to float
+            for (std::size_t x = 0; x < n; ++x)
+                magnitude += scale * cube_texel_solid_angle(n, x, y) * std::abs(set.views[map].faces[std::size_t(f)](x, y)[channel]);
+    return double(m + 3) * 0x1p-24 * magnitude + 0x1p-24 * std::abs(result);
+}
+
+template <int L>
+void check_against_reference(const cube_set& set) {
+    for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::avx2, cpu::sh_projection_path::portable}) {
+        const cpu::cube_map_sh_projector<L> projector(set.size, path);
+        std::vector<sh_coefficients<L, glm::vec3>> out(set.views.size());
+        projector.project(set.views, out);
+        for (std::size_t k = 0; k < set.views.size(); ++k) {
+            const auto reference = sh_project_cube_map<L>(set.views[k]);
+            for (std::size_t i = 0; i < sh_count(L); ++i)
+                for (int c = 0; c < 3; ++c) {
+                    INFO("size " << set.size << ", L " << L << ", path " << projector.path_name() << ", map " << k << ", coefficient " << i);
+                    CHECK(std::abs(double(out[k][i][c]) - reference[i][c]) <= error_bound<L>(set, k, i, c, reference[i][c]));
+                }
+        }
+    }
 }
 
 }  // namespace
 
 TEST_CASE("batch cube-map projection matches the double reference within the float summation bound", "[sh][cpu]") {
-    for (const std::size_t n : {64u, 13u}) {
-        const cube_set set(n, 5, 40 + n);
-        for (const auto path : {cpu::sh_projection_path::automatic, cpu::sh_projection_path::avx2, cpu::sh_projection_path::portable}) {
-            const cpu::cube_map_sh_projector<L> projector(n, path);
-            std::vector<sh_coefficients<L, glm::vec3>> out(set.views.size());
-            projector.project(set.views, out);
-            for (std::size_t k = 0; k < set.views.size(); ++k) {
-                const auto reference = sh_project_cube_map<L>(set.views[k]);
-                for (std::size_t i = 0; i < sh_count(L); ++i)
-                    for (int c = 0; c < 3; ++c) {
-                        INFO("size " << n << ", path " << projector.path_name() << ", map " << k << ", coefficient " << i);
-                        CHECK(std::abs(double(out[k][i][c]) - reference[i][c]) <= error_bound(set, k, i, c));
-                    }
-            }
-        }
-    }
+    for (const std::size_t n : {64u, 13u, 100u}) check_against_reference<L>(cube_set(n, 5, 40 + n));
+    SECTION("strided faces") { check_against_reference<L>(cube_set(21, 3, 5, 7)); }
+    SECTION("more coefficients of one parity than one pass holds") { check_against_reference<5>(cube_set(24, 3, 9)); }
 }
 
 TEST_CASE("batch cube-map projection is bitwise the same for any thread count and batching", "[sh][cpu]") {

@@ -1,38 +1,35 @@
 #pragma once
 /// \file sh_projection.hpp
 /// SH projection of many RGB cube maps of one size at once (a probe bake's worth): the
-/// direction set of a size x size cube map is the same for every probe, so Y_i(texel) times
+/// direction set of a size x size cube map is the same for every probe, so Y_j(texel) times
 /// the texel's exact solid angle is tabulated once (sh/projection.hpp of the core defines
-/// the layout and the quadrature), and projecting a map is a matrix product:
-/// c_i = sum over texels of table_i(texel) f(texel).
+/// the layout and the quadrature), and projecting a map is a matrix product.
 ///
-/// How the product is laid out for the memory system:
-/// - A block of rows of each map is first split into r, g and b planes (two blends and a
-///   permutation per 8 texels on AVX2), so each weight of the table is loaded once and used
-///   for three channels: per 8 texels 9 weight loads, 3 plane loads and 27 fused
-///   multiply-adds, the minimum for 9 coefficients x 3 channels. (A table with each weight
-///   repeated per channel, multiplying the interleaved texels directly, loads 3 times the
-///   bytes and was 10-20% slower.)
-/// - Maps are taken in groups (one TBB task each); the group walks the faces a few rows at
-///   a time and projects those rows of every map in the group while the rows' table
-///   (16 x 9 x 64 floats = 37 KB for L = 3, size 64) stays in L1/L2 (blocks of 16 rows
-///   measured 1.0-1.2 Gtexel per CPU-second, 4 rows 0.7-0.8, 64 rows 0.8-0.9). The table
-///   (0.9 MB at that size) is thus read from memory once per group, not once per map. The table's rows of
-///   one coefficient are contiguous, so a block is one long run for the vector loop.
-/// - On x86-64 with AVX2, FMA and F16C (checked at run time) the products use 256-bit
-///   fused multiply-adds, three coefficients at a time (nine accumulators in registers);
-///   elsewhere a portable loop the compiler vectorizes for the baseline ISA. (A 512-bit
-///   variant with all 27 accumulators in registers was slower on the AMD EPYC this was
-///   measured on, 0.45 against 0.58 Gtexel per CPU-second, and was dropped.)
+/// What is tabulated, and how the product is laid out (docs/sh-and-irradiance-volumes.md
+/// has the measurements):
+/// - One face's table serves all six: face f looks along R_f (u, -v, 1) with R_f a signed
+///   permutation, each band of SH is closed under it, so a face's coefficients are its
+///   moments against the +z face's table times a fixed orthogonal matrix per face (computed
+///   once by exact quadrature). Rows y and size - 1 - y differ only in the sign of the local
+///   y, under which Y_lm is even (m >= 0) or odd (m < 0): only the top half is tabulated,
+///   and each pair of texels is multiplied once, by its sum for even coefficients and its
+///   difference for odd ones. The table is 4 ceil(size / 2) size L^2 bytes (74 KB for
+///   L = 3, size 64: it stays in L2) and a texel costs 13.5 multiply-adds for L = 3.
+/// - A block of rows (and of their mirror rows) is first split into r, g and b planes in a
+///   streaming pass, with software prefetch 4 KB ahead, and then multiplied from L1 with
+///   the accumulators of a whole parity group in registers (AVX-512: 18 + 9 accumulators of
+///   16 lanes; AVX2: 9 of 8 lanes, three coefficients a pass). Splitting in registers in the
+///   same pass as the products measured 1.7x slower from memory.
+/// - Paths: AVX-512 (F, BW, VL), AVX2 + FMA + F16C (both checked at run time), or a portable
+///   loop the compiler vectorizes for the baseline ISA.
 /// - Texels are glm::vec3 (12 bytes) or `half_rgb` (IEEE binary16, 6 bytes: what a GL
-///   RGB16F render target reads back as). A bake of many maps streams from memory, where
-///   the bytes per texel set the pace (docs/sh-and-irradiance-volumes.md): half texels are
-///   converted in registers (F16C) on the AVX2 path.
-/// Float accumulators run over one face (at most 8 x 64 = 512 terms per lane for size 64:
-/// relative rounding below 512 x 2^-24 = 3e-5, 1e-6 typical), then add into double sums.
-/// Each map is summed in the same order whatever the thread count and the grouping, so
-/// results are bitwise reproducible for a given path (the paths differ by rounding, a few
-/// float ulps of the result).
+///   RGB16F render target reads back as), converted in registers (F16C) on the AVX paths.
+/// - Maps are projected in parallel (TBB), one map per task step; each map is summed in
+///   the same order whatever the thread count, so results are bitwise reproducible for a
+///   given path (the paths differ by rounding, a few float ulps of the result).
+/// Float lanes add at most chunk_texels / 8 = 512 terms each, whatever the size, before
+/// they go into double sums (relative rounding below 512 x 2^-24 = 3e-5 of the sum of the
+/// terms' magnitudes; tests/sh checks the bound against a double reference).
 
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
@@ -142,14 +139,14 @@ public:
     /// Tables for size x size faces (typical: 64; 1 to 4096). Throws parameter_error naming
     /// "size" outside that range.
     explicit cube_map_sh_projector(std::size_t size, sh_projection_path path = sh_projection_path::automatic)
-        : size_(size), face_texels_(size * size), stride_((size * size + 15) / 16 * 16), kind_(choose(path)) {
+        : size_(size), half_rows_((size + 1) / 2), stride_((half_rows_ * size + 15) / 16 * 16), kind_(choose(path)) {
         static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "texel rows are read as packed floats");
         require(size >= 1 && size <= 4096, "size", "cube-map size must be 1 to 4096 texels");
         // Each coefficient's weights start on a 64-byte boundary (whole-line vector loads);
         // 16 floats of padding: the vector loops read up to 15 weights past a run's end (times
         // zero texels).
         table_.assign(coefficients * stride_ + 16, 0.f);
-        for (std::size_t y = 0; y < size_; ++y)
+        for (std::size_t y = 0; y < half_rows_; ++y)
             for (std::size_t x = 0; x < size_; ++x) {
                 const auto basis = sh_basis<L, double, glm::dvec3>(cube_texel_direction(cube_face::positive_z, size_, x, y));
                 const double dw = cube_texel_solid_angle(size_, x, y);
@@ -161,7 +158,7 @@ public:
     std::size_t size() const noexcept { return size_; }
     /// The code that runs: "avx512", "avx2" or "portable".
     const char* path_name() const noexcept { return kind_ == kind::avx512 ? "avx512" : kind_ == kind::avx2 ? "avx2" : "portable"; }
-    /// Bytes of the table (4 size^2 L^2: one face's, shared by the six).
+    /// Bytes of the table (4 ceil(size / 2) size L^2: half of one face, shared by the six).
     std::size_t table_bytes() const noexcept { return table_.size() * sizeof(float); }
 
     /// SH coefficients of every map of `maps` into `out` (one per map), in parallel over
@@ -236,19 +233,67 @@ private:
         });
     }
 
-    // One map: per face, the moments against the shared table over runs of at most
-    // chunk_texels (the whole packed face, or row by row), mixed into the coefficients.
+    // Row y of a face and its mirror row size - 1 - y see directions that differ only in the
+    // sign of the local y (the table's face looks along (u, -v, 1)), under which Y_lm is even
+    // for m >= 0 and odd for m < 0 (sin |m| phi). So only the top half of the face is
+    // tabulated, and each texel pair is multiplied once: even coefficients by the sum of the
+    // two texels, odd ones by their difference (13.5 multiply-adds a texel instead of 27).
+    // parity_order_: the coefficients even in y (bands in order, m >= 0), then the odd ones.
+    static constexpr std::size_t even_count = std::size_t(L) * std::size_t(L + 1) / 2;
+    static constexpr std::array<std::size_t, coefficients> parity_order_ = [] {
+        std::array<std::size_t, coefficients> order{};
+        std::size_t k = 0;
+        for (int odd = 0; odd < 2; ++odd)
+            for (int l = 0; l < L; ++l)
+                for (int m = -l; m <= l; ++m)
+                    if ((m < 0) == bool(odd)) order[k++] = std::size_t(l * (l + 1) + m);
+        return order;
+    }();
+
+    // The texels are split into r, g, b planes a block of whole rows (or one row's segment)
+    // at a time: a streaming pass that leaves them in L1 (texels of the top rows in the first
+    // three planes, their mirror rows in the last three), then multiplied by the table in
+    // float lanes per channel (16 with AVX-512, 8 otherwise). The lanes go into double sums
+    // before a float lane has added chunk_texels / 8 pairs. (Splitting in registers and
+    // multiplying in the same pass measured 1.7x slower from memory: 27 accumulators, three
+    // channels and the permutations' indices overflow the registers.)
+    static constexpr std::size_t plane_texels = 512;
+    static constexpr std::size_t acc_stride = 48;  // per coefficient: 16 lanes of r, of g, of b
+
+    // One map: per face, the moments against the shared table, mixed into the coefficients.
     template <class Texel>
     sh_coefficients<L, glm::vec3> project_map(const cube_map_view<const Texel>& map) const {
         moments total{};
+        alignas(64) float planes[6 * plane_texels];
+        alignas(64) float acc[coefficients * acc_stride];
+        const std::size_t rows = std::max<std::size_t>(1, plane_texels / size_), segment = std::min(size_, plane_texels);
         for (std::size_t f = 0; f < 6; ++f) {
             const auto& face = map.faces[f];
             moments m{};
-            const bool packed = face.stride() == size_;
-            const std::size_t runs = packed ? 1 : size_, run = packed ? face_texels_ : size_;
-            for (std::size_t y = 0; y < runs; ++y)
-                for (std::size_t x = 0; x < run; x += chunk_texels)
-                    accumulate(&face(0, y) + x, std::min(chunk_texels, run - x), table_.data() + y * size_ + x, m);
+            std::fill(std::begin(acc), std::end(acc), 0.f);
+            std::size_t pending = 0;  // texel pairs in the float lanes
+            for (std::size_t y0 = 0; y0 < half_rows_; y0 += rows) {
+                const std::size_t y1 = std::min(half_rows_, y0 + rows);
+                for (std::size_t x0 = 0; x0 < size_; x0 += segment) {
+                    const std::size_t n = std::min(segment, size_ - x0), texels = (y1 - y0) * n, padded = (texels + 15) / 16 * 16;
+                    for (std::size_t y = y0; y < y1; ++y) {
+                        float* top = planes + (y - y0) * n;
+                        split(&face(x0, y), n, top, std::ptrdiff_t(prefetch_bytes));
+                        if (const std::size_t mirror = size_ - 1 - y; mirror != y)
+                            split(&face(x0, mirror), n, top + 3 * plane_texels, -std::ptrdiff_t(prefetch_bytes));
+                        else  // the middle row of an odd size: its own pair, once (odd weights are 0 there)
+                            for (std::size_t c = 3; c < 6; ++c) std::fill_n(top + c * plane_texels, n, 0.f);
+                    }
+                    for (std::size_t c = 0; c < 6; ++c) std::fill(planes + c * plane_texels + texels, planes + c * plane_texels + padded, 0.f);
+                    if (pending + texels > chunk_texels) {
+                        flush(acc, m);
+                        pending = 0;
+                    }
+                    multiply(planes, padded, table_.data() + y0 * size_ + x0, acc);
+                    pending += texels;
+                }
+            }
+            flush(acc, m);
             const auto& mix = face_mix_[f];
             for (std::size_t i = 0; i < coefficients; ++i)
                 for (std::size_t j = 0; j < coefficients; ++j)
@@ -261,50 +306,43 @@ private:
         return out;
     }
 
-    template <class Texel>
-    void accumulate(const Texel* src, std::size_t texels, const float* w, moments& m) const {
-        accumulate_planar(src, texels, w, m);
-    }
-
-    // The run is split into r, g, b planes `plane_texels` at a time (a streaming pass
-    // that leaves them in L1), multiplied by the table in float lanes per channel (16 with
-    // AVX-512, 8 otherwise), the lanes added in double at the end of the run. (Splitting in
-    // registers and multiplying in the same pass measured 1.7x slower from memory: 27
-    // accumulators, three channels and the permutations' indices overflow the registers.)
-    static constexpr std::size_t plane_texels = 512;
-    static constexpr std::size_t acc_stride = 48;  // per coefficient: 16 lanes of r, of g, of b
-
-    template <class Texel>
-    void accumulate_planar(const Texel* src, std::size_t texels, const float* w, moments& m) const {
-        alignas(64) float planes[3 * plane_texels];
-        alignas(64) float acc[coefficients * acc_stride] = {};
-        for (std::size_t x0 = 0; x0 < texels; x0 += plane_texels) {
-            const std::size_t n = std::min(plane_texels, texels - x0), padded = (n + 15) / 16 * 16;
-            float *r = planes, *g = planes + plane_texels, *b = planes + 2 * plane_texels;
-            switch (kind_) {
-#if BOUNCE_SH_PROJECTION_AVX2
-                case kind::avx512: deinterleave_avx512(src + x0, n, r, g, b); break;
-                case kind::avx2: deinterleave_avx2(src + x0, n, r, g, b); break;
-#endif
-                default: deinterleave_portable(src + x0, n, r, g, b);
-            }
-            std::fill(r + n, r + padded, 0.f);
-            std::fill(g + n, g + padded, 0.f);
-            std::fill(b + n, b + padded, 0.f);
-            switch (kind_) {
-#if BOUNCE_SH_PROJECTION_AVX2
-                case kind::avx512: accumulate_avx512<0>(planes, padded, w + x0, acc); break;
-                case kind::avx2: accumulate_avx2(planes, padded, w + x0, acc); break;
-#endif
-                default: accumulate_portable(planes, padded, w + x0, acc);
-            }
-        }
+    // The float lanes into the double moments, and cleared.
+    static void flush(float* acc, moments& m) {
         for (std::size_t j = 0; j < coefficients; ++j)
             for (std::size_t c = 0; c < 3; ++c) {
                 double s = 0;
                 for (std::size_t lane = 0; lane < 16; ++lane) s += double(acc[j * acc_stride + 16 * c + lane]);
                 m[3 * j + c] += s;
             }
+        std::fill_n(acc, coefficients * acc_stride, 0.f);
+    }
+
+    // `texels` texels at src into planes r = out, g = out + plane_texels, b = out + 2 plane_texels,
+    // asking for the texels `ahead` bytes on (negative for rows read bottom-up).
+    template <class Texel>
+    void split(const Texel* src, std::size_t texels, float* out, std::ptrdiff_t ahead) const {
+        float *r = out, *g = out + plane_texels, *b = out + 2 * plane_texels;
+        switch (kind_) {
+#if BOUNCE_SH_PROJECTION_AVX2
+            case kind::avx512: return deinterleave_avx512(src, texels, r, g, b, ahead);
+            case kind::avx2: return deinterleave_avx2(src, texels, r, g, b, ahead);
+#endif
+            default: deinterleave_portable(src, texels, r, g, b);
+        }
+    }
+
+    void multiply(const float* planes, std::size_t padded, const float* w, float* acc) const {
+        switch (kind_) {
+#if BOUNCE_SH_PROJECTION_AVX2
+            case kind::avx512:
+                multiply_avx512<false, 0>(planes, padded, w, acc);
+                return multiply_avx512<true, 0>(planes, padded, w, acc);
+            case kind::avx2:
+                multiply_avx2<false, 0>(planes, padded, w, acc);
+                return multiply_avx2<true, 0>(planes, padded, w, acc);
+#endif
+            default: multiply_portable(planes, padded, w, acc);
+        }
     }
 
     // The planes of `texels` texels (r, g, b, each plane_texels floats apart).
@@ -323,10 +361,12 @@ private:
         }
     }
 
-    // acc[j][c][lane] += sum over x = lane (mod 8) of w_j[x] plane_c[x] over `padded` texels
-    // (lanes 0-7 of each channel's 16).
-    void accumulate_portable(const float* planes, std::size_t padded, const float* w0, float* acc) const {
-        for (std::size_t j = 0; j < coefficients; ++j) {
+    // acc[j][c][lane] += sum over x = lane (mod 8) of w_j[x] (top_c[x] +- mirror_c[x]) over
+    // `padded` pairs (lanes 0-7 of each channel's 16).
+    void multiply_portable(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        for (std::size_t k = 0; k < coefficients; ++k) {
+            const std::size_t j = parity_order_[k];
+            const float sign = k < even_count ? 1.f : -1.f;
             const float* w = w0 + j * stride_;
             // Local accumulators: through `acc` the compiler must assume they alias the
             // table and the planes, and would load and store them every step.
@@ -334,7 +374,10 @@ private:
             for (std::size_t c = 0; c < 3; ++c) std::copy_n(acc + j * acc_stride + 16 * c, 8, a[c]);
             for (std::size_t x = 0; x < padded; x += 8)
                 for (std::size_t c = 0; c < 3; ++c)
-                    for (std::size_t lane = 0; lane < 8; ++lane) a[c][lane] += w[x + lane] * planes[c * plane_texels + x + lane];
+                    for (std::size_t lane = 0; lane < 8; ++lane) {
+                        const std::size_t at = c * plane_texels + x + lane;
+                        a[c][lane] += w[x + lane] * (planes[at] + sign * planes[at + 3 * plane_texels]);
+                    }
             for (std::size_t c = 0; c < 3; ++c) std::copy_n(a[c], 8, acc + j * acc_stride + 16 * c);
         }
     }
@@ -354,11 +397,11 @@ private:
 
     template <class Texel>
     __attribute__((target("avx2,fma,f16c"))) static void deinterleave_avx2(const Texel* src, std::size_t texels, float* r,
-                                                                           float* g, float* b) {
+                                                                           float* g, float* b, std::ptrdiff_t ahead) {
         std::size_t x = 0;
         for (; x + 8 <= texels; x += 8) {
-            const char* ahead = reinterpret_cast<const char*>(src + x) + prefetch_bytes;
-            for (std::size_t line = 0; line < 8 * sizeof(Texel); line += 64) _mm_prefetch(ahead + line, _MM_HINT_T0);
+            const char* next = reinterpret_cast<const char*>(src + x) + ahead;
+            for (std::size_t line = 0; line < 8 * sizeof(Texel); line += 64) _mm_prefetch(next + line, _MM_HINT_T0);
             if constexpr (std::is_same_v<Texel, half_rgb>) {
                 const auto* h = reinterpret_cast<const __m128i*>(src + x);
                 deinterleave8(_mm256_cvtph_ps(_mm_loadu_si128(h)), _mm256_cvtph_ps(_mm_loadu_si128(h + 1)),
@@ -371,44 +414,47 @@ private:
         deinterleave_portable(src + x, texels - x, r + x, g + x, b + x);
     }
 
+    // Pass over the coefficients parity_order_[Begin + First ...] of one parity, G at a time.
+    template <bool Odd, std::size_t First>
+    void multiply_avx2(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        constexpr std::size_t begin = Odd ? even_count : 0, end = Odd ? coefficients : even_count;
+        if constexpr (begin + First < end) {
+            group_avx2<Odd, begin + First, std::min<std::size_t>(3, end - begin - First)>(planes, padded, w0, acc);
+            multiply_avx2<Odd, First + 3>(planes, padded, w0, acc);
+        }
+    }
+
     // The products with 256-bit FMAs, G coefficients at a time: 3 G accumulators, the three
-    // planes and one weight vector in registers (13 of 16 for G = 3).
-    template <std::size_t G>
-    __attribute__((target("avx2,fma,f16c"))) void accumulate_group_avx2(const float* planes, std::size_t padded, const float* w0,
-                                                                         std::size_t first, float* acc) const {
+    // sums (or differences) of the pair and one weight vector in registers.
+    template <bool Odd, std::size_t K, std::size_t G>
+    __attribute__((target("avx2,fma,f16c"))) void group_avx2(const float* planes, std::size_t padded, const float* w0,
+                                                              float* acc) const {
         __m256 a[G][3];
         const float* w[G];
         for (std::size_t g = 0; g < G; ++g) {
-            w[g] = w0 + (first + g) * stride_;
-            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm256_loadu_ps(acc + (first + g) * acc_stride + 16 * c);
+            w[g] = w0 + parity_order_[K + g] * stride_;
+            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm256_load_ps(acc + parity_order_[K + g] * acc_stride + 16 * c);
         }
         for (std::size_t x = 0; x < padded; x += 8) {
-            const __m256 r = _mm256_loadu_ps(planes + x), gr = _mm256_loadu_ps(planes + plane_texels + x),
-                         b = _mm256_loadu_ps(planes + 2 * plane_texels + x);
+            __m256 p[3];
+            for (std::size_t c = 0; c < 3; ++c) {
+                const __m256 top = _mm256_load_ps(planes + c * plane_texels + x), low = _mm256_load_ps(planes + (c + 3) * plane_texels + x);
+                p[c] = Odd ? _mm256_sub_ps(top, low) : _mm256_add_ps(top, low);
+            }
             for (std::size_t g = 0; g < G; ++g) {
                 const __m256 weight = _mm256_loadu_ps(w[g] + x);
-                a[g][0] = _mm256_fmadd_ps(weight, r, a[g][0]);
-                a[g][1] = _mm256_fmadd_ps(weight, gr, a[g][1]);
-                a[g][2] = _mm256_fmadd_ps(weight, b, a[g][2]);
+                for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm256_fmadd_ps(weight, p[c], a[g][c]);
             }
         }
         for (std::size_t g = 0; g < G; ++g)
-            for (std::size_t c = 0; c < 3; ++c) _mm256_storeu_ps(acc + (first + g) * acc_stride + 16 * c, a[g][c]);
-    }
-
-    void accumulate_avx2(const float* planes, std::size_t padded, const float* w0, float* acc) const {
-        std::size_t j = 0;
-        for (; j + 3 <= coefficients; j += 3) accumulate_group_avx2<3>(planes, padded, w0, j, acc);
-        if constexpr (coefficients % 3 == 1) accumulate_group_avx2<1>(planes, padded, w0, j, acc);
-        if constexpr (coefficients % 3 == 2) accumulate_group_avx2<2>(planes, padded, w0, j, acc);
+            for (std::size_t c = 0; c < 3; ++c) _mm256_store_ps(acc + parity_order_[K + g] * acc_stride + 16 * c, a[g][c]);
     }
 
     // AVX-512: 16 texels a step split with two two-source permutations per channel, the
     // tail by the portable loop.
     template <class Texel>
-    __attribute__((target("avx512f,avx512bw,avx512vl,avx2,fma,f16c"))) static void deinterleave_avx512(const Texel* src,
-                                                                                                    std::size_t texels, float* r,
-                                                                                                    float* g, float* b) {
+    __attribute__((target("avx512f,avx512bw,avx512vl,avx2,fma,f16c"))) static void
+    deinterleave_avx512(const Texel* src, std::size_t texels, float* r, float* g, float* b, std::ptrdiff_t ahead) {
         alignas(64) static constexpr int from_ab[3][16] = {{0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0},
                                                            {1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0},
                                                            {2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0}};
@@ -418,8 +464,8 @@ private:
         float* out[3] = {r, g, b};
         std::size_t x = 0;
         for (; x + 16 <= texels; x += 16) {
-            const char* ahead = reinterpret_cast<const char*>(src + x) + prefetch_bytes;
-            for (std::size_t line = 0; line < 16 * sizeof(Texel); line += 64) _mm_prefetch(ahead + line, _MM_HINT_T0);
+            const char* next = reinterpret_cast<const char*>(src + x) + ahead;
+            for (std::size_t line = 0; line < 16 * sizeof(Texel); line += 64) _mm_prefetch(next + line, _MM_HINT_T0);
             __m512 v[3];
             for (std::size_t k = 0; k < 3; ++k) {
                 if constexpr (std::is_same_v<Texel, half_rgb>)  // maskz: GCC 12's plain form reads an undefined register
@@ -434,42 +480,47 @@ private:
         deinterleave_portable(src + x, texels - x, r + x, g + x, b + x);
     }
 
-    // The products, G <= 9 coefficients a pass: 3 G accumulators, the three planes in
-    // registers and the weights as memory operands (30 of 32 registers for G = 9).
-    template <std::size_t First>
-    void accumulate_avx512(const float* planes, std::size_t padded, const float* w0, float* acc) const {
-        accumulate_group_avx512<First, std::min<std::size_t>(9, coefficients - First)>(planes, padded, w0, acc);
-        if constexpr (First + 9 < coefficients) accumulate_avx512<First + 9>(planes, padded, w0, acc);
+    template <bool Odd, std::size_t First>
+    void multiply_avx512(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+        constexpr std::size_t begin = Odd ? even_count : 0, end = Odd ? coefficients : even_count;
+        if constexpr (begin + First < end) {
+            group_avx512<Odd, begin + First, std::min<std::size_t>(9, end - begin - First)>(planes, padded, w0, acc);
+            multiply_avx512<Odd, First + 9>(planes, padded, w0, acc);
+        }
     }
 
-    template <std::size_t First, std::size_t G>
-    __attribute__((target("avx512f,avx512bw,avx512vl,avx2,fma,f16c"))) void
-    accumulate_group_avx512(const float* planes, std::size_t padded, const float* w0, float* acc) const {
+    // The products, G <= 9 coefficients a pass: 3 G accumulators and the pair's three sums
+    // (or differences) in registers, the weights as memory operands.
+    template <bool Odd, std::size_t K, std::size_t G>
+    __attribute__((target("avx512f,avx512bw,avx512vl,avx2,fma,f16c"))) void group_avx512(const float* planes, std::size_t padded,
+                                                                                          const float* w0, float* acc) const {
         __m512 a[G][3];
 #pragma GCC unroll 9
         for (std::size_t g = 0; g < G; ++g)
 #pragma GCC unroll 3
-            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm512_load_ps(acc + (First + g) * acc_stride + 16 * c);
-        const float* w = w0 + First * stride_;
+            for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm512_load_ps(acc + parity_order_[K + g] * acc_stride + 16 * c);
         for (std::size_t x = 0; x < padded; x += 16) {
-            const __m512 r = _mm512_load_ps(planes + x), gr = _mm512_load_ps(planes + plane_texels + x),
-                         b = _mm512_load_ps(planes + 2 * plane_texels + x);
+            __m512 p[3];
+#pragma GCC unroll 3
+            for (std::size_t c = 0; c < 3; ++c) {
+                const __m512 top = _mm512_load_ps(planes + c * plane_texels + x), low = _mm512_load_ps(planes + (c + 3) * plane_texels + x);
+                p[c] = Odd ? _mm512_sub_ps(top, low) : _mm512_add_ps(top, low);
+            }
 #pragma GCC unroll 9
             for (std::size_t g = 0; g < G; ++g) {
-                const __m512 weight = _mm512_loadu_ps(w + g * stride_ + x);
-                a[g][0] = _mm512_fmadd_ps(weight, r, a[g][0]);
-                a[g][1] = _mm512_fmadd_ps(weight, gr, a[g][1]);
-                a[g][2] = _mm512_fmadd_ps(weight, b, a[g][2]);
+                const __m512 weight = _mm512_loadu_ps(w0 + parity_order_[K + g] * stride_ + x);
+#pragma GCC unroll 3
+                for (std::size_t c = 0; c < 3; ++c) a[g][c] = _mm512_fmadd_ps(weight, p[c], a[g][c]);
             }
         }
 #pragma GCC unroll 9
         for (std::size_t g = 0; g < G; ++g)
 #pragma GCC unroll 3
-            for (std::size_t c = 0; c < 3; ++c) _mm512_store_ps(acc + (First + g) * acc_stride + 16 * c, a[g][c]);
+            for (std::size_t c = 0; c < 3; ++c) _mm512_store_ps(acc + parity_order_[K + g] * acc_stride + 16 * c, a[g][c]);
     }
 #endif
 
-    std::size_t size_, face_texels_, stride_;  // stride_: floats from one coefficient's weights to the next
+    std::size_t size_, half_rows_, stride_;  // stride_: floats from one coefficient's weights to the next
     kind kind_;
     std::vector<float, line_allocator<float>> table_;  // [coefficient][texel of the +z face]
     std::array<std::array<double, coefficients * coefficients>, 6> face_mix_;
