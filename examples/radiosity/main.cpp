@@ -36,6 +36,7 @@
 #include "memory.hpp"
 #include "options.hpp"
 #include "oracle.hpp"
+#include "rebake.hpp"
 #include "report.hpp"
 
 #include <fmt/core.h>
@@ -205,6 +206,7 @@ int run(const options& o) {
     for (const auto& w : scene.warnings) fmt::print(stderr, "{}: {}\n", scene.name, w);
     const std::optional<image<glm::vec3>> versus = check_before_work(o, scene);
     const embree::accel bvh(scene);
+    if (!o.rebake_light.empty() || !o.rebake_move.empty()) return run_rebake(o, scene, bvh);  // rebake.hpp
 
     study::stage_timer timer;
     comparison cmp{bvh, scene, std::nullopt, {}};
@@ -293,6 +295,7 @@ int main(int argc, char** argv) {
     CLI::App app{"bounce: progressive refinement radiosity (Coombe and Harris, GPU Gems 2 ch. 39)"};
     options o;
     add_options(app, o);
+    add_rebake_options(app, o);
     CLI11_PARSE(app, argc, argv);
     return run_program("radiosity", [&] { return run(o); },
                        "ask for fewer --elements, a smaller view, or a smaller --resolution");

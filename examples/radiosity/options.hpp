@@ -69,6 +69,8 @@ struct options {
     bool quiet = false;
     view_kind view = view_kind::automatic;  // the camera's view: the lightmap, or the lights' direct light per pixel
     std::filesystem::path json, out, lightmaps, versus, reference_out, holes_out, oracle_out;
+    std::string rebake_light, rebake_move;  // re-bakes (rebake.hpp): K,SCALE and MATERIAL[#N],DX,DY,DZ
+    double rebake_check = 0.99;             // re-bakes: the converged fraction both solves are then taken to
 };
 
 inline void add_options(CLI::App& app, options& o) {

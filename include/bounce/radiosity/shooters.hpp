@@ -92,9 +92,13 @@ inline shooter_disc shooter_disc_of(const lightmap_atlas& atlas, std::uint32_t i
 /// where receivers lie close to a shooter (slivers, near-touching elements), and a shot that
 /// delivered more than it shot would create energy. Both solvers apply it. It is 1 unless
 /// receivers lie close to the shooter: in a closed box the near field's discs over-deliver
-/// into the corners and many block shots are scaled.
+/// into the corners and many block shots are scaled. After a re-bake (radiosity/rebake.hpp)
+/// power may be negative: the bound holds for magnitudes (a delivery of the other sign than
+/// the power, possible only where a shooter's elements hold both signs, is not scaled).
 inline glm::dvec3 shot_scale(const glm::dvec3& power, const glm::dvec3& intercepted) {
-    const auto one = [](double p, double got) { return got > p && got > 0 ? std::max(0.0, p) / got : 1.0; };
+    const auto one = [](double p, double got) {
+        return std::abs(got) > std::abs(p) && p * got > 0 ? std::abs(p) / std::abs(got) : 1.0;
+    };
     return {one(power.x, intercepted.x), one(power.y, intercepted.y), one(power.z, intercepted.z)};
 }
 

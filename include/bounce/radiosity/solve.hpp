@@ -136,13 +136,16 @@ energy_sums energy_of(const Solver& solver) {
 /// and was added. A shot hands out at most its power (shot_scale) times albedos at most 1,
 /// so the unshot power can only fall; a rise, or a non-finite sum, means energy was created.
 /// The message names the step, the shot's shooter and the element that took the most.
+/// Unshot power is counted in magnitude (|dB| A per channel: a re-bake shoots negative power,
+/// radiosity/rebake.hpp), and may not exceed `ceiling` (the larger of the emitted power and
+/// the unshot power when the solve began: a re-bake may start above the emitted power).
 template <class Solver>
-void check_energy(const Solver& solver, const energy_sums& before, const energy_sums& after) {
+void check_energy(const Solver& solver, const energy_sums& before, const energy_sums& after, double ceiling = 0) {
     const double added = after.emitted - before.emitted;
     const double rise = after.unshot - before.unshot - added;
     const double tolerance = std::ldexp(before.unshot + std::abs(added), -20);
     if (std::isfinite(after.unshot) && std::isfinite(after.emitted) && rise <= tolerance &&
-        after.unshot <= after.emitted * (1.0 + 1e-6))
+        after.unshot <= std::max(after.emitted, ceiling) * (1.0 + 1e-6))
         return;
     std::string where;
     if constexpr (requires { solver.last_shot(); }) {
@@ -202,6 +205,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
     };
     r.stop = radiosity_stop::converged;
     energy_sums before = energy_of(solver);
+    const double ceiling = std::max(before.emitted, before.unshot);
     while (measured_unshot(solver, o) > target) {
         if (o.max_seconds > 0 && elapsed() > o.max_seconds * 1e3) {
             r.stop = radiosity_stop::time_limit;
@@ -216,7 +220,7 @@ radiosity_solve_report run_radiosity_solve(Solver& solver, const radiosity_solve
         r.splits += after_step(r.steps);
         const double f = measured_unshot(solver, o);
         const energy_sums after = energy_of(solver);
-        check_energy(solver, before, after);
+        check_energy(solver, before, after, ceiling);
         before = after;
         r.converged.push_back(1.0 - f);
         r.step_ms.push_back(elapsed());

@@ -349,6 +349,7 @@ public:
     }
 
 private:
+    template <class Solver> friend struct rebake_access;  // re-baking what changed (radiosity_rebake.hpp)
     using clock = std::chrono::steady_clock;
 
     // Shooters: the atlas's blocks, or one per element, once per side (shooter k is block
@@ -369,9 +370,7 @@ private:
                                            {options_.group_discs, options_.near_field, options_.group_near_field});
         refresh_powers();
     }
-    static double ms_since(clock::time_point t) {
-        return std::chrono::duration<double, std::milli>(clock::now() - t).count();
-    }
+    static double ms_since(clock::time_point t) { return std::chrono::duration<double, std::milli>(clock::now() - t).count(); }
     // Shooters per chunk of the distribution: fixed, so sums do not depend on threads.
     static constexpr std::size_t chunk = 64;
 
@@ -406,7 +405,7 @@ private:
         for (std::size_t k = 0; k < power_.size(); ++k) {
             const std::size_t b = k % blocks, o = n * (k / blocks);
             double p = 0;
-            for (std::uint32_t i = first_[b]; i < first_[b + 1]; ++i) p += channel_sum(unshot_[o + i]) * double(atlas_.area[i]);
+            for (std::uint32_t i = first_[b]; i < first_[b + 1]; ++i) p += channel_sum(glm::abs(unshot_[o + i])) * double(atlas_.area[i]);
             power_[k] = p;
             unshot_total_ += p;
         }
@@ -429,7 +428,7 @@ private:
                         receive(i, s);
                         if (!refresh) continue;
                         for (std::size_t side = 0; side < sides_; ++side)
-                            p[side] += channel_sum(unshot_[side * n + i]) * double(atlas_.area[i]);
+                            p[side] += channel_sum(glm::abs(unshot_[side * n + i])) * double(atlas_.area[i]);
                     }
                     if (!refresh) continue;
                     for (std::size_t side = 0; side < sides_; ++side) {
@@ -478,7 +477,7 @@ private:
         timings_.visibility_ms += ms_since(start);
 
         start = clock::now();
-        finish_shot(power, gather_shot(at.chart[i0], vec(normal)), start, k, i0);
+        finish_shot(power, gather_shot(at.chart[i0], vec(normal), [](std::uint32_t) { return true; }), start, k, i0);
     }
 
     // Pass 2 of a shot whose pass 1 (begun at `start`) found `incident`: the deliveries scaled
@@ -493,18 +492,18 @@ private:
         escaped_ += power - total.intercepted;
         intercepted_ += total.intercepted;
         last_shot_ = {shots_, k, first, total.top_receiver,
-                      total.top_power / std::max(bounce::detail::channel_total(power), 1e-300), scale};
+                      total.top_power / std::max(bounce::detail::channel_total(glm::abs(power)), 1e-300), scale};
         if (scale != glm::dvec3(1.0)) ++clamped_shots_;
-        shot_power_ += bounce::detail::channel_total(power);
+        shot_power_ += bounce::detail::channel_total(glm::abs(power));
         ++shots_;
     }
 
     // Pass 1 of a shot from the near-field tree near_ (normal `ns`, chart `chart`): each
-    // element's incident radiosity sum_j dB_j F_{r->j} V (element_form_factor, the receiver's
+    // element i with keep(i) (re-bakes ask only some), its incident radiosity sum_j dB_j F_{r->j} V (element_form_factor, the receiver's
     // area in it) into received_, and the power they intercept together (W per channel).
     // Two-sided, each node of the tree lights the receiver's side that faces it (its normal
     // flipped towards the node), so a receiver may take light on both sides from one shot.
-    glm::dvec3 gather_shot(std::uint32_t chart, const vec ns) {
+    template <class Keep> glm::dvec3 gather_shot(std::uint32_t chart, const vec ns, const Keep& keep) {
         const lightmap_atlas& at = atlas_;
         const std::uint32_t root = std::uint32_t(near_.size() - 1);
         const Real near2 = Real(options_.near_field) * Real(options_.near_field);
@@ -513,7 +512,7 @@ private:
         received_.assign(sides_ * n, vec(0));
         const Visibility& vis = visibility_;
         const chunk_sums total = for_elements([&](std::uint32_t i, chunk_sums& s) {
-            if (at.chart[i] == chart) return;  // coplanar with the shooter: F = 0
+            if (at.chart[i] == chart || !keep(i)) return;  // coplanar with the shooter: F = 0; or not asked
             const vec pr = vec(at.position[i]), nr = vec(at.normal[i]);
             const Real ar = Real(at.area[i]);
             vec incident(0), incident_back(0);
@@ -532,8 +531,8 @@ private:
                     for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = node.first_child + c;
                 }
             }
-            const auto positive = [](const vec& x) { return x.x > Real(0) || x.y > Real(0) || x.z > Real(0); };
-            if (!positive(incident) && !positive(incident_back)) return;
+            const auto some = [](const vec& x) { return x != vec(0); };  // negative after a re-bake
+            if (!some(incident) && !some(incident_back)) return;
             const Real v = Real(vis.visible(at.position[i], at.chart[i]));
             if (!(v > Real(0))) return;
             received_[i] = incident * v;
@@ -578,7 +577,7 @@ private:
                 const glm::dvec3 intercepted = glm::dvec3(incident) * double(at.area[i]);
                 s.intercepted += intercepted;
                 s.absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * intercepted;
-                const double taken = bounce::detail::channel_total(intercepted);
+                const double taken = bounce::detail::channel_total(glm::abs(intercepted));
                 if (taken > s.top_power) s.top_power = taken, s.top_receiver = i;
             }
         });

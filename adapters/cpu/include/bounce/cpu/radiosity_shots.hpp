@@ -36,7 +36,7 @@ std::uint32_t progressive_radiosity<Visibility, Real>::build_group_node(std::uin
             atlas_, i0, i1, options_.shoot_blocks, b, [&](std::uint32_t i) { return glm::dvec3(unshot[i]); },
             [&](glm::dvec3 centre, double node_area, glm::dvec3 mean_unshot, std::uint32_t first_child, std::uint32_t children) {
                 group_node q{vec(centre), Real(node_area), Real(node_area), vec(mean_unshot), normal, Real(0),
-                             std::uint32_t(links_.size()), children, chart, Real(bounce::detail::channel_total(mean_unshot) * node_area)};
+                             std::uint32_t(links_.size()), children, chart, Real(bounce::detail::channel_total(glm::abs(mean_unshot)) * node_area)};
                 for (std::uint32_t c = 0; c < children; ++c) links_.push_back(base + first_child + c);
                 group_nodes_.push_back(q);
             });
@@ -127,7 +127,7 @@ glm::dvec3 progressive_radiosity<Visibility, Real>::gather_group(std::uint32_t r
             const Real f = element_form_factor<Real, vec>(pr, side ? -nr : nr, ar, node.position, node.normal, node.area);
             if (!(f > Real(0))) continue;
             const vec light = node.unshot * f;
-            const double w = channel_sum(light);
+            const double w = channel_sum(glm::abs(light));  // |.|: negative after a re-bake
             if (!(w > 0)) continue;
             incident[side] += light;
             weight[side] += w;

@@ -1,0 +1,206 @@
+#pragma once
+/// \file radiosity_rebake.hpp
+/// Re-baking what changed with cpu::progressive_radiosity (issue 30): after a light changes
+/// (rebake_light) or one object moves rigidly (rebake_move), the solver's state is corrected
+/// as radiosity/rebake.hpp derives, its equation (2): B and the unshot radiosity dB change by
+/// the same amount, so what every element has shot (S = B - dB) is kept, and the unshot power
+/// may turn negative where light is taken away. Then solve(radiosity_solve_options) again:
+/// it shoots by |unshot power| and converges to the changed scene's solution, what a fresh
+/// solve converges to. The atlas is reused (a rigid move keeps the charts' texels).
+///
+///   cpu::progressive_radiosity solver(scene, atlas, embree::radiosity_visibility(bvh, atlas.chart_of_triangle));
+///   solver.solve(o);                                         // the bake
+///   // ... the object's vertices moved in `moved` (a copy of the scene), its BVH built:
+///   cpu::rebake_move(solver, moved, object_triangles, move,
+///                    embree::radiosity_visibility(moved_bvh, solver.atlas().chart_of_triangle));
+///   solver.solve(o);                                         // the re-bake
+///
+/// The cost of a move's correction: every block-side that has shot re-shoots its S twice
+/// (old and new geometry), each time only to the receivers whose delivery can differ (the
+/// moved object's elements, and those whose visibility ray from the shooter's centre meets the
+/// object's box before or after the move), plus one shot per light; with the item buffers,
+/// each of those shots draws its item buffer whole.
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/radiosity/rebake.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <span>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace bounce::cpu {
+
+/// The re-bakes' access to the solver's state (a friend of progressive_radiosity).
+template <class Solver>
+struct rebake_access {
+    using vec = typename Solver::vec;
+
+    // S = B - dB per element and side: what each element has shot.
+    static std::vector<vec> shot(const Solver& s) {
+        std::vector<vec> out(s.radiosity_.size());
+        for (std::size_t j = 0; j < out.size(); ++j) out[j] = s.radiosity_[j] - s.unshot_[j];
+        return out;
+    }
+
+    // One pass of a move's correction: every block-side whose S holds power shoots it, as the
+    // solver's shot does, to the receivers keep(shooter centre, element) asks for (a moved
+    // block: to every receiver, scaled to its power as a shot is), and `sign` times what it
+    // delivers is added to `delta` (incident radiosity per element and side).
+    template <class Keep>
+    static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& moved_block, const Keep& keep,
+                        double sign, std::vector<glm::dvec3>& delta, radiosity_rebake_report& r) {
+        const lightmap_atlas& at = s.atlas_;
+        const std::size_t blocks = s.first_.size() - 1, n = at.size();
+        std::atomic<std::size_t> pairs{0};
+        for (std::size_t k = 0; k < s.sides_ * blocks; ++k) {
+            const std::size_t b = k % blocks, side = k / blocks;
+            const std::uint32_t i0 = s.first_[b], i1 = s.first_[b + 1];
+            const vec* from = S.data() + side * n;
+            glm::dvec3 power(0);
+            double magnitude = 0;
+            for (std::uint32_t i = i0; i < i1; ++i) {
+                power += glm::dvec3(from[i]) * double(at.area[i]);
+                magnitude += Solver::channel_sum(glm::abs(from[i])) * double(at.area[i]);
+            }
+            if (!(magnitude > 0)) continue;
+            ++r.shooters;
+            s.build_near_tree(std::uint32_t(b), from);
+            const glm::vec3 normal = side == 0 ? at.normal[i0] : -at.normal[i0], centre = s.centre_[b];
+            s.visibility_.begin_shot(shot_frame{centre, normal, false, at.chart[i0]});
+            const bool whole = moved_block[b] != 0;
+            const glm::dvec3 got = s.gather_shot(at.chart[i0], vec(normal), [&](std::uint32_t i) {
+                if (!whole && !keep(centre, i)) return false;
+                pairs.fetch_add(1, std::memory_order_relaxed);
+                return true;
+            });
+            if (!whole) r.pairs_tested += n;
+            const glm::dvec3 scale = sign * (whole ? shot_scale(power, got) : glm::dvec3(1.0));
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, delta.size(), 4096), [&](const tbb::blocked_range<std::size_t>& q) {
+                for (std::size_t j = q.begin(); j != q.end(); ++j)
+                    if (s.received_[j] != vec(0)) delta[j] += scale * glm::dvec3(s.received_[j]);
+            });
+        }
+        r.pairs += pairs.load();
+    }
+
+    // The lights' direct irradiance at every element again, from the solver's lights, atlas
+    // and visibility as they are now; returns what it was.
+    static std::vector<vec> regather_direct(Solver& s) {
+        const auto start = Solver::clock::now();
+        std::vector<vec> old = s.direct_;
+        s.direct_.assign(old.size(), vec(0));
+        for (const packed_light& l : s.lights_) s.shoot_light(l, true);
+        s.timings_.lights_ms += Solver::ms_since(start);
+        return old;
+    }
+
+    // Equation (2): B and dB raised by rho (delta + the change of the direct irradiance), the
+    // irradiance the shots delivered by delta; the balance's sums kept (emitted: the direct
+    // light's change; the deliveries' change moves power between intercepted and escaped).
+    static void apply(Solver& s, const std::vector<glm::dvec3>& delta, const std::vector<vec>& old_direct) {
+        const lightmap_atlas& at = s.atlas_;
+        const std::size_t n = at.size();
+        glm::dvec3 added(0), corrected(0), absorbed(0);
+        for (std::size_t j = 0; j < s.direct_.size(); ++j) {
+            const glm::dvec3 d = delta.empty() ? glm::dvec3(0) : delta[j];
+            const glm::dvec3 e = glm::dvec3(s.direct_[j]) - glm::dvec3(old_direct[j]);
+            if (d == glm::dvec3(0) && e == glm::dvec3(0)) continue;
+            const glm::dvec3 rho(at.albedo[j % n]);
+            const double area = double(at.area[j % n]);
+            const vec gain = vec(rho * (d + e));
+            s.radiosity_[j] += gain;
+            s.unshot_[j] += gain;
+            s.gathered_[j] += vec(d);
+            added += e * area;
+            corrected += d * area;
+            absorbed += (glm::dvec3(1.0) - rho) * (d + e) * area;
+        }
+        s.emitted_ += added;
+        s.intercepted_ += added + corrected;
+        s.escaped_ -= corrected;
+        s.absorbed_ += absorbed;
+        s.refresh_powers();
+    }
+
+    static radiosity_rebake_report change_light(Solver& s, std::size_t index, const bounce::light& changed) {
+        if (index >= s.lights_.size())
+            throw parameter_error("index", "is light " + std::to_string(index) + " of the scene's " +
+                                               std::to_string(s.lights_.size()) + " (point, spot, directional)");
+        validate_lights(std::span<const bounce::light>(&changed, 1), "changed");
+        const auto start = Solver::clock::now();
+        radiosity_rebake_report r;
+        r.unshot_before = s.unshot_fraction();
+        s.lights_[index] = pack(changed);
+        apply(s, {}, regather_direct(s));
+        r.unshot_after = s.unshot_fraction();
+        r.ms = Solver::ms_since(start);
+        return r;
+    }
+
+    template <class Visibility>
+    static radiosity_rebake_report move_object(Solver& s, const scene_view& moved_scene, std::span<const std::uint32_t> moved,
+                                        const rigid_move& m, Visibility&& visibility) {
+        m.validate();
+        moved_scene.validate();
+        require(moved_scene.triangles.size() == s.atlas_.chart_of_triangle.size(), "moved_scene",
+                "is not the solver's scene moved (triangle counts differ)");
+        const auto start = Solver::clock::now();
+        radiosity_rebake_report r;
+        r.unshot_before = s.unshot_fraction();
+        const std::vector<std::uint8_t> charts = moved_charts(s.atlas_, moved);
+        const moved_boxes boxes = boxes_of_move(moved_scene, moved, m);
+        const glm::vec3 extent = glm::max(boxes.before.hi - boxes.before.lo, glm::vec3(0.f));
+        const float margin = 1e-4f * (glm::length(extent) + glm::length(m.translation)) + 1e-6f;
+        const lightmap_atlas& at = s.atlas_;
+        const std::size_t n = at.size(), blocks = s.first_.size() - 1;
+        std::vector<std::uint8_t> moved_element(n), moved_block(blocks);
+        for (std::size_t i = 0; i < n; ++i) moved_element[i] = charts[at.chart[i]], r.moved_elements += charts[at.chart[i]];
+        for (std::size_t b = 0; b < blocks; ++b) moved_block[b] = charts[at.chart[s.first_[b]]];
+        // A pair's delivery can change only with a moved end or a ray through either box.
+        const auto keep = [&](const glm::vec3& centre, std::uint32_t i) {
+            return moved_element[i] != 0 || segment_meets_box(centre, at.position[i], boxes.before, margin) ||
+                   segment_meets_box(centre, at.position[i], boxes.after, margin);
+        };
+        const std::vector<vec> S = shot(s);
+        std::vector<glm::dvec3> delta(S.size(), glm::dvec3(0));
+        reshoot(s, S, moved_block, keep, -1.0, delta, r);  // the old geometry and visibility
+        move_charts(s.atlas_, charts, m);
+        s.visibility_ = std::forward<Visibility>(visibility);
+        s.build_shooters();  // the moved blocks' centres, the groups' boxes
+        reshoot(s, S, moved_block, keep, 1.0, delta, r);   // the new
+        apply(s, delta, regather_direct(s));
+        r.unshot_after = s.unshot_fraction();
+        r.ms = Solver::ms_since(start);
+        return r;
+    }
+};
+
+/// Light `index` of the solver's scene (its point, spot and directional lights, in the
+/// scene's order) becomes `changed` (any kind, anywhere): the change of every element's direct
+/// irradiance, times its albedo, is added to its radiosity and unshot radiosity (negative
+/// where the light dimmed). Then solve() again. Throws parameter_error ("index", "changed").
+template <shot_visibility Visibility, floating Real>
+radiosity_rebake_report rebake_light(progressive_radiosity<Visibility, Real>& solver, std::size_t index, const light& changed) {
+    return rebake_access<progressive_radiosity<Visibility, Real>>::change_light(solver, index, changed);
+}
+
+/// The triangles `moved` of the solver's scene moved by `move`: `moved_scene` is the scene
+/// after the move (the same triangles, those vertices moved) and `visibility` the visibility
+/// of it (built with the solver's atlas's chart_of_triangle), which the solver keeps. The
+/// state is corrected as radiosity/rebake.hpp derives; then solve() again. Throws
+/// parameter_error ("moved_triangles": out of range, or sharing a chart with unmoved triangles;
+/// "moved_scene"; "rigid_move.*").
+template <shot_visibility Visibility, floating Real>
+radiosity_rebake_report rebake_move(progressive_radiosity<Visibility, Real>& solver, const scene_view& moved_scene,
+                                    std::span<const std::uint32_t> moved, const rigid_move& move, Visibility visibility) {
+    static_assert(std::is_move_assignable_v<Visibility>, "the solver takes the moved scene's visibility in place of its own");
+    return rebake_access<progressive_radiosity<Visibility, Real>>::move_object(solver, moved_scene, moved, move, std::move(visibility));
+}
+
+}  // namespace bounce::cpu

@@ -1,0 +1,183 @@
+#pragma once
+/// \file radiosity/rebake.hpp
+/// Re-baking what changed (issue 30; Chen 1990, "Incremental radiosity", and George et al.
+/// 1990): after one light changes or one object moves rigidly, a progressive solver continues
+/// from its previous solution instead of starting from zero. The CPU solver's re-bakes are
+/// cpu::rebake_light and cpu::rebake_move (cpu/radiosity_rebake.hpp); this file has what they
+/// share with any backend: the rigid move, the moved charts, the atlas moved with them, and
+/// the test that tells which shooter-receiver pairs a move can change.
+///
+/// The state. A progressive solver keeps per element (and side) its radiosity B and its unshot
+/// radiosity dB; S = B - dB is what the element has shot. Every shot keeps
+///     B = E + rho F S                                                      (1)
+/// (E: emission plus the lights' direct deposit rho E_d), and the solve converges to
+/// B* = E + rho F B* as dB -> 0, from any state that satisfies (1). A change makes E' and F'.
+/// The re-bake keeps S and sets
+///     B' = B + (E' - E) + rho (F' - F) S,   dB' = dB + (the same),         (2)
+/// which satisfies (1) for the changed scene; the solve then shoots the new unshot power, of
+/// either sign, and converges to the changed scene's B* as a fresh solve does: exact in the
+/// limit, whatever the previous solve's convergence. The correction is the difference of
+/// what every shooter's S delivers with the new and with the old geometry:
+///  - a light: F' = F, and E' - E is rho times the change of the lights' direct irradiance,
+///    re-evaluated at every element (one light shot);
+///  - a moved object (its charts: a rigid move keeps their texels, so the atlas is reused):
+///    F changes in the rows and columns of the moved elements (all their pairs), and between
+///    two other elements only where the segment between them (the shot's visibility ray, from
+///    the shooter's centre to the receiver) meets the object's box before or after the move.
+///    Every shooter that shot re-shoots its S to exactly those receivers, negatively with the
+///    old geometry and visibility and positively with the new; every other pair's delivery is
+///    the same both times and is skipped (segment_meets_box). The lights' direct deposit is
+///    re-evaluated as for a light change (shadows of the object).
+/// The deliveries use the solver's own shot (block discs, near-field trees, one visibility
+/// ray from the block's centre), so the correction is exact for it but for two things the
+/// history of the previous solve leaves in B and that S alone does not keep: shots scaled
+/// down to their power (shot_scale; the moved object's own shooters are re-shot whole and
+/// scaled, the others' partial re-shots are not) and grouped shooters' sampled visibility
+/// (radiosity_options::shooter_groups: the correction uses the blocks' shot). Both leave an
+/// error of the order of the clamp's or the sampling's share of the corrected light, which
+/// the tests and docs/radiosity.md measure against a fresh solve.
+///
+/// The solve after a re-bake selects shooters by |unshot power| and checks that the unshot
+/// power in magnitude never rises (radiosity/solve.hpp), so negative shots stay conservative.
+
+#include <bounce/errors.hpp>
+#include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/scene_view.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+#include <glm/vec3.hpp>
+
+namespace bounce::inline radiosity {
+
+/// A rigid move: p -> rotation p + translation (rotation orthonormal, determinant +1).
+struct rigid_move {
+    glm::mat3 rotation{1.f};
+    glm::vec3 translation{0.f};
+
+    glm::vec3 point(const glm::vec3& p) const { return rotation * p + translation; }
+    glm::vec3 direction(const glm::vec3& d) const { return rotation * d; }
+    /// The point that `point` moved here.
+    glm::vec3 before(const glm::vec3& p) const { return glm::transpose(rotation) * (p - translation); }
+
+    /// Throws parameter_error ("rigid_move.rotation", "rigid_move.translation") unless the
+    /// rotation is orthonormal with determinant +1 (to 1e-4) and everything is finite.
+    void validate() const {
+        const glm::mat3 e = glm::transpose(rotation) * rotation - glm::mat3(1.f);
+        float off = 0;
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) off = std::max(off, std::abs(e[c][r]));
+        require(off <= 1e-4f && std::abs(glm::determinant(rotation) - 1.f) <= 1e-4f, "rigid_move.rotation",
+                "must be a rotation (orthonormal, determinant +1)");
+        require(std::isfinite(translation.x) && std::isfinite(translation.y) && std::isfinite(translation.z),
+                "rigid_move.translation", "must be finite");
+    }
+};
+
+/// An axis-aligned box (world).
+struct world_box {
+    glm::vec3 lo{std::numeric_limits<float>::max()}, hi{-std::numeric_limits<float>::max()};
+    void add(const glm::vec3& p) { lo = glm::min(lo, p), hi = glm::max(hi, p); }
+    bool empty() const { return lo.x > hi.x; }
+};
+
+/// Whether the segment from `a` to `b` meets `box` (slab test, the box widened by `margin`
+/// on every side): a visibility ray between two points that misses the box of an object, in
+/// either of its places, sees the same occluders before and after the object moves.
+inline bool segment_meets_box(const glm::vec3& a, const glm::vec3& b, const world_box& box, float margin) {
+    float t0 = 0, t1 = 1;
+    for (int k = 0; k < 3; ++k) {
+        const float lo = box.lo[k] - margin, hi = box.hi[k] + margin, d = b[k] - a[k];
+        if (d == 0.f) {
+            if (a[k] < lo || a[k] > hi) return false;
+            continue;
+        }
+        float u = (lo - a[k]) / d, v = (hi - a[k]) / d;
+        if (u > v) std::swap(u, v);
+        t0 = std::max(t0, u), t1 = std::min(t1, v);
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
+/// Per chart of `atlas`, 1 when it holds the triangles `moved` (scene triangle indices).
+/// Throws parameter_error ("moved_triangles") when an index is out of range, or a chart holds
+/// both moved and unmoved triangles (a rigid move must carry whole charts: the object's
+/// triangles share no chart with the rest of the scene).
+inline std::vector<std::uint8_t> moved_charts(const lightmap_atlas& atlas, std::span<const std::uint32_t> moved) {
+    std::vector<std::uint8_t> tri(atlas.chart_of_triangle.size(), 0), charts(atlas.charts.size(), 0);
+    for (const std::uint32_t t : moved) {
+        if (t >= tri.size()) throw parameter_error("moved_triangles", "triangle " + std::to_string(t) + " is not in the scene");
+        tri[t] = 1;
+        if (atlas.chart_of_triangle[t] != lightmap_atlas::none) charts[atlas.chart_of_triangle[t]] = 1;
+    }
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+        if (!charts[c]) continue;
+        const lightmap_chart& ch = atlas.charts[c];
+        for (std::uint32_t k = ch.first_triangle; k < ch.first_triangle + ch.triangle_count; ++k)
+            if (tri[atlas.chart_triangles[k]] == 0)
+                throw parameter_error("moved_triangles", "chart " + std::to_string(c) +
+                                                             " holds moved and unmoved triangles (triangle " +
+                                                             std::to_string(atlas.chart_triangles[k]) +
+                                                             " stays): move whole objects");
+    }
+    return charts;
+}
+
+/// Moves the charts marked in `charts` (moved_charts) and their elements by `move`: positions,
+/// normals and chart frames; texels, areas, blocks and the layout stay.
+inline void move_charts(lightmap_atlas& atlas, const std::vector<std::uint8_t>& charts, const rigid_move& move) {
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+        if (!charts[c]) continue;
+        lightmap_chart& ch = atlas.charts[c];
+        ch.origin = move.point(ch.origin);
+        ch.axis_u = move.direction(ch.axis_u), ch.axis_v = move.direction(ch.axis_v), ch.normal = move.direction(ch.normal);
+    }
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+        if (!charts[atlas.chart[i]]) continue;
+        atlas.position[i] = move.point(atlas.position[i]);
+        atlas.normal[i] = move.direction(atlas.normal[i]);
+    }
+}
+
+/// The boxes of the triangles `moved` of `moved_scene` (the scene after the move) where they
+/// are and where they were before `move`.
+struct moved_boxes {
+    world_box before, after;
+};
+inline moved_boxes boxes_of_move(const scene_view& moved_scene, std::span<const std::uint32_t> moved, const rigid_move& move) {
+    moved_boxes b;
+    for (const std::uint32_t t : moved) {
+        if (t >= moved_scene.triangles.size())
+            throw parameter_error("moved_triangles", "triangle " + std::to_string(t) + " is not in the scene");
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec3 p = moved_scene.positions[moved_scene.triangles[t][k]];
+            b.after.add(p);
+            b.before.add(move.before(p));
+        }
+    }
+    return b;
+}
+
+/// What a re-bake did (cpu::rebake_light, cpu::rebake_move); the solve that follows is the
+/// caller's (solve(radiosity_solve_options) again).
+struct radiosity_rebake_report {
+    double ms = 0;                  ///< wall-clock time of the correction (2), lights included
+    std::size_t moved_elements = 0; ///< elements of the moved charts (0 for a light)
+    std::size_t shooters = 0;       ///< block-sides that had shot and re-shot their S (each twice)
+    std::size_t pairs = 0;          ///< receiver-shooter pairs re-evaluated, both passes counted
+    std::size_t pairs_tested = 0;   ///< receiver-shooter pairs tested against the boxes
+    double unshot_before = 0;       ///< |unshot| power / emitted power before the correction
+    double unshot_after = 0;        ///< the same after it (may exceed 1: a dimmed light)
+};
+
+}  // namespace bounce::radiosity

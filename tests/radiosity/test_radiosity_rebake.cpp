@@ -1,0 +1,200 @@
+// Re-baking what changed (cpu/radiosity_rebake.hpp, radiosity/rebake.hpp): after a light
+// changes or a block moves in a closed box, the solver corrected from its previous solution
+// converges to what a fresh solve of the changed scene converges to; negative unshot power is
+// shot; the energy check counts the unshot power in magnitude and still fires.
+#include "radiosity_scenes.hpp"
+#include "ray_cast_visibility.hpp"
+
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/cpu/radiosity_rebake.hpp>
+#include <bounce/radiosity/rebake.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+using namespace bounce;
+using namespace bounce::radiosity_test;
+
+namespace {
+
+using solver_type = cpu::progressive_radiosity<ray_cast_visibility>;
+constexpr float albedo = 0.7f;
+
+// A closed box 2 m wide with a glowing lamp under its ceiling, a point light and a block
+// 0.4 m on the floor (its top and four sides: triangles 14-23, the last ones).
+owned_scene box_with_block() {
+    owned_scene s = closed_box(2.f, albedo, 3.f);
+    const auto m = s.add_material(glm::vec3(0.6f, 0.7f, 0.5f));
+    const glm::vec3 lo(0.5f, 0.f, 0.5f), hi(0.9f, 0.4f, 0.9f);
+    const auto p = [&](int x, int y, int z) { return glm::vec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z); };
+    s.add_quad(p(0, 1, 0), p(0, 1, 1), p(1, 1, 1), p(1, 1, 0), m);  // top, +y
+    s.add_quad(p(0, 0, 0), p(1, 0, 0), p(1, 1, 0), p(0, 1, 0), m);  // -z
+    s.add_quad(p(0, 0, 1), p(0, 1, 1), p(1, 1, 1), p(1, 0, 1), m);  // +z
+    s.add_quad(p(0, 0, 0), p(0, 1, 0), p(0, 1, 1), p(0, 0, 1), m);  // -x
+    s.add_quad(p(1, 0, 0), p(1, 0, 1), p(1, 1, 1), p(1, 1, 0), m);  // +x
+    s.lights.push_back(point_light{glm::vec3(1.3f, 1.5f, 1.2f), glm::vec3(2.f)});
+    return s;
+}
+
+std::vector<std::uint32_t> block_triangles() {
+    std::vector<std::uint32_t> t(10);
+    std::iota(t.begin(), t.end(), 14u);
+    return t;
+}
+
+radiosity_solve_options to(double converge) {
+    radiosity_solve_options o;
+    o.converge = converge;
+    o.measure = radiosity_measure::emitted;
+    return o;
+}
+
+// |B_a - B_b| summed over elements, sides and channels, times area, over the same of |B_b|.
+double relative_l1(const solver_type& a, const solver_type& b) {
+    double diff = 0, total = 0;
+    for (int side = 0; side < a.sides(); ++side) {
+        const auto ra = a.radiosity(side), rb = b.radiosity(side);
+        for (std::size_t i = 0; i < ra.size(); ++i) {
+            const double area = a.atlas().area[i];
+            const glm::dvec3 d = glm::abs(glm::dvec3(ra[i]) - glm::dvec3(rb[i]));
+            diff += (d.x + d.y + d.z) * area;
+            total += (std::abs(rb[i].x) + std::abs(rb[i].y) + std::abs(rb[i].z)) * area;
+        }
+    }
+    return diff / total;
+}
+
+// How far two solves that each left `u` of the emitted power unshot (in magnitude) may lie
+// apart: the unshot power dB of a solve is what separates it from the converged answer,
+// which it would raise by (I - rho F)^-1 rho F dB, at most rho / (1 - rho) |dB| in power.
+double convergence_bound(const solver_type& a, const solver_type& b) {
+    double total = 0;
+    for (int side = 0; side < b.sides(); ++side) {
+        const auto rb = b.radiosity(side);
+        for (std::size_t i = 0; i < rb.size(); ++i) total += (rb[i].x + rb[i].y + rb[i].z) * b.atlas().area[i];
+    }
+    const double e = a.emitted_power().x + a.emitted_power().y + a.emitted_power().z;
+    const double f = b.emitted_power().x + b.emitted_power().y + b.emitted_power().z;
+    return albedo / (1 - albedo) * (a.unshot_fraction() * e + b.unshot_fraction() * f) / total;
+}
+
+double negative_unshot(const solver_type& s) {
+    double neg = 0;
+    for (int side = 0; side < s.sides(); ++side)
+        for (const auto& u : s.unshot(side)) neg += std::min(0.f, u.x) + std::min(0.f, u.y) + std::min(0.f, u.z);
+    return neg;
+}
+
+// A solver whose unshot fraction (in magnitude) follows a script from `start`.
+struct scripted_solver {
+    double start;
+    std::vector<double> fractions;
+    std::size_t steps = 0;
+    bool step() { return steps < fractions.size() ? (++steps, true) : false; }
+    double unshot_fraction() const { return steps == 0 ? start : fractions[steps - 1]; }
+    radiosity_progress progress() const { return {steps, steps, unshot_fraction(), 0.0}; }
+    glm::dvec3 emitted_power() const { return glm::dvec3(1, 0, 0); }
+    glm::dvec3 unshot_power() const { return glm::dvec3(unshot_fraction(), 0, 0); }
+    glm::dvec3 intercepted_power() const { return glm::dvec3(1, 0, 0); }
+};
+
+}  // namespace
+
+TEST_CASE("a re-bake after a light change converges to the fresh solve of the changed scene", "[radiosity][rebake]") {
+    const owned_scene s = box_with_block();
+    const lightmap_atlas atlas = build_lightmap_atlas(s.view(), {.elements = 600});
+    for (const float scale : {0.25f, 0.f, 3.f}) {
+        CAPTURE(scale);
+        owned_scene changed = s;
+        changed.lights[0] = point_light{glm::vec3(1.3f, 1.5f, 1.2f), glm::vec3(2.f * scale)};
+        solver_type rebaked(s.view(), atlas, ray_cast_visibility{&s, &atlas});
+        rebaked.solve(to(0.99));
+        const std::size_t shots_before = rebaked.progress().shots;
+        const auto r = cpu::rebake_light(rebaked, 0, changed.lights[0]);
+        CHECK(r.unshot_after != r.unshot_before);
+        // Dimmed, the lit elements hold negative unshot power, which the solve shoots away.
+        if (scale < 1) CHECK(negative_unshot(rebaked) < 0);
+        rebaked.solve(to(0.999));
+        CHECK(rebaked.progress().shots > shots_before);
+        CHECK(rebaked.unshot_fraction() <= 1e-3);
+        solver_type fresh(changed.view(), atlas, ray_cast_visibility{&changed, &atlas});
+        fresh.solve(to(0.999));
+        const double bound = convergence_bound(rebaked, fresh);
+        CAPTURE(bound);
+        CHECK(relative_l1(rebaked, fresh) <= 2 * bound);
+        CHECK(rebaked.emitted_power().x == Approx(fresh.emitted_power().x).epsilon(1e-5));
+    }
+}
+
+TEST_CASE("a re-bake after moving the block converges to the fresh solve of the moved scene", "[radiosity][rebake]") {
+    const owned_scene s = box_with_block();
+    const lightmap_atlas atlas = build_lightmap_atlas(s.view(), {.elements = 600});
+    rigid_move move;
+    move.translation = {0.5f, 0.f, 0.3f};
+    owned_scene moved = s;
+    for (std::size_t v = 4 * 7; v < moved.positions.size(); ++v) moved.positions[v] = move.point(moved.positions[v]);
+    const auto tris = block_triangles();
+    // The fresh solve on the same elements moved (the atlas of the moved scene may differ by rounding).
+    lightmap_atlas moved_atlas = atlas;
+    move_charts(moved_atlas, moved_charts(atlas, tris), move);
+
+    solver_type rebaked(s.view(), atlas, ray_cast_visibility{&s, &atlas});
+    rebaked.solve(to(0.99));
+    const auto r = cpu::rebake_move(rebaked, moved.view(), tris, move, ray_cast_visibility{&moved, &moved_atlas});
+    CHECK(r.moved_elements > 0);
+    CHECK(r.shooters > 0);
+    // Pairs whose rays miss the block's two boxes were skipped.
+    CHECK(r.pairs < r.pairs_tested);
+    CHECK(negative_unshot(rebaked) < 0);  // the block's old shadow's light taken back and its old place's light
+    rebaked.solve(to(0.999));
+    CHECK(rebaked.atlas().position == moved_atlas.position);
+
+    solver_type fresh(moved.view(), moved_atlas, ray_cast_visibility{&moved, &moved_atlas});
+    fresh.solve(to(0.999));
+    const double bound = convergence_bound(rebaked, fresh);
+    CAPTURE(bound, rebaked.clamped_shots(), fresh.clamped_shots());
+    // Besides convergence the re-bake may differ by the shots scaled to their power
+    // (shot_scale) in the closed box's corners, whose partial re-shots are not (rebake.hpp):
+    // here within the convergence's bound (0.0027 against 0.0059).
+    const double err = relative_l1(rebaked, fresh);
+    CAPTURE(err);
+    CHECK(err <= 2 * bound);
+    // Without the correction (the moved state solved on), the error is the block's move itself.
+    solver_type stale(s.view(), atlas, ray_cast_visibility{&s, &atlas});
+    stale.solve(to(0.999));
+    CHECK(relative_l1(stale, fresh) > 5 * err);
+}
+
+TEST_CASE("a re-bake's bad input is refused by name", "[radiosity][rebake][errors]") {
+    const owned_scene s = box_with_block();
+    const lightmap_atlas atlas = build_lightmap_atlas(s.view(), {.elements = 300});
+    solver_type solver(s.view(), atlas, ray_cast_visibility{&s, &atlas});
+    CHECK_THROWS_WITH(cpu::rebake_light(solver, 1, s.lights[0]), Catch::Contains("index"));
+    CHECK_THROWS_WITH(cpu::rebake_light(solver, 0, point_light{glm::vec3(0.f), glm::vec3(-1.f)}), Catch::Contains("changed"));
+    rigid_move m;
+    // A wall's triangle without its other half: the chart would tear.
+    const std::vector<std::uint32_t> half{0};
+    CHECK_THROWS_WITH(cpu::rebake_move(solver, s.view(), half, m, ray_cast_visibility{&s, &atlas}),
+                      Catch::Contains("moved_triangles"));
+    m.rotation[0][0] = 2;
+    CHECK_THROWS_WITH(cpu::rebake_move(solver, s.view(), block_triangles(), m, ray_cast_visibility{&s, &atlas}),
+                      Catch::Contains("rigid_move.rotation"));
+}
+
+TEST_CASE("the energy check counts the unshot power in magnitude: a re-bake may start above the emitted power, never rise",
+          "[radiosity][rebake][errors]") {
+    const auto run = [](scripted_solver& s) { return detail::run_radiosity_solve(s, {}, [](std::size_t) { return std::size_t(0); }); };
+    // A dimmed light leaves more unshot power (in magnitude) than the scene now emits; it falls.
+    scripted_solver falling{2.5, {2.0, 1.1, 0.6, 0.05}};
+    CHECK_NOTHROW(run(falling));
+    // A rise from there is energy created, named.
+    scripted_solver rising{2.5, {2.0, 2.2}};
+    CHECK_THROWS_WITH(run(rising), Catch::Contains("step 2") && Catch::Contains("rose from 2 to 2.2"));
+    // Above where the solve began: also refused, even without a rise between the sums checked.
+    scripted_solver above{0.5, {0.6}};
+    CHECK_THROWS_AS(run(above), radiosity_error);
+}
