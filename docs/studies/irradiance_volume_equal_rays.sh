@@ -9,7 +9,11 @@
 # and with its stored probes baked again with the grid's total rays spread over them
 # (equal total rays). Results: docs/results/irradiance_volume_equal_rays.json; table:
 # docs/studies/irradiance_volume_equal_rays.py. A few minutes a scene on 2 shared cores.
-# Usage: docs/studies/irradiance_volume_equal_rays.sh [SCENE...]   (BOUNCE_BIN: default build/bin; BOUNCE_RUNS: default build/runs)
+# MODE=fixed: tolerances 1, 3, 8 only, each octree also with 512 rays a probe (equal rays
+# per probe, nothing pooled), runs "equal-rays-512-SCENE". MODE=floor: the Cornell boxes'
+# path only, with 4096-sample references (the path measure's noise floor), runs
+# "equal-rays-floor-SCENE".
+# Usage: [MODE=fixed|floor] docs/studies/irradiance_volume_equal_rays.sh [SCENE...]   (BOUNCE_BIN: default build/bin; BOUNCE_RUNS: default build/runs)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 bin="${BOUNCE_BIN:-build/bin}/irradiance_volume"
@@ -18,10 +22,19 @@ results=docs/results/irradiance_volume_equal_rays.json
 mkdir -p "$out"
 scenes=("$@")
 [[ ${#scenes[@]} -gt 0 ]] || scenes=(cornell cornell-box bunny living-room modern-hall sponza conference)
+mode="${MODE:-main}"
+tolerances=(0.1 0.2 0.35 0.5 0.75 1 1.5 2 3 5 8)
+extra=(--sweep-surface)
+name=equal-rays
+case "$mode" in
+  fixed) tolerances=(1 3 8); name=equal-rays-512 ;;
+  floor) tolerances=(1 3 8); name=equal-rays-floor; extra=(--ref-samples 4096)
+         [[ $# -gt 0 ]] || scenes=(cornell cornell-box) ;;
+esac
 for sc in "${scenes[@]}"; do
   "$bin" --scene "$sc" --mode uniform --max-depth 4 --noise-estimate rotated-repeat --calibrate-noise off \
     --gradient-step 0 --hanging-corners computed --bias-tolerance-unit noise --sweep-depths 4 \
-    --sweep-bias-tolerance 0.1 0.2 0.35 0.5 0.75 1 1.5 2 3 5 8 --sweep-surface --sweep-equal-rays 4 \
-    --json "$out/equal-rays-$sc.json" 2>/dev/null | grep -E "^(grid|sweep|rebaked|$sc)"
-  python3 docs/studies/results.py add "$results" "equal-rays-$sc" "$out/equal-rays-$sc.json"
+    --sweep-bias-tolerance "${tolerances[@]}" "${extra[@]}" --sweep-equal-rays 4 \
+    --json "$out/$name-$sc.json" 2>/dev/null | grep -E "^(grid|sweep|rebaked|$sc)"
+  python3 docs/studies/results.py add "$results" "$name-$sc" "$out/$name-$sc.json"
 done

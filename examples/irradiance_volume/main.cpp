@@ -99,6 +99,7 @@ int run(const options& o) {
     if (!o.json.empty()) io::check_output_file("--json", o.json);
     if (!o.out.empty()) io::check_image_output("--out", o.out);
     check_memory(o);
+    examples::check_volume_options(o);
     std::optional<tbb::global_control> threads;
     if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
 
@@ -210,7 +211,7 @@ int run(const options& o) {
         embree::probe_baker_settings more = bs;  // --sweep-equal-rays: the same probes with more rays
         more.rays = rays, more.progress = {};
         embree::probe_baker(light, bvh, scene, more)(at, out);
-    }, std::uint64_t(irradiance_volume::uniform_probe_count(std::max(0, o.sweep_equal_rays))) * o.rays};
+    }, std::uint64_t(irradiance_volume::uniform_probe_count(std::max(0, o.sweep_equal_rays))) * o.rays, o.rays};
     const auto* rebaking = o.sweep_equal_rays >= 0 ? &rebake : nullptr;
     const auto sweep = o.sweep_depths.empty()
                            ? study::bias_budget_sweep(scene, lo, hi, merged, memo, sphere, o.sweep, o.sweep_sigmas,

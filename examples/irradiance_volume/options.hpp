@@ -135,8 +135,8 @@ inline void add_volume_options(CLI::App& app, volume_options& o) {
     app.add_flag("--sweep-surface", o.sweep_surface, "also measure the sweep's octrees at the camera's surface points "
                                                      "(--surface-size, --ref-samples)");
     app.add_option("--sweep-equal-rays", o.sweep_equal_rays, "also measure each of the sweep's octrees with its probes baked "
-                                                             "again with the total rays of the uniform grid of this depth "
-                                                             "(needs --hanging-corners computed)")
+                                                             "again with the total rays of the uniform grid of this depth, "
+                                                             "and with --rays each (needs --hanging-corners computed)")
         ->check(CLI::Range(0, irradiance_volume::depth_limit));
     add_choice(app, "--hanging-corners", o.hanging, hanging_names,
                "adaptive: a probe at each T-junction corner (stored), or none, interpolated by the trilinear lookup");
@@ -161,6 +161,13 @@ inline void add_volume_options(CLI::App& app, volume_options& o) {
         ->check(CLI::IsMember({"on", "off"}));
     app.add_option("--self-shadow-bias", o.self_shadow_bias, "visibility test's self-shadow bias (fraction of 0.75 cell)")
         ->check(detail::number_in(0, 4, true, "a bias"));
+}
+
+/// Refuses options that need another: --sweep-equal-rays bakes the octrees' stored probes
+/// again, which needs their hanging corners computed (a stored one would keep the old light).
+inline void check_volume_options(const volume_options& o) {
+    if (o.sweep_equal_rays >= 0 && o.hanging != hanging_corner_storage::computed)
+        throw parameter_error("--sweep-equal-rays", "bakes the sweep's stored probes again, which needs --hanging-corners computed");
 }
 
 /// The build's settings from the options (memory_limit_bytes left to the caller).

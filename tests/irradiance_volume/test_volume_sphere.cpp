@@ -203,4 +203,33 @@ TEST_CASE("a probe memo bakes each position once, and a sweep's octrees come fro
     CHECK_THROWS_AS(study::volume_depth_sweep(s, lo, hi, vs, memo, sphere, std::vector<int>{11}, {}, {}), parameter_error);
     CHECK_THROWS_AS(study::bias_tolerance_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{0.f}), parameter_error);
     CHECK_THROWS_AS(study::probe_memo(nullptr), parameter_error);
+    // Equal total rays: each merged octree again with its stored probes baked with the
+    // grid's 125 x 64 rays spread over them, and with 64 each; computed hanging corners
+    // are not among the probes. Stored ones are refused by name.
+    std::vector<std::uint32_t> asked;
+    const study::volume_rebake rebake{[&](std::uint32_t rays, std::span<const glm::vec3> at, std::span<irradiance_probe> out) {
+        asked.push_back(rays);
+        embree::probe_baker_settings more = bs;
+        more.rays = rays;
+        embree::probe_baker(light, bvh, s, more)(at, out);
+    }, 125 * 64, 64};
+    vs.hanging_corners = hanging_corner_storage::computed;
+    const auto rebaked = study::bias_tolerance_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{10.f}, {}, nullptr, &rebake);
+    REQUIRE(rebaked.size() == 3);
+    CHECK(memo.baked() == 125);  // the rebakes do not go through the memo
+    CHECK(rebaked[0].rays_per_probe == 0);
+    CHECK(rebaked[1].rays_per_probe == 125 * 64 / rebaked[0].probes);
+    CHECK(rebaked[1].rays_per_probe > 64);
+    CHECK(rebaked[2].rays_per_probe == 64);
+    CHECK((rebaked[1].probes == rebaked[0].probes && rebaked[1].leaves == rebaked[0].leaves));
+    CHECK(asked == std::vector<std::uint32_t>{rebaked[1].rays_per_probe, 64u});
+    CHECK(rebaked[1].trilinear.error.rel_rms != rebaked[0].trilinear.error.rel_rms);  // other probes, the same layout
+    CHECK(study::to_json(rebaked)[1]["rays_per_probe"] == rebaked[1].rays_per_probe);
+    vs.hanging_corners = hanging_corner_storage::stored;
+    try {
+        (void)study::bias_tolerance_sweep(s, lo, hi, vs, memo, sphere, std::vector<float>{10.f}, {}, nullptr, &rebake);
+        if (by_depth[7].hanging > 0) FAIL("a rebake of stored hanging corners was accepted");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "volume");
+    }
 }

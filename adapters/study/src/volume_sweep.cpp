@@ -102,15 +102,18 @@ std::vector<volume_sweep_point> merge_sweep(const scene_view& scene, glm::vec3 l
             p.noise_sigmas = k;
             print_point("sweep", p);
             out.push_back(p);
-            if (!rebake || !rebake->bake || volume.stored_hanging_corners() > 0) continue;
-            irradiance_volume again = volume;  // the same layout, its probes baked with the total rays
-            const auto rays = std::uint32_t(std::max<std::uint64_t>(1, rebake->total_rays / std::max<std::size_t>(1, volume.probes().size())));
-            again.rebake([&](std::span<const glm::vec3> at, std::span<irradiance_probe> baked) { rebake->bake(rays, at, baked); });
-            volume_sweep_point q = measure_point(again, stats, sphere, surface);
-            q.max_depth = p.max_depth, q.bias_budget = p.bias_budget, q.bias_tolerance = p.bias_tolerance, q.noise_sigmas = k;
-            q.rays_per_probe = rays;
-            print_point("rebaked", q);
-            out.push_back(std::move(q));
+            if (!rebake || !rebake->bake) continue;  // rebake refuses stored hanging corners by name
+            const auto total = std::uint32_t(std::max<std::uint64_t>(1, rebake->total_rays / std::max<std::size_t>(1, volume.probes().size())));
+            for (const std::uint32_t rays : {total, rebake->fixed_rays}) {
+                if (rays == 0) continue;
+                irradiance_volume again = volume;  // the same layout, its probes baked with `rays` each
+                again.rebake([&](std::span<const glm::vec3> at, std::span<irradiance_probe> baked) { rebake->bake(rays, at, baked); });
+                volume_sweep_point q = measure_point(again, stats, sphere, surface);
+                q.max_depth = p.max_depth, q.bias_budget = p.bias_budget, q.bias_tolerance = p.bias_tolerance, q.noise_sigmas = k;
+                q.rays_per_probe = rays;
+                print_point("rebaked", q);
+                out.push_back(std::move(q));
+            }
         }
     }
     return out;

@@ -72,6 +72,9 @@ struct volume_sweep_point {
 struct volume_rebake {
     std::function<void(std::uint32_t, std::span<const glm::vec3>, std::span<irradiance_probe>)> bake;
     std::uint64_t total_rays = 0;  ///< e.g. the uniform grid's probes times its rays per probe
+    /// > 0: each octree is also measured with its stored probes baked again with this many
+    /// rays each (equal rays per probe, nothing pooled by the refit)
+    std::uint32_t fixed_rays = 0;
 };
 
 /// For every budget (> 0, finite) and every noise_sigmas (>= 0, finite; empty: settings'
