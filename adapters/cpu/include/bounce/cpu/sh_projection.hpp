@@ -331,15 +331,31 @@ private:
         }
     }
 
+    // Calls f(odd, k, g) (integral constants) for the coefficients parity_order_[k .. k + g)
+    // of one parity, `Width` at a time.
+    template <bool Odd, std::size_t Width, std::size_t First = 0, class F>
+    static void for_groups(F&& f) {
+        constexpr std::size_t begin = Odd ? even_count : 0, end = Odd ? coefficients : even_count;
+        if constexpr (begin + First < end) {
+            f(std::bool_constant<Odd>{}, std::integral_constant<std::size_t, begin + First>{},
+              std::integral_constant<std::size_t, std::min(Width, end - begin - First)>{});
+            for_groups<Odd, Width, First + Width>(f);
+        }
+    }
+
     void multiply(const float* planes, std::size_t padded, const float* w, float* acc) const {
         switch (kind_) {
 #if BOUNCE_SH_PROJECTION_AVX2
-            case kind::avx512:
-                multiply_avx512<false, 0>(planes, padded, w, acc);
-                return multiply_avx512<true, 0>(planes, padded, w, acc);
-            case kind::avx2:
-                multiply_avx2<false, 0>(planes, padded, w, acc);
-                return multiply_avx2<true, 0>(planes, padded, w, acc);
+            case kind::avx512: {
+                const auto group = [&](auto odd, auto k, auto g) { group_avx512<odd(), k(), g()>(planes, padded, w, acc); };
+                for_groups<false, 9>(group);
+                return for_groups<true, 9>(group);
+            }
+            case kind::avx2: {
+                const auto group = [&](auto odd, auto k, auto g) { group_avx2<odd(), k(), g()>(planes, padded, w, acc); };
+                for_groups<false, 3>(group);
+                return for_groups<true, 3>(group);
+            }
 #endif
             default: multiply_portable(planes, padded, w, acc);
         }
@@ -414,16 +430,6 @@ private:
         deinterleave_portable(src + x, texels - x, r + x, g + x, b + x);
     }
 
-    // Pass over the coefficients parity_order_[Begin + First ...] of one parity, G at a time.
-    template <bool Odd, std::size_t First>
-    void multiply_avx2(const float* planes, std::size_t padded, const float* w0, float* acc) const {
-        constexpr std::size_t begin = Odd ? even_count : 0, end = Odd ? coefficients : even_count;
-        if constexpr (begin + First < end) {
-            group_avx2<Odd, begin + First, std::min<std::size_t>(3, end - begin - First)>(planes, padded, w0, acc);
-            multiply_avx2<Odd, First + 3>(planes, padded, w0, acc);
-        }
-    }
-
     // The products with 256-bit FMAs, G coefficients at a time: 3 G accumulators, the three
     // sums (or differences) of the pair and one weight vector in registers.
     template <bool Odd, std::size_t K, std::size_t G>
@@ -478,15 +484,6 @@ private:
                                                                     _mm512_load_si512(from_tc[c]), v[2]));
         }
         deinterleave_portable(src + x, texels - x, r + x, g + x, b + x);
-    }
-
-    template <bool Odd, std::size_t First>
-    void multiply_avx512(const float* planes, std::size_t padded, const float* w0, float* acc) const {
-        constexpr std::size_t begin = Odd ? even_count : 0, end = Odd ? coefficients : even_count;
-        if constexpr (begin + First < end) {
-            group_avx512<Odd, begin + First, std::min<std::size_t>(9, end - begin - First)>(planes, padded, w0, acc);
-            multiply_avx512<Odd, First + 9>(planes, padded, w0, acc);
-        }
     }
 
     // The products, G <= 9 coefficients a pass: 3 G accumulators and the pair's three sums
