@@ -16,14 +16,12 @@ crossing interpolated ("<= s": already at the sparsest; "none": never, with its 
 
 Usage: python3 docs/studies/irradiance_volume_equal_rays.py [RESULTS]"""
 import json
+import os
 import sys
 
-SCENES = ["cornell", "cornell-box", "bunny", "living-room", "modern-hall", "sponza", "conference"]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from irradiance_volume_deeper import SCENES, err, share_at  # noqa: E402  (the same frontier and crossing)
 FAMILIES = ("pooled", "total", "512")
-
-
-def err(p, measure):
-    return p["rel_rms"] if measure == "path" else p["surface"]["all"]["rel_rms"]
 
 
 def grid(run):
@@ -45,23 +43,6 @@ def family(run, kind):
             out.append(p)
             last = None
     return out
-
-
-def share_at(pts, n, target, measure):
-    pts = sorted((p["probes"] / n, err(p, measure)) for p in pts)
-    front, best = [], float("inf")
-    for s, e in pts:
-        if e < best:
-            front.append((s, e))
-            best = e
-    for i, (s, e) in enumerate(front):
-        if e <= target:
-            if i == 0:
-                return f"<= {100 * s:.0f}%", s
-            s0, e0 = front[i - 1]
-            return f"{100 * (s0 + (s - s0) * (e0 - target) / (e0 - e)):.0f}%", s0 + (s - s0) * (e0 - target) / (e0 - e)
-    s, e = min(front, key=lambda f: f[1])
-    return f"none ({100 * s:.0f}% at {e:.4f})", None
 
 
 def main():
