@@ -264,3 +264,65 @@ TEST_CASE("bad view selection parameters are refused by name", "[rsm][view_selec
     o.view_selection.receivers = 0;
     CHECK_THROWS_WITH(o.validate(), Catch::Contains("view_selection.receivers"));
 }
+
+TEST_CASE("the near field finds the pixels in each candidate's ball and weighs them against the grid's",
+          "[rsm][view_selection]") {
+    small_scene s;
+    const gbuffer_view<float> gb = s.gb.view();
+    const double stride = receiver_stride(8, 8, 16);
+    REQUIRE(stride == 2.0);
+    const cpu::near_pixels pixels(gb, 0.1f);
+    std::vector<view_receiver> out;
+    for (const auto& [centre, radius] : {std::pair{glm::vec3(0.1f, 0.05f, -0.2f), 0.4f},
+                                         std::pair{glm::vec3(-0.9f, 0.f, -0.9f), 0.3f},
+                                         std::pair{glm::vec3(0.f, 0.f, 0.f), 5.f}}) {
+        pixels.within(centre, radius, stride, 1024, out);
+        std::size_t want = 0;
+        for (std::size_t y = 0; y < 8; ++y)
+            for (std::size_t x = 0; x < 8; ++x)
+                want += gb.covered(x, y) && glm::length(glm::vec3(gb.position(x, y)) - centre) < radius ? 1 : 0;
+        CHECK(out.size() == want);
+        for (const view_receiver& r : out) {
+            CHECK(glm::length(r.position - centre) < radius);
+            CHECK(r.weight == Approx(0.5f * near_field_weight(stride, want, want)));
+        }
+    }
+    // At most `cap`, each then standing for found / taken pixels.
+    pixels.within(glm::vec3(0.f), 5.f, stride, 9, out);
+    CHECK(out.size() == 9);
+    CHECK(out[0].weight == Approx(0.5 * std::sqrt(63.0 / 9.0) / stride));
+    CHECK(near_field_radius(4.f, 0.25f) == 2.f);
+    CHECK(near_field_radius(0.f, 0.25f) == 0.f);
+    CHECK(combined_importance(3.0, 4.0) == Approx(5.0));
+}
+
+TEST_CASE("a sender's peak between the grid's receivers is measured with the near field",
+          "[rsm][view_selection]") {
+    // Two senders 2 cm above the floor, one over a grid receiver (pixel 1, 1 of the 2-pixel
+    // grid), one over a pixel between receivers (2, 2): without the near field the grid sees
+    // the first's peak and only the far tail of the second's; with it both are measured alike.
+    small_scene s;
+    const gbuffer_view<float> gb = s.gb.view();
+    const auto above = [&](std::size_t x, std::size_t y) {
+        return vpl{glm::vec3(gb.position(x, y)) + glm::vec3(0.f, 0.02f, 0.f), {0.f, -1.f, 0.f}, glm::vec3(1.f), 1e-4f};
+    };
+    const std::vector<vpl> senders{above(1, 1), above(2, 2)};
+    const float d2 = 0.0004f;  // the clamp at 2 cm
+    const auto terms = [&](const vpl& c, const view_receiver& r, auto&& add) {
+        const glm::vec3 d = c.position - r.position;
+        add(1.f / std::max(glm::dot(d, d), d2), visibility_segment{r.position, r.normal, c.position, c.normal});
+    };
+    const std::vector<view_receiver> grid = view_receivers(gb, 16);
+    const std::vector<double> plain = cpu::view_importances<vpl>(senders, grid, nullptr, terms);
+    CHECK(plain[0] > 20 * plain[1]);
+    const float radius = near_field_radius(4.f, d2);
+    const auto far_terms = [&](const vpl& c, const view_receiver& r, auto&& add) {
+        if (glm::length(r.position - c.position) >= radius) terms(c, r, add);
+    };
+    const std::vector<double> far = cpu::view_importances<vpl>(senders, grid, nullptr, far_terms);
+    const cpu::near_pixels pixels(gb, radius);
+    const std::vector<double> near = cpu::near_field_importances<vpl>(
+        senders, pixels, receiver_stride(8, 8, 16), nullptr, [&](const vpl&) { return radius; }, terms);
+    const double t0 = combined_importance(far[0], near[0]), t1 = combined_importance(far[1], near[1]);
+    CHECK(t1 == Approx(t0).epsilon(0.05));
+}

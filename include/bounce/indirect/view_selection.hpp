@@ -63,6 +63,10 @@ struct view_selection_params {
     /// The share of the mixture that keeps the candidates' own distribution, (0, 1]
     /// (typical 0.3; 1: uniform over the candidates, no view importance).
     float defensive = 0.3f;
+    /// The near field, in clamp distances (>= 0; 0: off; typical 4): each candidate is also
+    /// measured at every covered pixel within this many of its own 1/d^2 clamp distances,
+    /// the peak that falls between the grid's receivers (near_field_radius).
+    float near_field = 4.f;
 
     bool operator==(const view_selection_params&) const = default;
     bool enabled() const noexcept { return candidates > 1; }
@@ -72,6 +76,8 @@ struct view_selection_params {
         require(receivers >= 1, "view_selection.receivers", "must be positive");
         require(std::isfinite(defensive) && defensive > 0.f && defensive <= 1.f, "view_selection.defensive",
                 "must lie in (0, 1]");
+        require(std::isfinite(near_field) && near_field >= 0.f && near_field <= 64.f, "view_selection.near_field",
+                "must lie in [0, 64]");
     }
 };
 
@@ -83,6 +89,13 @@ struct view_receiver {
     float weight = 1.f;
 };
 
+/// The side, in pixels, of the square of pixels each of view_receivers' `count` receivers
+/// stands for on a w x h image (at least 1).
+inline double receiver_stride(std::size_t w, std::size_t h, std::size_t count) {
+    require(count > 0, "receivers", "must be positive");
+    return std::max(1.0, std::sqrt(double(w) * double(h) / double(count)));
+}
+
 /// The covered pixels of `gb` on a regular grid of about `count` cells over the image (the
 /// pixel at each cell's centre; uncovered ones skipped), row by row.
 template <class T>
@@ -91,7 +104,7 @@ std::vector<view_receiver> view_receivers(const gbuffer_view<T>& gb, std::size_t
     std::vector<view_receiver> out;
     const std::size_t w = gb.width(), h = gb.height();
     if (w == 0 || h == 0) return out;
-    const double stride = std::max(1.0, std::sqrt(double(w) * double(h) / double(count)));
+    const double stride = receiver_stride(w, h, count);
     for (double y = stride / 2; y < double(h); y += stride)
         for (double x = stride / 2; x < double(w); x += stride) {
             const auto u = std::size_t(x), v = std::size_t(y);
@@ -139,6 +152,30 @@ double view_importance(std::span<const view_receiver> receivers, Terms&& terms, 
     }
     return std::sqrt(sum2);
 }
+
+/// The near field of a candidate clamped at d^2 >= min_distance2: the ball of `near_field`
+/// clamp distances around it. Its irradiance's square integrated over a receiving surface,
+/// int 1 / max(d^2, d_min^2)^2 dA, comes for (1 - 1 / near_field^2) of its part beyond d_min
+/// from inside that ball (15/16 at 4): the peak of a sender next to a surface, narrower than
+/// the grid's stride wherever the clamp distance is below a few pixels' footprint, so the
+/// grid misses it or, landing on it, counts it for stride^2 pixels. The receivers in the
+/// ball are measured each for itself (near_field_weight) and the grid's receivers inside it
+/// are left out: one sum over the image's pixels, its near part exact.
+inline float near_field_radius(float near_field, float min_distance2) noexcept {
+    const float r = near_field * std::sqrt(std::max(0.f, min_distance2));
+    return std::isfinite(r) ? r : 0.f;
+}
+
+/// The factor on a near-field receiver's term, relative to a grid receiver's (standing for
+/// stride^2 pixels, so 1 / stride on the term before it is squared), when `taken` of the
+/// `found` pixels in the ball are measured (each then standing for found / taken of them).
+inline float near_field_weight(double stride, std::size_t found, std::size_t taken) noexcept {
+    return taken == 0 ? 0.f : float(std::sqrt(double(found) / double(taken)) / stride);
+}
+
+/// t of a candidate from its grid part and its near part (each view_importance's root of the
+/// summed squares, over receivers that do not overlap): the root of the sum of both squares.
+inline double combined_importance(double grid, double near) noexcept { return std::sqrt(grid * grid + near * near); }
 
 /// P_j = defensive / M + (1 - defensive) t_j / sum t (uniform where the sum is 0 or not
 /// finite). Every P_j >= defensive / M > 0; they sum to 1.
