@@ -53,6 +53,7 @@
 #include <tbb/parallel_for.h>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <cpuid.h>
 #include <immintrin.h>
 #define BOUNCE_SH_PROJECTION_AVX2 1
 #else
@@ -188,7 +189,10 @@ private:
     static kind choose(sh_projection_path path) noexcept {
 #if BOUNCE_SH_PROJECTION_AVX2
         if (path == sh_projection_path::portable) return kind::portable;
-        const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+        // F16C through CPUID leaf 1 (ECX bit 29): Clang 14's __builtin_cpu_supports does not know it.
+        unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+        const bool f16c = __get_cpuid(1, &eax, &ebx, &ecx, &edx) && (ecx & (1u << 29));
+        const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && f16c;
         if (avx2 && path == sh_projection_path::automatic && __builtin_cpu_supports("avx512f") &&
             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
             return kind::avx512;
