@@ -51,6 +51,8 @@ def main():
     kinds = {"512": {}, "floor": {}, "main": {}}
     for r in every:
         rest = r["name"].removeprefix("equal-rays-")
+        if rest.startswith("lookup-"):
+            continue  # MODE=lookup: two program runs, read by hand
         kind = next((k for k in ("512", "floor") if rest.startswith(k + "-")), "main")
         kinds[kind][rest.removeprefix(kind + "-") if kind != "main" else rest] = r
     runs = kinds["main"]

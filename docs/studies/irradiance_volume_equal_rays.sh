@@ -12,7 +12,8 @@
 # MODE=fixed: tolerances 1, 3, 8 only, each octree also with 512 rays a probe (equal rays
 # per probe, nothing pooled), runs "equal-rays-512-SCENE". MODE=floor: the Cornell boxes'
 # path only, with 4096-sample references (the path measure's noise floor), runs
-# "equal-rays-floor-SCENE".
+# "equal-rays-floor-SCENE". MODE=lookup: the program's adaptive octree on the Cornell box with
+# hanging corners stored and computed (probes, error, trilinear lookup time on 1 thread).
 # Usage: [MODE=fixed|floor] docs/studies/irradiance_volume_equal_rays.sh [SCENE...]   (BOUNCE_BIN: default build/bin; BOUNCE_RUNS: default build/runs)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -23,6 +24,14 @@ mkdir -p "$out"
 scenes=("$@")
 [[ ${#scenes[@]} -gt 0 ]] || scenes=(cornell cornell-box bunny living-room modern-hall sponza conference)
 mode="${MODE:-main}"
+if [[ "$mode" == lookup ]]; then  # the program's adaptive octree, hanging corners stored and computed: probes, error, lookup time
+  for h in stored computed; do
+    "$bin" --scene cornell --gradient-step 0 --hanging-corners "$h" --repeat 15 --threads 1 --json "$out/lookup-$h.json" 2>/dev/null \
+      | grep -E "^(trilinear|cornell)"
+    python3 docs/studies/results.py add "$results" "equal-rays-lookup-$h-cornell" "$out/lookup-$h.json"
+  done
+  exit 0
+fi
 tolerances=(0.1 0.2 0.35 0.5 0.75 1 1.5 2 3 5 8)
 extra=(--sweep-surface)
 name=equal-rays
