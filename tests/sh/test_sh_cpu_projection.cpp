@@ -178,7 +178,7 @@ TEST_CASE("float_to_half rounds to nearest even and inverts half_to_float on eve
     CHECK(cpu::float_to_half(NAN) == 0x7e00);
 }
 
-TEST_CASE("half-float maps project as their decoded float values do, on both paths", "[sh][cpu]") {
+TEST_CASE("half-float maps project as their decoded float values do, on every path", "[sh][cpu]") {
     for (const std::size_t n : {64u, 13u}) {
         const cube_set set(n, 4, 70 + n);
         std::vector<std::array<image<cpu::half_rgb>, 6>> halves(set.views.size());
