@@ -144,3 +144,38 @@ TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_vo
     for (std::size_t i = 0; i < points.size(); ++i)
         for (int k = 0; k < 3; ++k) REQUIRE(none[i][k] == Approx(volume.trilinear(points[i], normals[i])[k]).margin(1e-5));
 }
+
+TEST_CASE("the GPU lookup refuses a volume whose hanging corners the CPU lookup computes", "[irradiance_volume][gl]") {
+    gl_test::shared_context();
+    test::owned_scene scene;
+    scene.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
+    scene.positions = {{0.3f, -0.9f, -0.9f}, {0.3f, 0.9f, -0.9f}, {0.3f, -0.9f, 0.9f}};
+    scene.triangles = {{0, 1, 2}};
+    scene.material_of = {0};
+    // Light with a step at x = 0.5: merged octrees keep depth 3 there, coarser elsewhere.
+    const auto source = [](std::span<const glm::vec3> p, std::span<irradiance_probe> out) {
+        for (std::size_t j = 0; j < p.size(); ++j) {
+            out[j] = {};
+            out[j].position = p[j];
+            out[j].radiance[0] = glm::vec3(2 + 3 / (1 + std::exp(-(p[j].x - 0.5f) / 0.02f)));
+            out[j].noise = 1e-4f;
+            out[j].harmonic_mean_distance = 1;
+        }
+    };
+    irradiance_volume_settings s;
+    s.min_depth = 1;
+    s.max_depth = 3;
+    s.calibrate_noise = false;
+    s.bias_tolerance = 0.01f;
+    s.hanging_corners = hanging_corner_storage::computed;
+    const auto computed = irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, source);
+    REQUIRE(!computed.hanging_corners().empty());
+    try {
+        const gl::irradiance_volume_buffers buffers(computed);
+        FAIL("the GPU buffers of a volume without probes at its hanging corners were made");
+    } catch (const parameter_error& e) {
+        CHECK(e.parameter() == "volume");
+    }
+    s.hanging_corners = hanging_corner_storage::stored;  // the same octree with its corners stored
+    CHECK_NOTHROW(gl::irradiance_volume_buffers(irradiance_volume::build(scene, glm::vec3(-1), glm::vec3(1), s, source)));
+}
