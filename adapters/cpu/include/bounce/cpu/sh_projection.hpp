@@ -124,14 +124,14 @@ enum class sh_projection_path {
 };
 
 /// Projects RGB cube maps of a fixed size (glm::vec3 or half_rgb texels) onto bands
-/// 0 .. L - 1. Construct once per size (it tabulates size^2 L^2 weights), then call
-/// `project` for each batch of maps.
+/// 0 .. L - 1. Construct once per size (it tabulates ceil(size / 2) size L^2 weights), then
+/// call `project` for each batch of maps.
 template <int L>
 class cube_map_sh_projector {
 public:
     static constexpr std::size_t coefficients = sh_count(L);
-    /// Texels summed in float before the sums go into double: a float accumulator lane adds
-    /// at most chunk_texels / 8 products, whatever the size (the error bound of tests/sh).
+    /// Texel pairs summed in float before the sums go into double: a float accumulator lane
+    /// adds at most chunk_texels / 8 products, whatever the size (the error bound of tests/sh).
     static constexpr std::size_t chunk_texels = 4096;
     static constexpr std::size_t maps_per_task = 4;  ///< maps one TBB task projects (one after the other)
     /// How far ahead of the texel being multiplied the AVX paths ask for texels (bytes).
