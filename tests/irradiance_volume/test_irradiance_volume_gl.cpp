@@ -25,13 +25,23 @@
 
 using namespace bounce;
 
-TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_volume][gl]") {
-    gl_test::shared_context();
+namespace {
+
+// One triangle across the volume (the scene a build needs; the probes come from fields).
+test::owned_scene one_triangle() {
     test::owned_scene scene;
     scene.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
     scene.positions = {{0.3f, -0.9f, -0.9f}, {0.3f, 0.9f, -0.9f}, {0.3f, -0.9f, 0.9f}};
     scene.triangles = {{0, 1, 2}};
     scene.material_of = {0};
+    return scene;
+}
+
+}  // namespace
+
+TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_volume][gl]") {
+    gl_test::shared_context();
+    const test::owned_scene scene = one_triangle();
     // A smooth non-linear field with analytic gradients; probes with z < -0.8 are inside.
     const auto source = [](std::span<const glm::vec3> p, std::span<irradiance_probe> out) {
         for (std::size_t j = 0; j < p.size(); ++j) {
@@ -147,11 +157,7 @@ TEST_CASE("GPU and CPU irradiance-volume lookups agree to 1e-5", "[irradiance_vo
 
 TEST_CASE("the GPU lookup refuses a volume whose hanging corners the CPU lookup computes", "[irradiance_volume][gl]") {
     gl_test::shared_context();
-    test::owned_scene scene;
-    scene.materials = {material{glm::vec3(0.5f), glm::vec3(0.f)}};
-    scene.positions = {{0.3f, -0.9f, -0.9f}, {0.3f, 0.9f, -0.9f}, {0.3f, -0.9f, 0.9f}};
-    scene.triangles = {{0, 1, 2}};
-    scene.material_of = {0};
+    const test::owned_scene scene = one_triangle();
     // Light with a step at x = 0.5: merged octrees keep depth 3 there, coarser elsewhere.
     const auto source = [](std::span<const glm::vec3> p, std::span<irradiance_probe> out) {
         for (std::size_t j = 0; j < p.size(); ++j) {
