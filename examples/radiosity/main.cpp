@@ -134,7 +134,7 @@ solve_result solve(Solver& solver, const options& o, const io::scene& scene, dou
     if (cmp.reference && !o.holes_out.empty())
         write_holes(o.holes_out, cmp.bvh, a, r.lightmap, r.lightmap_back.width() ? r.lightmap_back : r.lightmap,
                     cmp.scene.camera, r.view, cmp.reference->radiance, cmp.mask, level);
-    if (cmp.reference && !o.oracle_out.empty())  // (check_options refused it on GL and with --adaptive)
+    if (cmp.reference && !o.oracle_out.empty())  // (check_options refused it with --adaptive)
         write_oracle(o.oracle_out, cmp.bvh, scene, solver, reference_settings_for(o), *cmp.reference, cmp.mask, r.view, o.width, o.height);
     return r;
 }

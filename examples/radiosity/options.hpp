@@ -127,7 +127,7 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(CLI::Range(1, 16))->capture_default_str();
     app.add_flag("--one-sided", o.one_sided,
                  "only the front (counter-clockwise) side of a surface receives and shoots (default: both sides, "
-                 "as the reference; the GL backend needs it)");
+                 "as the reference)");
     app.add_option("--repeat", o.repeat, "solve N times; timings are medians")->check(CLI::Range(1, 100))
         ->capture_default_str();
     app.add_option("--width", o.width, "view width")->check(CLI::Range(1, 16384))->capture_default_str();
@@ -146,7 +146,7 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--holes-out", o.holes_out, "write a CSV of the view's black pixels where the reference is lit (holes.hpp)");
     add_choice(app, "--view", o.view, view_names,
                "lightmap (B / pi looked up) | direct+indirect (the lights' direct light per pixel, the rest looked up) | "
-               "auto (direct+indirect on the CPU backend, lightmap on GL)")
+               "auto (direct+indirect)")
         ->capture_default_str();
     app.add_option("--oracle-out", o.oracle_out, "write the error's split and the best lightmap's error (JSON, oracle.hpp)");
     app.add_option("--reference-out", o.reference_out, "write the reference view here (.png or .exr)");
@@ -200,19 +200,14 @@ inline void check_options(const options& o) {
     if (o.shooter_groups != 0 && o.visibility != visibility_kind::rays)
         throw parameter_error("--shooter-groups", "needs --visibility rays: a group's rays leave from its members, and "
                                                   "an item buffer renders from one point per shot");
-    if (!o.oracle_out.empty() && (o.adaptive || o.backend == backend::gl))
-        throw parameter_error("--oracle-out", "needs the CPU backend without --adaptive (base texels, the direct deposit apart)");
+    if (!o.oracle_out.empty() && o.adaptive)
+        throw parameter_error("--oracle-out", "needs base texels: not with --adaptive");
     if (o.backend != backend::gl) return;
-    if (o.view == view_kind::direct_indirect)
-        throw parameter_error("--view", "'direct+indirect' needs the CPU backend (its solver keeps the lights' direct deposit apart)");
     // What the GL solver does not offer (docs/radiosity-gl.md).
     if (o.visibility == visibility_kind::rays)
         throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
     if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
     if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
-    if (!o.one_sided)
-        throw parameter_error("--one-sided", "the GL backend solves one-sided surfaces only: add --one-sided "
-                                             "(two-sided surfaces, the default, run on the CPU backend)");
 }
 
 inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
@@ -248,8 +243,8 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
             {"group_near_field", o.group_near_field},
-            {"view", name_of(view_names, o.view != view_kind::automatic ? o.view
-                                         : o.backend == backend::gl ? view_kind::lightmap : view_kind::direct_indirect)}, {"reference_paths", o.reference_paths}, {"seed", o.seed}};
+            {"view", name_of(view_names, o.view != view_kind::automatic ? o.view : view_kind::direct_indirect)},
+            {"reference_paths", o.reference_paths}, {"seed", o.seed}};
 }
 
 /// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),

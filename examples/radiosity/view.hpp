@@ -14,8 +14,8 @@
 
 namespace bounce::examples {
 
-// automatic: direct+indirect where the solver keeps the direct deposit apart (the CPU
-// solver), else the lightmap (the GL solver); measured lower on every shared scene
+// automatic: direct+indirect where the solver keeps the direct deposit apart (both the CPU
+// and the GL solver do), else the lightmap; measured lower on every shared scene
 // (docs/radiosity.md, "Where the error is").
 enum class view_kind { automatic, lightmap, direct_indirect };
 inline const choices<view_kind> view_names{{"auto", view_kind::automatic}, {"lightmap", view_kind::lightmap},
@@ -36,8 +36,7 @@ image<glm::vec3> render_view(const embree::accel& bvh, const scene_view& scene, 
         return embree::lightmap_direct_view(bvh, scene, solver.atlas(), front.view(), back.view(), level, cam,
                                             width, height);
     } else {
-        throw parameter_error("--view", "'direct+indirect' needs the CPU backend (its solver keeps the lights' direct "
-                                        "deposit apart)");
+        throw parameter_error("--view", "'direct+indirect' needs a solver that keeps the lights' direct deposit apart");
     }
 }
 

@@ -144,8 +144,7 @@ TEST_CASE("study: the Cornell box with about 10,000 elements to 90% on GL and on
                     cpu::item_buffer_visibility(
                         scene.view(), atlas,
                         {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
-                         .resolution = res}),
-                    {.two_sided = false});  // as the GL solver
+                         .resolution = res}));  // two-sided, as the GL solver's default
                 solver.solve(fraction);
                 run_figures f;
                 f.total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -199,8 +198,8 @@ TEST_CASE("study: Sponza (66k triangles, 100,000 elements) to 90% on GL and on t
         const auto t0 = std::chrono::steady_clock::now();
         cpu::progressive_radiosity solver(
             scene.view(), atlas,
-            cpu::item_buffer_visibility(scene.view(), atlas, {.projection = cpu::item_projection::hemicube, .resolution = 128}),
-            {.two_sided = false});  // as the GL solver
+            cpu::item_buffer_visibility(scene.view(), atlas, {.projection = cpu::item_projection::hemicube, .resolution = 128}));
+        // two-sided, as the GL solver's default
         solver.solve(fraction, within_a_minute(t0));
         const double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         const auto& t = solver.timings();

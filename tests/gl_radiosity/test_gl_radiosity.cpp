@@ -22,16 +22,21 @@ using namespace bounce::radiosity_test;
 
 namespace {
 
-// Per-shooter unshot power from per-element unshot radiosities, in double and in element
-// order (the sum both solvers form), and the largest with ties to the lowest index.
-std::pair<std::uint32_t, double> largest_power(const gl::progressive_radiosity& solver,
-                                               const std::vector<glm::vec3>& unshot) {
+// Per-shooter unshot power from the per-element unshot radiosities read back (each side's),
+// in double and in element order (the sum both solvers form), and the largest with ties to
+// the lowest index. Shooter k is block k % blocks on side k / blocks.
+std::pair<std::uint32_t, double> largest_power(const gl::progressive_radiosity& solver) {
     const lightmap_atlas& atlas = solver.atlas();
+    std::vector<std::vector<glm::vec3>> unshot;
+    for (int side = 0; side < solver.sides(); ++side) unshot.push_back(solver.unshot(side));
+    const std::size_t blocks = solver.shooters() / std::size_t(solver.sides());
     std::pair<std::uint32_t, double> best{0, -1.0};
     for (std::size_t k = 0; k < solver.shooters(); ++k) {
         double p = 0;
-        for (std::uint32_t i = solver.shooter_first(k); i < solver.shooter_first(k + 1); ++i)
-            p += (double(unshot[i].x) + double(unshot[i].y) + double(unshot[i].z)) * double(atlas.area[i]);
+        const std::size_t b = k % blocks;
+        const std::vector<glm::vec3>& u = unshot[k / blocks];
+        for (std::uint32_t i = solver.shooter_first(b); i < solver.shooter_first(b + 1); ++i)
+            p += (double(u[i].x) + double(u[i].y) + double(u[i].z)) * double(atlas.area[i]);
         if (p > best.second) best = {std::uint32_t(k), p};
     }
     return best;
@@ -55,27 +60,33 @@ TEST_CASE("without occlusion, GL and CPU shoot the same shooters and agree to fl
     for (std::size_t v = scene.positions.size() - 4; v < scene.positions.size(); ++v)
         scene.positions[v] += glm::vec3(0.13f, 0.f, 0.05f);
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400});
-    cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.two_sided = false});  // as the GL
+    // Two-sided, both (the default): the lamp's back and the ceiling above it light each other.
+    cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{});
     gl::progressive_radiosity gl_solver(scene.view(), atlas, {.visibility = gl::radiosity_visibility::none});
     REQUIRE(gl_solver.shooters() == cpu_solver.shooters());
     CHECK(gl_solver.emitted_power().x == Approx(cpu_solver.emitted_power().x).epsilon(1e-12));
     const int shots = 40;
     for (int s = 0; s < shots; ++s) {
-        const auto u = gl_solver.unshot();
-        const auto expected = largest_power(gl_solver, u);
+        const auto expected = largest_power(gl_solver);
         INFO("step " << s);
         CHECK(gl_solver.next_shooter() == expected.first);
         CHECK(gl_solver.next_shooter_power() == Approx(expected.second).epsilon(1e-12));
         REQUIRE(gl_solver.step());
         REQUIRE(cpu_solver.step());
     }
-    const auto bg = gl_solver.radiosity();
-    const auto bc = cpu_solver.radiosity();
-    double worst = 0;
-    for (std::size_t i = 0; i < bc.size(); ++i)
-        for (int c = 0; c < 3; ++c)
-            if (bc[i][c] > 0) worst = std::max(worst, std::abs(double(bg[i][c]) - double(bc[i][c])) / double(bc[i][c]));
+    REQUIRE(gl_solver.sides() == 2);
+    double worst = 0, back = 0;
+    for (int side = 0; side < 2; ++side) {
+        const auto bg = gl_solver.radiosity(side);
+        const auto bc = cpu_solver.radiosity(side);
+        for (std::size_t i = 0; i < bc.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                if (bc[i][c] > 0) worst = std::max(worst, std::abs(double(bg[i][c]) - double(bc[i][c])) / double(bc[i][c]));
+                if (side == 1) back += double(bc[i][c]);
+            }
+    }
     INFO("worst relative difference " << worst);
+    CHECK(back > 0);  // the backs took light
     // Shots scaled down to their power (shot_scale; the near field over-delivers into the
     // box's corners) are among them, and scaled alike.
     CHECK(cpu_solver.clamped_shots() > 0);
@@ -95,23 +106,27 @@ TEST_CASE("the GL solver's outputs are the CPU solver's: irradiance or radiance,
     scene.lights.push_back(point_light{{0.6f, 1.2f, 0.8f}, glm::vec3(2.f, 1.5f, 1.f)});
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
     for (const bool ambient : {false, true}) {
-        cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.ambient = ambient, .two_sided = false});
+        cpu::progressive_radiosity cpu_solver(scene.view(), atlas, cpu::all_visible{}, {.ambient = ambient});
         gl::progressive_radiosity gl_solver(scene.view(), atlas,
-                                            {.shooting = {.ambient = ambient, .two_sided = false}, .visibility = gl::radiosity_visibility::none});
+                                            {.shooting = {.ambient = ambient}, .visibility = gl::radiosity_visibility::none});
         for (int s = 0; s < 20; ++s) {
             REQUIRE(gl_solver.step());
             REQUIRE(cpu_solver.step());
         }
         for (const auto q : {output_quantity::irradiance, output_quantity::radiance})
             for (const auto paths : {light_paths::indirect, light_paths::direct, light_paths::all}) {
-                const auto c = cpu_solver.output(q, paths), g = gl_solver.output(q, paths);
-                REQUIRE(c.size() == g.size());
+                // Both sides against the front's largest value (the backs: the lamp's, the
+                // ceiling's corners; no direct light reaches a back here).
                 float largest = 0;
-                for (const glm::vec3& v : c) largest = std::max({largest, v.x, v.y, v.z});
+                for (const glm::vec3& v : cpu_solver.output(q, paths, 0)) largest = std::max({largest, v.x, v.y, v.z});
                 REQUIRE(largest > 0.f);
-                INFO(to_string(q) << " " << to_string(paths) << " ambient " << ambient);
-                for (std::size_t i = 0; i < c.size(); ++i)
-                    for (int k = 0; k < 3; ++k) CHECK(g[i][k] == Approx(c[i][k]).margin(1e-4 * largest));
+                for (int side = 0; side < 2; ++side) {
+                    const auto c = cpu_solver.output(q, paths, side), g = gl_solver.output(q, paths, side);
+                    REQUIRE(c.size() == g.size());
+                    INFO(to_string(q) << " " << to_string(paths) << " ambient " << ambient << " side " << side);
+                    for (std::size_t i = 0; i < c.size(); ++i)
+                        for (int k = 0; k < 3; ++k) CHECK(g[i][k] == Approx(c[i][k]).margin(1e-4 * largest));
+                }
             }
         // The output texture is lightmap(quantity, paths), alpha 1 where a chart (or its
         // padding) is; the renderer's sampler reads it with the atlas's corner_uvs.
@@ -176,7 +191,7 @@ cpu::progressive_radiosity<cpu::item_buffer_visibility> cpu_item_buffer_solver(c
         cpu::item_buffer_visibility(scene.view(), atlas,
                                     {.projection = hemicube ? cpu::item_projection::hemicube : cpu::item_projection::stereographic,
                                      .resolution = res}),
-        {.two_sided = false});  // the GL solver is one-sided
+        {});  // two-sided, as the GL solver's default
 }
 gl::radiosity_options gl_item_buffer_options(bool hemicube, int res) {
     return {.visibility = hemicube ? gl::radiosity_visibility::hemicube : gl::radiosity_visibility::stereographic,
@@ -275,7 +290,7 @@ TEST_CASE("with item-buffer visibility, k shots on GL and CPU agree", "[gl][radi
     gl::progressive_radiosity gl_solver(scene.view(), atlas, gl_item_buffer_options(hemicube, res));
     std::size_t same_shooter = 0;
     for (int s = 0; s < shots; ++s) {
-        const auto expected = largest_power(gl_solver, gl_solver.unshot());
+        const auto expected = largest_power(gl_solver);
         same_shooter += expected.first == gl_solver.next_shooter() ? 1 : 0;
         REQUIRE(gl_solver.step());
         REQUIRE(cpu_solver.step());
@@ -314,8 +329,7 @@ TEST_CASE("a directional light shot first gives the CPU's direct radiosity, shad
     scene.lights.push_back(sun);
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 600});
     cpu::progressive_radiosity cpu_solver(
-        scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 64, .parallel_resolution = 256}),
-        {.two_sided = false});
+        scene.view(), atlas, cpu::item_buffer_visibility(scene.view(), atlas, {.resolution = 64, .parallel_resolution = 256}));
     gl::progressive_radiosity gl_solver(scene.view(), atlas, {.resolution = 64, .parallel_resolution = 256});
     const auto bc = cpu_solver.radiosity();
     const auto bg = gl_solver.radiosity();
@@ -342,31 +356,37 @@ TEST_CASE("the GL lightmap texture is the solver's radiosity lightmap, padding f
     gl_test::shared_context();
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 300, .padding = 2});
+    // One-sided, a back lightmap is refused by name.
+    gl::progressive_radiosity one(scene.view(), atlas, {.shooting = {.two_sided = false}, .resolution = 64});
+    CHECK(one.sides() == 1);
+    CHECK_THROWS_WITH(one.radiosity_lightmap(0, 1), Catch::Contains("side"));
+    CHECK_THROWS_WITH(one.update_lightmap_texture(1), Catch::Contains("side"));
     for (const bool ambient : {false, true}) {
-        gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient, .two_sided = false}, .resolution = 64});
+        gl::progressive_radiosity solver(scene.view(), atlas, {.shooting = {.ambient = ambient}, .resolution = 64});
+        REQUIRE(solver.sides() == 2);
         for (int s = 0; s < 10; ++s) REQUIRE(solver.step());
-        const auto expected = solver.radiosity_lightmap();
-        CHECK(solver.sides() == 1);  // one-sided: a back lightmap is refused by name
-        CHECK_THROWS_WITH(solver.radiosity_lightmap(0, 1), Catch::Contains("side"));
-        const gl::texture_ref t = solver.update_lightmap_texture();
-        REQUIRE(t.width == atlas.width);
-        REQUIRE(t.height == atlas.height);
-        const auto got = t.read_floats();
-        double worst = 0;
-        std::size_t charted = 0;
-        for (std::uint32_t y = 0; y < atlas.height; ++y)
-            for (std::uint32_t x = 0; x < atlas.width; ++x) {
-                const float* g = &got[4 * (std::size_t(y) * atlas.width + x)];
-                const glm::vec3 e = expected(x, y);
-                const bool on_chart = atlas.element_at(x, y) >= 0;
-                charted += on_chart ? 1 : 0;
-                CHECK(g[3] == (on_chart ? 1.f : 0.f));
-                for (int c = 0; c < 3; ++c)
-                    worst = std::max(worst, std::abs(double(g[c]) - double(e[c])) / std::max(1e-30, double(std::abs(e[c]))));
-            }
-        INFO("ambient " << ambient << ", worst relative difference " << worst);
-        CHECK(charted > atlas.size());  // padding texels were filled
-        CHECK(worst <= (ambient ? 1e-6 : 0.0));
+        for (int side = 0; side < 2; ++side) {
+            const auto expected = solver.radiosity_lightmap(0, side);
+            const gl::texture_ref t = solver.update_lightmap_texture(side);
+            REQUIRE(t.width == atlas.width);
+            REQUIRE(t.height == atlas.height);
+            const auto got = t.read_floats();
+            double worst = 0;
+            std::size_t charted = 0;
+            for (std::uint32_t y = 0; y < atlas.height; ++y)
+                for (std::uint32_t x = 0; x < atlas.width; ++x) {
+                    const float* g = &got[4 * (std::size_t(y) * atlas.width + x)];
+                    const glm::vec3 e = expected(x, y);
+                    const bool on_chart = atlas.element_at(x, y) >= 0;
+                    charted += on_chart ? 1 : 0;
+                    CHECK(g[3] == (on_chart ? 1.f : 0.f));
+                    for (int c = 0; c < 3; ++c)
+                        worst = std::max(worst, std::abs(double(g[c]) - double(e[c])) / std::max(1e-30, double(std::abs(e[c]))));
+                }
+            INFO("ambient " << ambient << ", side " << side << ", worst relative difference " << worst);
+            CHECK(charted > atlas.size());  // padding texels were filled
+            CHECK(worst <= (ambient ? 1e-6 : 0.0));
+        }
     }
 }
 
@@ -437,7 +457,6 @@ TEST_CASE("bad GL solver input raises parameter_error naming it", "[gl][radiosit
     };
     throws_naming({.shooting = {.near_field = -1, .two_sided = false}}, "radiosity_options.near_field");
     throws_naming({.shooting = {.shooters_per_step = 2, .two_sided = false}}, "radiosity_options.shooters_per_step");
-    throws_naming({.shooting = {.two_sided = true}}, "radiosity_options.two_sided");  // one-sided only
     throws_naming({.shooting = {.two_sided = false, .light_samples = 2}}, "radiosity_options.light_samples");
     throws_naming({.resolution = 4}, "radiosity_options.resolution");
     throws_naming({.visibility = gl::radiosity_visibility::hemicube, .resolution = 65}, "radiosity_options.resolution");

@@ -11,6 +11,7 @@
 
 #include <bounce/gl/kernel_map.hpp>
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/sides.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -147,5 +148,25 @@ TEST_CASE("the item-buffer lookups and the near-field test decide alike on the G
         CHECK(check_decisions(gpu, cpu, in, margin) <= in.size() / 100);
         CHECK(std::count(cpu.begin(), cpu.end(), 1.f) > 10);  // both outcomes occur
         CHECK(std::count(cpu.begin(), cpu.end(), 0.f) > 10);
+    }
+    {
+        // The side a source lights (radiosity/sides.hpp): two-sided and one-sided.
+        using args = std::tuple<glm::vec3, glm::vec3, glm::vec3, float>;
+        std::vector<args> in;
+        std::vector<double> margin;
+        for (int k = 0; k < random_count; ++k) {
+            const glm::vec3 r = random_point(rng, 1.f), q = random_point(rng, 1.f);
+            const glm::vec3 n = glm::normalize(random_point(rng, 1.f) + glm::vec3(1e-3f));
+            const float two_sided = k % 4 == 0 ? 0.f : 1.f;
+            in.emplace_back(r, n, q, two_sided);
+            margin.push_back(glm::dot(glm::dvec3(n), glm::dvec3(q - r)) / std::max(1e-30, glm::length(glm::dvec3(q - r))));
+        }
+        std::vector<float> cpu;
+        for (const auto& a : in) cpu.push_back(std::apply(bounce::receiving_side<float, glm::vec3>, a));
+        const auto gpu = gl::map_kernel(bounce::receiving_side<f32, vec3>, in);
+        CHECK(check_decisions(gpu, cpu, in, margin) <= in.size() / 100);
+        CHECK(std::count(cpu.begin(), cpu.end(), 1.f) > 10);  // both outcomes occur
+        CHECK(std::count(cpu.begin(), cpu.end(), 0.f) > 10);
+        for (std::size_t e = 0; e < in.size(); e += 4) CHECK(cpu[e] == 0.f);  // one-sided: the front always
     }
 }

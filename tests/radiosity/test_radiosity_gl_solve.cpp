@@ -19,7 +19,7 @@ TEST_CASE("the GL solver's solve(options) stops where the CPU solver's does", "[
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400, .block_texels = 4});
     gl::progressive_radiosity g(scene.view(), atlas, {.visibility = gl::radiosity_visibility::none});
-    cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{}, {.two_sided = false});  // the GL is one-sided
+    cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{});  // two-sided, as the GL by default
     radiosity_solve_options o;
     o.converge = 0.8;
     o.checkpoints = 2;
@@ -41,13 +41,19 @@ TEST_CASE("the GL solver's solve(options) stops where the CPU solver's does", "[
     CHECK(ig.indirect_unshot_fraction == Approx(ic.indirect_unshot_fraction).epsilon(1e-4));
 }
 
-TEST_CASE("the GL solver names reversed winding and refuses a tolerance below the floor", "[radiosity][solve][gl][errors]") {
+TEST_CASE("the GL solver names reversed winding one-sided and refuses a tolerance below the floor", "[radiosity][solve][gl][errors]") {
     gl_test::shared_context();
     owned_scene box = closed_box(1.f, 0.7f, 2.f);
     for (glm::uvec3& t : box.triangles) std::swap(t.y, t.z);
     const auto atlas = build_lightmap_atlas(box.view(), {.elements = 300, .block_texels = 4});
-    gl::progressive_radiosity g(box.view(), atlas, {.resolution = 64});
+    gl::progressive_radiosity g(box.view(), atlas, {.shooting = {.two_sided = false}, .resolution = 64});
     CHECK_THROWS_AS(g.solve(0.1), radiosity_error);
+    // Two-sided (the default), the same box solves: its walls take the lamp's light on their backs.
+    gl::progressive_radiosity two(box.view(), atlas, {.resolution = 64});
+    radiosity_solve_options to_90;
+    to_90.converge = 0.9;
+    CHECK(two.solve(to_90).stop == radiosity_stop::converged);
+    CHECK(two.intercepted_power().x > 0);
     const auto good = cornell_box();
     const auto good_atlas = build_lightmap_atlas(good.view(), {.elements = 300, .block_texels = 4});
     CHECK_THROWS_WITH(gl::progressive_radiosity(good.view(), good_atlas, {.resolution = 64, .tolerance_px = 1e-6f}),

@@ -9,8 +9,6 @@ namespace bounce::gl {
 void radiosity_options::validate() const {
     shooting.validate();
     require(shooting.shooters_per_step == 1, "radiosity_options.shooters_per_step", "must be 1 on the GL solver");
-    require(!shooting.two_sided, "radiosity_options.two_sided",
-            "must be false on the GL solver, which is one-sided (cpu::progressive_radiosity solves two-sided surfaces)");
     require(shooting.light_samples == 1, "radiosity_options.light_samples",
             "must be 1 on the GL solver, which takes lights at element points");
     require(shooting.shooter_groups == 0, "radiosity_options.shooter_groups",
@@ -57,9 +55,12 @@ progressive_radiosity::progressive_radiosity(const scene_view& scene, const ligh
     for (const light& l : scene.lights) s_->shoot_light(pack(l));
     finish();
     s_->timings.lights_ms = ms_since(start);
-    direct_ = radiosity();
+    for (int side = 0; side < sides(); ++side) {
+        const auto d = radiosity(side);
+        direct_.insert(direct_.end(), d.begin(), d.end());
+    }
     s_->reduce();
-    check_lights_reach_surfaces(scene, s_->atlas, s_->emitted);
+    check_lights_reach_surfaces(scene, s_->atlas, s_->emitted, two_sided());
 }
 
 progressive_radiosity::~progressive_radiosity() = default;
@@ -98,43 +99,48 @@ double progressive_radiosity::indirect_unshot_fraction() const noexcept {
 }
 std::uint32_t progressive_radiosity::next_shooter() const noexcept { return s_->next; }
 double progressive_radiosity::next_shooter_power() const noexcept { return s_->next_power; }
-std::size_t progressive_radiosity::shooters() const noexcept { return s_->first.size() - 1; }
-std::uint32_t progressive_radiosity::shooter_first(std::size_t k) const { return s_->first.at(k); }
+std::size_t progressive_radiosity::shooters() const noexcept { return s_->blocks() * s_->sides; }
+std::uint32_t progressive_radiosity::shooter_first(std::size_t block) const { return s_->first.at(block); }
+int progressive_radiosity::sides() const noexcept { return int(s_->sides); }
 std::size_t progressive_radiosity::clamped_shots() const noexcept { return s_->clamped_shots; }
 glm::dvec3 progressive_radiosity::emitted_power() const noexcept { return s_->emitted; }
 glm::dvec3 progressive_radiosity::absorbed_power() const noexcept { return s_->absorbed; }
 glm::dvec3 progressive_radiosity::escaped_power() const noexcept { return s_->escaped; }
 glm::dvec3 progressive_radiosity::intercepted_power() const noexcept { return s_->intercepted_power; }
 glm::dvec3 progressive_radiosity::unshot_power() const {
-    const auto u = unshot();
     glm::dvec3 sum(0.0);
-    for (std::size_t i = 0; i < u.size(); ++i) sum += glm::dvec3(u[i]) * double(s_->atlas.area[i]);
+    for (int side = 0; side < sides(); ++side) {
+        const auto u = unshot(side);
+        for (std::size_t i = 0; i < u.size(); ++i) sum += glm::dvec3(u[i]) * double(s_->atlas.area[i]);
+    }
     return sum;
 }
-std::vector<glm::vec3> progressive_radiosity::radiosity() const { return s_->read_elements(s_->radiosity); }
-std::vector<glm::vec3> progressive_radiosity::unshot() const { return s_->read_elements(s_->unshot); }
+std::vector<glm::vec3> progressive_radiosity::radiosity(int side) const { return s_->read_elements(s_->radiosity, side); }
+std::vector<glm::vec3> progressive_radiosity::unshot(int side) const { return s_->read_elements(s_->unshot, side); }
 glm::dvec3 progressive_radiosity::ambient() const {
     const glm::dvec3 rho_avg = s_->albedo_area / s_->total_area;
     return unshot_power() / s_->total_area / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
 }
-std::vector<glm::vec3> progressive_radiosity::display_radiosity() const {
-    std::vector<glm::vec3> out = radiosity();
+std::vector<glm::vec3> progressive_radiosity::display_radiosity(int side) const {
+    std::vector<glm::vec3> out = radiosity(side);
     const glm::vec3 amb = s_->options.shooting.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
     for (std::size_t i = 0; i < out.size(); ++i)
         out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb);
     return out;
 }
-std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, light_paths paths) const {
+std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, light_paths paths, int side) const {
     const lightmap_atlas& at = s_->atlas;
-    std::vector<glm::vec3> out = radiosity();
+    std::vector<glm::vec3> out = radiosity(side);  // checks the side
+    const std::size_t o = at.size() * std::size_t(side);
     const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
     const glm::vec3 amb = s_->options.shooting.ambient && indirect ? glm::vec3(ambient()) : glm::vec3(0.f);
     for (std::size_t i = 0; i < out.size(); ++i) {
-        // Reflected radiosity of the parts asked for: rho E.
-        const glm::vec3 reflected = (direct ? direct_[i] - at.emission[i] : glm::vec3(0.f)) +
-                                    (indirect ? out[i] - direct_[i] + at.albedo[i] * amb : glm::vec3(0.f));
+        // Reflected radiosity of the parts asked for: rho E (the emission on the side that emits).
+        const glm::vec3 emission = s_->emits_on(i, side) ? at.emission[i] : glm::vec3(0.f);
+        const glm::vec3 reflected = (direct ? direct_[o + i] - emission : glm::vec3(0.f)) +
+                                    (indirect ? out[i] - direct_[o + i] + at.albedo[i] * amb : glm::vec3(0.f));
         if (quantity == output_quantity::radiance) {
-            out[i] = (reflected + (direct ? at.emission[i] : glm::vec3(0.f))) * float(1.0 / std::numbers::pi);
+            out[i] = (reflected + (direct ? emission : glm::vec3(0.f))) * float(1.0 / std::numbers::pi);
             continue;
         }
         for (int c = 0; c < 3; ++c)
@@ -142,17 +148,17 @@ std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, l
     }
     return out;
 }
-image<glm::vec3> progressive_radiosity::lightmap(output_quantity quantity, light_paths paths, int level) const {
-    const auto values = output(quantity, paths);
+image<glm::vec3> progressive_radiosity::lightmap(output_quantity quantity, light_paths paths, int level, int side) const {
+    const auto values = output(quantity, paths, side);
     return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
 }
 image<glm::vec3> progressive_radiosity::radiosity_lightmap(int level, int side) const {
-    require(side == 0, "side", "the GL solver is one-sided: only side 0 has a lightmap");
-    const auto values = display_radiosity();
+    const auto values = display_radiosity(side);
     return s_->atlas.to_fine_texels(std::span<const glm::vec3>(values), level);
 }
-texture_ref progressive_radiosity::update_lightmap_texture() {
+texture_ref progressive_radiosity::update_lightmap_texture(int side) {
     state& st = *s_;
+    require(side >= 0 && side < sides(), "side", two_sided() ? "must be 0 or 1" : "must be 0 (one-sided)");
     if (!st.lightmap_program) {
         st.lightmap_program = std::make_unique<program>(program::compute(radiosity_glsl::lightmap_compute()));
         st.lightmap_texture = std::make_unique<texture>(texel_format::rgba32f, st.width, st.height);
@@ -180,6 +186,7 @@ texture_ref progressive_radiosity::update_lightmap_texture() {
         p.set(u::atlas_width, int(st.width));
         p.set(u::atlas_height, int(st.height));
         p.set(u::ambient, amb);
+        p.set(u::source_row, side * int(st.height));
         glDispatchCompute((st.width + 7) / 8, (st.height + 7) / 8, 1);
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         check_error("progressive_radiosity: the lightmap pass");
@@ -187,9 +194,9 @@ texture_ref progressive_radiosity::update_lightmap_texture() {
     return texture_ref(*st.lightmap_texture);
 }
 
-texture_ref progressive_radiosity::update_output_texture(output_quantity quantity, light_paths paths) {
+texture_ref progressive_radiosity::update_output_texture(output_quantity quantity, light_paths paths, int side) {
     const lightmap_atlas& at = s_->atlas;
-    const image<glm::vec3> values = lightmap(quantity, paths);
+    const image<glm::vec3> values = lightmap(quantity, paths, 0, side);
     // Atlas row y is texture row y, as update_lightmap_texture writes it.
     std::vector<glm::vec4> texels(std::size_t(s_->width) * s_->height, glm::vec4(0.f));
     for (std::uint32_t y = 0; y < at.height; ++y)

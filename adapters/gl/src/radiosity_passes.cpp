@@ -10,9 +10,10 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
       options(o),
       width(std::max<std::uint32_t>(a.width, 1)),
       height(std::max<std::uint32_t>(a.height, 1)),
-      radiosity(texel_format::rgba32f, width, height),
-      unshot(texel_format::rgba32f, width, height),
-      intercepted(texel_format::rgba32f, width, height),
+      sides(o.shooting.two_sided ? 2 : 1),
+      radiosity(texel_format::rgba32f, width, std::size_t(height) * sides),
+      unshot(texel_format::rgba32f, width, std::size_t(height) * sides),
+      intercepted(texel_format::rgba32f, width, std::size_t(height) * sides),
       item_color(texel_format::rgba32f, std::size_t(o.resolution), item_rows(o)),
       item_depth(texel_format::depth32f, std::size_t(o.resolution), item_rows(o)),
       texels(std::size_t(width) * height * sizeof(texel_attributes)),
@@ -22,9 +23,13 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
       element_texel(std::max<std::size_t>(a.size(), 1) * sizeof(std::uint32_t)),
       partials(sizeof(double)) {
     const std::size_t n = atlas.size();
-    // Element attributes per texel, and the initial radiosity and unshot radiosity E.
+    // Two-sided, an emitter emits on the side the reference integrator gives it (its vertex
+    // normals' side, emission_sides), as on the CPU; one-sided, on its front.
+    if (sides == 2) emits_back = emission_sides(scene, atlas);
+    // Element attributes per texel, and the initial radiosity and unshot radiosity E (each
+    // side's rows).
     std::vector<texel_attributes> attributes(std::size_t(width) * height);
-    std::vector<glm::vec4> initial(std::size_t(width) * height, glm::vec4(0.f));
+    std::vector<glm::vec4> initial(std::size_t(width) * height * sides, glm::vec4(0.f));
     std::vector<std::uint32_t> packed(std::max<std::size_t>(n, 1), 0u);
     glm::dvec3 emitted_surfaces(0.0);
     for (std::size_t i = 0; i < n; ++i) {
@@ -32,7 +37,7 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
         const std::size_t at = std::size_t(tx.y) * width + tx.x;
         attributes[at] = {glm::vec4(atlas.position[i], atlas.area[i]), glm::vec4(atlas.normal[i], float(atlas.chart[i])),
                           glm::vec4(atlas.albedo[i], 0.f)};
-        initial[at] = glm::vec4(atlas.emission[i], 0.f);
+        initial[at + (emits_on(i, 0) ? 0 : std::size_t(width) * height)] = glm::vec4(atlas.emission[i], 0.f);
         packed[i] = tx.x | (tx.y << 16);
         emitted_surfaces += glm::dvec3(atlas.emission[i]) * double(atlas.area[i]);
         total_area += double(atlas.area[i]);
@@ -44,7 +49,8 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     {
         detail::unpack_state unpack;
         for (const texture* tex : {&radiosity, &unshot})
-            glTextureSubImage2D(tex->id(), 0, 0, 0, GLsizei(width), GLsizei(height), GL_RGBA, GL_FLOAT, initial.data());
+            glTextureSubImage2D(tex->id(), 0, 0, 0, GLsizei(width), GLsizei(height * sides), GL_RGBA, GL_FLOAT,
+                                initial.data());
         const glm::vec4 zero(0.f);
         glClearTexImage(intercepted.id(), 0, GL_RGBA, GL_FLOAT, &zero);
         check_error("uploading the radiosity textures");
@@ -66,7 +72,7 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     }
     std::vector<std::uint32_t> first_padded(first);
     first_buffer = buffer(first_padded.size() * sizeof(std::uint32_t), first_padded.data());
-    partials = buffer((shooters + 2) * partial_doubles * sizeof(double));
+    partials = buffer((shooters * sides + 2) * partial_doubles * sizeof(double));
     // The near-field tree of a block of b x b texels: b^2 + (b/2)^2 + ... nodes at most.
     if (options.shooting.shoot_blocks) {
         int b = atlas.block_texels, count = 0;

@@ -8,6 +8,7 @@
 #include <bounce/direct_light.hpp>
 #include <bounce/glsl/emit.hpp>
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/sides.hpp>
 
 #include <initializer_list>
 #include <utility>
@@ -72,6 +73,7 @@ std::string lookup_functions() {
            "plane_normal", "plane_offset", "shown_depth", "direction", "diagonal");
     fs.add("radiosity_item_sees", item_buffer_sees<f32, vec3>, "element", "element_chart", "shown_chart",
            "plane_normal", "plane_offset", "shown_depth", "diagonal");
+    fs.add("radiosity_side_normal", side_normal<f32, vec3>, "normal", "side");
     return fs.source();
 }
 
@@ -87,7 +89,8 @@ std::string shot_uniforms() {
                      {occlusion, "int occlusion"},
                      {resolution, "float resolution"},
                      {diagonal, "float diagonal"},
-                     {hemicube, "int hemicube"}});
+                     {hemicube, "int hemicube"},
+                     {two_sided, "int two_sided"}});
 }
 
 // What the distribution and light passes share: the element texels, the images, the
@@ -121,6 +124,13 @@ void receive(ivec2 xy, vec3 gain, vec3 intercepted) {
     imageStore(radiosity_image, xy, imageLoad(radiosity_image, xy) + vec4(gain, 0.0));
     imageStore(unshot_image, xy, imageLoad(unshot_image, xy) + vec4(gain, 0.0));
     imageStore(intercepted_image, xy, vec4(intercepted, 0.0));
+}
+// The element at texel xy of the fronts' rows on side `side` (the backs' rows follow them).
+ivec2 side_texel(ivec2 xy, int side) { return xy + ivec2(0, side * atlas_height); }
+// Nothing intercepted on either side (the reduction reads both).
+void intercept_nothing(ivec2 xy) {
+    imageStore(intercepted_image, xy, vec4(0.0));
+    if (two_sided != 0) imageStore(intercepted_image, side_texel(xy, 1), vec4(0.0));
 }
 )";
 }
@@ -236,6 +246,7 @@ std::string distribute_compute(int max_nodes, int stack_size) {
     fs.add("radiosity_form_factor", element_form_factor<f32, vec3>, "receiver_position", "receiver_normal",
            "receiver_area", "shooter_position", "shooter_normal", "shooter_area");
     fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
+    fs.add("radiosity_receiving_side", receiving_side<f32, vec3>, "receiver", "receiver_normal", "source", "two_sided");
     return version_line + "layout(local_size_x = 64) in;\n" + shot_uniforms() +
            uniforms({{distribute_uniform::node_count, "int node_count"}, {distribute_uniform::near2, "float near2"}}) +
            lookup_functions() + fs.source() + shot_common() + "const int max_nodes = " + std::to_string(max_nodes) +
@@ -249,41 +260,47 @@ void main() {
     ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
     texel_attributes a = texel[xy.y * atlas_width + xy.x];
     if (!(a.position_area.w > 0.0)) return;
-    if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    if (a.normal_chart.w == shot_chart) { intercept_nothing(xy); return; }
     vec3 pr = a.position_area.xyz, nr = a.normal_chart.xyz, rho = a.albedo.rgb;
     float ar = a.position_area.w;
-    // precise: no fused multiply-add in the sum, so it rounds as the CPU's does (a shooter's
+    // precise: no fused multiply-add in the sums, so they round as the CPU's do (a shooter's
     // power decides the next shot, and equal powers in a symmetric scene must stay equal).
-    precise vec3 incident = vec3(0.0);
+    precise vec3 incident = vec3(0.0), incident_back = vec3(0.0);
     // The block as one disc where the receiver is farther than near_field times its side,
     // else as its four quadrants, recursively, down to elements: the CPU solver's traversal
-    // (a stack, children pushed in order, so terms are summed in its order). Each node is
-    // visited at most once, so max_nodes bounds the loop.
-    // Most receivers are far from the whole block: one disc, no stack.
-    near_node root = node[node_count - 1];
-    if (root.meta.y == 0 || !(radiosity_near_field(pr, root.position_area.xyz, root.position_area.w, near2) > 0.5)) {
-        float f = radiosity_form_factor(pr, nr, ar, root.position_area.xyz, shot_n, root.position_area.w);
-        if (f > 0.0) incident = root.unshot.xyz * f;
-    } else {
-        int stack[stack_size];
-        int top = 0;
-        for (int c = 0; c < root.meta.y; ++c) stack[top++] = root.meta.x + c;
-        for (int visit = 0; visit < max_nodes && top > 0; ++visit) {
-            near_node nd = node[stack[--top]];
-            bool near_node_ = radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5;
-            if (nd.meta.y == 0 || !near_node_) {
-                float f = radiosity_form_factor(pr, nr, ar, nd.position_area.xyz, shot_n, nd.position_area.w);
-                if (f > 0.0) incident += nd.unshot.xyz * f;
-            } else {
-                for (int c = 0; c < nd.meta.y && top < stack_size; ++c) stack[top++] = nd.meta.x + c;
+    // (a stack, children pushed in order, so terms are summed in its order), each node
+    // lighting the receiver's side that faces it (receiving_side, radiosity/sides.hpp: the
+    // back only when two-sided). Each node is visited at most once, so max_nodes bounds the
+    // loop; most receivers are far from the whole block and visit the root alone.
+    int stack[stack_size];
+    int top = 0, current = node_count - 1;
+    for (int visit = 0; visit < max_nodes; ++visit) {
+        near_node nd = node[current];
+        if (nd.meta.y == 0 || !(radiosity_near_field(pr, nd.position_area.xyz, nd.position_area.w, near2) > 0.5)) {
+            float side = radiosity_receiving_side(pr, nr, nd.position_area.xyz, float(two_sided));
+            float f = radiosity_form_factor(pr, radiosity_side_normal(nr, side), ar, nd.position_area.xyz, shot_n,
+                                            nd.position_area.w);
+            if (f > 0.0) {
+                if (side > 0.5) incident_back += nd.unshot.xyz * f;
+                else incident += nd.unshot.xyz * f;
             }
+        } else {
+            for (int c = 0; c < nd.meta.y && top < stack_size; ++c) stack[top++] = nd.meta.x + c;
         }
+        if (top == 0) break;
+        current = stack[--top];
     }
-    if (!(incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    bool front_lit = incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0;
+    bool back_lit = incident_back.x > 0.0 || incident_back.y > 0.0 || incident_back.z > 0.0;
+    if (!front_lit && !back_lit) { intercept_nothing(xy); return; }
     float v = shot_visibility(pr, a.normal_chart.w);
-    if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    if (!(v > 0.0)) { intercept_nothing(xy); return; }
     vec3 received = incident * v;
     receive(xy, rho * received, received * ar);
+    if (two_sided != 0) {
+        vec3 received_back = incident_back * v;
+        receive(side_texel(xy, 1), rho * received_back, received_back * ar);
+    }
 }
 )";
 }
@@ -295,7 +312,11 @@ void main() {
 std::string rescale_compute() {
     using namespace rescale_uniform;
     return version_line + "layout(local_size_x = 64) in;\n" +
-           uniforms({{atlas_width, "int atlas_width"}, {element_count, "uint element_count"}, {scale, "vec3 scale"}}) +
+           uniforms({{atlas_width, "int atlas_width"},
+                     {element_count, "uint element_count"},
+                     {scale, "vec3 scale"},
+                     {atlas_height, "int atlas_height"},
+                     {sides, "int sides"}}) +
            "\n" + texel_attributes_struct +
            storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
            storage_block(element_binding, "readonly buffer element_block { uint element_texel[]; }") +
@@ -306,12 +327,17 @@ void main() {
     uint code = element_texel[gl_GlobalInvocationID.x];
     ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
     texel_attributes a = texel[xy.y * atlas_width + xy.x];
-    vec3 got = imageLoad(intercepted_image, xy).rgb;
-    if (!(a.position_area.w > 0.0) || got == vec3(0.0)) return;
-    vec3 change = a.albedo.rgb * (got / a.position_area.w * (scale - vec3(1.0)));
-    imageStore(radiosity_image, xy, imageLoad(radiosity_image, xy) + vec4(change, 0.0));
-    imageStore(unshot_image, xy, max(imageLoad(unshot_image, xy) + vec4(change, 0.0), vec4(0.0)));
-    imageStore(intercepted_image, xy, vec4(got * scale, 0.0));
+    if (!(a.position_area.w > 0.0)) return;
+    // Each side's rows (the backs' follow the fronts').
+    for (int side = 0; side < sides; ++side) {
+        ivec2 at = xy + ivec2(0, side * atlas_height);
+        vec3 got = imageLoad(intercepted_image, at).rgb;
+        if (got == vec3(0.0)) continue;
+        vec3 change = a.albedo.rgb * (got / a.position_area.w * (scale - vec3(1.0)));
+        imageStore(radiosity_image, at, imageLoad(radiosity_image, at) + vec4(change, 0.0));
+        imageStore(unshot_image, at, max(imageLoad(unshot_image, at) + vec4(change, 0.0), vec4(0.0)));
+        imageStore(intercepted_image, at, vec4(got * scale, 0.0));
+    }
 }
 )";
 }
@@ -347,6 +373,12 @@ float parallel_visibility(vec3 p, float chart) {
     vec4 plane = item.x >= 0.0 ? local_plane[int(item.y)] : vec4(0.0, 0.0, 1.0, 0.0);
     return radiosity_parallel_sees(p, chart, item.x, plane.xyz, plane.w, item.z, shot_n, diagonal);
 }
+// The light's irradiance at p on the side of normal n (emitted from direct_light.hpp).
+vec3 light_irradiance(vec3 p, vec3 n) {
+    return parallel != 0 ? radiosity_directional_irradiance(n, light_axis, intensity)
+         : spot != 0     ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
+                         : radiosity_point_irradiance(p, n, shot_position, intensity);
+}
 void main() {
     // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
     if (gl_GlobalInvocationID.x >= element_count) return;
@@ -354,17 +386,23 @@ void main() {
     ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
     texel_attributes a = texel[xy.y * atlas_width + xy.x];
     if (!(a.position_area.w > 0.0)) return;
-    if (a.normal_chart.w == shot_chart) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    intercept_nothing(xy);
+    if (a.normal_chart.w == shot_chart) return;
     vec3 p = a.position_area.xyz, n = a.normal_chart.xyz;
     // Each element belongs to one hemisphere of the light: z >= 0 of the first, z > 0 of the second.
-    bool side = parallel != 0 || radiosity_light_side(p, shot_position, shot_n, float(strict_side)) > 0.5;
-    vec3 e = parallel != 0 ? radiosity_directional_irradiance(n, light_axis, intensity)
-           : spot != 0     ? radiosity_spot_irradiance(p, n, shot_position, light_axis, intensity, cos_cone, cosine_falloff)
-                           : radiosity_point_irradiance(p, n, shot_position, intensity);
-    if (!side || !(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
+    bool hemisphere = parallel != 0 || radiosity_light_side(p, shot_position, shot_n, float(strict_side)) > 0.5;
+    if (!hemisphere) return;
+    // The side facing the light: the front, or (two-sided) the back, as the CPU solver takes it.
+    vec3 e = light_irradiance(p, n);
+    int side = 0;
+    if (two_sided != 0 && !(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) {
+        side = 1;
+        e = light_irradiance(p, radiosity_side_normal(n, 1.0));
+    }
+    if (!(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) return;
     float v = parallel != 0 ? parallel_visibility(p, a.normal_chart.w) : shot_visibility(p, a.normal_chart.w);
-    if (!(v > 0.0)) { imageStore(intercepted_image, xy, vec4(0.0)); return; }
-    receive(xy, a.albedo.rgb * (e * v), e * (v * a.position_area.w));
+    if (!(v > 0.0)) return;
+    receive(side_texel(xy, side), a.albedo.rgb * (e * v), e * (v * a.position_area.w));
 }
 )";
 }
@@ -376,7 +414,11 @@ void main() {
 // (ties to the lowest index) and a shared-memory tree over its 64 partial results.
 std::string reduce_compute() {
     using namespace reduce_uniform;
-    return version_line + uniforms({{atlas_width, "int atlas_width"}, {shooter_count, "uint shooter_count"}}) +
+    return version_line +
+           uniforms({{atlas_width, "int atlas_width"},
+                     {shooter_count, "uint shooter_count"},
+                     {blocks, "uint blocks"},
+                     {atlas_height, "int atlas_height"}}) +
            "\nlayout(local_size_x = 64) in;\n" + texel_attributes_struct +
            storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
            storage_block(first_binding, "readonly buffer first_block { uint shooter_first[]; }") +
@@ -387,15 +429,18 @@ std::string reduce_compute() {
 void main() {
     uint k = gl_GlobalInvocationID.x;
     if (k >= shooter_count) return;
+    // Shooter k: block k % blocks on side k / blocks (that side's rows), as on the CPU.
+    uint block = k % blocks;
+    ivec2 rows = ivec2(0, int(k / blocks) * atlas_height);
     double power = 0.0;
     dvec3 ic = dvec3(0.0), ab = dvec3(0.0);
-    for (uint e = shooter_first[k]; e < shooter_first[k + 1u]; ++e) {
+    for (uint e = shooter_first[block]; e < shooter_first[block + 1u]; ++e) {
         uint code = element_texel[e];
         ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
         texel_attributes a = texel[xy.y * atlas_width + xy.x];
-        vec4 u = imageLoad(unshot_image, xy);
+        vec4 u = imageLoad(unshot_image, xy + rows);
         power += (double(u.r) + double(u.g) + double(u.b)) * double(a.position_area.w);
-        dvec3 got = dvec3(imageLoad(intercepted_image, xy).rgb);
+        dvec3 got = dvec3(imageLoad(intercepted_image, xy + rows).rgb);
         ic += got;
         ab += (dvec3(1.0) - dvec3(a.albedo.rgb)) * got;
     }
@@ -444,8 +489,9 @@ void main() {
 }
 
 // The display lightmap: each lightmap texel shows its element's radiosity with the ambient
-// term (radiosity_with_ambient, emitted); source_texel holds the element's atlas texel packed
-// as x | y << 16, or 0xffffffff where the texel shows no element.
+// term (radiosity_with_ambient, emitted), on the side whose rows start at source_row;
+// source_texel holds the element's atlas texel packed as x | y << 16, or 0xffffffff where the
+// texel shows no element.
 std::string lightmap_compute() {
     using namespace lightmap_uniform;
     glsl::function_set fs;
@@ -455,7 +501,10 @@ std::string lightmap_compute() {
            storage_block(source_binding, "readonly buffer source_block { uint source_texel[]; }") +
            image(radiosity_unit, "readonly image2D radiosity_image") +
            image(lightmap_unit, "writeonly image2D lightmap_image") +
-           uniforms({{atlas_width, "int atlas_width"}, {atlas_height, "int atlas_height"}, {ambient, "vec3 ambient"}}) +
+           uniforms({{atlas_width, "int atlas_width"},
+                     {atlas_height, "int atlas_height"},
+                     {ambient, "vec3 ambient"},
+                     {source_row, "int source_row"}}) +
            R"(
 void main() {
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
@@ -463,7 +512,7 @@ void main() {
     uint code = source_texel[xy.y * atlas_width + xy.x];
     if (code == 0xffffffffu) { imageStore(lightmap_image, xy, vec4(0.0)); return; }
     ivec2 from = ivec2(int(code & 0xffffu), int(code >> 16u));
-    vec3 b = imageLoad(radiosity_image, from).rgb;
+    vec3 b = imageLoad(radiosity_image, from + ivec2(0, source_row)).rgb;
     vec3 rho = texel[from.y * atlas_width + from.x].albedo.rgb;
     imageStore(lightmap_image, xy, vec4(radiosity_display(b, rho, ambient), 1.0));
 }

@@ -68,6 +68,7 @@ enum : int {
     diagonal = 9,
     hemicube = 20,
     element_count = 21,
+    two_sided = 22,  // 1: the backs' rows follow the fronts' (atlas_height rows on)
 };
 }
 
@@ -94,12 +95,12 @@ enum : int {
 
 // The display lightmap's pass (update_lightmap_texture).
 namespace lightmap_uniform {
-enum : int { atlas_width = 0, atlas_height = 1, ambient = 2 };
+enum : int { atlas_width = 0, atlas_height = 1, ambient = 2, source_row = 3 };
 }
 
 // The reduction's two passes.
 namespace reduce_uniform {
-enum : int { atlas_width = 0, shooter_count = 1 };
+enum : int { atlas_width = 0, shooter_count = 1, blocks = 2, atlas_height = 3 };
 }
 namespace finish_uniform {
 enum : int { shooter_count = 0 };
@@ -107,7 +108,7 @@ enum : int { shooter_count = 0 };
 
 // The pass that scales a shot down to its power.
 namespace rescale_uniform {
-enum : int { atlas_width = 0, element_count = 1, scale = 2 };
+enum : int { atlas_width = 0, element_count = 1, scale = 2, atlas_height = 3, sides = 4 };
 }
 
 std::string item_buffer_vertex();

@@ -50,12 +50,15 @@ progressive_radiosity::state::reduction progressive_radiosity::state::reduce() {
         bind_common();
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         glUseProgram(reduce_program->id());
-        reduce_program->set(radiosity_glsl::reduce_uniform::atlas_width, int(width));
-        reduce_program->set(radiosity_glsl::reduce_uniform::shooter_count, unsigned(first.size() - 1));
-        glDispatchCompute(GLuint((first.size() - 1 + reduce_group - 1) / reduce_group), 1, 1);
+        namespace u = radiosity_glsl::reduce_uniform;
+        reduce_program->set(u::atlas_width, int(width));
+        reduce_program->set(u::atlas_height, int(height));
+        reduce_program->set(u::shooter_count, unsigned(blocks() * sides));
+        reduce_program->set(u::blocks, unsigned(blocks()));
+        glDispatchCompute(GLuint((blocks() * sides + reduce_group - 1) / reduce_group), 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glUseProgram(finish_program->id());
-        finish_program->set(radiosity_glsl::finish_uniform::shooter_count, unsigned(first.size() - 1));
+        finish_program->set(radiosity_glsl::finish_uniform::shooter_count, unsigned(blocks() * sides));
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         check_error("progressive_radiosity: the shooter reduction");
@@ -63,7 +66,7 @@ progressive_radiosity::state::reduction progressive_radiosity::state::reduce() {
     std::array<double, 9> r{};
     partials.read(0, r.data(), sizeof(double) * 9);
     next_power = std::max(0.0, r[0]);
-    next = std::uint32_t(std::clamp(r[1], 0.0, double(first.size() - 2)));
+    next = std::uint32_t(std::clamp(r[1], 0.0, double(blocks() * sides - 1)));
     unshot_total = r[2];
     timings.choice_ms += ms_since(start);
     return {{r[3], r[4], r[5]}, {r[6], r[7], r[8]}};
@@ -238,11 +241,13 @@ void progressive_radiosity::state::draw_hemicube() {
     check_error("progressive_radiosity: drawing the hemicube");
 }
 
-std::vector<glm::vec3> progressive_radiosity::state::read_elements(const texture& tex) const {
+std::vector<glm::vec3> progressive_radiosity::state::read_elements(const texture& tex, int side) const {
+    require(side >= 0 && std::uint32_t(side) < sides, "side", sides == 2 ? "must be 0 or 1" : "must be 0 (one-sided)");
     const std::vector<float> all = tex.read_floats();
     std::vector<glm::vec3> out(atlas.size());
     for (std::size_t i = 0; i < out.size(); ++i) {
-        const std::size_t at = 4 * (std::size_t(atlas.texel[i].y) * width + atlas.texel[i].x);
+        const std::size_t row = std::size_t(atlas.texel[i].y) + std::size_t(side) * height;
+        const std::size_t at = 4 * (row * width + atlas.texel[i].x);
         out[i] = glm::vec3(all[at], all[at + 1], all[at + 2]);
     }
     return out;
@@ -250,11 +255,14 @@ std::vector<glm::vec3> progressive_radiosity::state::read_elements(const texture
 
 void progressive_radiosity::state::shoot(std::uint32_t k) {
     auto start = clock_type::now();
-    const std::uint32_t i0 = first[k], i1 = first[k + 1];
+    // Block `block`'s elements on `side` (their rows of the textures): they shoot into the
+    // hemisphere of that side's normal.
+    const std::uint32_t block = std::uint32_t(k % blocks()), side = std::uint32_t(k / blocks());
+    const std::uint32_t i0 = first[block], i1 = first[block + 1];
     // The shooter's texels, read back: its power and its near-field tree (the CPU solver's
     // build_near_tree: elements, then 2 x 2 groups of its grid cells, ..., the block last);
     // then cleared.
-    const glm::uvec4 r = rect[k];
+    const glm::uvec4 r = rect[block] + glm::uvec4(0u, side * height, 0u, 0u);
     std::vector<glm::vec4> texels_back(std::size_t(r.z) * r.w);
     {
         detail::pack_state pack;
@@ -267,13 +275,13 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     }
     // The shooter's unshot radiosity per element, from the texels read back.
     const auto unshot_of = [&](std::uint32_t i) {
-        const glm::uvec2 tx = atlas.texel[i] - glm::uvec2(r.x, r.y);
+        const glm::uvec2 tx = atlas.texel[i] + glm::uvec2(0u, side * height) - glm::uvec2(r.x, r.y);
         return glm::dvec3(glm::vec3(texels_back[std::size_t(tx.y) * r.z + tx.x]));
     };
     glm::dvec3 power(0.0);
     for (std::uint32_t i = i0; i < i1; ++i) power += unshot_of(i) * double(atlas.area[i]);
     near.clear();
-    build_near_field_tree(atlas, i0, i1, options.shooting.shoot_blocks, k, unshot_of,
+    build_near_field_tree(atlas, i0, i1, options.shooting.shoot_blocks, block, unshot_of,
                           [&](glm::dvec3 position, double area, glm::dvec3 mean_unshot, std::uint32_t first_child,
                               std::uint32_t children) {
                               near.push_back({glm::vec4(glm::vec3(position), float(area)),
@@ -284,7 +292,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     nodes.write(0, near.data(), near.size() * sizeof(gpu_node));
 
     const float chart = float(atlas.chart[i0]);
-    set_shot(centre[k], atlas.normal[i0], chart);
+    set_shot(centre[block], side_normal<float, glm::vec3>(atlas.normal[i0], float(side)), chart);
     draw_visibility();
     if (options.timed_stages) finish();
     timings.visibility_ms += ms_since(start);
@@ -329,6 +337,8 @@ void progressive_radiosity::state::rescale(glm::vec3 scale) {
         const program& p = *rescale_program;
         glUseProgram(p.id());
         p.set(radiosity_glsl::rescale_uniform::atlas_width, int(width));
+        p.set(radiosity_glsl::rescale_uniform::atlas_height, int(height));
+        p.set(radiosity_glsl::rescale_uniform::sides, int(sides));
         p.set(radiosity_glsl::rescale_uniform::element_count, unsigned(atlas.size()));
         p.set(radiosity_glsl::rescale_uniform::scale, scale);
         glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
@@ -350,6 +360,7 @@ void progressive_radiosity::state::set_shot_uniforms(const program& p, float cha
     p.set(u::diagonal, diagonal);
     p.set(u::hemicube, hemicube ? 1 : 0);
     p.set(u::element_count, unsigned(atlas.size()));
+    p.set(u::two_sided, sides == 2 ? 1 : 0);
 }
 
 void progressive_radiosity::state::set_light_uniforms(const program& p, const packed_light& l, bool spot,

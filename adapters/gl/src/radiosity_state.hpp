@@ -9,6 +9,7 @@
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
 #include <bounce/radiosity/shooters.hpp>
+#include <bounce/radiosity/sides.hpp>
 #include <bounce/radiosity/solve.hpp>
 #include <bounce/sampling.hpp>
 #include <bounce/radiosity/stereographic_tessellation.hpp>
@@ -132,6 +133,11 @@ struct progressive_radiosity::state {
     lightmap_atlas atlas;
     radiosity_options options;
     std::uint32_t width = 0, height = 0;
+    // Two-sided (options.shooting.two_sided): the radiosity, unshot and intercepted textures
+    // hold the fronts in rows [0, height) and the backs in rows [height, 2 height); shooter k
+    // is block k % blocks on side k / blocks, as on the CPU.
+    std::uint32_t sides = 1;
+    std::vector<std::uint8_t> emits_back;  // per chart, 1 when it emits from its back (emission_sides)
     // Shooters.
     std::vector<std::uint32_t> first;
     std::vector<glm::vec3> centre;
@@ -214,7 +220,14 @@ struct progressive_radiosity::state {
     void set_frame_uniforms(const program& p, int t_location, int b_location, int n_location) const;
     // The farthest corner of the scene's box from the shot's position.
     float farthest_from_shot() const;
-    std::vector<glm::vec3> read_elements(const texture& t) const;
+    // Whether element i's emission leaves from side `side` (its front when one-sided).
+    bool emits_on(std::size_t i, int side) const {
+        const bool back = !emits_back.empty() && emits_back[atlas.chart[i]];
+        return back == (side == 1);
+    }
+    std::size_t blocks() const noexcept { return first.size() - 1; }
+    // Element values of side `side` read back from t (one of the textures with a row band per side).
+    std::vector<glm::vec3> read_elements(const texture& t, int side) const;
     void bind_common() const;
 };
 

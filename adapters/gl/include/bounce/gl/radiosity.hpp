@@ -31,7 +31,12 @@
 ///
 /// Visibility can also come from a hemicube (five perspective faces drawn by GL, no
 /// tessellation needed) or be left out. Not here (the CPU solver has them): several shooters
-/// per step, adaptive subdivision.
+/// per step, grouped shooters, adaptive subdivision.
+///
+/// Elements are two-sided by default, as on the CPU (radiosity/sides.hpp): a radiosity per
+/// side, the backs in rows [height, 2 height) of the textures, shooter k block k % blocks on
+/// side k / blocks; a receiver takes each node of a shot on the side that faces it
+/// (receiving_side, emitted) and a light on the side that faces the light.
 ///
 /// Every pass works in the context current on the calling thread, on textures and buffers the
 /// solver owns, and restores the context state it touches (program, framebuffers, viewport,
@@ -69,8 +74,7 @@ enum class radiosity_visibility {
 /// (radiosity/options.hpp; shooters_per_step must be 1 here) and the item-buffer options of
 /// cpu::item_buffer_visibility::options, with the same meanings and defaults.
 struct radiosity_options {
-    bounce::radiosity_options shooting{.two_sided = false};  ///< as cpu::progressive_radiosity takes them;
-                                                         ///< one-sided only (two_sided is refused)
+    bounce::radiosity_options shooting{};  ///< as cpu::progressive_radiosity takes them (two-sided by default)
     radiosity_visibility visibility = radiosity_visibility::stereographic;
     int resolution = 256;            ///< item buffer side, pixels (hemicube: per face, even; typical: 128-512)
     float tolerance_px = 0.25f;      ///< largest sagitta of a tessellated edge, pixels
@@ -97,8 +101,9 @@ public:
     /// scene's lights and runs the first reduction. `scene` is read only here. Throws
     /// parameter_error on bad options (tolerance_px below stereographic_tolerance_floor
     /// included), an atlas not built from `scene`, a subdivided atlas, or blocks wider than
-    /// 16 texels; radiosity_error when the scene's lights reach no surface's front side
-    /// (check_lights_reach_surfaces); gl_error when GL cannot run it.
+    /// 16 texels; radiosity_error when the scene's lights reach no surface (no front side,
+    /// one-sided: check_lights_reach_surfaces); gl_error when GL cannot run it (the textures
+    /// are sides() times the atlas's height: GL_MAX_TEXTURE_SIZE bounds it).
     progressive_radiosity(const scene_view& scene, const lightmap_atlas& atlas, radiosity_options options = {});
     ~progressive_radiosity();
     progressive_radiosity(progressive_radiosity&&) noexcept;
@@ -130,10 +135,12 @@ public:
     /// power (W, channels summed); power 0 when nothing is left.
     std::uint32_t next_shooter() const noexcept;
     double next_shooter_power() const noexcept;
-    /// Number of shooters (blocks, or elements without shoot_blocks); shooter k is the
-    /// elements [shooter_first(k), shooter_first(k + 1)).
+    /// Number of shooters: blocks (or elements without shoot_blocks) times sides(); shooter k
+    /// is block b = k % (shooters() / sides()) on side k / (shooters() / sides()), the elements
+    /// [shooter_first(b), shooter_first(b + 1)).
     std::size_t shooters() const noexcept;
-    std::uint32_t shooter_first(std::size_t k) const;
+    /// The first element of block `block` (in [0, shooters() / sides()]).
+    std::uint32_t shooter_first(std::size_t block) const;
     /// Shots whose form factors summed above 1 and were scaled down to deliver their power
     /// (shot_scale, radiosity/shooters.hpp), as cpu::progressive_radiosity counts them.
     std::size_t clamped_shots() const noexcept;
@@ -149,42 +156,49 @@ public:
     glm::dvec3 intercepted_power() const noexcept;
     glm::dvec3 unshot_power() const;
 
-    /// Radiosity B and unshot radiosity per element (read back), W/m^2 per channel.
-    std::vector<glm::vec3> radiosity() const;
-    std::vector<glm::vec3> unshot() const;
+    /// Radiosity B and unshot radiosity per element of `side` (0 the front, counter-clockwise;
+    /// 1 the back, two-sided only), read back, W/m^2 per channel.
+    std::vector<glm::vec3> radiosity(int side = 0) const;
+    std::vector<glm::vec3> unshot(int side = 0) const;
     /// The ambient radiosity (Cohen et al. 1988) and B plus rho times it when the options ask.
     glm::dvec3 ambient() const;
-    std::vector<glm::vec3> display_radiosity() const;
+    std::vector<glm::vec3> display_radiosity(int side = 0) const;
     /// Per element, the light of `paths` as `quantity` (output.hpp), as
     /// cpu::progressive_radiosity::output gives it. The parts come from B and the B read back
     /// after the lights were shot (direct radiosity B_e + rho E_d): irradiance is a part's
     /// reflected radiosity divided by rho per channel, so a channel whose albedo is 0 reports
     /// 0 here (the CPU solver, which keeps irradiance itself, reports the light that arrived).
+    /// `side` as cpu::progressive_radiosity takes it (the emission counted on the side that
+    /// emits); so the direct part, times rho, is the lights' direct deposit that
+    /// embree::lightmap_direct_view replaces by its own direct light (bounced_radiosity_lightmap).
     std::vector<glm::vec3> output(output_quantity quantity = output_quantity::irradiance,
-                                  light_paths paths = light_paths::indirect) const;
-    /// output(quantity, paths) laid out as the atlas (lightmap_atlas::to_fine_texels; level 0:
-    /// to_texels, padding filled), as cpu::progressive_radiosity::lightmap gives it.
+                                  light_paths paths = light_paths::indirect, int side = 0) const;
+    /// output(quantity, paths, side) laid out as the atlas (lightmap_atlas::to_fine_texels;
+    /// level 0: to_texels, padding filled), as cpu::progressive_radiosity::lightmap gives it.
     image<glm::vec3> lightmap(output_quantity quantity = output_quantity::irradiance,
-                              light_paths paths = light_paths::indirect, int level = 0) const;
-    /// display_radiosity (B, W/m^2) laid out the same way: what embree::lightmap_view takes.
-    /// `side` as cpu::progressive_radiosity takes it; only 0 here (parameter_error otherwise).
+                              light_paths paths = light_paths::indirect, int level = 0, int side = 0) const;
+    /// display_radiosity(side) (B, W/m^2) laid out the same way: what embree::lightmap_view
+    /// takes (the back's for the views of back sides). parameter_error for a side it lacks.
     image<glm::vec3> radiosity_lightmap(int level = 0, int side = 0) const;
-    /// 1: the GL solver is one-sided (it refuses radiosity_options::two_sided).
-    int sides() const noexcept { return 1; }
-    /// Writes display_radiosity laid out as the atlas into the solver's lightmap texture
+    /// 2 when elements are two-sided (radiosity_options::two_sided, the default), else 1.
+    int sides() const noexcept;
+    bool two_sided() const noexcept { return sides() == 2; }
+    /// Writes display_radiosity(side) laid out as the atlas into the solver's lightmap texture
     /// (RGBA32F, atlas size, alpha 1 on charts, 0 elsewhere) on the GPU, padding texels
     /// filled from their element as radiosity_lightmap() fills them, so a renderer can sample it
-    /// bilinearly with the atlas's corner_uvs; returns it (valid while the solver lives).
-    texture_ref update_lightmap_texture();
-    /// lightmap(quantity, paths) at level 0 in a texture of the solver's (RGBA32F, atlas size,
+    /// bilinearly with the atlas's corner_uvs; returns it (valid while the solver lives; one
+    /// texture for either side, the next call overwrites it).
+    texture_ref update_lightmap_texture(int side = 0);
+    /// lightmap(quantity, paths, 0, side) in a texture of the solver's (RGBA32F, atlas size,
     /// alpha 1 on charts and their padding, 0 elsewhere), uploaded from the host: what a
     /// renderer with its own light pass samples with the atlas's corner_uvs (by default the
     /// indirect irradiance, so its direct light is not counted twice). Returns it (valid
     /// while the solver lives; the next call overwrites it).
     texture_ref update_output_texture(output_quantity quantity = output_quantity::irradiance,
-                                      light_paths paths = light_paths::indirect);
-    /// The solver's radiosity and unshot textures (RGBA32F, atlas size, element texels only;
-    /// padding texels hold 0); valid while the solver lives.
+                                      light_paths paths = light_paths::indirect, int side = 0);
+    /// The solver's radiosity and unshot textures (RGBA32F, the atlas's width and sides()
+    /// times its height: the fronts' rows, then the backs'; element texels only, padding
+    /// texels hold 0); valid while the solver lives.
     texture_ref radiosity_texture() const noexcept;
     texture_ref unshot_texture() const noexcept;
 
@@ -198,7 +212,7 @@ public:
 private:
     struct state;
     std::unique_ptr<state> s_;
-    std::vector<glm::vec3> direct_;  // B once the lights were shot (emission + rho E_d), per element
+    std::vector<glm::vec3> direct_;  // B once the lights were shot (emission + rho E_d), per side and element (side-major)
     std::optional<texture> output_texture_;  // update_output_texture's
 };
 
