@@ -33,8 +33,8 @@ struct radiosity_options {
                                    ///< recursively; 0: always one disc (typical: 2-4)
     bool two_sided = true;         ///< every element receives and shoots on both sides, a radiosity
                                    ///< per side (the reference integrator's convention, issue 30);
-                                   ///< false: only the front (counter-clockwise) side. The GL
-                                   ///< solver is one-sided and refuses true
+                                   ///< false: only the front (counter-clockwise) side. Both
+                                   ///< solvers, CPU and GL
     int light_samples = 1;         ///< point, spot and directional lights are taken at k x k points of
                                    ///< each whole texel (light_sample_point), not only at its element's
                                    ///< point, so light narrower than a texel (the sun through a slit) is

@@ -264,8 +264,8 @@ auto back_radiosity_lightmap(const Solver& solver, int level) -> decltype(solver
     return solver.sides() == 2 ? solver.radiosity_lightmap(level, 1) : decltype(solver.radiosity_lightmap(level, 1)){};
 }
 
-/// Whether a solver keeps its lights' direct deposit apart per side (the CPU solver does, the
-/// GL solver does not): what a view that computes the direct light per pixel needs.
+/// Whether a solver keeps its lights' direct deposit apart per side (the CPU and the GL
+/// solvers do): what a view that computes the direct light per pixel needs.
 template <class Solver>
 concept splits_direct = requires(const Solver& s) {
     s.display_radiosity(0);
