@@ -212,6 +212,10 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
                    {"unshot_before", rb.unshot_before}, {"unshot_after", rb.unshot_after}};
     j["bake"] = {{"steps", bake.steps}, {"ms", bake.solve_ms}};
     j["ratio"] = rebake_ms / fresh_ms;
+    // Without the load: receiver-shooter pairs evaluated (a shot walks every element).
+    const double fresh_pairs = double(fr.steps) * double(fresh_atlas.size());
+    const double rebake_pairs = double(rb.pairs) + double(at_steps) * double(atlas.size());
+    j["pairs"] = {{"fresh", fresh_pairs}, {"rebake", rebake_pairs}, {"ratio", rebake_pairs / fresh_pairs}};
     j["converged_rel_rms"] = converged_apart;
     if (reference) {
         j["reference_rel_rms"] = {{"fresh", error(fresh_view, reference->radiance)}, {"rebake", error(rebake_view, reference->radiance)},
@@ -219,9 +223,10 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     }
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
     fmt::print("radiosity re-bake {} ({}): {} elements; fresh {:.0f} ms (setup {:.0f}, {} steps), error {:.4f}; re-bake {:.0f} ms "
-               "(correction {:.0f}, {} steps), error {:.4f}{}; ratio {:.3f}; converged apart {:.4f}{}\n",
+               "(correction {:.0f}, {} steps), error {:.4f}{}; ratio {:.3f} ({:.3f} in pairs); converged apart {:.4f}{}\n",
                scene.name, j["change"].get<std::string>(), atlas.size(), fresh_ms, fresh_setup_ms, fr.steps, fresh_error,
-               rebake_ms, rb.ms, at_steps, rebake_error, reached ? "" : " (not reached)", rebake_ms / fresh_ms, converged_apart,
+               rebake_ms, rb.ms, at_steps, rebake_error, reached ? "" : " (not reached)", rebake_ms / fresh_ms,
+               rebake_pairs / fresh_pairs, converged_apart,
                reference ? fmt::format("; against the reference fresh {:.4f}, re-bake {:.4f}",
                                        j["reference_rel_rms"]["fresh"].get<double>(), j["reference_rel_rms"]["rebake"].get<double>())
                          : std::string());

@@ -26,16 +26,18 @@
 ///    the shooter's centre to the receiver) meets the object's box before or after the move.
 ///    Every shooter that shot re-shoots its S to exactly those receivers, negatively with the
 ///    old geometry and visibility and positively with the new; every other pair's delivery is
-///    the same both times and is skipped (segment_meets_box). The lights' direct deposit is
-///    re-evaluated as for a light change (shadows of the object).
+///    the same both times and is skipped (segment_meets_box). What the moved elements received
+///    before needs no re-shot: it is the irradiance the shots delivered to them, which the
+///    solver keeps. The lights' direct deposit is re-evaluated as for a light change (shadows
+///    of the object).
 /// The deliveries use the solver's own shot (block discs, near-field trees, one visibility
 /// ray from the block's centre), so the correction is exact for it but for two things the
 /// history of the previous solve leaves in B and that S alone does not keep: shots scaled
 /// down to their power (shot_scale; the moved object's own shooters are re-shot whole and
-/// scaled, the others' partial re-shots are not) and grouped shooters' sampled visibility
-/// (radiosity_options::shooter_groups: the correction uses the blocks' shot). Both leave an
-/// error of the order of the clamp's or the sampling's share of the corrected light, which
-/// the tests and docs/radiosity.md measure against a fresh solve.
+/// scaled, the others' partial re-shots to unmoved elements are not) and grouped shooters'
+/// sampled visibility (radiosity_options::shooter_groups: the correction uses the blocks'
+/// shot). Both leave an error of the order of the clamp's or the sampling's share of the
+/// corrected light, which the tests and docs/radiosity.md measure against a fresh solve.
 ///
 /// The solve after a re-bake selects shooters by |unshot power| and checks that the unshot
 /// power in magnitude never rises (radiosity/solve.hpp), so negative shots stay conservative.

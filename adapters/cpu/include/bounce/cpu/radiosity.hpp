@@ -494,7 +494,7 @@ private:
         last_shot_ = {shots_, k, first, total.top_receiver,
                       total.top_power / std::max(bounce::detail::channel_total(glm::abs(power)), 1e-300), scale};
         if (scale != glm::dvec3(1.0)) ++clamped_shots_;
-        shot_power_ += bounce::detail::channel_total(glm::abs(power));
+        shot_power_ += bounce::detail::channel_total(power);
         ++shots_;
     }
 
@@ -687,7 +687,7 @@ private:
         return back == (side == 1);
     }
     double unshot_total_ = 0, total_area_ = 0;
-    double shot_power_ = 0;  // power shot by surfaces so far, channels summed (W)
+    double shot_power_ = 0;  // power shot by surfaces so far, channels summed, signed (W): sum of S A after a re-bake
     glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, intercepted_{0}, albedo_area_{0};
     radiosity_timings timings_;
     std::size_t steps_ = 0, shots_ = 0;

@@ -16,10 +16,12 @@
 ///   solver.solve(o);                                         // the re-bake
 ///
 /// The cost of a move's correction: every block-side that has shot re-shoots its S twice
-/// (old and new geometry), each time only to the receivers whose delivery can differ (the
-/// moved object's elements, and those whose visibility ray from the shooter's centre meets the
-/// object's box before or after the move), plus one shot per light; with the item buffers,
-/// each of those shots draws its item buffer whole.
+/// (old and new geometry), each time only to the receivers whose delivery can differ: those
+/// whose visibility ray from the shooter's centre meets the object's box before or after the
+/// move, and, with the new geometry, the moved object's elements (what they received before
+/// is their gathered irradiance, taken away as it is); a moved block re-shoots to every
+/// receiver both times. Then one shot per light. With the item buffers, each of those shots
+/// draws its item buffer whole.
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/radiosity/rebake.hpp>
@@ -51,10 +53,12 @@ struct rebake_access {
     // One pass of a move's correction: every block-side whose S holds power shoots it, as the
     // solver's shot does, to the receivers keep(shooter centre, element) asks for (a moved
     // block: to every receiver, scaled to its power as a shot is), and `sign` times what it
-    // delivers is added to `delta` (incident radiosity per element and side).
+    // delivers is added to `delta` (incident radiosity per element and side), but for the
+    // elements `skip` marks.
     template <class Keep>
     static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& moved_block, const Keep& keep,
-                        double sign, std::vector<glm::dvec3>& delta, radiosity_rebake_report& r) {
+                        double sign, const std::vector<std::uint8_t>& skip, std::vector<glm::dvec3>& delta,
+                        radiosity_rebake_report& r) {
         const lightmap_atlas& at = s.atlas_;
         const std::size_t blocks = s.first_.size() - 1, n = at.size();
         std::atomic<std::size_t> pairs{0};
@@ -83,7 +87,7 @@ struct rebake_access {
             const glm::dvec3 scale = sign * (whole ? shot_scale(power, got) : glm::dvec3(1.0));
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, delta.size(), 4096), [&](const tbb::blocked_range<std::size_t>& q) {
                 for (std::size_t j = q.begin(); j != q.end(); ++j)
-                    if (s.received_[j] != vec(0)) delta[j] += scale * glm::dvec3(s.received_[j]);
+                    if (s.received_[j] != vec(0) && !skip[j % n]) delta[j] += scale * glm::dvec3(s.received_[j]);
             });
         }
         r.pairs += pairs.load();
@@ -163,17 +167,24 @@ struct rebake_access {
         for (std::size_t i = 0; i < n; ++i) moved_element[i] = charts[at.chart[i]], r.moved_elements += charts[at.chart[i]];
         for (std::size_t b = 0; b < blocks; ++b) moved_block[b] = charts[at.chart[s.first_[b]]];
         // A pair's delivery can change only with a moved end or a ray through either box.
-        const auto keep = [&](const glm::vec3& centre, std::uint32_t i) {
-            return moved_element[i] != 0 || segment_meets_box(centre, at.position[i], boxes.before, margin) ||
+        const auto through = [&](const glm::vec3& centre, std::uint32_t i) {
+            return segment_meets_box(centre, at.position[i], boxes.before, margin) ||
                    segment_meets_box(centre, at.position[i], boxes.after, margin);
         };
         const std::vector<vec> S = shot(s);
+        // What the moved elements received is known, to the bit of every past shot's scale:
+        // the irradiance the shots delivered (gathered_). The old pass leaves them out.
         std::vector<glm::dvec3> delta(S.size(), glm::dvec3(0));
-        reshoot(s, S, moved_block, keep, -1.0, delta, r);  // the old geometry and visibility
+        for (std::size_t j = 0; j < delta.size(); ++j)
+            if (moved_element[j % n]) delta[j] = -glm::dvec3(s.gathered_[j]);
+        const std::vector<std::uint8_t> none(n, 0);
+        reshoot(s, S, moved_block, [&](const glm::vec3& c, std::uint32_t i) { return !moved_element[i] && through(c, i); }, -1.0,
+                moved_element, delta, r);  // the old geometry and visibility
         move_charts(s.atlas_, charts, m);
         s.visibility_ = std::forward<Visibility>(visibility);
         s.build_shooters();  // the moved blocks' centres, the groups' boxes
-        reshoot(s, S, moved_block, keep, 1.0, delta, r);   // the new
+        reshoot(s, S, moved_block, [&](const glm::vec3& c, std::uint32_t i) { return moved_element[i] || through(c, i); }, 1.0,
+                none, delta, r);  // the new
         apply(s, delta, regather_direct(s));
         r.unshot_after = s.unshot_fraction();
         r.ms = Solver::ms_since(start);
