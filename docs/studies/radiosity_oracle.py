@@ -11,6 +11,11 @@ best lightmap of the same atlas (the reference integrator over each texel), each
 docs/results/radiosity_oracle.json.
 
     python3 docs/studies/radiosity_oracle.py [--elements 100000] [--converge 0.9] [--scenes a,b] [--build build-charts]
+        [--extra '--ambient on']
+
+The oracle file also ranks the charts by their share of the bounced light's error
+(indirect_by_chart, direct_by_chart) and writes the bounced light of the solver, the
+reference and the oracle as PNGs beside it; --holes-out lists the black pixels (holes.hpp).
 """
 import argparse, json, os, subprocess, sys, time, datetime
 
@@ -26,6 +31,9 @@ def main():
     ap.add_argument("--build", default="build-charts")
     ap.add_argument("--tmp", default="/tmp/radbound")
     ap.add_argument("--results", default=os.path.join(ROOT, "docs/results/radiosity_oracle.json"))
+    ap.add_argument("--extra", default="", help="more radiosity options, e.g. '--ambient on'")
+    ap.add_argument("--binary", default="", help="the radiosity program (default: BUILD/bin/radiosity)")
+    ap.add_argument("--note", default="", help="provenance kept with each record (what the binary was built from)")
     a = ap.parse_args()
     os.makedirs(a.tmp, exist_ok=True)
     env = dict(os.environ)
@@ -35,10 +43,11 @@ def main():
     results = json.load(open(a.results)) if os.path.exists(a.results) else {"runs": []}
     for scene in a.scenes.split(","):
         stem = os.path.join(a.tmp, f"{scene}-{a.elements}")
-        cmd = [os.path.join(ROOT, a.build, "bin/radiosity"), "--scene", scene, "--elements", str(a.elements),
+        cmd = [a.binary or os.path.join(ROOT, a.build, "bin/radiosity"), "--scene", scene, "--elements", str(a.elements),
                "--visibility", "rays", "--converge", str(a.converge), "--reference-paths", "64", "--curve-points", "0",
-               "--shooter-groups", "256", "--quiet", "--json", stem + ".json", "--oracle-out", stem + "-oracle.json"]
-        load = os.getloadavg()[0]
+               "--shooter-groups", "256", "--quiet", "--json", stem + ".json", "--oracle-out", stem + "-oracle.json",
+               "--holes-out", stem + "-holes.csv"] + a.extra.split()
+        load = os.getloadavg()[0]  # the 1-minute load average before the run
         t0 = time.time()
         p = subprocess.run(cmd, env=env, capture_output=True, text=True)
         if p.returncode != 0:
@@ -47,10 +56,13 @@ def main():
         run = json.load(open(stem + ".json"))
         oracle = json.load(open(stem + "-oracle.json"))
         rec = {"scene": scene, "elements_asked": a.elements, "converge": a.converge, "commit": commit,
-               "command": " ".join(cmd[1:]), "date": datetime.datetime.utcnow().isoformat(timespec="seconds") + "Z",
-               "load_before": load, "wall_s_loaded": time.time() - t0,
-               "run": {k: run.get(k) for k in ("counts", "error", "black_pixels", "converged_fraction")},
+               "command": " ".join(cmd[1:]), "note": a.note, "date": datetime.datetime.utcnow().isoformat(timespec="seconds") + "Z",
+               "load_before": load, "load_after": os.getloadavg()[0], "wall_s_loaded": time.time() - t0,
+               "run": {k: run.get(k) for k in ("counts", "error", "black_pixels", "converged_fraction", "elements",
+                                               "iterations", "timings_ms", "indirect_unshot_fraction")},
                "split": oracle}
+        # Read again before appending: another run of this script may have added records since.
+        results = json.load(open(a.results)) if os.path.exists(a.results) else {"runs": []}
         results["runs"].append(rec)
         json.dump(results, open(a.results, "w"), indent=1)
         s, o = oracle["solver"], oracle["oracle"]

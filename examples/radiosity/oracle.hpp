@@ -121,6 +121,41 @@ inline nlohmann::ordered_json part_error(const image<glm::vec3>& x, const image<
     return j;
 }
 
+// Per chart and side seen, the indirect part's squared error of the solver's and the oracle's
+// lookup against the references' mean (luminance sums over its pixels), the largest first:
+// where the solver's bounced light differs from the best lightmap's.
+inline nlohmann::ordered_json indirect_by_chart(const std::vector<embree::lightmap_hit>& hits, const lightmap_atlas& atlas,
+                                                const image<glm::vec3>& solver, const image<glm::vec3>& oracle,
+                                                const image<glm::vec3>& a, const image<glm::vec3>& b, const image<float>& mask) {
+    struct sums { double solver_sq = 0, oracle_sq = 0, solver = 0, oracle = 0, ref = 0; std::size_t pixels = 0; };
+    std::vector<sums> per(2 * atlas.charts.size());
+    const auto lum = [](const glm::vec3& c) { return double(rec709_luminance<double, glm::dvec3>(glm::dvec3(c))); };
+    double total = 0;
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+        const std::size_t x = i % solver.width(), y = i / solver.width();
+        if (mask(x, y) == 0.f || hits[i].chart == lightmap_atlas::none) continue;
+        sums& s = per[2 * hits[i].chart + (hits[i].back ? 1 : 0)];
+        const double r = 0.5 * (lum(a(x, y)) + lum(b(x, y))), ls = lum(solver(x, y)), lo = lum(oracle(x, y));
+        s.solver_sq += (ls - r) * (ls - r), s.oracle_sq += (lo - r) * (lo - r);
+        s.solver += ls, s.oracle += lo, s.ref += r, ++s.pixels;
+        total += (ls - r) * (ls - r);
+    }
+    std::vector<std::size_t> order(per.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return per[p].solver_sq > per[q].solver_sq; });
+    nlohmann::ordered_json j = nlohmann::ordered_json::array();
+    for (std::size_t k = 0; k < std::min<std::size_t>(40, order.size()); ++k) {
+        const sums& s = per[order[k]];
+        const lightmap_chart& ch = atlas.charts[order[k] / 2];
+        j.push_back({{"chart", order[k] / 2}, {"back", order[k] % 2}, {"share", s.solver_sq / std::max(total, 1e-30)},
+                     {"pixels", s.pixels}, {"solver_mean", s.solver / double(s.pixels)}, {"oracle_mean", s.oracle / double(s.pixels)},
+                     {"ref_mean", s.ref / double(s.pixels)}, {"oracle_share", s.oracle_sq / std::max(total, 1e-30)},
+                     {"planar", ch.planar}, {"triangles", ch.triangle_count},
+                     {"normal", {ch.normal.x, ch.normal.y, ch.normal.z}}, {"origin", {ch.origin.x, ch.origin.y, ch.origin.z}}});
+    }
+    return j;
+}
+
 // Writes the split and the oracle (JSON) to `file`; `view` is the solve's lightmap view.
 template <splits_direct Solver>
 void write_split(const std::filesystem::path& file, const embree::accel& bvh, const io::scene& scene, const Solver& solver,
@@ -181,6 +216,44 @@ void write_split(const std::filesystem::path& file, const embree::accel& bvh, co
                    {"indirect", part_error(ira, ia, ib, ta, tb, mask, &irb)},
                    {"black_pixels", black_pixels(va, ta, mask)},
                    {"paths_per_texel", settings.paths}, {"points_per_whole_texel", 16}};
+    {  // the direct+indirect view's black pixels: the element the lookup's nearest texel reads, its
+       // bounced light in the solver and the oracle's (both seeds' mean), both sides' luminance
+        const double mean = reference_mean(ta, mask);
+        const std::size_t n = atlas.size();
+        const auto lum = [](const glm::vec3& c) { return rec709_luminance<float, glm::vec3>(c); };
+        const float pi = float(std::numbers::pi);
+        const auto bs = solver.display_radiosity(0), bb = solver.display_radiosity(solver.sides() - 1);
+        const auto ds = direct_deposit(solver, 0), db = direct_deposit(solver, solver.sides() - 1);
+        nlohmann::ordered_json holes = nlohmann::ordered_json::array();
+        for (std::size_t y = 0; y < h; ++y)
+            for (std::size_t x = 0; x < w; ++x) {
+                const embree::lightmap_hit& hit = hits[y * w + x];
+                if (!black_pixel(with_direct, ta, mask, mean, x, y) || hit.chart == lightmap_atlas::none) continue;
+                const auto tx = std::uint32_t(std::clamp(hit.uv.x, 0.f, float(atlas.width - 1)));
+                const auto ty = std::uint32_t(std::clamp(hit.uv.y, 0.f, float(atlas.height - 1)));
+                const std::int32_t e = atlas.element_at(tx, ty);
+                if (e < 0) continue;
+                const auto i = std::size_t(e), side = std::size_t(hit.back ? 1 : 0);
+                holes.push_back({{"x", x}, {"y", y}, {"chart", hit.chart}, {"back", hit.back}, {"element", e},
+                                 {"reference", lum(ta(x, y)) / mean}, {"reference_rest", lum(0.5f * (ia(x, y) + ib(x, y))) / mean},
+                                 {"solver_rest_front", lum(bs[i] - ds[i]) / pi / mean}, {"solver_rest_back", lum(bb[i] - db[i]) / pi / mean},
+                                 {"oracle_rest_seen", lum(0.5f * (ra[side * n + i] + rb[side * n + i])) / pi / mean},
+                                 {"oracle_total_seen", lum(0.5f * (oa.total[side * n + i] + ob.total[side * n + i])) / pi / mean}});
+            }
+        j["black_pixels_direct_indirect"] = holes;
+    }
+    j["indirect_by_chart"] = indirect_by_chart(hits, atlas, solver_rest, ira, ia, ib, mask);
+    j["direct_by_chart"] = indirect_by_chart(hits, atlas, solver_direct, da, direct, direct, mask);
+    {
+        image<glm::vec3> ref_rest(w, h);
+        for (std::size_t y = 0; y < h; ++y)
+            for (std::size_t x = 0; x < w; ++x) ref_rest(x, y) = 0.5f * (ia(x, y) + ib(x, y));
+        const float exposure = io::auto_exposure(ref_rest.view(), mask.view());
+        const auto stem = file.parent_path() / file.stem();
+        io::write_png(stem.string() + "-rest-solver.png", solver_rest.view(), exposure);
+        io::write_png(stem.string() + "-rest-reference.png", ref_rest.view(), exposure);
+        io::write_png(stem.string() + "-rest-oracle.png", ira.view(), exposure);
+    }
     j["elements"] = atlas.size();
     j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     io::write_text_file(file, j.dump(2) + "\n");
