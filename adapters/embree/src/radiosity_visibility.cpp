@@ -6,6 +6,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <glm/geometric.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -75,18 +77,30 @@ void radiosity_visibility::set_shot(const radiosity_shot& shot) {
 
 namespace {
 
-// The ray for `point`: from the shooter to the point, t in [0, 1 - tolerance], or from the
-// point against a parallel light, t in [0, inf).
-void set_ray(const radiosity_shot& shot, float tolerance, const glm::vec3& p, glm::vec3& origin, glm::vec3& dir,
-             float& tfar) {
+// The end of a ray from `origin` to `point` (t = 1 at the point): short of the point by
+// `tolerance` of the distance or by `epsilon`, the larger. A surface closer to the point than
+// the accel's ray_epsilon does not shadow it: the reference integrator's rays leave a point
+// ray_epsilon off its surface, so such a layer (a coplanar face of another chart a fraction of
+// a millimetre over the element: the conference room's tables) never shadows it there.
+float ray_end(const glm::vec3& origin, const glm::vec3& point, float tolerance, float epsilon) {
+    const float d = glm::length(point - origin);
+    return 1.f - std::max(tolerance, d > 0.f ? std::min(0.5f, epsilon / d) : 0.f);
+}
+
+// The ray for `point`: from the shooter to the point, t in [0, ray_end], or from the point
+// against a parallel light, t in [epsilon, inf).
+void set_ray(const radiosity_shot& shot, float tolerance, float epsilon, const glm::vec3& p, glm::vec3& origin,
+             glm::vec3& dir, float& tnear, float& tfar) {
     if (shot.parallel) {
         origin = p;
         dir = -shot.axis;
+        tnear = epsilon;
         tfar = std::numeric_limits<float>::infinity();
     } else {
         origin = shot.position;
         dir = p - shot.position;
-        tfar = 1.f - tolerance;
+        tnear = 0.f;
+        tfar = ray_end(shot.position, p, tolerance, epsilon);
     }
 }
 
@@ -95,13 +109,13 @@ void set_ray(const radiosity_shot& shot, float tolerance, const glm::vec3& p, gl
 float radiosity_visibility::visible(const glm::vec3& point, std::uint32_t chart) const {
     chart_context ctx = context_for(*chart_, shot_.chart, false);
     glm::vec3 o, d;
-    float tfar;
-    set_ray(shot_, options_.end_tolerance, point, o, d, tfar);
+    float tnear, tfar;
+    set_ray(shot_, options_.end_tolerance, bvh_.ray_epsilon(), point, o, d, tnear, tfar);
     RTCRay r;
     r.org_x = o.x;
     r.org_y = o.y;
     r.org_z = o.z;
-    r.tnear = 0.f;
+    r.tnear = tnear;
     r.dir_x = d.x;
     r.dir_y = d.y;
     r.dir_z = d.z;
@@ -127,7 +141,7 @@ float radiosity_visibility::visible_from(const glm::vec3& origin, std::uint32_t 
     r.dir_y = point.y - origin.y;
     r.dir_z = point.z - origin.z;
     r.time = 0.f;
-    r.tfar = 1.f - options_.end_tolerance;
+    r.tfar = ray_end(origin, point, options_.end_tolerance, bvh_.ray_epsilon());
     r.mask = ~0u;
     r.id = chart;
     r.flags = 0;
@@ -140,6 +154,7 @@ void radiosity_visibility::visible(std::span<const glm::vec3> points, std::span<
     require(charts.size() == points.size(), "charts", "must have one chart per point");
     require(out.size() == points.size(), "out", "must have one entry per point");
     chart_context ctx = context_for(*chart_, shot_.chart, true);  // coherent: a shot's rays share their origin
+    const float epsilon = bvh_.ray_epsilon();
     for (std::size_t first = 0; first < points.size(); first += 8) {
         const std::size_t n = std::min<std::size_t>(8, points.size() - first);
         alignas(32) std::array<int, 8> valid{};
@@ -147,13 +162,13 @@ void radiosity_visibility::visible(std::span<const glm::vec3> points, std::span<
         for (std::size_t i = 0; i < 8; ++i) {
             const std::size_t k = first + std::min(i, n - 1);
             glm::vec3 o, d;
-            float tfar;
-            set_ray(shot_, options_.end_tolerance, points[k], o, d, tfar);
+            float tnear, tfar;
+            set_ray(shot_, options_.end_tolerance, epsilon, points[k], o, d, tnear, tfar);
             valid[i] = i < n ? -1 : 0;
             r.org_x[i] = o.x;
             r.org_y[i] = o.y;
             r.org_z[i] = o.z;
-            r.tnear[i] = 0.f;
+            r.tnear[i] = tnear;
             r.dir_x[i] = d.x;
             r.dir_y[i] = d.y;
             r.dir_z[i] = d.z;

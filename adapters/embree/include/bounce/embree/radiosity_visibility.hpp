@@ -46,7 +46,10 @@ class radiosity_visibility {
 public:
     struct options {
         /// Hits within this fraction of the shooter-to-point distance short of the point do
-        /// not block (float rounding of coincident surfaces of other charts; typical: 1e-5).
+        /// not block (float rounding of coincident surfaces of other charts; typical: 1e-5),
+        /// nor hits within the accel's ray_epsilon of the point (the reference integrator's
+        /// rays leave a point that far off its surface, so a layer closer than that never
+        /// shadows it there).
         float end_tolerance = 1e-5f;
     };
 
