@@ -55,9 +55,38 @@ struct rebake_access {
     // block: to every receiver, scaled to its power as a shot is), and `sign` times what it
     // delivers is added to `delta` (incident radiosity per element and side), but for the
     // elements `skip` marks.
+    // Which receivers a shooter's re-shot asks for: by the block first (the segment from the
+    // shooter to the block's centre against the boxes widened by the block's radius: no
+    // element of a block that misses can have a segment that meets them), then by element.
+    struct move_filter {
+        const lightmap_atlas& at;
+        const moved_boxes& boxes;
+        float margin;
+        std::vector<glm::vec3> centre;       // per block: its elements' bounding sphere
+        std::vector<float> radius;
+        std::vector<std::uint32_t> block_of; // per element
+        std::vector<std::uint8_t> near;      // per block, for the shooter begun
+        move_filter(const Solver& s, const moved_boxes& b, float m) : at(s.atlas_), boxes(b), margin(m) {
+            const std::size_t blocks = s.first_.size() - 1;
+            centre.resize(blocks), radius.assign(blocks, 0.f), block_of.resize(at.size()), near.resize(blocks);
+            for (std::size_t k = 0; k < blocks; ++k) {
+                centre[k] = s.centre_[k];
+                for (std::uint32_t i = s.first_[k]; i < s.first_[k + 1]; ++i)
+                    block_of[i] = std::uint32_t(k), radius[k] = std::max(radius[k], glm::length(at.position[i] - centre[k]));
+            }
+        }
+        bool meets(const glm::vec3& a, const glm::vec3& b, float m) const {
+            return segment_meets_box(a, b, boxes.before, m) || segment_meets_box(a, b, boxes.after, m);
+        }
+        void begin(const glm::vec3& c) {
+            for (std::size_t k = 0; k < near.size(); ++k) near[k] = meets(c, centre[k], margin + radius[k] * 1.0001f);
+        }
+        bool through(const glm::vec3& c, std::uint32_t i) const { return near[block_of[i]] && meets(c, at.position[i], margin); }
+    };
+
     template <class Keep>
-    static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& moved_block, const Keep& keep,
-                        double sign, const std::vector<std::uint8_t>& skip, std::vector<glm::dvec3>& delta,
+    static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& moved_block, move_filter& filter,
+                        const Keep& keep, double sign, const std::vector<std::uint8_t>& skip, std::vector<glm::dvec3>& delta,
                         radiosity_rebake_report& r) {
         const lightmap_atlas& at = s.atlas_;
         const std::size_t blocks = s.first_.size() - 1, n = at.size();
@@ -78,6 +107,7 @@ struct rebake_access {
             const glm::vec3 normal = side == 0 ? at.normal[i0] : -at.normal[i0], centre = s.centre_[b];
             s.visibility_.begin_shot(shot_frame{centre, normal, false, at.chart[i0]});
             const bool whole = moved_block[b] != 0;
+            if (!whole) filter.begin(centre);
             const glm::dvec3 got = s.gather_shot(at.chart[i0], vec(normal), [&](std::uint32_t i) {
                 if (!whole && !keep(centre, i)) return false;
                 pairs.fetch_add(1, std::memory_order_relaxed);
@@ -85,9 +115,14 @@ struct rebake_access {
             });
             if (!whole) r.pairs_tested += n;
             const glm::dvec3 scale = sign * (whole ? shot_scale(power, got) : glm::dvec3(1.0));
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, delta.size(), 4096), [&](const tbb::blocked_range<std::size_t>& q) {
-                for (std::size_t j = q.begin(); j != q.end(); ++j)
-                    if (s.received_[j] != vec(0) && !skip[j % n]) delta[j] += scale * glm::dvec3(s.received_[j]);
+            // Only the blocks asked for hold deliveries (a moved shooter's: every block).
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.sides_ * blocks, 64), [&](const tbb::blocked_range<std::size_t>& q) {
+                for (std::size_t kb = q.begin(); kb != q.end(); ++kb) {
+                    const std::size_t bb = kb % blocks, o = (kb / blocks) * n;
+                    if (!whole && !filter.near[bb] && !moved_block[bb]) continue;
+                    for (std::uint32_t i = s.first_[bb]; i < s.first_[bb + 1]; ++i)
+                        if (s.received_[o + i] != vec(0) && !skip[i]) delta[o + i] += scale * glm::dvec3(s.received_[o + i]);
+                }
             });
         }
         r.pairs += pairs.load();
@@ -167,10 +202,8 @@ struct rebake_access {
         for (std::size_t i = 0; i < n; ++i) moved_element[i] = charts[at.chart[i]], r.moved_elements += charts[at.chart[i]];
         for (std::size_t b = 0; b < blocks; ++b) moved_block[b] = charts[at.chart[s.first_[b]]];
         // A pair's delivery can change only with a moved end or a ray through either box.
-        const auto through = [&](const glm::vec3& centre, std::uint32_t i) {
-            return segment_meets_box(centre, at.position[i], boxes.before, margin) ||
-                   segment_meets_box(centre, at.position[i], boxes.after, margin);
-        };
+        move_filter filter(s, boxes, margin);
+        const auto through = [&](const glm::vec3& c, std::uint32_t i) { return filter.through(c, i); };
         const std::vector<vec> S = shot(s);
         // What the moved elements received is known, to the bit of every past shot's scale:
         // the irradiance the shots delivered (gathered_). The old pass leaves them out.
@@ -178,13 +211,13 @@ struct rebake_access {
         for (std::size_t j = 0; j < delta.size(); ++j)
             if (moved_element[j % n]) delta[j] = -glm::dvec3(s.gathered_[j]);
         const std::vector<std::uint8_t> none(n, 0);
-        reshoot(s, S, moved_block, [&](const glm::vec3& c, std::uint32_t i) { return !moved_element[i] && through(c, i); }, -1.0,
-                moved_element, delta, r);  // the old geometry and visibility
+        reshoot(s, S, moved_block, filter, [&](const glm::vec3& c, std::uint32_t i) { return !moved_element[i] && through(c, i); },
+                -1.0, moved_element, delta, r);  // the old geometry and visibility
         move_charts(s.atlas_, charts, m);
         s.visibility_ = std::forward<Visibility>(visibility);
         s.build_shooters();  // the moved blocks' centres, the groups' boxes
-        reshoot(s, S, moved_block, [&](const glm::vec3& c, std::uint32_t i) { return moved_element[i] || through(c, i); }, 1.0,
-                none, delta, r);  // the new
+        reshoot(s, S, moved_block, filter, [&](const glm::vec3& c, std::uint32_t i) { return moved_element[i] || through(c, i); },
+                1.0, none, delta, r);  // the new
         apply(s, delta, regather_direct(s));
         r.unshot_after = s.unshot_fraction();
         r.ms = Solver::ms_since(start);
