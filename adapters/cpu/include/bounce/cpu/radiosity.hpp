@@ -524,8 +524,9 @@ private:
             while (top > 0) {
                 const near_node& node = near_[stack[--top]];
                 if (node.child_count == 0 || !(near_field_opens<Real, vec>(pr, node.position, node.area, near2) > Real(0.5))) {
-                    const bool back = two && glm::dot(nr, node.position - pr) < Real(0);
-                    const Real f = element_form_factor<Real, vec>(pr, back ? -nr : nr, ar, node.position, ns, node.area);
+                    const Real side = receiving_side<Real, vec>(pr, nr, node.position, Real(two ? 1 : 0));
+                    const bool back = side > Real(0.5);
+                    const Real f = element_form_factor<Real, vec>(pr, side_normal<Real, vec>(nr, side), ar, node.position, ns, node.area);
                     if (f > Real(0)) (back ? incident_back : incident) += node.unshot * f;
                 } else {
                     for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = node.first_child + c;

@@ -123,8 +123,9 @@ glm::dvec3 progressive_radiosity<Visibility, Real>::gather_group(std::uint32_t r
                 for (std::uint32_t c = 0; c < node.child_count; ++c) stack[top++] = links_[node.first_link + c];
                 continue;
             }
-            const int side = two && glm::dot(nr, node.position - pr) < Real(0) ? 1 : 0;
-            const Real f = element_form_factor<Real, vec>(pr, side ? -nr : nr, ar, node.position, node.normal, node.area);
+            const Real back = receiving_side<Real, vec>(pr, nr, node.position, Real(two ? 1 : 0));
+            const int side = back > Real(0.5) ? 1 : 0;
+            const Real f = element_form_factor<Real, vec>(pr, side_normal<Real, vec>(nr, back), ar, node.position, node.normal, node.area);
             if (!(f > Real(0))) continue;
             const vec light = node.unshot * f;
             const double w = channel_sum(glm::abs(light));  // |.|: negative after a re-bake
