@@ -7,7 +7,8 @@
 // bench::measure_error as the benchmark. It also blurs each reference itself with the 4x4
 // geometry-aware tent (the blur's bias on the true light: what the blurred frame averages to
 // over the VPLs' draws). --dump DIR writes every image as raw float32 (W H 3, row-major) for
-// per-pixel analysis.
+// per-pixel analysis. Each frame with rays also reports how its error splits against the frame
+// without visibility ("split"), and --occlusion swaps the occlusion query for diagnostic ones.
 //
 //   build/bin/rsm_visibility_study --scenes cornell-box,conference --vpls 4096 [--dump DIR]
 #include <bounce/cpu/indirect_renderer.hpp>
