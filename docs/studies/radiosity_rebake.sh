@@ -14,12 +14,12 @@ run() {  # name scene check change-option value [extra]
     nice "$BIN/radiosity" --scene "$scene" --elements 30000 --visibility rays --quiet --rebake-check "$check" \
         "$opt" "$value" --json "$OUT/$name.json" "$@" || echo "$name failed"
 }
-run cornell-tall cornell 0.98 --rebake-move 'white#2,0.1,0,0.1' --reference on
 run sponza-column sponza 0.97 --rebake-move 'default#67,0,0,0.3' --reference off
-run living-table living-room 0.97 --rebake-move 'TableWood#1,0.2,0,0.2' --reference off
 run hall-bench modern-hall 0.97 --rebake-move 'Wood#11,0.3,0,0' --reference off
-run conference-chair conference 0.97 --rebake-move 'default#160,30,0,0' --reference off
+run cornell-tall cornell 0.98 --rebake-move 'white#2,0.1,0,0.1' --reference on
+run living-table living-room 0.97 --rebake-move 'TableWood#1,0.2,0,0.2' --reference off
 run cornellbox-tall cornell-box 0.98 --rebake-move 'tallBox,0.1,0,0.1' --reference off
+run conference-chair conference 0.97 --rebake-move 'default#160,30,0,0' --reference off
 run cornell-light cornell 0.98 --rebake-light 0,0.5 --reference on
 run bunny-light bunny 0.97 --rebake-light 0,0.5 --reference off
 python3 - "$OUT" <<'PY'
