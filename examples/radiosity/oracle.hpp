@@ -259,12 +259,13 @@ void write_split(const std::filesystem::path& file, const embree::accel& bvh, co
     io::write_text_file(file, j.dump(2) + "\n");
 }
 
-// write_split for the CPU solver; the GL solver (refused by check_options) throws.
+// write_split for a solver that keeps the lights' direct deposit apart (splits_direct: the CPU and the GL
+// solver); any other throws naming --oracle-out.
 template <class Solver>
 void write_oracle(const std::filesystem::path& file, const embree::accel& bvh, const io::scene& scene, const Solver& solver,
                   const embree::multi_bounce_settings& settings, const embree::multi_bounce_image& reference,
                   const image<float>& mask, const image<glm::vec3>& view, std::size_t w, std::size_t h) {
-    if constexpr (!splits_direct<Solver>) throw parameter_error("--oracle-out", "needs the CPU backend");
+    if constexpr (!splits_direct<Solver>) throw parameter_error("--oracle-out", "needs a solver that keeps the direct light apart");
     else write_split(file, bvh, scene, solver, settings, reference, mask, view, w, h);
 }
 
