@@ -55,6 +55,7 @@ struct options {
     int shooters_per_step = 1;
     double near_field = 4;
     bool ambient = false;
+    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  // with ambient: Cohen's, or from the shots
     bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
     int light_samples = 4;            // the lights' shot at k x k points of each whole texel (CPU)
     int shooter_groups = 0;           // grouped shooters: at most N groups of blocks (0: off; rays only)
@@ -112,7 +113,16 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(CLI::Range(1, 4096))->capture_default_str();
     app.add_option("--near-field", o.near_field, "a block shoots as its quadrants within this many sides (0: one disc)")
         ->check(examples::finite_non_negative)->capture_default_str();
-    on_off("--ambient", o.ambient, "show the ambient term (Cohen et al. 1988): on | off");
+    app.add_option_function<std::string>(
+           "--ambient",
+           [&o](const std::string& v) {
+               o.ambient = v != "off";
+               o.ambient_shape = v == "shots" ? radiosity_ambient::shots : radiosity_ambient::uniform;
+           },
+           "show the ambient term: off | on (= uniform, Cohen et al. 1988) | uniform | shots (amount and shape "
+           "measured from the recent shots, radiosity/ambient.hpp; CPU)")
+        ->check(CLI::IsMember({"off", "on", "uniform", "shots"}))
+        ->default_str("off");
     app.add_option("--light-samples", o.light_samples,
                    "point, spot and directional lights taken at k x k points of each whole texel (1: its element's point)")
         ->check(CLI::Range(1, 16))->capture_default_str();
@@ -169,6 +179,7 @@ inline radiosity_options solver_options_for(const options& o) {
     r.shoot_blocks = o.block > 1;
     r.shooters_per_step = o.shooters_per_step;
     r.ambient = o.ambient;
+    r.ambient_shape = o.ambient_shape;
     r.near_field = o.near_field;
     r.two_sided = !o.one_sided;
     r.light_samples = o.light_samples;
@@ -208,6 +219,8 @@ inline void check_options(const options& o) {
         throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
     if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
     if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
+    if (o.ambient && o.ambient_shape == radiosity_ambient::shots)
+        throw parameter_error("--ambient", "'shots' runs on the CPU backend only");
 }
 
 inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
@@ -240,7 +253,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
             {"converge", o.converge}, {"converge_on", name_of(measure_names, o.converge_on)}, {"max_seconds", o.max_seconds},
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
-            {"ambient", o.ambient ? "on" : "off"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
+            {"ambient", !o.ambient ? "off" : o.ambient_shape == radiosity_ambient::shots ? "shots" : "on"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
             {"group_near_field", o.group_near_field},
             {"view", name_of(view_names, o.view != view_kind::automatic ? o.view : view_kind::direct_indirect)},

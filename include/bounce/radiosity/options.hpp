@@ -22,12 +22,18 @@
 
 namespace bounce::inline radiosity {
 
+/// The ambient term's amount and shape (radiosity_options::ambient_shape): Cohen et al. 1988's
+/// uniform one, or the one measured from the solve's recent shots (radiosity/ambient.hpp).
+enum class radiosity_ambient { uniform, shots };
+
 /// How a solver shoots.
 struct radiosity_options {
     bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
     int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16;
                                    ///< the GL solver shoots one)
     bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
+    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  ///< with ambient: uniform, or shaped
+                                   ///< by the recent shots (radiosity/ambient.hpp; CPU solver only)
     double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
                                    ///< times its side (sqrt of its area), else as its quadrants,
                                    ///< recursively; 0: always one disc (typical: 2-4)

@@ -40,6 +40,7 @@
 /// Determinism: elements are updated by exactly one task each, and sums run over fixed chunks
 /// of shooters added in chunk order, so results are bitwise the same for any thread count.
 
+#include <bounce/cpu/radiosity_ambient.hpp>
 #include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
@@ -225,8 +226,7 @@ public:
     int sides() const noexcept { return int(sides_); }
     bool two_sided() const noexcept { return sides_ == 2; }
 
-    /// The ambient radiosity (Cohen et al. 1988): 1 / (1 - rho_avg) times the area-weighted
-    /// mean unshot radiosity, per channel.
+    /// The ambient radiosity (Cohen et al. 1988): 1 / (1 - rho_avg) times the mean unshot radiosity.
     glm::dvec3 ambient() const {
         const glm::dvec3 rho_avg = albedo_area_ / total_area_;
         return unshot_power() / total_area_ / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
@@ -244,10 +244,10 @@ public:
         const std::size_t n = atlas_.size(), o = n * std::size_t(checked_side(side));
         std::vector<glm::vec3> out(n);
         const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
-        const glm::vec3 amb = options_.ambient && indirect ? glm::vec3(ambient()) : glm::vec3(0.f);
+        const auto amb = ambient_field(indirect, side);
         for (std::size_t i = 0; i < out.size(); ++i) {
             const glm::vec3 e = (direct ? glm::vec3(direct_[o + i]) : glm::vec3(0.f)) +
-                                (indirect ? glm::vec3(gathered_[o + i]) + amb : glm::vec3(0.f));
+                                (indirect ? glm::vec3(gathered_[o + i]) + amb[i] : glm::vec3(0.f));
             out[i] = quantity == output_quantity::irradiance ? e : lambertian_radiance<float, glm::vec3>(atlas_.albedo[i], e);
             if (quantity == output_quantity::radiance && direct && emits_on(i, side))
                 out[i] += atlas_.emission[i] * float(1.0 / std::numbers::pi);
@@ -270,9 +270,9 @@ public:
     std::vector<glm::vec3> display_radiosity(int side = 0) const {
         const auto b = radiosity(side);
         std::vector<glm::vec3> out(b.size());
-        const glm::vec3 amb = options_.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+        const auto amb = ambient_field(true, side);
         for (std::size_t i = 0; i < out.size(); ++i)
-            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(b[i]), atlas_.albedo[i], amb);
+            out[i] = radiosity_with_ambient<float, glm::vec3>(glm::vec3(b[i]), atlas_.albedo[i], amb[i]);
         return out;
     }
 
@@ -449,10 +449,7 @@ private:
         if (refresh) unshot_total_ = total.unshot;
         return total;
     }
-    template <class Receive>
-    chunk_sums distribute(const Receive& receive) {
-        return for_elements(receive, true);
-    }
+    template <class Receive> chunk_sums distribute(const Receive& receive) { return for_elements(receive, true); }
 
     // A shot in two passes: every element's incident radiosity from the shooter (form factors
     // and visibility, into received_), then, scaled so that the shot delivers at most its own
@@ -487,6 +484,7 @@ private:
                      std::uint32_t first) {
         const glm::dvec3 scale = shot_scale(power, incident);
         const chunk_sums total = apply_shot(Real(scale.x), Real(scale.y), Real(scale.z));
+        shot_ambient_.record(options_, received_, scale, power, total.intercepted, total.absorbed, unshot_total_);
         timings_.distribution_ms += ms_since(start);
         absorbed_ += total.absorbed;
         escaped_ += power - total.intercepted;
@@ -692,6 +690,8 @@ private:
     glm::dvec3 emitted_{0}, absorbed_{0}, escaped_{0}, intercepted_{0}, albedo_area_{0};
     radiosity_timings timings_;
     std::size_t steps_ = 0, shots_ = 0;
+    shot_ambient_state<Real> shot_ambient_;  // the ambient term per element (Cohen's or the shots': radiosity_ambient.hpp)
+    std::vector<glm::vec3> ambient_field(bool on, int side) const { return shot_ambient_.field(on, options_, *this, side); }
 };
 
 }  // namespace bounce::cpu
