@@ -320,6 +320,27 @@ TEST_CASE("solve stops at the fraction asked, reporting the unshot fraction afte
     CHECK(taken == 1);
 }
 
+TEST_CASE("Cohen's ambient spreads the unshot power over every side that shows it", "[radiosity][solver]") {
+    // Shown on both sides of a two-sided element, the ambient radiosity times the area it is
+    // shown on is the unshot power with its interreflections, U / (1 - rho_avg), not twice it.
+    const auto box = closed_box(1.f, 0.7f, 2.f);
+    const auto atlas = build_lightmap_atlas(box.view(), {.elements = 100, .block_texels = 1});
+    cpu::progressive_radiosity<cpu::all_visible, double> solver(box.view(), atlas, {}, {.ambient = true});
+    REQUIRE(solver.sides() == 2);
+    solver.step();
+    double area = 0;
+    glm::dvec3 albedo_area(0.0);
+    for (std::size_t i = 0; i < atlas.size(); ++i) {
+        area += double(atlas.area[i]);
+        albedo_area += glm::dvec3(atlas.albedo[i]) * double(atlas.area[i]);
+    }
+    const glm::dvec3 shown = solver.ambient() * area * 2.0;
+    const glm::dvec3 expected = solver.unshot_power() / (glm::dvec3(1.0) - albedo_area / area);
+    REQUIRE(expected.x > 0);
+    for (int c = 0; c < 3; ++c) CHECK(shown[c] == Approx(expected[c]).epsilon(1e-9));
+    CHECK(cohen_ambient(glm::dvec3(1.0), 2.0, glm::dvec3(1.0), 2).x == Approx(0.5 * cohen_ambient(glm::dvec3(1.0), 2.0, glm::dvec3(1.0), 1).x));
+}
+
 TEST_CASE("the ambient term brightens the display before convergence and vanishes after", "[radiosity][solver]") {
     const auto box = closed_box(1.f, 0.7f, 2.f);
     const auto atlas = build_lightmap_atlas(box.view(), {.elements = 100, .block_texels = 1});

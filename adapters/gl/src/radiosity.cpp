@@ -118,8 +118,7 @@ glm::dvec3 progressive_radiosity::unshot_power() const {
 std::vector<glm::vec3> progressive_radiosity::radiosity(int side) const { return s_->read_elements(s_->radiosity, side); }
 std::vector<glm::vec3> progressive_radiosity::unshot(int side) const { return s_->read_elements(s_->unshot, side); }
 glm::dvec3 progressive_radiosity::ambient() const {
-    const glm::dvec3 rho_avg = s_->albedo_area / s_->total_area;
-    return unshot_power() / s_->total_area / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
+    return cohen_ambient(unshot_power(), s_->total_area, s_->albedo_area, int(s_->sides));
 }
 std::vector<glm::vec3> progressive_radiosity::display_radiosity(int side) const {
     std::vector<glm::vec3> out = radiosity(side);

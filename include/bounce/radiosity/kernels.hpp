@@ -108,6 +108,17 @@ V radiosity_with_ambient(const V& radiosity, const V& albedo, const V& ambient) 
     return radiosity + albedo * ambient;
 }
 
+/// Cohen et al. 1988's ambient radiosity (W/m^2 per channel): the unshot power spread over
+/// the area the radiosity lives on, times the interreflection factor 1 / (1 - rho_avg)
+/// (rho_avg = albedo_area / area, at most 0.999). `area` is one side's total area and
+/// `sides` 2 for two-sided elements: each side shows the ambient, so its area counts twice
+/// (with one side's area the ambient shown would hold twice the unshot power).
+inline glm::dvec3 cohen_ambient(const glm::dvec3& unshot_power, double area, const glm::dvec3& albedo_area, int sides) {
+    if (!(area > 0)) return glm::dvec3(0.0);
+    const glm::dvec3 rho_avg = glm::min(albedo_area / area, glm::dvec3(0.999));
+    return unshot_power / (area * double(sides)) / (glm::dvec3(1.0) - rho_avg);
+}
+
 // ---------------------------------------------------------------------------------------
 // The shooter's frame and the hemispherical (stereographic) projection
 

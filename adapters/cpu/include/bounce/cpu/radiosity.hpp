@@ -227,10 +227,7 @@ public:
     bool two_sided() const noexcept { return sides_ == 2; }
 
     /// The ambient radiosity (Cohen et al. 1988): 1 / (1 - rho_avg) times the mean unshot radiosity.
-    glm::dvec3 ambient() const {
-        const glm::dvec3 rho_avg = albedo_area_ / total_area_;
-        return unshot_power() / total_area_ / (glm::dvec3(1.0) - glm::min(rho_avg, glm::dvec3(0.999)));
-    }
+    glm::dvec3 ambient() const { return cohen_ambient(unshot_power(), total_area_, albedo_area_, sides()); }
 
     /// Per element, the light of `paths` as `quantity` (output.hpp): irradiance (W/m^2) or
     /// the radiance of the atlas's albedo (W/(m^2 sr)). Direct: the point, spot and
