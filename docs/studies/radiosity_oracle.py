@@ -58,9 +58,14 @@ def main():
         rec = {"scene": scene, "elements_asked": a.elements, "converge": a.converge, "commit": commit,
                "command": " ".join(cmd[1:]), "note": a.note, "date": datetime.datetime.utcnow().isoformat(timespec="seconds") + "Z",
                "load_before": load, "load_after": os.getloadavg()[0], "wall_s_loaded": time.time() - t0,
-               "run": {k: run.get(k) for k in ("counts", "error", "black_pixels", "converged_fraction", "elements",
+               "run": {k: run.get(k) for k in ("counts", "error", "black_pixels", "elements",
                                                "iterations", "timings_ms", "indirect_unshot_fraction")},
                "split": oracle}
+        # The per-step convergence series is left out (no table reads it): its last value only.
+        for k in ("indirect_by_chart", "direct_by_chart"):  # the 12 charts with the largest share
+            if isinstance(oracle.get(k), list):
+                oracle[k] = oracle[k][:12]
+        rec["run"]["converged_fraction_final"] = (run.get("converged_fraction") or [None])[-1]
         # Read again before appending: another run of this script may have added records since.
         results = json.load(open(a.results)) if os.path.exists(a.results) else {"runs": []}
         results["runs"].append(rec)

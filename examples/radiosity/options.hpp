@@ -54,7 +54,7 @@ struct options {
     double max_seconds = 0;           // also stop after this much solving (0: no limit)
     int shooters_per_step = 1;
     double near_field = 4;
-    bool ambient = false;
+    bool ambient = true;  // Cohen's uniform term, the library's default
     radiosity_ambient ambient_shape = radiosity_ambient::uniform;  // with ambient: Cohen's, or from the shots
     bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
     int light_samples = 4;            // the lights' shot at k x k points of each whole texel (CPU)

@@ -41,7 +41,7 @@ struct ambient_case {
 // the power the solve without ambient delivers from there on to convergence.
 ambient_case measure(const owned_scene& scene, std::size_t elements, int steps) {
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = elements, .block_texels = 1});
-    solver_t none(scene.view(), atlas, {}), uniform(scene.view(), atlas, {}, {.ambient = true}),
+    solver_t none(scene.view(), atlas, {}, {.ambient = false}), uniform(scene.view(), atlas, {}, {.ambient = true}),
         shots(scene.view(), atlas, {}, {.ambient = true, .ambient_shape = radiosity_ambient::shots});
     for (int s = 0; s < steps; ++s) {
         REQUIRE(none.step());
@@ -93,7 +93,7 @@ TEST_CASE("the shaped ambient shows as the uniform one does: B + rho a, a added 
           "[radiosity][outputs]") {
     const auto box = closed_box(1.f, 0.7f, 2.f);
     const auto atlas = build_lightmap_atlas(box.view(), {.elements = 100, .block_texels = 1});
-    solver_t none(box.view(), atlas, {}), shots(box.view(), atlas, {}, {.ambient = true, .ambient_shape = radiosity_ambient::shots});
+    solver_t none(box.view(), atlas, {}, {.ambient = false}), shots(box.view(), atlas, {}, {.ambient = true, .ambient_shape = radiosity_ambient::shots});
     // Before any shot: Cohen's term.
     const auto first = shots.display_radiosity();
     const glm::dvec3 cohen = shots.ambient();

@@ -28,7 +28,7 @@ TEST_CASE("right after construction the direct irradiance is the lights' and not
           "[radiosity][outputs]") {
     const auto box = lit_box();
     const auto atlas = build_lightmap_atlas(box.view(), {.elements = 200, .block_texels = 1});
-    cpu::progressive_radiosity<cpu::all_visible> solver(box.view(), atlas, {});
+    cpu::progressive_radiosity<cpu::all_visible> solver(box.view(), atlas, {}, {.ambient = false});
     const auto direct = solver.output(output_quantity::irradiance, light_paths::direct);
     const auto indirect = solver.output();  // the default: indirect irradiance
     for (std::size_t i = 0; i < atlas.size(); ++i) {

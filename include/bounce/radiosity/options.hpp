@@ -31,7 +31,7 @@ struct radiosity_options {
     bool shoot_blocks = true;      ///< substructuring: shoot per atlas block (true) or per element
     int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16;
                                    ///< the GL solver shoots one)
-    bool ambient = false;          ///< display_radiosity adds the ambient term (Cohen et al. 1988)
+    bool ambient = true;           ///< display_radiosity adds the ambient term (Cohen et al. 1988)
     radiosity_ambient ambient_shape = radiosity_ambient::uniform;  ///< with ambient: uniform, or shaped
                                    ///< by the recent shots (radiosity/ambient.hpp; CPU solver only)
     double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
