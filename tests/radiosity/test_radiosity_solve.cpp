@@ -124,11 +124,12 @@ TEST_CASE("a solve stops at its time limit, checkpoints not counted", "[radiosit
     const auto r = detail::run_radiosity_solve(s, o, [](std::size_t) { return std::size_t(0); });
     CHECK(r.stop == radiosity_stop::time_limit);
     CHECK(r.steps >= 2);
+    // The limit counted only the steps: the steps' own time reached it although every step
+    // had its 10 ms checkpoint (had the checkpoints counted, the solve would have stopped with
+    // its steps' time below the limit). Not compared with the steps' time: on a loaded machine
+    // a 2 ms sleep can last as long as a 10 ms one.
     CHECK(r.solve_ms >= 50);
-    // Every step had its 10 ms checkpoint, five times a step's own time, and the limit still
-    // counted only the steps.
     CHECK(r.checkpoint_ms >= 10.0 * double(r.steps));
-    CHECK(r.checkpoint_ms > r.solve_ms);
 }
 
 TEST_CASE("a solve that creates energy is stopped with the step named", "[radiosity][solve][errors]") {
