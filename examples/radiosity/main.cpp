@@ -190,8 +190,7 @@ std::optional<image<glm::vec3>> check_before_work(const options& o, const io::sc
     if (o.reference) study::check_cache_dir();
     check_memory(o, scene);
     if (o.versus.empty()) return std::nullopt;
-    // Another run's view (say, with ray-cast visibility) to compare with: read now, so a
-    // missing or wrong-sized file is refused before the solve.
+    // Another run's view to compare with, read now: a missing or wrong-sized file is refused before the solve.
     if (!std::filesystem::is_regular_file(o.versus)) throw parameter_error("--versus", "no such file: " + o.versus.string());
     image<glm::vec3> other = io::read_rgb(o.versus);
     if (other.width() != o.width || other.height() != o.height)
@@ -295,7 +294,6 @@ int main(int argc, char** argv) {
     CLI::App app{"bounce: progressive refinement radiosity (Coombe and Harris, GPU Gems 2 ch. 39)"};
     options o;
     add_options(app, o);
-    add_rebake_options(app, o);
     CLI11_PARSE(app, argc, argv);
     return run_program("radiosity", [&] { return run(o); },
                        "ask for fewer --elements, a smaller view, or a smaller --resolution");

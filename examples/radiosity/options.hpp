@@ -161,6 +161,15 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--oracle-out", o.oracle_out, "write the error's split and the best lightmap's error (JSON, oracle.hpp)");
     app.add_option("--reference-out", o.reference_out, "write the reference view here (.png or .exr)");
     app.add_option("--versus", o.versus, "also compare the view with this EXR view of another run (same size)");
+    // The re-bakes (rebake.hpp).
+    app.add_option("--rebake-light", o.rebake_light,
+                   "bake, scale light K's intensity by SCALE (K,SCALE), re-bake from the solution and compare with a fresh solve");
+    app.add_option("--rebake-move", o.rebake_move,
+                   "bake, move an object (MATERIAL[#N],DX,DY,DZ: the material's N-th group of connected triangles) by "
+                   "DX, DY, DZ, re-bake from the solution and compare with a fresh solve");
+    app.add_option("--rebake-check", o.rebake_check, "re-bakes: the converged fraction both solves are then taken to")
+        ->check(CLI::Range(0.0, 0.99999))
+        ->capture_default_str();
 }
 
 /// The settings of the atlas the options ask for.

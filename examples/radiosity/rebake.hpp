@@ -37,17 +37,6 @@
 
 namespace bounce::examples {
 
-inline void add_rebake_options(CLI::App& app, options& o) {
-    app.add_option("--rebake-light", o.rebake_light,
-                   "bake, scale light K's intensity by SCALE (K,SCALE), re-bake from the solution and compare with a fresh solve");
-    app.add_option("--rebake-move", o.rebake_move,
-                   "bake, move an object (MATERIAL[#N],DX,DY,DZ: the material's N-th group of connected triangles) by "
-                   "DX, DY, DZ, re-bake from the solution and compare with a fresh solve");
-    app.add_option("--rebake-check", o.rebake_check, "re-bakes: the converged fraction both solves are then taken to")
-        ->check(CLI::Range(0.0, 0.99999))
-        ->capture_default_str();
-}
-
 // "a,b,c" as numbers; `count` of them, else parameter_error naming `option`.
 inline std::vector<double> rebake_numbers(const std::string& text, std::size_t count, const char* option, const char* form) {
     std::vector<double> v;
