@@ -188,37 +188,6 @@ image<glm::vec3> reached_sub_buffers(const gbuffer_view<float>& g, const indirec
     return out;
 }
 
-/// How the frame with rays's error splits (issue 29's ratio for the RSM gather): with b_rays =
-/// x_rays - r_occluded and b_none = x_none - r_unoccluded per pixel (luminance, over the mask,
-/// the references' noise taken out as compare_luminance_debiased does), |b_none| / |r_occluded|
-/// is the frame without visibility's error in the units of the occluded reference, and
-/// |b_rays - b_none| / |r_occluded| what visibility changes; the ratio the headline asks is
-/// |b_rays| / |b_none| times |r_unoccluded| / |r_occluded|, the last the references' own.
-nlohmann::ordered_json split_error(image_view<const glm::vec3> rays, image_view<const glm::vec3> none,
-                                   const bench::halves_reference& occ, const bench::halves_reference& unocc,
-                                   image_view<const float> mask) {
-    const auto lum = [](const glm::vec3& c) { return rec709_luminance<double, glm::dvec3>(glm::dvec3(c)); };
-    double none_sq = 0, diff_sq = 0, occ_sq = 0, unocc_sq = 0, occ_noise = 0, unocc_noise = 0;
-    for (std::size_t y = 0; y < rays.height(); ++y)
-        for (std::size_t x = 0; x < rays.width(); ++x) {
-            if (!mask.empty() && mask(x, y) == 0.f) continue;
-            const double oa = lum(occ.a(x, y)), ob = lum(occ.b(x, y)), ua = lum(unocc.a(x, y)), ub = lum(unocc.b(x, y));
-            const double ro = 0.5 * (oa + ob), ru = 0.5 * (ua + ub);
-            const double no = 0.25 * (oa - ob) * (oa - ob), nu = 0.25 * (ua - ub) * (ua - ub);
-            const double bn = lum(none(x, y)) - ru, br = lum(rays(x, y)) - ro;
-            none_sq += bn * bn - nu;
-            diff_sq += (br - bn) * (br - bn) - no - nu;
-            occ_sq += ro * ro - no;
-            unocc_sq += ru * ru - nu;
-            occ_noise += no;
-            unocc_noise += nu;
-        }
-    const auto root = [](double a, double b) { return b > 0 ? std::sqrt(std::max(a, 0.0) / b) : 0.0; };
-    return {{"none_error_in_occluded_units", root(none_sq, occ_sq)},
-            {"visibility_change", root(diff_sq, occ_sq)},
-            {"references_rms_ratio", root(unocc_sq, occ_sq)}};
-}
-
 int run(const options& o) {
     if (!o.json.empty()) io::check_output_file("--json", o.json);
     nlohmann::ordered_json report = {{"technique", "rsm_visibility_study"},
@@ -364,7 +333,7 @@ int run(const options& o) {
                                             {"ms_loaded_machine", ms}});
                 dump_image(o, scene.name, c.name + (rays_on ? "-rays" : "-none"), e.view());
                 if (!rays_on || without.empty()) continue;
-                auto split = split_error(with_rays.view(), without.view(), occluded, unoccluded, s.mask.view());
+                auto split = bench::visibility_error_split(with_rays.view(), without.view(), occluded, unoccluded, s.mask.view());
                 fmt::print("{} {} vpls {}: none's error in the occluded reference's units {:.4f}, visibility's change "
                            "{:.4f}, references' rms ratio {:.3f}\n",
                            scene.name, c.name, o.vpls, split["none_error_in_occluded_units"].get<double>(),

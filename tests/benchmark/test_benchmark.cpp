@@ -264,3 +264,29 @@ TEST_CASE("the results file carries its provenance and settings", "[benchmark]")
     CHECK_FALSE(scene_summary(j["scenes"][0]).empty());
     CHECK_THROWS_WITH(run_benchmark({"cornell", "no-such-scene-here"}, settings, ""), Catch::Contains("no-such-scene-here"));
 }
+
+TEST_CASE("the visibility error split: the frame without visibility in the occluded reference's units, what visibility changes, the references' ratio",
+          "[benchmark]") {
+    // Noise-free halves (a == b); the occluded reference is half the unoccluded one on the
+    // right half of the image. Both frames 10% above their references: the frame without
+    // visibility errs 0.1 |r_u| / |r_o| in the occluded units, visibility changes
+    // 0.1 |r_o - r_u| / |r_o|, and the references' ratio is |r_u| / |r_o|.
+    const std::size_t w = 8, h = 4;
+    bench::halves_reference occ, unocc;
+    for (auto* r : {&occ, &unocc}) r->a = r->b = r->mean = image<glm::vec3>(w, h);
+    image<glm::vec3> rays(w, h), none(w, h);
+    double uu = 0, oo = 0, dd = 0;
+    for (std::size_t y = 0; y < h; ++y)
+        for (std::size_t x = 0; x < w; ++x) {
+            const float u = 1.f + float(x), o = x < w / 2 ? u : 0.5f * u;
+            unocc.a(x, y) = unocc.b(x, y) = glm::vec3(u);
+            occ.a(x, y) = occ.b(x, y) = glm::vec3(o);
+            none(x, y) = glm::vec3(1.1f * u);
+            rays(x, y) = glm::vec3(1.1f * o);
+            uu += double(u) * u, oo += double(o) * o, dd += 0.01 * double(o - u) * (o - u);
+        }
+    const auto s = bench::visibility_error_split(rays.view(), none.view(), occ, unocc, {});
+    CHECK(s["none_error_in_occluded_units"].get<double>() == Approx(0.1 * std::sqrt(uu / oo)).epsilon(1e-5));
+    CHECK(s["visibility_change"].get<double>() == Approx(std::sqrt(dd / oo)).epsilon(1e-5));
+    CHECK(s["references_rms_ratio"].get<double>() == Approx(std::sqrt(uu / oo)).epsilon(1e-6));
+}

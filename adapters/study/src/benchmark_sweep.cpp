@@ -1,4 +1,5 @@
 // The benchmark's error figures, Monte Carlo sweeps, and the equal-error points read off them.
+#include <bounce/luminance.hpp>
 #include <bounce/study/benchmark_parts.hpp>
 #include <bounce/study/image_comparison.hpp>
 #include <bounce/study/ssim.hpp>
@@ -22,6 +23,30 @@ ojson measured_error::to_json() const {
             {"rel_rms_debiased_se", number_or_null(rel_rms_debiased_se)},
             {"ssim", number_or_null(ssim)},
             {"debiased_resolved", resolved}};
+}
+
+ojson visibility_error_split(image_view<const glm::vec3> rays, image_view<const glm::vec3> none,
+                             const halves_reference& occ, const halves_reference& unocc, image_view<const float> mask) {
+    const auto lum = [](const glm::vec3& c) { return rec709_luminance<double, glm::dvec3>(glm::dvec3(c)); };
+    double none_sq = 0, diff_sq = 0, occ_sq = 0, unocc_sq = 0, occ_noise = 0, unocc_noise = 0;
+    for (std::size_t y = 0; y < rays.height(); ++y)
+        for (std::size_t x = 0; x < rays.width(); ++x) {
+            if (!mask.empty() && mask(x, y) == 0.f) continue;
+            const double oa = lum(occ.a(x, y)), ob = lum(occ.b(x, y)), ua = lum(unocc.a(x, y)), ub = lum(unocc.b(x, y));
+            const double ro = 0.5 * (oa + ob), ru = 0.5 * (ua + ub);
+            const double no = 0.25 * (oa - ob) * (oa - ob), nu = 0.25 * (ua - ub) * (ua - ub);
+            const double bn = lum(none(x, y)) - ru, br = lum(rays(x, y)) - ro;
+            none_sq += bn * bn - nu;
+            diff_sq += (br - bn) * (br - bn) - no - nu;
+            occ_sq += ro * ro - no;
+            unocc_sq += ru * ru - nu;
+            occ_noise += no;
+            unocc_noise += nu;
+        }
+    const auto root = [](double a, double b) { return b > 0 ? std::sqrt(std::max(a, 0.0) / b) : 0.0; };
+    return {{"none_error_in_occluded_units", root(none_sq, occ_sq)},
+            {"visibility_change", root(diff_sq, occ_sq)},
+            {"references_rms_ratio", root(unocc_sq, occ_sq)}};
 }
 
 measured_error measure_error(image_view<const glm::vec3> x, const halves_reference& ref, image_view<const float> mask) {

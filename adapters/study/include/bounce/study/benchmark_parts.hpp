@@ -52,6 +52,17 @@ struct measured_error {
 };
 measured_error measure_error(image_view<const glm::vec3> x, const halves_reference& ref, image_view<const float> mask);
 
+/// How a frame with visibility's error splits against the same frame without it (issue 29's ratio for the RSM gather): with b_rays =
+/// x_rays - r_occluded and b_none = x_none - r_unoccluded per pixel (luminance, over the mask,
+/// the references' noise taken out as compare_luminance_debiased does), |b_none| / |r_occluded|
+/// is the frame without visibility's error in the units of the occluded reference, and
+/// |b_rays - b_none| / |r_occluded| what visibility changes; the ratio the headline asks is
+/// |b_rays| / |b_none| times |r_unoccluded| / |r_occluded|, the last the references' own.
+/// {"none_error_in_occluded_units", "visibility_change", "references_rms_ratio"}.
+ojson visibility_error_split(image_view<const glm::vec3> rays, image_view<const glm::vec3> none,
+                             const halves_reference& occluded, const halves_reference& unoccluded,
+                             image_view<const float> mask);
+
 // ---- Monte Carlo sweeps and equal error --------------------------------------------------------
 
 /// One Monte Carlo run of a sweep.
