@@ -13,6 +13,7 @@
 //   build/bin/rsm_visibility_study --scenes cornell-box,conference --vpls 4096 [--dump DIR]
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/near_field_rays.hpp>
 #include <bounce/embree/occlusion_rays.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/io/scene.hpp>
@@ -54,6 +55,7 @@ struct options {
     float complete_below = 0.5f;  // the 4x4-blur-complete configs
     view_selection_params view;    // with rays: the view's choice of VPLs (candidates 1: off)
     std::string occlusion = "rays";
+    std::uint32_t compensation_rays = 16;  // the gather with rays: the clamp's compensation (0: off)
 };
 
 /// The occlusion queries --occlusion compares (the RSM gather's bias with rays, issue 29):
@@ -192,17 +194,11 @@ int run(const options& o) {
     if (!o.json.empty()) io::check_output_file("--json", o.json);
     nlohmann::ordered_json report = {{"technique", "rsm_visibility_study"},
                                      {"parameters",
-                                      {{"vpls", o.vpls},
-                                       {"seed", o.seed},
-                                       {"width", o.width},
-                                       {"height", o.height},
-                                       {"flat_normals", o.flat_normals},
-                                       {"occlusion", o.occlusion},
-                                       {"rsm_resolution", 256},
-                                       {"view_candidates", o.view.candidates},
-                                       {"view_receivers", o.view.receivers},
-                                       {"view_defensive", o.view.defensive},
-                                       {"view_near_field", o.view.near_field},
+                                      {{"vpls", o.vpls}, {"seed", o.seed}, {"width", o.width}, {"height", o.height},
+                                       {"flat_normals", o.flat_normals}, {"occlusion", o.occlusion},
+                                       {"compensation_rays", o.compensation_rays}, {"rsm_resolution", 256},
+                                       {"view_candidates", o.view.candidates}, {"view_receivers", o.view.receivers},
+                                       {"view_defensive", o.view.defensive}, {"view_near_field", o.view.near_field},
                                        {"visibility_sigmas", o.sigmas}}},
                                      {"frames", nlohmann::ordered_json::array()},
                                      {"blurred_references", nlohmann::ordered_json::array()}};
@@ -237,7 +233,8 @@ int run(const options& o) {
         embree::rsm_ray_caster caster(bvh, scene, rs);
         caster.render();
         const diagnostic_occlusion rays(bvh, scene, o.occlusion);
-        cpu::indirect_renderer renderer({}, &rays);
+        const embree::near_field_rays near(bvh, scene.view());
+        cpu::indirect_renderer renderer({}, &rays, nullptr, &near);
 
         indirect_options base;
         base.technique = indirect_technique::sii;
@@ -300,26 +297,26 @@ int run(const options& o) {
                 opt.light = default_pixel_light(scene.view(), c.pattern);
                 opt.light.footprint_scale = c.footprint ? 1.f : 0.f;
                 opt.view_selection = o.view;
+                opt.clamp_compensation_rays = o.compensation_rays;
                 if (!c.view) opt.view_selection.candidates = 1;
                 opt.discontinuity.visibility_sigmas = c.sigmas < 0.f ? o.sigmas : c.sigmas;
                 if (c.complete) opt.discontinuity.complete_below = o.complete_below;
                 image<glm::vec3>& e = vis == indirect_visibility::rays ? with_rays : without;
                 e = image<glm::vec3>(s.g.width(), s.g.height());
                 const auto f0 = std::chrono::steady_clock::now();
-                renderer.render(opt, s.g.view(), scene.camera, caster.views(), e.view(), output_quantity::radiance);
+                const indirect_timings t =
+                    renderer.render(opt, s.g.view(), scene.camera, caster.views(), e.view(), output_quantity::radiance);
                 const double ms =
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - f0).count();
                 const bool rays_on = vis == indirect_visibility::rays;
                 const bench::measured_error err =
                     bench::measure_error(e.view(), rays_on ? occluded : unoccluded, s.mask.view());
-                fmt::print("{} {} {} vpls {}: raw {:.4f} debiased {:.4f} (se {:.4f}) {:.0f} ms\n", scene.name, c.name,
-                           rays_on ? "rays" : "none", o.vpls, err.rel_rms, err.rel_rms_debiased,
-                           err.rel_rms_debiased_se, ms);
+                fmt::print("{} {} {} vpls {}: raw {:.4f} debiased {:.4f} (se {:.4f}) {:.0f} ms, compensation {} rays "
+                           "{:.4f} of the light\n", scene.name, c.name, rays_on ? "rays" : "none", o.vpls, err.rel_rms,
+                           err.rel_rms_debiased, err.rel_rms_debiased_se, ms, t.compensation_rays, t.compensation_share);
                 std::fflush(stdout);
-                report["frames"].push_back({{"scene", scene.name},
-                                            {"config", c.name},
-                                            {"visibility", rays_on ? "rays" : "none"},
-                                            {"vpls", o.vpls},
+                report["frames"].push_back({{"scene", scene.name}, {"config", c.name},
+                                            {"visibility", rays_on ? "rays" : "none"}, {"vpls", o.vpls},
                                             {"pattern", c.pattern.cells() > 1 ? "4x4" : "1x1"},
                                             {"blur", c.blur},
                                             {"complete_below", opt.discontinuity.complete_below},
@@ -330,7 +327,8 @@ int run(const options& o) {
                                             {"rel_rms", err.rel_rms},
                                             {"rel_rms_debiased", err.rel_rms_debiased},
                                             {"rel_rms_debiased_se", err.rel_rms_debiased_se},
-                                            {"ms_loaded_machine", ms}});
+                                            {"ms_loaded_machine", ms}, {"compensation_rays", t.compensation_rays},
+                                            {"compensation_share", t.compensation_share}});
                 dump_image(o, scene.name, c.name + (rays_on ? "-rays" : "-none"), e.view());
                 if (!rays_on || without.empty()) continue;
                 auto split = bench::visibility_error_split(with_rays.view(), without.view(), occluded, unoccluded, s.mask.view());
@@ -370,6 +368,8 @@ int main(int argc, char** argv) {
     app.add_option("--receivers", o.view.receivers, "view_selection.receivers")->check(CLI::Range(1, 1 << 20));
     app.add_option("--defensive", o.view.defensive, "view_selection.defensive")->check(CLI::Range(0.001f, 1.f));
     app.add_option("--near-field", o.view.near_field, "view_selection.near_field (0: off)")->check(CLI::Range(0.f, 64.f));
+    app.add_option("--compensation-rays", o.compensation_rays, "gather with rays: the clamp's compensation (0: off)")
+        ->check(CLI::Range(0, 4096));
     app.add_option("--occlusion", o.occlusion, "diagnostic occlusion query: rays (the library's), geometric, shortened");
     app.add_flag("--flat-normals", o.flat_normals, "every triangle shaded with its own geometric normal");
     app.add_option("--json", o.json, "write the frames' errors here (docs/studies/results.py adds it)");

@@ -138,6 +138,11 @@ struct indirect_options {
     /// as DS05/DS06 do; rays tests every pair the frame sums (the renderer needs an
     /// occlusion_query, CPU only).
     indirect_visibility visibility = indirect_visibility::none;
+    /// With visibility rays, the RSM gather (CPU): cosine rays per pixel that give back the light
+    /// the clamp (light.min_distance2) removes within its distance (indirect/clamp_compensation.hpp;
+    /// docs section 15, seventh session); the renderer then needs a near_field_query. 0: off
+    /// (the library's default); typical 16. Ignored without rays and by SII.
+    std::uint32_t clamp_compensation_rays = 0;
     /// With visibility rays (CPU): SII's VPLs drawn again from a larger pool by their
     /// visible contribution to a sparse grid of pixels (indirect/view_selection.hpp; docs
     /// section 15; the RSM gather keeps its pattern). candidates 1 turns it off.
@@ -175,6 +180,7 @@ struct indirect_options {
         require(std::isfinite(r_max) && r_max > 0.f && r_max <= 2.f, "r_max", "must lie in (0, 2]");
         light.validate();
         require(std::isfinite(sii_cutoff) && sii_cutoff >= 0.f, "sii_cutoff", "must be finite and >= 0");
+        require(clamp_compensation_rays <= 4096, "clamp_compensation_rays", "must lie in [0, 4096]");
         require(low_resolution >= 1 && low_resolution <= 8, "low_resolution", "must lie in [1, 8]");
         require(low_resolution == 1 || technique == indirect_technique::rsm_gather, "low_resolution",
                 "applies to the RSM gather only");
@@ -224,6 +230,10 @@ struct indirect_timings {
     double upsample_ms = 0;           ///< low-resolution upsampling with full-resolution fallback
     std::size_t vpls = 0;             ///< SII: VPLs splatted; RSM gather: disc samples per pixel and map
     std::size_t fallback_pixels = 0;  ///< pixels the upsampling gathered at full resolution
+    std::size_t compensation_rays = 0;  ///< RSM gather with rays: rays of the clamp's compensation
+    /// RSM gather with rays: the share of the frame's irradiance (channels summed over the
+    /// shaded pixels) the clamp's compensation added.
+    double compensation_share = 0;
     double total_ms() const noexcept { return split_ms + shade_ms + gather_ms + blur_ms + upsample_ms; }
 };
 

@@ -42,13 +42,22 @@ class indirect_renderer {
 public:
     /// `occlusion` answers the visibility queries of options.visibility == rays
     /// (embree::occlusion_query); `points` samples the scene for visibility ism. Both must
-    /// outlive the frames that use them.
+    /// outlive the frames that use them. `near_field` answers the rays of the RSM gather's
+    /// clamp compensation (options.clamp_compensation_rays > 0 with rays; embree::near_field_rays).
     explicit indirect_renderer(const indirect_options& options = {}, const occlusion_query* occlusion = nullptr,
-                               const ism_point_sampler* points = nullptr)
-        : options_(options), occlusion_(occlusion), points_(points) {
+                               const ism_point_sampler* points = nullptr, const near_field_query* near_field = nullptr)
+        : options_(options), occlusion_(occlusion), points_(points), near_field_(near_field) {
         options_.validate();
         require_occlusion(options_, occlusion_);
         require_points(options_, points_);
+        require_near_field(options_, near_field_);
+    }
+
+    /// The near-field query of the next frames (the gather's clamp compensation); nullptr
+    /// allowed only while the options ask for no compensation. Throws parameter_error otherwise.
+    void set_near_field_query(const near_field_query* near_field) {
+        require_near_field(options_, near_field);
+        near_field_ = near_field;
     }
 
     /// The scene's point sampler of the next frames (visibility ism); nullptr allowed only
@@ -75,6 +84,7 @@ public:
         options.validate();
         require_occlusion(options, occlusion_);
         require_points(options, points_);
+        require_near_field(options, near_field_);
         if (options == options_) return;
         options_ = options;
         full_pattern_.clear();
@@ -112,6 +122,7 @@ private:
         require(!gb.depth.empty(), "gb", "is empty");
         for (const auto& m : maps) m.validate();
         indirect_timings t;
+        totals_ = {};
         const int f = options_.low_resolution;
         if (f == 1) {
             frame(gb, cam, maps, irradiance, full_, t);
@@ -128,9 +139,12 @@ private:
         t.split_ms += ms_since(start);
         frame(low_gb_.view(), cam, maps, low_irradiance_.view(), low_, t);
         start = clock::now();
+        compensation_totals fallback;
         t.fallback_pixels = upsample_or_gather(gb, cam, low_gb_.view(), low_irradiance_.view(), f, options_.upsample,
-                                               maps, full_pattern_, options_.light, irradiance, occlusion());
+                                               maps, full_pattern_, options_.light, irradiance, occlusion(),
+                                               compensation(), &fallback);
         t.upsample_ms = ms_since(start);
+        add_totals(fallback, t);
         return t;
     }
 
@@ -231,8 +245,29 @@ private:
         const light_groups g = assign_lights(full_pattern_.size(), imaps.pattern.cells(), light_assignment::interleaved,
                                              {}, options_.shift);
         const auto grouped = grouped_pattern(full_pattern_, g);
-        rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out, options_.energy_correct,
-                   occlusion());
+        const compensation_totals c = rsm_gather(gb, imaps, maps, grouped, identity_groups(g), options_.light, out,
+                                                 options_.energy_correct, occlusion(), compensation());
+        add_totals(c, t);
+    }
+
+    /// The gather's clamp compensation: active with rays, a positive ray count and a clamp.
+    gather_compensation compensation() const {
+        gather_compensation c;
+        if (occlusion() == nullptr || options_.clamp_compensation_rays == 0) return c;
+        c.query = near_field_;
+        c.grid = compensation_grid(options_.clamp_compensation_rays);
+        c.min_distance2 = options_.light.min_distance2;
+        c.seed = options_.seed;
+        return c;
+    }
+
+    /// Accumulates a gather pass's compensation into the frame's timings.
+    void add_totals(const compensation_totals& c, indirect_timings& t) {
+        totals_.added += c.added;
+        totals_.total += c.total;
+        totals_.rays += c.rays;
+        t.compensation_rays = totals_.rays;
+        t.compensation_share = totals_.share();
     }
 
     void shade_splat(const gbuffer_view<float>& gb, const camera& cam, std::span<const rsm_view> maps,
@@ -290,6 +325,13 @@ private:
                                                 "renderer");
     }
 
+    static void require_near_field(const indirect_options& o, const near_field_query* q) {
+        if (o.visibility == indirect_visibility::rays && o.technique == indirect_technique::rsm_gather &&
+            o.clamp_compensation_rays > 0 && !q)
+            throw parameter_error("clamp_compensation_rays", "needs a near_field_query (embree::near_field_rays) "
+                                                             "given to the renderer");
+    }
+
     static void require_points(const indirect_options& o, const ism_point_sampler* p) {
         if (o.visibility == indirect_visibility::ism && !p)
             throw parameter_error("visibility", "ism needs the scene's ism_point_sampler given to the renderer");
@@ -314,6 +356,8 @@ private:
     std::size_t pattern_texels_ = 0;
     std::vector<vpl> vpls_;
     const ism_point_sampler* points_ = nullptr;
+    const near_field_query* near_field_ = nullptr;
+    compensation_totals totals_;  // the frame's compensation so far
     std::vector<glm::vec3> ism_points_;
     std::uint64_t ism_seed_ = 0;
     imperfect_shadow_maps ism_;

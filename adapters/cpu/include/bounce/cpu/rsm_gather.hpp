@@ -17,6 +17,7 @@
 #include <bounce/camera.hpp>
 #include <bounce/cpu/interleave.hpp>
 #include <bounce/gbuffer.hpp>
+#include <bounce/indirect/clamp_compensation.hpp>
 #include <bounce/indirect/options.hpp>
 #include <bounce/indirect/rsm.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
@@ -34,6 +35,24 @@
 #include <tbb/parallel_for.h>
 
 namespace bounce::cpu {
+
+/// The clamp's compensation of a gather with visibility by rays (indirect/clamp_compensation.hpp):
+/// `grid` cosine rays per receiver of length sqrt(min_distance2) asked of `query`.
+struct gather_compensation {
+    const near_field_query* query = nullptr;
+    compensation_grid grid{16};
+    float min_distance2 = 0.f;
+    std::uint64_t seed = 1;
+    bool active() const noexcept { return query != nullptr && min_distance2 > 0.f; }
+};
+
+/// What a gather's compensation added: irradiance summed over pixels and channels, the
+/// frame's total likewise, and the rays traced.
+struct compensation_totals {
+    double added = 0, total = 0;
+    std::size_t rays = 0;
+    double share() const noexcept { return total > 0 ? added / total : 0.0; }
+};
 
 namespace detail {
 /// The centre of a receiver's disc in `map` (rsm_disc_centre).
@@ -69,14 +88,39 @@ struct visible_gather_scratch {
     std::vector<visibility_segment> segments;
     std::vector<glm::vec3> terms;
     std::vector<std::uint8_t> blocked;
+    std::vector<near_field_ray> rays;
+    std::vector<glm::vec3> radiance;
+    std::vector<float> distance2;
+    compensation_totals totals;  // what this thread's compensation added
 };
+
+/// The clamp's compensation at receiver x (unit normal n): the light of the surfaces its
+/// rays meet within the clamp's distance, weighted by the clamp's complement.
+inline glm::vec3 compensation_at(const glm::vec3& x, const glm::vec3& n, const gather_compensation& comp,
+                                 visible_gather_scratch& sc) {
+    sc.rays.clear();
+    clamp_compensation_rays(x, n, comp.min_distance2, comp.grid, comp.seed, sc.rays);
+    sc.radiance.resize(sc.rays.size());
+    sc.distance2.resize(sc.rays.size());
+    comp.query->radiance(sc.rays, sc.radiance, sc.distance2);
+    glm::vec3 e(0.f);
+    const float count = float(sc.rays.size());
+    for (std::size_t k = 0; k < sc.rays.size(); ++k)
+        if (sc.distance2[k] < comp.min_distance2)
+            e += clamp_compensation_term<float, glm::vec3>(sc.radiance[k], sc.distance2[k], comp.min_distance2, count);
+    sc.totals.rays += sc.rays.size();
+    sc.totals.added += double(e.x + e.y + e.z);
+    return e;
+}
 
 /// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
 /// receiver from every map; with `occlusion`, only from the texels it sees (one segment a
-/// sample that gives light, asked in one batch).
+/// sample that gives light, asked in one batch), plus the clamp's compensation when `comp`
+/// is active.
 inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<const rsm_view> maps,
                            std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp,
-                           const occlusion_query* occlusion = nullptr, visible_gather_scratch* scratch = nullptr) {
+                           const occlusion_query* occlusion = nullptr, visible_gather_scratch* scratch = nullptr,
+                           const gather_compensation& comp = {}) {
     glm::vec3 e(0.f);
     if (!occlusion) {
         for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
@@ -96,7 +140,20 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
     occlusion->occluded(sc.segments, sc.blocked);
     for (std::size_t k = 0; k < sc.terms.size(); ++k)
         if (!sc.blocked[k]) e += sc.terms[k];
+    if (comp.active()) e += compensation_at(x, n, comp, sc);
+    sc.totals.total += double(e.x + e.y + e.z);
     return e;
+}
+
+/// The totals of every thread's scratch.
+inline compensation_totals sum_totals(tbb::enumerable_thread_specific<visible_gather_scratch>& scratches) {
+    compensation_totals t;
+    for (const auto& sc : scratches) {
+        t.added += sc.totals.added;
+        t.total += sc.totals.total;
+        t.rays += sc.totals.rays;
+    }
+    return t;
 }
 }  // namespace detail
 
@@ -106,11 +163,14 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
 /// times interleaved_weight_scale(n, m) (weight 1 with `energy_correct` false, the thesis's
 /// choice, for comparison). `out` (irradiance, W/m^2) is written everywhere; 0 where the
 /// G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather. With
-/// `occlusion`, a pixel sums only the samples whose texel it sees (indirect/visibility.hpp).
-inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& imaps, std::span<const rsm_view> maps,
-                       std::span<const glm::vec3> pattern, const light_groups& groups, const pixel_light_params& lp,
-                       image_view<glm::vec3> out, bool energy_correct = true,
-                       const occlusion_query* occlusion = nullptr) {
+/// `occlusion`, a pixel sums only the samples whose texel it sees (indirect/visibility.hpp),
+/// and with an active `comp` gets back the light the clamp removes (clamp_compensation.hpp).
+/// Returns what the compensation added (zeros without it).
+inline compensation_totals rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& imaps,
+                                      std::span<const rsm_view> maps, std::span<const glm::vec3> pattern,
+                                      const light_groups& groups, const pixel_light_params& lp,
+                                      image_view<glm::vec3> out, bool energy_correct = true,
+                                      const occlusion_query* occlusion = nullptr, const gather_compensation& comp = {}) {
     lp.validate();
     for (const auto& m : maps) {
         m.validate();
@@ -135,10 +195,11 @@ inline void rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& ima
             const int s = imaps.cell(u, v);
             const auto group = pattern.subspan(groups.begin[std::size_t(s)],
                                                groups.begin[std::size_t(s) + 1] - groups.begin[std::size_t(s)]);
-            out(u, v) =
-                detail::gather_at(gb.position(u, v), gb.normal(u, v), maps, group, scale, lp, occlusion, &scratch);
+            out(u, v) = detail::gather_at(gb.position(u, v), gb.normal(u, v), maps, group, scale, lp, occlusion,
+                                          &scratch, comp);
         }
     });
+    return detail::sum_totals(scratches);
 }
 
 /// The plain gather (no interleaving, DS05): every pixel of `gb` sums the whole `pattern`.
@@ -150,6 +211,20 @@ inline void rsm_gather(const gbuffer_view<float>& gb, std::span<const rsm_view> 
     all.order.resize(pattern.size());
     for (std::size_t k = 0; k < pattern.size(); ++k) all.order[k] = std::uint32_t(k);
     rsm_gather(gb, imaps, maps, pattern, all, lp, out);
+}
+
+/// The plain gather with visibility by `occlusion` and the clamp's compensation `comp`:
+/// every pixel of `gb` sums the whole `pattern`. Returns what the compensation added.
+inline compensation_totals rsm_gather(const gbuffer_view<float>& gb, std::span<const rsm_view> maps,
+                                      std::span<const glm::vec3> pattern, const pixel_light_params& lp,
+                                      image_view<glm::vec3> out, const occlusion_query& occlusion,
+                                      const gather_compensation& comp) {
+    const interleave_maps imaps({1, 1}, gb.width(), gb.height());
+    light_groups all;
+    all.begin = {0, std::uint32_t(pattern.size())};
+    all.order.resize(pattern.size());
+    for (std::size_t k = 0; k < pattern.size(); ++k) all.order[k] = std::uint32_t(k);
+    return rsm_gather(gb, imaps, maps, pattern, all, lp, out, true, &occlusion, comp);
 }
 
 /// Picks the G-buffer pixel at the centre of each factor x factor block
@@ -181,7 +256,8 @@ inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camer
                                       image_view<const glm::vec3> low_irradiance, int factor, const upsample_params& up,
                                       std::span<const rsm_view> maps, std::span<const glm::vec3> pattern,
                                       const pixel_light_params& lp, image_view<glm::vec3> out,
-                                      const occlusion_query* occlusion = nullptr) {
+                                      const occlusion_query* occlusion = nullptr, const gather_compensation& comp = {},
+                                      compensation_totals* totals = nullptr) {
     require(out.width() == gb.width() && out.height() == gb.height(), "out", "size differs from the G-buffer");
     const float f = float(factor);
     std::vector<std::size_t> fallbacks(gb.height(), 0);
@@ -212,11 +288,12 @@ inline std::size_t upsample_or_gather(const gbuffer_view<float>& gb, const camer
                 out(x, y) = es[0] * w[0] + es[1] * w[1] + es[2] * w[2] + es[3] * w[3];
             } else {
                 out(x, y) = detail::gather_at(gb.position(x, y), gb.normal(x, y), maps, pattern, 1.f, lp, occlusion,
-                                              &scratch);
+                                              &scratch, comp);
                 ++fallbacks[y];
             }
         }
     });
+    if (totals) *totals = detail::sum_totals(scratches);
     std::size_t total = 0;
     for (auto c : fallbacks) total += c;
     return total;

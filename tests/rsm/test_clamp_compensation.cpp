@@ -1,0 +1,161 @@
+// The RSM gather's clamp compensation (indirect/clamp_compensation.hpp) with Embree's rays:
+// the kernel is the exact complement of pixel_light_irradiance's clamp; at a crease (a lit
+// wall meeting a receiver floor) the clamped texel sum plus the compensation converges to
+// Lambert's unclamped irradiance; no surface within the clamp's distance, or a shadowed one,
+// gives exactly zero; and the renderer refuses the compensation without a near-field query.
+#include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/embree/near_field_rays.hpp>
+#include <bounce/embree/occlusion_rays.hpp>
+#include <bounce/embree/rsm_ray_cast.hpp>
+#include <bounce/errors.hpp>
+
+#include "../embree/hand_built_scenes.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+using namespace bounce;
+
+namespace {
+
+constexpr float rho = 0.8f, e0 = 2.f;
+constexpr float clamp_distance = 0.1f;  // r_c: 20 texels of the 512^2 map
+
+// A wall (x = 0, |y| <= 1, z in [0, 1], facing +x, albedo rho) lit straight on by a
+// directional light of irradiance e0 travelling along -x (exitance M = rho e0), meeting a
+// floor (z = 0, x in [0, 1], facing +z) the light grazes (it reflects nothing). With
+// `shadowed`, a screen at x = 2 (facing +x) keeps the light off the wall.
+hand_built::scene crease(bool shadowed) {
+    hand_built::scene s;
+    const auto mat = hand_built::add_material(s, glm::vec3(rho));
+    hand_built::add_quad(s, {0, -1, 0}, {0, 1, 0}, {0, 1, 1}, {0, -1, 1}, {1, 0, 0}, mat);
+    hand_built::add_quad(s, {0, -1, 0}, {1, -1, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, mat);
+    if (shadowed) hand_built::add_quad(s, {2, -2, -1}, {2, 2, -1}, {2, 2, 2}, {2, -2, 2}, {1, 0, 0}, mat);
+    s.lights.push_back(directional_light{{-1, 0, 0}, glm::vec3(e0)});
+    return s;
+}
+
+// The scene's accel, its 512^2 map, and the gather of one receiver over every lit texel
+// exactly once (a pattern of weight-1 offsets from the receiver's disc centre), with
+// visibility by rays and, with `rays` > 0, the clamp's compensation.
+struct crease_gather {
+    hand_built::scene s;
+    embree::accel bvh{s.view()};
+    embree::rsm_ray_caster caster{bvh, s.view(), {512, 60.f}};
+    embree::occlusion_rays occlusion{bvh};
+    embree::near_field_rays near{bvh, s.view()};
+
+    explicit crease_gather(bool shadowed) : s(crease(shadowed)) { caster.render(); }
+
+    struct result {
+        glm::vec3 e;
+        cpu::compensation_totals totals;
+    };
+    result at(glm::vec3 x, std::uint32_t rays, std::uint64_t seed = 1) {
+        gbuffer<float> g(1, 1);
+        g.view().position(0, 0) = x;
+        g.view().normal(0, 0) = {0, 0, 1};
+        g.view().albedo(0, 0) = glm::vec3(1.f);
+        g.view().depth(0, 0) = 1.f;
+        const rsm_view& map = caster.views()[0];
+        const glm::vec2 centre = cpu::detail::disc_centre(map, x);
+        std::vector<glm::vec3> pattern;
+        for (std::size_t ty = 0; ty < map.height(); ++ty)
+            for (std::size_t tx = 0; tx < map.width(); ++tx)
+                pattern.emplace_back((float(tx) + 0.5f) / float(map.width()) - centre.x,
+                                     (float(ty) + 0.5f) / float(map.height()) - centre.y, 1.f);
+        pixel_light_params lp;
+        lp.min_distance2 = clamp_distance * clamp_distance;
+        cpu::gather_compensation comp;
+        if (rays > 0) comp = {&near, compensation_grid(rays), lp.min_distance2, seed};
+        image<glm::vec3> out(1, 1);
+        const auto totals = cpu::rsm_gather(g.view(), caster.views(), pattern, lp, out.view(), occlusion, comp);
+        return {out(0, 0), totals};
+    }
+};
+
+}  // namespace
+
+TEST_CASE("the compensation's weight is the exact complement of the clamp", "[rsm][clamp_compensation]") {
+    const glm::vec3 flux(1.f, 2.f, 3.f), n(0, 0, 1), np(1, 0, 0);
+    const float r2 = 0.01f;
+    for (const float h : {0.001f, 0.02f, 0.05f, 0.09f, 0.2f}) {
+        const glm::vec3 x(h, 0, 0), xp(0, 0, 0.3f * h);
+        const glm::vec3 plain = pixel_light_irradiance<float, glm::vec3>(x, n, xp, np, flux, 0.f, 0.f);
+        const glm::vec3 clamped = pixel_light_irradiance<float, glm::vec3>(x, n, xp, np, flux, 0.f, r2);
+        const float d2 = glm::dot(x - xp, x - xp);
+        const glm::vec3 restored = clamped + plain * clamp_complement_weight<float>(d2, r2);
+        for (int c = 0; c < 3; ++c) CHECK(restored[c] == Approx(plain[c]).epsilon(1e-5));
+    }
+    CHECK(clamp_complement_weight<float>(0.02f, 0.01f) == 0.f);
+    CHECK(clamp_complement_weight<float>(0.f, 0.f) == 0.f);
+    CHECK(clamp_complement_weight<float>(0.f, 0.01f) == 1.f);
+    CHECK(compensation_grid(16).count() == 16);  // 2 x 8
+    CHECK(compensation_grid(1).count() == 1);
+}
+
+TEST_CASE("at a crease the clamped gather plus its compensation converges to the unclamped irradiance",
+          "[rsm][embree][clamp_compensation]") {
+    crease_gather c(false);
+    const double m = double(rho) * double(e0);
+    const std::vector<glm::dvec3> wall{{0, -1, 0}, {0, 1, 0}, {0, 1, 1}, {0, -1, 1}};
+    const std::uint32_t rays = 16384;
+    for (const float h : {0.01f, 0.03f, 0.06f, 0.09f}) {
+        const glm::vec3 x(h, 0, 0);
+        const double exact = m / std::numbers::pi * hand_built::lambert_polygon(glm::dvec3(x), {0, 0, 1}, wall);
+        const auto clamped = c.at(x, 0);
+        const auto compensated = c.at(x, rays);
+        // Each ray's estimate pi L w lies in [0, M]: the mean of K has a standard deviation
+        // of at most M / (2 sqrt K) (stratification only lowers it); 4 of them, plus 1% for
+        // the texel sum's midpoint rule on the clamped kernel (texels 1/20 of r_c).
+        const double tolerance = 4 * m / (2 * std::sqrt(double(compensated.totals.rays))) + 0.01 * exact;
+        CAPTURE(h, exact, clamped.e.x, compensated.e.x, tolerance);
+        CHECK(compensated.totals.rays == compensation_grid(rays).count());
+        CHECK(std::abs(double(compensated.e.x) - exact) < tolerance);
+        if (h <= 0.06f) CHECK(exact - double(clamped.e.x) > 2 * tolerance);  // the removed light, seen
+    }
+}
+
+TEST_CASE("no surface within the clamp's distance gives exactly zero compensation", "[rsm][embree][clamp_compensation]") {
+    crease_gather c(false);
+    const glm::vec3 x(0.5f, 0, 0);  // five clamp distances from the wall
+    const auto plain = c.at(x, 0);
+    const auto compensated = c.at(x, 64);
+    CHECK(compensated.totals.rays == compensation_grid(64).count());
+    CHECK(compensated.totals.added == 0.0);
+    CHECK(compensated.e == plain.e);
+}
+
+TEST_CASE("a shadowed surface within the clamp's distance gives zero compensation", "[rsm][embree][clamp_compensation]") {
+    crease_gather c(true);
+    const glm::vec3 x(0.02f, 0, 0);
+    // The rays find the wall within r_c, but it is in the screen's shadow.
+    const near_field_ray r{x, {0, 0, 1}, glm::normalize(glm::vec3(-1, 0, 1)), clamp_distance, 7};
+    glm::vec3 radiance(1.f);
+    float d2 = 0.f;
+    c.near.radiance({&r, 1}, {&radiance, 1}, {&d2, 1});
+    CHECK(d2 < clamp_distance * clamp_distance);
+    CHECK(radiance == glm::vec3(0.f));
+    const auto compensated = c.at(x, 256);
+    CHECK(compensated.totals.rays == compensation_grid(256).count());
+    CHECK(compensated.totals.added == 0.0);
+}
+
+TEST_CASE("the gather's compensation with rays needs a near-field query", "[rsm][clamp_compensation]") {
+    hand_built::scene s = crease(false);
+    const embree::accel bvh(s.view());
+    const embree::occlusion_rays occlusion(bvh);
+    indirect_options o;
+    o.technique = indirect_technique::rsm_gather;
+    o.visibility = indirect_visibility::rays;
+    o.clamp_compensation_rays = 16;
+    CHECK_THROWS_WITH(cpu::indirect_renderer(o, &occlusion), Catch::Contains("clamp_compensation_rays"));
+    o.clamp_compensation_rays = 5000;
+    CHECK_THROWS_WITH(o.validate(), Catch::Contains("clamp_compensation_rays"));
+    const embree::near_field_rays near(bvh, s.view());
+    o.clamp_compensation_rays = 16;
+    CHECK_NOTHROW(cpu::indirect_renderer(o, &occlusion, nullptr, &near));
+}
