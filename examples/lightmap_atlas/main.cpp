@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <string>
 
 using namespace bounce;
@@ -29,6 +30,7 @@ struct options {
     std::size_t elements = 10000;
     double cone = atlas_options{}.cone_degrees;
     int padding = 1;
+    tiny_chart_clusters clusters = atlas_options{}.clusters;
     std::filesystem::path json, png;
     int zoom = 1;
 };
@@ -49,7 +51,7 @@ int run(const options& o) {
     const io::scene scene = io::load_scene_arg(o.scene);
     const auto t0 = std::chrono::steady_clock::now();
     const lightmap_atlas atlas = build_lightmap_atlas(scene.view(), {.elements = o.elements, .padding = o.padding,
-                                                                     .cone_degrees = o.cone});
+                                                                     .cone_degrees = o.cone, .clusters = o.clusters});
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     const atlas_statistics& s = atlas.statistics;
     nlohmann::ordered_json j;
@@ -74,6 +76,8 @@ int run(const options& o) {
     j["overlaps_refused"] = s.overlaps_refused;
     j["texel_size"] = s.texel_size;
     j["densities_tried"] = s.densities_tried;
+    j["clusters"] = s.clusters;
+    j["clustered_charts"] = s.clustered_charts;
     j["atlas_ms"] = ms;
     fmt::print("{}\n", j.dump());
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
@@ -106,6 +110,10 @@ int main(int argc, char** argv) {
     app.add_option("--elements", o.elements, "element count asked")->check(CLI::PositiveNumber);
     app.add_option("--cone", o.cone, "chart cone half-angle, degrees, in [0, 90)");
     app.add_option("--padding", o.padding, "texels around each chart");
+    app.add_option("--clusters", o.clusters, "tiny charts sharing one element: never, when-needed (the budget missed by >10%), always")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, tiny_chart_clusters>{
+            {"never", tiny_chart_clusters::never}, {"when-needed", tiny_chart_clusters::when_needed},
+            {"always", tiny_chart_clusters::always}}));
     app.add_option("--json", o.json, "report file");
     app.add_option("--png", o.png, "picture of the atlas");
     app.add_option("--zoom", o.zoom, "pixels per texel in the picture")->check(CLI::Range(1, 16));

@@ -1,14 +1,18 @@
 // The lightmap atlas: charts, exact element areas, layout without bleeding, blocks.
 #include "radiosity_scenes.hpp"
 
+#include <bounce/cpu/radiosity.hpp>
+#include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/radiosity/shooters.hpp>
+#include <bounce/radiosity/subdivision.hpp>
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <set>
 
@@ -431,6 +435,172 @@ TEST_CASE("the element budget holds within 10% on a scene of many small triangle
         // Every chart has an element.
         for (const auto& ch : atlas.charts) CHECK(ch.element_count >= 1);
     }
-    // Planar charts only (cone 0, as before): a chart per flat quad, the budget missed.
-    CHECK(build_lightmap_atlas(s.view(), {.elements = 10000, .cone_degrees = 0}).size() > 14000);
+    // Planar charts only (cone 0, as before) and no clusters: a chart per flat quad, the
+    // budget missed; clusters of the quads smaller than a texel keep it.
+    CHECK(build_lightmap_atlas(s.view(), {.elements = 10000, .cone_degrees = 0, .clusters = tiny_chart_clusters::never})
+              .size() > 14000);
+    const auto planar = build_lightmap_atlas(s.view(), {.elements = 10000, .cone_degrees = 0});
+    CHECK(std::abs(double(planar.size()) - 10000.0) <= 0.10 * 10000.0);
+    CHECK(planar.statistics.clusters > 0);
+}
+
+namespace {
+
+// A small lamp (5 cm square, facing down) over 3,750 separate 1 mm triangles, 4 mm apart:
+// 2,500 on a floor facing up and 1,250 on a wall facing +x, each triangle its own chart.
+owned_scene tiny_triangles_under_a_lamp() {
+    owned_scene s;
+    const auto floor = s.add_material(glm::vec3(0.6f)), wall = s.add_material(glm::vec3(0.4f, 0.5f, 0.6f));
+    const auto lamp = s.add_material(glm::vec3(0.f), glm::vec3(20.f));
+    s.add_quad({0.10f, 0.10f, 0.10f}, {0.10f, 0.15f, 0.10f}, {0.15f, 0.15f, 0.10f}, {0.15f, 0.10f, 0.10f}, lamp);
+    const auto triangle = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t m) {
+        const auto base = std::uint32_t(s.positions.size());
+        s.positions.insert(s.positions.end(), {a, b, c});
+        s.triangles.emplace_back(base, base + 1, base + 2);
+        s.material_of.push_back(m);
+    };
+    const float mm = 0.001f, step = 0.004f;
+    for (int i = 0; i < 50; ++i)
+        for (int j = 0; j < 50; ++j) {
+            const glm::vec3 p(step * float(i), step * float(j), 0.f);
+            triangle(p, p + glm::vec3(mm, 0, 0), p + glm::vec3(0, mm, 0), floor);
+        }
+    for (int j = 0; j < 50; ++j)
+        for (int k = 0; k < 25; ++k) {
+            const glm::vec3 p(0.f, step * float(j), 0.002f + step * float(k));
+            triangle(p, p + glm::vec3(0, mm, 0), p + glm::vec3(0, 0, mm), wall);
+        }
+    return s;
+}
+
+}  // namespace
+
+TEST_CASE("tiny separate charts share elements in clusters: the budget holds, each triangle in one texel",
+          "[radiosity][atlas][clusters]") {
+    const auto s = tiny_triangles_under_a_lamp();
+    const auto area_of = [&](std::uint32_t t) { return triangle_area(s, t); };
+    for (std::size_t asked : {200u, 1000u}) {
+        const auto atlas = build_lightmap_atlas(s.view(), {.elements = asked});
+        INFO("asked " << asked << ", made " << atlas.size() << ", clusters " << atlas.statistics.clusters);
+        CHECK(std::abs(double(atlas.size()) - double(asked)) <= 0.10 * double(asked));
+        CHECK(atlas.statistics.clusters > 0);
+        std::vector<double> chart_area(atlas.charts.size(), 0.0);
+        const auto uv = atlas.corner_uvs(s.view());
+        for (std::uint32_t t = 0; t < s.triangles.size(); ++t) {
+            const std::uint32_t c = atlas.chart_of_triangle[t];
+            REQUIRE(c != lightmap_atlas::none);
+            chart_area[c] += area_of(t);
+            const lightmap_chart& ch = atlas.charts[c];
+            if (!ch.cluster()) continue;
+            // Every corner in the cluster's one texel, whose element is the cluster's.
+            for (int k = 0; k < 3; ++k) {
+                const glm::vec2 p = uv[3 * t + std::size_t(k)] * glm::vec2(float(atlas.width), float(atlas.height));
+                CHECK(p.x >= float(ch.atlas_x) - 1e-3f);
+                CHECK(p.x <= float(ch.atlas_x + 1) + 1e-3f);
+                CHECK(p.y >= float(ch.atlas_y) - 1e-3f);
+                CHECK(p.y <= float(ch.atlas_y + 1) + 1e-3f);
+            }
+            CHECK(atlas.element_at(ch.atlas_x, ch.atlas_y) == std::int32_t(ch.first_element));
+        }
+        std::set<std::uint32_t> material_of_cluster;
+        for (std::uint32_t c = 0; c < atlas.charts.size(); ++c) {
+            const lightmap_chart& ch = atlas.charts[c];
+            if (!ch.cluster()) continue;
+            REQUIRE(ch.element_count == 1);
+            CHECK(ch.width == 1);
+            CHECK(ch.height == 1);
+            CHECK(ch.clustered_charts >= 2);
+            CHECK(ch.triangle_count == ch.clustered_charts);  // a chart per triangle here
+            const std::uint32_t e = ch.first_element;
+            // Its area is its triangles' sum; its point lies on one of them; one material.
+            CHECK(std::abs(double(atlas.area[e]) - chart_area[c]) <= 1e-5 * chart_area[c]);
+            CHECK(ch.tilt_degrees <= 30.f + 1e-3f);
+            double nearest = 1;
+            for (std::uint32_t k = 0; k < ch.triangle_count; ++k) {
+                const std::uint32_t t = atlas.chart_triangles[ch.first_triangle + k];
+                CHECK(s.material_of[t] == ch.material);
+                const glm::vec3 a = s.positions[s.triangles[t].x], b = s.positions[s.triangles[t].y],
+                                cc = s.positions[s.triangles[t].z];
+                const glm::vec3 n = glm::normalize(glm::cross(b - a, cc - a));
+                const glm::vec3 q = atlas.position[e];
+                const float plane = std::abs(glm::dot(q - a, n));
+                const float u = glm::dot(glm::cross(b - a, q - a), n), v = glm::dot(glm::cross(cc - b, q - b), n),
+                            w = glm::dot(glm::cross(a - cc, q - cc), n);
+                const float tol = -1e-9f;
+                if (plane < 1e-6f && u >= tol && v >= tol && w >= tol) nearest = 0;
+            }
+            CHECK(nearest == 0);
+            CHECK(glm::dot(atlas.normal[e], ch.normal) > 0.999f);
+        }
+        // A cluster never mixes the floor's and the wall's triangles (90 degrees apart).
+        for (const auto& ch : atlas.charts) {
+            if (!ch.cluster()) continue;
+            std::set<std::uint32_t> mats;
+            for (std::uint32_t k = 0; k < ch.triangle_count; ++k) mats.insert(s.material_of[atlas.chart_triangles[ch.first_triangle + k]]);
+            CHECK(mats.size() == 1);
+        }
+        // The element areas add up to the scene's area.
+        double sum = 0, scene_area = 0;
+        for (const float a : atlas.area) sum += a;
+        for (std::uint32_t t = 0; t < s.triangles.size(); ++t) scene_area += area_of(t);
+        CHECK(std::abs(sum - scene_area) <= 1e-4 * scene_area);
+    }
+    // Without clusters a chart per triangle: 3,751 elements at least, whatever is asked.
+    CHECK(build_lightmap_atlas(s.view(), {.elements = 200, .clusters = tiny_chart_clusters::never}).size() > 3750);
+    // A scene whose budget holds without clusters makes none unless asked for them.
+    const auto box = closed_box(2.f, 0.6f, 5.f);
+    CHECK(build_lightmap_atlas(box.view(), {.elements = 600}).statistics.clusters == 0);
+}
+
+TEST_CASE("a cluster's texel is never sampled as a whole texel, and subdivision refuses to split it",
+          "[radiosity][atlas][clusters]") {
+    const auto s = tiny_triangles_under_a_lamp();
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 200});
+    const auto whole = whole_texels(atlas);
+    std::uint32_t cluster_block = std::numeric_limits<std::uint32_t>::max();
+    for (std::uint32_t k = 0; k < atlas.blocks(); ++k)
+        if (atlas.charts[atlas.chart[atlas.block_first[k]]].cluster()) {
+            cluster_block = k;
+            CHECK(atlas.block_first[k + 1] == atlas.block_first[k] + 1);
+            CHECK(whole[atlas.block_first[k]] == 0);
+        }
+    REQUIRE(cluster_block < atlas.blocks());
+    const std::vector<std::uint32_t> split{cluster_block};
+    CHECK_THROWS_AS(refine_lightmap_atlas(s.view(), atlas, split), parameter_error);
+    CHECK_THROWS_WITH(refine_lightmap_atlas(s.view(), atlas, split), Catch::Contains("atlas_options::clusters"));
+}
+
+TEST_CASE("a solve over clusters of tiny charts conserves energy and lights every triangle",
+          "[radiosity][atlas][clusters][solve]") {
+    const auto s = tiny_triangles_under_a_lamp();
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 300});
+    REQUIRE(atlas.statistics.clusters > 0);
+    cpu::progressive_radiosity solver(s.view(), atlas, cpu::item_buffer_visibility(s.view(), atlas, {.resolution = 128}));
+    double unshot = solver.unshot_fraction();
+    radiosity_solve_options o;
+    o.converge = 0.99;
+    o.progress = [&](const radiosity_progress& p) {
+        CHECK(p.unshot_fraction <= unshot * (1 + 1e-6));  // the unshot power never rises
+        CHECK(p.unshot_fraction >= 0);
+        CHECK(solver.last_shot().top_share <= 1 + 1e-6);
+        unshot = p.unshot_fraction;
+        return true;
+    };
+    REQUIRE_NOTHROW(solver.solve(o));
+    // Energy: absorbed + unshot + escaped = emitted, per channel.
+    const glm::dvec3 balance = solver.absorbed_power() + solver.unshot_power() + solver.escaped_power() - solver.emitted_power();
+    for (int c = 0; c < 3; ++c) CHECK(std::abs(balance[c]) <= 1e-4 * solver.emitted_power()[c]);
+    // Every tiny triangle's element (the texel its centroid maps to) is lit.
+    const auto b = solver.display_radiosity();
+    const glm::vec2 size(float(atlas.width), float(atlas.height));
+    const auto uv = atlas.corner_uvs(s.view());
+    std::size_t dark = 0;
+    for (std::uint32_t t = 1 + 1; t < s.triangles.size(); ++t) {  // after the lamp's two
+        const glm::vec2 p = (uv[3 * t] + uv[3 * t + 1] + uv[3 * t + 2]) / 3.f * size;
+        const std::int32_t e = atlas.element_at(std::uint32_t(p.x), std::uint32_t(p.y));
+        REQUIRE(e >= 0);
+        CHECK(atlas.chart[std::size_t(e)] == atlas.chart_of_triangle[t]);
+        dark += b[std::size_t(e)].x + b[std::size_t(e)].y + b[std::size_t(e)].z > 0.f ? 0 : 1;
+    }
+    CHECK(dark == 0);
 }

@@ -43,15 +43,16 @@ namespace bounce::detail {
 
 inline glm::dvec3 to_d(const glm::vec3& v) { return glm::dvec3(v); }
 
-/// Unit normals and areas of a scene's triangles, in double; degenerate triangles have area
-/// 0 and normal 0.
+/// Unit normals, areas and centroids of a scene's triangles, in double; degenerate triangles
+/// have area 0 and normal 0.
 struct triangle_faces {
     std::vector<glm::dvec3> normal;
     std::vector<double> area;
+    std::vector<glm::dvec3> centroid;
 };
 inline triangle_faces face_normals_and_areas(const scene_view& scene) {
     const std::size_t nt = scene.triangles.size();
-    triangle_faces faces{std::vector<glm::dvec3>(nt), std::vector<double>(nt, 0.0)};
+    triangle_faces faces{std::vector<glm::dvec3>(nt), std::vector<double>(nt, 0.0), std::vector<glm::dvec3>(nt)};
     for (std::size_t t = 0; t < nt; ++t) {
         const auto& tri = scene.triangles[t];
         const glm::dvec3 a = to_d(scene.positions[tri.x]), b = to_d(scene.positions[tri.y]), c = to_d(scene.positions[tri.z]);
@@ -59,6 +60,7 @@ inline triangle_faces face_normals_and_areas(const scene_view& scene) {
         const double len = glm::length(cr);
         faces.area[t] = 0.5 * len;
         faces.normal[t] = len > 0 ? cr / len : glm::dvec3(0);
+        faces.centroid[t] = (a + b + c) / 3.0;
     }
     return faces;
 }
@@ -316,6 +318,49 @@ inline grown_charts grow_charts(const scene_view& scene, const triangle_faces& f
     return out;
 }
 
+/// A chart's frame on its plane (origin, unit in-plane axes u and v) and its extent along
+/// them (m).
+struct chart_extent {
+    glm::dvec3 origin, u, v;
+    double eu = 0, ev = 0;
+};
+
+/// The frame of a chart (its triangles `tris`, its unit normal n) whose axis u runs along one of its triangles' edges and whose
+/// bounding rectangle is the smallest (a rectangle's own sides for walls and quads). At most
+/// 64 edges are tried, which covers every chart of a few dozen triangles.
+inline chart_extent smallest_bounding_frame(const scene_view& scene, std::span<const std::uint32_t> tris,
+                                            const glm::dvec3& n) {
+    chart_extent out{};
+    const auto corner = [&](std::uint32_t t, int k) { return to_d(scene.positions[scene.triangles[t][k]]); };
+    double best = std::numeric_limits<double>::infinity();
+    int tried = 0;
+    for (const std::uint32_t t : tris) {
+        for (int k = 0; k < 3 && tried < 64; ++k, ++tried) {
+            const glm::dvec3 e = corner(t, (k + 1) % 3) - corner(t, k);
+            glm::dvec3 u = e - n * glm::dot(e, n);
+            if (glm::length(u) <= 0) continue;
+            u = glm::normalize(u);
+            const glm::dvec3 v = glm::cross(n, u);
+            glm::dvec2 mn(std::numeric_limits<double>::infinity()), mx(-std::numeric_limits<double>::infinity());
+            for (const std::uint32_t s : tris)
+                for (int m = 0; m < 3; ++m) {
+                    const glm::dvec3 p = corner(s, m);
+                    const glm::dvec2 q(glm::dot(p, u), glm::dot(p, v));
+                    mn = glm::min(mn, q);
+                    mx = glm::max(mx, q);
+                }
+            const glm::dvec2 size = mx - mn;
+            if (size.x * size.y < best) {
+                best = size.x * size.y;
+                // Origin on the chart's plane: the rectangle's corner, moved onto the plane.
+                const glm::dvec3 on_plane = n * glm::dot(to_d(scene.positions[scene.triangles[tris[0]].x]), n);
+                out = {on_plane + u * mn.x + v * mn.y, u, v, size.x, size.y};
+            }
+        }
+    }
+    return out;
+}
+
 }  // namespace bounce::detail
 
 namespace bounce::inline radiosity {
@@ -334,6 +379,8 @@ struct atlas_statistics {
     std::size_t seed_plane_kept = 0, overlaps_refused = 0;  ///< chart_growth.hpp
     double texel_size = 0;         ///< h (m on the charts' planes): density 1 / h^2 texels per m^2
     int densities_tried = 0;       ///< cut_to_element_count's iterations
+    std::size_t clusters = 0;          ///< charts that are clusters of tiny charts (chart_clusters.hpp), in `charts`
+    std::size_t clustered_charts = 0;  ///< the tiny charts they hold
 };
 
 }  // namespace bounce::radiosity

@@ -14,7 +14,9 @@
 /// position lies on the surface. Charts are packed on shelves with `padding` texels around
 /// each, and padding texels (and texels of a chart's rectangle that miss its triangles)
 /// point to the nearest element of the same chart, so a filtered lightmap lookup never
-/// mixes two charts.
+/// mixes two charts. Where the budget's texels are larger than many charts, charts that fit
+/// in one texel share one element in clusters (chart_clusters.hpp; atlas_options::clusters):
+/// a cluster is a chart of one texel holding all their triangles.
 ///
 /// Elements are stored struct-of-arrays, chart by chart, and within a chart by square
 /// blocks of `block_texels` x `block_texels` texels: a block is a contiguous range of
@@ -24,7 +26,9 @@
 #include <bounce/errors.hpp>
 #include <bounce/image.hpp>
 #include <bounce/radiosity/cell_overlap.hpp>
+#include <bounce/radiosity/chart_clusters.hpp>
 #include <bounce/radiosity/chart_growth.hpp>
+#include <bounce/radiosity/lightmap_atlas_data.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <algorithm>
@@ -43,212 +47,6 @@
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
-
-namespace bounce::inline radiosity {
-
-/// How to cut a scene into elements.
-struct atlas_options {
-    std::size_t elements = 10000;  ///< target element count (the program's --elements N); the
-                                   ///< result is within a few percent of it (typical: 1e4-1e5)
-    int padding = 1;               ///< texels around each chart in the atlas, >= 0 (typical: 1; 2 for mipmaps)
-    int block_texels = 4;          ///< side of a shooting block, texels, >= 1 (typical: 4; 1 = no substructuring)
-    double cone_degrees = 30;        ///< largest angle between a chart's triangles' normals and the
-                                     ///< seed's and the chart's mean normal, in [0, 90) (degrees;
-                                     ///< 0 = planar charts only); chart_growth.hpp
-    double coplanar_degrees = 0.05;  ///< a chart whose normals all lie within this of its normal is
-                                     ///< planar: its elements take the chart's normal and plane
-
-    void validate() const {
-        require(elements > 0, "atlas_options.elements", "must be positive");
-        require(padding >= 0 && padding <= 64, "atlas_options.padding", "must lie in [0, 64]");
-        require(block_texels >= 1 && block_texels <= 256, "atlas_options.block_texels", "must lie in [1, 256]");
-        require(cone_degrees >= 0 && cone_degrees < 90, "atlas_options.cone_degrees", "must lie in [0, 90)");
-        require(coplanar_degrees >= 0 && coplanar_degrees < 90, "atlas_options.coplanar_degrees",
-                "must lie in [0, 90)");
-    }
-};
-
-/// One chart: a planar set of triangles and its rectangle of texels. Texel (i, j) of the
-/// chart covers origin + axis_u [i, i+1] + axis_v [j, j+1] (axis lengths are the texel's
-/// sides, m) and sits at atlas texel (atlas_x + i, atlas_y + j).
-struct lightmap_chart {
-    glm::vec3 origin{0.f}, axis_u{0.f}, axis_v{0.f}, normal{0.f, 0.f, 1.f};
-    std::uint32_t width = 0, height = 0;    ///< texels
-    std::uint32_t atlas_x = 0, atlas_y = 0; ///< atlas texel of the chart's texel (0, 0)
-    std::uint32_t material = 0;
-    std::uint32_t first_triangle = 0, triangle_count = 0;  ///< range of lightmap_atlas::chart_triangles
-    std::uint32_t first_element = 0, element_count = 0;    ///< range of the elements
-    float tilt_degrees = 0;  ///< largest angle between a triangle's normal and `normal`
-    bool planar = true;      ///< tilt_degrees within atlas_options::coplanar_degrees
-};
-
-/// The elements of a scene and where they lie in the lightmap atlas.
-struct lightmap_atlas {
-    static constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
-
-    std::uint32_t width = 0, height = 0;          ///< atlas size, texels
-    std::vector<lightmap_chart> charts;
-    std::vector<std::uint32_t> chart_triangles;   ///< triangles of each chart (ranges in lightmap_chart)
-    std::vector<std::uint32_t> chart_of_triangle; ///< chart of each scene triangle; none for degenerate ones
-
-    // Elements, struct of arrays (index = element id).
-    std::vector<glm::vec3> position;  ///< centroid of the texel's overlap with the chart (world, m)
-    std::vector<glm::vec3> normal;    ///< unit normal of the chart (front side: counter-clockwise)
-    std::vector<float> area;          ///< overlap area, m^2
-    std::vector<glm::vec3> albedo;    ///< diffuse reflectance rho per channel
-    std::vector<glm::vec3> emission;  ///< emitted radiosity E = pi L_e, W/m^2 per channel
-    std::vector<std::uint32_t> chart; ///< chart of each element
-    std::vector<glm::uvec2> texel;    ///< atlas texel of each element
-
-    /// Shooting blocks: block k is the elements [block_first[k], block_first[k+1]), all of one
-    /// chart. block_first has blocks() + 1 entries.
-    std::vector<std::uint32_t> block_first;
-    int block_texels = 1;
-    /// Each block's rectangle in its chart's texel coordinates (x0, y0, width, height, in
-    /// texels of the base grid) and its grid of grid.x x grid.y texels: a base block's grid is
-    /// its rectangle's texels; adaptive subdivision (radiosity/subdivision.hpp) splits a block
-    /// into four quadrants with the same grid, so level L texels are 2^-L base texels wide.
-    std::vector<glm::vec4> block_rect;
-    std::vector<glm::uvec2> block_grid;
-    std::vector<std::uint8_t> block_level;  ///< 0 for base blocks
-
-    /// Element at each atlas texel: the texel's own element, the nearest element of the same
-    /// chart for padding texels and texels that miss the chart's triangles, -1 elsewhere.
-    image<std::int32_t> element_at;
-
-    atlas_statistics statistics;  ///< what build_lightmap_atlas made
-
-    std::size_t size() const noexcept { return area.size(); }
-    std::size_t blocks() const noexcept { return block_first.empty() ? 0 : block_first.size() - 1; }
-
-    /// Atlas texel coordinates (continuous: texel (x, y) spans [x, x+1] x [y, y+1]) of the
-    /// world point `p` on chart `c`'s plane: the lightmap UV of a vertex, times the atlas size.
-    glm::vec2 atlas_coords(std::uint32_t c, const glm::vec3& p) const {
-        const lightmap_chart& ch = charts.at(c);
-        const glm::vec3 d = p - ch.origin;
-        return {float(ch.atlas_x) + glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u),
-                float(ch.atlas_y) + glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v)};
-    }
-
-    /// Lightmap coordinates in [0, 1]^2 of every triangle corner of `scene` (the scene the
-    /// atlas was built from), three per triangle, (0, 0) for degenerate triangles: what a
-    /// renderer's vertex buffer needs to sample a lightmap of width x height texels.
-    std::vector<glm::vec2> corner_uvs(const scene_view& scene) const {
-        require(scene.triangles.size() == chart_of_triangle.size(), "scene",
-                "is not the scene the atlas was built from (triangle counts differ)");
-        std::vector<glm::vec2> uv(3 * scene.triangles.size(), glm::vec2(0.f));
-        const glm::vec2 size(float(std::max<std::uint32_t>(width, 1)), float(std::max<std::uint32_t>(height, 1)));
-        for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
-            if (chart_of_triangle[t] == none) continue;
-            for (int k = 0; k < 3; ++k)
-                uv[3 * t + std::size_t(k)] = atlas_coords(chart_of_triangle[t], scene.positions[scene.triangles[t][k]]) / size;
-        }
-        return uv;
-    }
-
-    /// to_texels at 2^level times the atlas resolution, for atlases refined by adaptive
-    /// subdivision (radiosity/subdivision.hpp): an element of level l fills the 2^(level - l)
-    /// square of fine texels its cell covers (elements deeper than `level` are averaged,
-    /// area-weighted); fine texels no element covers (a chart's slanted edge, padding) take
-    /// their base texel's to_texels value. level = 0 is to_texels.
-    /// With `interpolate_base`, the fine texels of elements that were never split (level 0)
-    /// take the bilinear interpolation of the base texels at their centres instead of their
-    /// element's constant value, so that a bilinear lookup of the fine map shows unsplit
-    /// regions as a bilinear lookup of the base map would (the chapter's reconstruction of
-    /// the coarse level), rather than as blocks of 2^level texels.
-    template <class T>
-    image<T> to_fine_texels(std::span<const T> values, int level, const T& background = T{},
-                            bool interpolate_base = false) const {
-        require(level >= 0 && level <= 8, "level", "must lie in [0, 8]");
-        const image<T> base = to_texels(values, background);
-        if (level == 0) return base;
-        const std::size_t f = std::size_t(1) << level;
-        const std::size_t w = base.width() * f, h = base.height() * f;
-        std::vector<T> sum(w * h, T{});
-        std::vector<float> weight(w * h, 0.f);
-        std::vector<std::int64_t> single(w * h, -1);  // the one element of a fine texel, or -2 for several
-        std::vector<std::uint8_t> unsplit(size(), 0);  // elements of level 0
-        for (std::size_t k = 0; k < blocks(); ++k) {
-            const int l = block_level.empty() ? 0 : int(block_level[k]);
-            for (std::uint32_t e = block_first[k]; e < block_first[k + 1]; ++e) unsplit[e] = l == 0 ? 1 : 0;
-            const double cells = std::ldexp(1.0, l);  // cells per base texel
-            for (std::uint32_t e = block_first[k]; e < block_first[k + 1]; ++e) {
-                const lightmap_chart& ch = charts[chart[e]];
-                const glm::vec3 d = position[e] - ch.origin;
-                const glm::dvec2 c(glm::dot(d, ch.axis_u) / glm::dot(ch.axis_u, ch.axis_u),
-                                   glm::dot(d, ch.axis_v) / glm::dot(ch.axis_v, ch.axis_v));
-                // The element's cell, clamped into its base texel (its centroid lies inside).
-                const glm::dvec2 in_texel = glm::clamp(c * cells - glm::dvec2(texel[e] - glm::uvec2(ch.atlas_x, ch.atlas_y)) * cells,
-                                                       glm::dvec2(0.0), glm::dvec2(cells - 1e-9));
-                const glm::uvec2 cell(glm::floor(in_texel));
-                // Fine texels per cell: f / 2^l (>= 1), or one fine texel shared by 2^(l - level)^2 cells.
-                const std::size_t span = l <= level ? f >> l : 1;
-                const std::size_t x0 = texel[e].x * f + (l <= level ? cell.x * span : cell.x >> (l - level));
-                const std::size_t y0 = texel[e].y * f + (l <= level ? cell.y * span : cell.y >> (l - level));
-                for (std::size_t y = y0; y < y0 + span; ++y)
-                    for (std::size_t x = x0; x < x0 + span; ++x) {
-                        sum[y * w + x] += values[e] * area[e];
-                        weight[y * w + x] += area[e];
-                        single[y * w + x] = single[y * w + x] == -1 ? std::int64_t(e) : -2;
-                    }
-            }
-        }
-        image<T> out(w, h, background);
-        for (std::size_t y = 0; y < h; ++y)
-            for (std::size_t x = 0; x < w; ++x) {
-                const std::size_t bx = x / f, by = y / f;
-                const std::int32_t e = bx < width && by < height ? element_at(bx, by) : -1;
-                if (e < 0) continue;
-                // Only a texel's own fine texels come from its elements; padding copies its source texel.
-                const bool own = texel[std::size_t(e)].x == bx && texel[std::size_t(e)].y == by;
-                const std::int64_t one = single[y * w + x];
-                if (interpolate_base && own && one >= 0 && unsplit[std::size_t(one)]) {
-                    // Base texel coordinates of the fine texel's centre; base texel i's centre is i + 1/2.
-                    const double u = (double(x) + 0.5) / double(f) - 0.5, v = (double(y) + 0.5) / double(f) - 0.5;
-                    const double fu = std::floor(u), fv = std::floor(v);
-                    const float tu = float(u - fu), tv = float(v - fv);
-                    const auto at = [&](double i, double j) {
-                        return base(std::size_t(std::clamp(i, 0.0, double(base.width() - 1))),
-                                    std::size_t(std::clamp(j, 0.0, double(base.height() - 1))));
-                    };
-                    out(x, y) = (1.f - tv) * ((1.f - tu) * at(fu, fv) + tu * at(fu + 1, fv)) +
-                                tv * ((1.f - tu) * at(fu, fv + 1) + tu * at(fu + 1, fv + 1));
-                    continue;
-                }
-                out(x, y) = !own || one == -1 ? base(bx, by) : one >= 0 ? values[std::size_t(one)] : sum[y * w + x] / weight[y * w + x];
-            }
-        return out;
-    }
-
-    /// A per-element quantity (per unit area, like a radiosity) laid out as the atlas: texel
-    /// (x, y) holds the area-weighted mean of `values` over the elements in the base texel of
-    /// element_at(x, y) (that element's own value unless its block was subdivided),
-    /// `background` where no chart is. `values` has one entry per element; T is a float or a
-    /// GLM vector of floats.
-    template <class T>
-    image<T> to_texels(std::span<const T> values, const T& background = T{}) const {
-        require(values.size() == size(), "values", "needs one value per element");
-        const std::size_t w = std::max<std::uint32_t>(width, 1), h = std::max<std::uint32_t>(height, 1);
-        std::vector<T> sum(w * h, T{});
-        std::vector<float> weight(w * h, 0.f);
-        for (std::size_t e = 0; e < size(); ++e) {
-            const std::size_t i = std::size_t(texel[e].y) * w + texel[e].x;
-            sum[i] += values[e] * area[e];
-            weight[i] += area[e];
-        }
-        image<T> out(w, h, background);
-        for (std::uint32_t y = 0; y < height; ++y)
-            for (std::uint32_t x = 0; x < width; ++x)
-                if (const std::int32_t e = element_at(x, y); e >= 0) {
-                    const std::size_t i = std::size_t(texel[std::size_t(e)].y) * w + texel[std::size_t(e)].x;
-                    // One element: its value exactly (no division round trip).
-                    out(x, y) = weight[i] == area[std::size_t(e)] ? values[std::size_t(e)] : sum[i] / weight[i];
-                }
-        return out;
-    }
-};
-
-}  // namespace bounce::radiosity
 
 namespace bounce::detail {
 
@@ -277,51 +75,6 @@ inline grown_charts group_into_charts(const scene_view& scene, const triangle_fa
         atlas.charts.push_back(ch);
     }
     return g;
-}
-
-/// A chart's frame on its plane (origin, unit in-plane axes u and v) and its extent along
-/// them (m).
-struct chart_extent {
-    glm::dvec3 origin, u, v;
-    double eu = 0, ev = 0;
-};
-
-/// The frame of chart `ch` whose axis u runs along one of its triangles' edges and whose
-/// bounding rectangle is the smallest (a rectangle's own sides for walls and quads). At most
-/// 64 edges are tried, which covers every chart of a few dozen triangles.
-inline chart_extent smallest_bounding_frame(const scene_view& scene, const lightmap_atlas& atlas,
-                                            const lightmap_chart& ch) {
-    chart_extent out{};
-    const glm::dvec3 n = glm::dvec3(ch.normal);
-    const auto tris = std::span(atlas.chart_triangles).subspan(ch.first_triangle, ch.triangle_count);
-    const auto corner = [&](std::uint32_t t, int k) { return to_d(scene.positions[scene.triangles[t][k]]); };
-    double best = std::numeric_limits<double>::infinity();
-    int tried = 0;
-    for (const std::uint32_t t : tris) {
-        for (int k = 0; k < 3 && tried < 64; ++k, ++tried) {
-            const glm::dvec3 e = corner(t, (k + 1) % 3) - corner(t, k);
-            glm::dvec3 u = e - n * glm::dot(e, n);
-            if (glm::length(u) <= 0) continue;
-            u = glm::normalize(u);
-            const glm::dvec3 v = glm::cross(n, u);
-            glm::dvec2 mn(std::numeric_limits<double>::infinity()), mx(-std::numeric_limits<double>::infinity());
-            for (const std::uint32_t s : tris)
-                for (int m = 0; m < 3; ++m) {
-                    const glm::dvec3 p = corner(s, m);
-                    const glm::dvec2 q(glm::dot(p, u), glm::dot(p, v));
-                    mn = glm::min(mn, q);
-                    mx = glm::max(mx, q);
-                }
-            const glm::dvec2 size = mx - mn;
-            if (size.x * size.y < best) {
-                best = size.x * size.y;
-                // Origin on the chart's plane: the rectangle's corner, moved onto the plane.
-                const glm::dvec3 on_plane = n * glm::dot(to_d(scene.positions[scene.triangles[tris[0]].x]), n);
-                out = {on_plane + u * mn.x + v * mn.y, u, v, size.x, size.y};
-            }
-        }
-    }
-    return out;
 }
 
 /// The exact overlap of one texel with its chart's triangles, in texels of the chart's grid:
@@ -419,13 +172,15 @@ inline std::size_t cut_chart(const scene_view& scene, const lightmap_atlas& atla
     return count;
 }
 
-/// Every chart cut into texels of about h (m); returns the element count.
+/// Every chart cut into texels of about h (m), but for the charts `grouping` clusters (one
+/// element per cluster); returns the element count.
 inline std::size_t cut_charts(const scene_view& scene, const triangle_faces& faces,
                               const std::vector<chart_extent>& extents, double h, bool place, lightmap_atlas& atlas,
-                              std::vector<std::vector<texel_sum>>& sums) {
-    std::size_t count = 0;
+                              std::vector<std::vector<texel_sum>>& sums, const chart_grouping& grouping) {
+    std::size_t count = grouping.members.size();
     for (std::size_t c = 0; c < atlas.charts.size(); ++c)
-        count += cut_chart(scene, atlas, faces, extents[c], h, place, atlas.charts[c], sums[c]);
+        if (grouping.cluster_of_chart.empty() || grouping.cluster_of_chart[c] == chart_grouping::none)
+            count += cut_chart(scene, atlas, faces, extents[c], h, place, atlas.charts[c], sums[c]);
     return count;
 }
 
@@ -435,17 +190,23 @@ inline std::size_t cut_charts(const scene_view& scene, const triangle_faces& fac
 /// and never falls below one per chart; it jumps where a chart's ceil(extent / h) steps.
 /// Density x: x N / count until the count is bracketed, then secant steps inside the
 /// bracket (bisection where a step would leave it), until within 0.5% of the count or 32
-/// densities, keeping the closest count seen.
+/// densities, keeping the closest count seen. With a `clusterer`, the tiny charts at each
+/// density are grouped (chart_clusters.hpp) and `grouping` is the grouping at the density kept.
 inline std::pair<double, int> cut_to_element_count(const scene_view& scene, const triangle_faces& faces,
                                                    const std::vector<chart_extent>& extents, double plane_area,
                                                    const atlas_options& options, lightmap_atlas& atlas,
-                                                   std::vector<std::vector<texel_sum>>& sums) {
+                                                   std::vector<std::vector<texel_sum>>& sums,
+                                                   const chart_clusterer* clusterer, chart_grouping& grouping) {
+    const auto count_at = [&](double h, bool place) {
+        if (clusterer) grouping = clusterer->group(h);
+        return double(cut_charts(scene, faces, extents, h, place, atlas, sums, grouping));
+    };
     const double target = double(options.elements);
     double x = target / plane_area, best_x = x, best_miss = std::numeric_limits<double>::infinity();
     double lo = 0, lo_count = 0, hi = std::numeric_limits<double>::infinity(), hi_count = 0;
     int tried = 0;
     for (; tried < 32; ++tried) {
-        const double count = double(cut_charts(scene, faces, extents, 1.0 / std::sqrt(x), false, atlas, sums));
+        const double count = count_at(1.0 / std::sqrt(x), false);
         const double miss = std::abs(count - target);
         if (miss < best_miss) best_miss = miss, best_x = x;
         if (miss <= 0.005 * target) break;
@@ -461,7 +222,7 @@ inline std::pair<double, int> cut_to_element_count(const scene_view& scene, cons
         if (next == x) break;
         x = next;
     }
-    cut_charts(scene, faces, extents, 1.0 / std::sqrt(best_x), true, atlas, sums);
+    count_at(1.0 / std::sqrt(best_x), true);
     return {1.0 / std::sqrt(best_x), tried + 1};
 }
 
@@ -531,6 +292,12 @@ inline void pack_charts_on_shelves(std::uint32_t pad, lightmap_atlas& atlas) {
     atlas.height = std::max<std::uint32_t>(y + shelf, 1);
 }
 
+/// The radiosity pi L_e a material emits (0 when the scene's emission is off).
+inline glm::vec3 emitted_radiosity(const scene_view& scene, const material& mat) {
+    const bool emits = scene.use_emission && (mat.emission.r > 0.f || mat.emission.g > 0.f || mat.emission.b > 0.f);
+    return emits ? float(std::numbers::pi) * mat.emission : glm::vec3(0.f);
+}
+
 /// The elements of chart c, block by block and row by row within a block: one per texel
 /// kept (cut_chart), at its point on the chart (the overlap's centroid, or its largest
 /// piece's), lifted from the chart's plane onto the triangle it lies on; a block with
@@ -539,8 +306,7 @@ inline void add_chart_elements(const scene_view& scene, std::uint32_t c, const c
                                const std::vector<texel_sum>& sums, std::uint32_t b, lightmap_atlas& atlas) {
     lightmap_chart& ch = atlas.charts[c];
     const material& mat = scene.materials[ch.material];
-    const bool emits = scene.use_emission && (mat.emission.r > 0.f || mat.emission.g > 0.f || mat.emission.b > 0.f);
-    const glm::vec3 emitted = emits ? float(std::numbers::pi) * mat.emission : glm::vec3(0.f);
+    const glm::vec3 emitted = emitted_radiosity(scene, mat);
     ch.first_element = std::uint32_t(atlas.size());
     const double su = ex.eu / ch.width, sv = ex.ev / ch.height;
     const auto point_of = [&](const texel_sum& ts) {
@@ -581,6 +347,107 @@ inline void add_chart_elements(const scene_view& scene, std::uint32_t c, const c
             }
         }
     ch.element_count = std::uint32_t(atlas.size()) - ch.first_element;
+}
+
+/// The one element of cluster chart c (chart_clusters.hpp), its texel and its 1 x 1 block.
+inline void add_cluster_element(const scene_view& scene, const triangle_faces& faces, std::uint32_t c,
+                                lightmap_atlas& atlas) {
+    lightmap_chart& ch = atlas.charts[c];
+    const cluster_element ce =
+        cluster_of_triangles(scene, faces, std::span(atlas.chart_triangles).subspan(ch.first_triangle, ch.triangle_count));
+    ch.first_element = std::uint32_t(atlas.size());
+    ch.element_count = 1;
+    atlas.block_first.push_back(ch.first_element);
+    atlas.block_rect.emplace_back(0.f, 0.f, 1.f, 1.f);
+    atlas.block_grid.emplace_back(1u, 1u);
+    atlas.block_level.push_back(0);
+    atlas.position.push_back(glm::vec3(ce.position));
+    atlas.normal.push_back(glm::vec3(ce.normal));
+    atlas.area.push_back(float(ce.area));
+    atlas.albedo.push_back(scene.materials[ch.material].albedo);
+    atlas.emission.push_back(emitted_radiosity(scene, scene.materials[ch.material]));
+    atlas.chart.push_back(c);
+    atlas.texel.emplace_back(ch.atlas_x, ch.atlas_y);
+    atlas.element_at(ch.atlas_x, ch.atlas_y) = std::int32_t(ch.first_element);
+}
+
+/// Replaces the charts `grouping` clusters by one chart per cluster, after the others: one
+/// texel on the frame cluster_of_triangles gives; extents and sums follow the charts.
+inline void merge_clusters(const scene_view& scene, const triangle_faces& faces, const chart_grouping& grouping,
+                           std::vector<chart_extent>& extents, std::vector<std::vector<texel_sum>>& sums,
+                           lightmap_atlas& atlas) {
+    std::vector<lightmap_chart> charts;
+    std::vector<std::uint32_t> tris;
+    std::vector<chart_extent> ex;
+    std::vector<std::vector<texel_sum>> su;
+    const auto take = [&](lightmap_chart ch, std::span<const std::uint32_t> t) {
+        ch.first_triangle = std::uint32_t(tris.size());
+        ch.triangle_count = std::uint32_t(t.size());
+        for (const std::uint32_t u : t) tris.push_back(u), atlas.chart_of_triangle[u] = std::uint32_t(charts.size());
+        charts.push_back(ch);
+    };
+    const auto triangles_of = [&](std::uint32_t c) {
+        return std::span(atlas.chart_triangles).subspan(atlas.charts[c].first_triangle, atlas.charts[c].triangle_count);
+    };
+    for (std::uint32_t c = 0; c < atlas.charts.size(); ++c)
+        if (grouping.cluster_of_chart[c] == chart_grouping::none) {
+            take(atlas.charts[c], triangles_of(c));
+            ex.push_back(extents[c]);
+            su.push_back(std::move(sums[c]));
+        }
+    for (const std::vector<std::uint32_t>& members : grouping.members) {
+        std::vector<std::uint32_t> mine;
+        for (const std::uint32_t c : members) mine.insert(mine.end(), triangles_of(c).begin(), triangles_of(c).end());
+        std::sort(mine.begin(), mine.end());
+        const cluster_element ce = cluster_of_triangles(scene, faces, mine);
+        lightmap_chart ch;
+        ch.origin = glm::vec3(ce.origin), ch.axis_u = glm::vec3(ce.axis_u), ch.axis_v = glm::vec3(ce.axis_v);
+        ch.normal = glm::vec3(ce.normal);
+        ch.width = ch.height = 1;
+        ch.material = atlas.charts[members[0]].material;
+        ch.tilt_degrees = float(ce.tilt_degrees);
+        ch.planar = false;
+        ch.clustered_charts = std::uint32_t(members.size());
+        take(ch, mine);
+        ex.emplace_back();
+        su.emplace_back();
+    }
+    atlas.charts = std::move(charts);
+    atlas.chart_triangles = std::move(tris);
+    extents = std::move(ex);
+    sums = std::move(su);
+}
+
+/// cut_to_element_count without clusters, then with them (merged into the atlas) where
+/// options.clusters asks: always, or when the count misses the asked one by more than 10%.
+inline std::pair<double, int> cut_within_budget(const scene_view& scene, const triangle_faces& faces,
+                                                std::vector<chart_extent>& extents, double plane_area,
+                                                const atlas_options& options, lightmap_atlas& atlas,
+                                                std::vector<std::vector<texel_sum>>& sums) {
+    chart_grouping grouping;
+    std::pair<double, int> plain{0.0, 0};
+    if (options.clusters != tiny_chart_clusters::always) {
+        plain = cut_to_element_count(scene, faces, extents, plane_area, options, atlas, sums, nullptr, grouping);
+        double count = 0;
+        for (const auto& s : sums)
+            for (const texel_sum& ts : s) count += ts.keep ? 1 : 0;
+        const double asked = double(options.elements);
+        if (options.clusters == tiny_chart_clusters::never || std::abs(count - asked) <= 0.1 * asked) return plain;
+    }
+    std::vector<std::span<const std::uint32_t>> tris;
+    std::vector<std::uint32_t> material;
+    std::vector<double> extent;
+    for (std::size_t c = 0; c < atlas.charts.size(); ++c) {
+        const lightmap_chart& ch = atlas.charts[c];
+        tris.push_back(std::span(atlas.chart_triangles).subspan(ch.first_triangle, ch.triangle_count));
+        material.push_back(ch.material);
+        extent.push_back(std::max(extents[c].eu, extents[c].ev));
+    }
+    const chart_clusterer clusterer(faces, std::move(tris), std::move(material), std::move(extent),
+                                    std::max(options.cone_degrees, options.coplanar_degrees));
+    const auto clustered = cut_to_element_count(scene, faces, extents, plane_area, options, atlas, sums, &clusterer, grouping);
+    merge_clusters(scene, faces, grouping, extents, sums, atlas);
+    return {clustered.first, plain.second + clustered.second};
 }
 
 /// Points the empty texels of chart `ch`'s padded rectangle (`pad` texels around it) at the
@@ -634,7 +501,9 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
     const detail::grown_charts grown = detail::group_into_charts(scene, faces, options, atlas);
     std::vector<detail::chart_extent> extents(atlas.charts.size());
     for (std::size_t c = 0; c < atlas.charts.size(); ++c)
-        extents[c] = detail::smallest_bounding_frame(scene, atlas, atlas.charts[c]);
+        extents[c] = detail::smallest_bounding_frame(
+            scene, std::span(atlas.chart_triangles).subspan(atlas.charts[c].first_triangle, atlas.charts[c].triangle_count),
+            glm::dvec3(atlas.charts[c].normal));
 
     // Area on the charts' planes, and the surface's stretch over it.
     atlas_statistics& st = atlas.statistics;
@@ -653,13 +522,14 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
     st.stretch_mean = total_area / plane_area;
     std::vector<std::vector<detail::texel_sum>> sums(atlas.charts.size());
     std::tie(st.texel_size, st.densities_tried) =
-        detail::cut_to_element_count(scene, faces, extents, plane_area, options, atlas, sums);
+        detail::cut_within_budget(scene, faces, extents, plane_area, options, atlas, sums);
 
     const std::uint32_t pad = std::uint32_t(options.padding);
     detail::pack_charts_on_shelves(pad, atlas);
     atlas.element_at = image<std::int32_t>(atlas.width, atlas.height, -1);
     for (std::uint32_t c = 0; c < atlas.charts.size(); ++c) {
-        detail::add_chart_elements(scene, c, extents[c], sums[c], std::uint32_t(options.block_texels), atlas);
+        if (atlas.charts[c].cluster()) detail::add_cluster_element(scene, faces, c, atlas);
+        else detail::add_chart_elements(scene, c, extents[c], sums[c], std::uint32_t(options.block_texels), atlas);
         detail::fill_chart_padding(atlas.charts[c], pad, atlas);
     }
     atlas.block_first.push_back(std::uint32_t(atlas.size()));
@@ -675,7 +545,10 @@ inline lightmap_atlas build_lightmap_atlas(const scene_view& scene, const atlas_
         per_chart[c] = atlas.charts[c].element_count;
         st.chart_texels += std::size_t(atlas.charts[c].width) * atlas.charts[c].height;
         st.one_element_charts += per_chart[c] == 1 ? 1 : 0;
-        st.curved_charts += atlas.charts[c].planar ? 0 : 1;
+        st.curved_charts += atlas.charts[c].planar || atlas.charts[c].cluster() ? 0 : 1;
+        st.clusters += atlas.charts[c].cluster() ? 1 : 0;
+        st.clustered_charts += atlas.charts[c].clustered_charts;
+        st.cone_max_degrees = std::max(st.cone_max_degrees, double(atlas.charts[c].tilt_degrees));
     }
     std::nth_element(per_chart.begin(), per_chart.begin() + std::ptrdiff_t(per_chart.size() / 2), per_chart.end());
     st.median_elements_per_chart = per_chart.empty() ? 0 : per_chart[per_chart.size() / 2];

@@ -46,7 +46,8 @@ inline std::vector<std::uint8_t> whole_texels(const lightmap_atlas& atlas) {
         if (!atlas.block_level.empty() && atlas.block_level[k] != 0) continue;
         for (std::uint32_t e = atlas.block_first[k]; e < atlas.block_first[k + 1]; ++e) {
             const lightmap_chart& ch = atlas.charts[atlas.chart[e]];
-            whole[e] = atlas.area[e] >= 0.9999f * glm::length(glm::cross(ch.axis_u, ch.axis_v)) ? 1 : 0;
+            // A cluster's texel spans the air between its tiny charts: never whole.
+            whole[e] = !ch.cluster() && atlas.area[e] >= 0.9999f * glm::length(glm::cross(ch.axis_u, ch.axis_v)) ? 1 : 0;
         }
     }
     return whole;

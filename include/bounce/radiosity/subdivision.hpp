@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -280,6 +281,9 @@ inline atlas_refinement refine_lightmap_atlas(const scene_view& scene, const lig
     std::vector<char> splits(atlas.blocks(), 0);
     for (const std::uint32_t k : split) {
         require(k < atlas.blocks(), "split", "block index out of range");
+        if (atlas.charts[atlas.chart[atlas.block_first[k]]].cluster())
+            throw parameter_error("split", "block " + std::to_string(k) +
+                                               " is a cluster of tiny charts (atlas_options::clusters): one texel, not split");
         splits[k] = 1;
     }
     atlas_refinement r;
@@ -313,8 +317,8 @@ std::vector<std::uint32_t> blocks_to_subdivide(const lightmap_atlas& atlas, std:
     std::vector<std::uint32_t> out;
     std::vector<std::int64_t> cell;
     for (std::size_t k = 0; k < atlas.blocks(); ++k) {
-        if (atlas.block_level[k] >= options.max_level) continue;
         const std::uint32_t e0 = atlas.block_first[k], e1 = atlas.block_first[k + 1];
+        if (atlas.block_level[k] >= options.max_level || atlas.charts[atlas.chart[e0]].cluster()) continue;
         const glm::vec4 rect = atlas.block_rect[k];
         const glm::uvec2 grid = atlas.block_grid[k];
         const lightmap_chart& ch = atlas.charts[atlas.chart[e0]];
