@@ -4,6 +4,7 @@
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/rebake.hpp>
 #include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/subdivision.hpp>
 
@@ -568,6 +569,13 @@ TEST_CASE("a cluster's texel is never sampled as a whole texel, and subdivision 
     const std::vector<std::uint32_t> split{cluster_block};
     CHECK_THROWS_AS(refine_lightmap_atlas(s.view(), atlas, split), parameter_error);
     CHECK_THROWS_WITH(refine_lightmap_atlas(s.view(), atlas, split), Catch::Contains("atlas_options::clusters"));
+    // A re-bake moving part of a cluster is refused, naming the option; the whole cluster moves.
+    const lightmap_chart& ch = atlas.charts[atlas.chart[atlas.block_first[cluster_block]]];
+    const std::vector<std::uint32_t> part{atlas.chart_triangles[ch.first_triangle]};
+    CHECK_THROWS_AS(moved_charts(atlas, part), parameter_error);
+    CHECK_THROWS_WITH(moved_charts(atlas, part), Catch::Contains("atlas_options::clusters"));
+    const auto all = std::span(atlas.chart_triangles).subspan(ch.first_triangle, ch.triangle_count);
+    CHECK(moved_charts(atlas, all)[atlas.chart[atlas.block_first[cluster_block]]] == 1);
 }
 
 TEST_CASE("a solve over clusters of tiny charts conserves energy and lights every triangle",

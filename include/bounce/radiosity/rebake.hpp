@@ -129,8 +129,10 @@ inline std::vector<std::uint8_t> moved_charts(const lightmap_atlas& atlas, std::
             if (tri[atlas.chart_triangles[k]] == 0)
                 throw parameter_error("moved_triangles", "chart " + std::to_string(c) +
                                                              " holds moved and unmoved triangles (triangle " +
-                                                             std::to_string(atlas.chart_triangles[k]) +
-                                                             " stays): move whole objects");
+                                                             std::to_string(atlas.chart_triangles[k]) + " stays): " +
+                                                             (ch.cluster() ? "it is a cluster of tiny charts; build the "
+                                                                             "atlas with atlas_options::clusters = never"
+                                                                           : "move whole objects"));
     }
     return charts;
 }
@@ -175,7 +177,9 @@ inline moved_boxes boxes_of_move(const scene_view& moved_scene, std::span<const 
 struct radiosity_rebake_report {
     double ms = 0;                  ///< wall-clock time of the correction (2), lights included
     std::size_t moved_elements = 0; ///< elements of the moved charts (0 for a light)
-    std::size_t shooters = 0;       ///< block-sides that had shot and re-shot their S (each twice)
+    std::size_t shooters = 0;       ///< block-sides that had shot and re-shot their S, both passes counted
+    std::size_t moved_shooters = 0; ///< of them the moved object's (to every receiver), both passes counted
+    std::size_t moved_pairs = 0;    ///< pairs the moved object's shooters re-evaluated, both passes
     std::size_t pairs = 0;          ///< receiver-shooter pairs re-evaluated, both passes counted
     std::size_t pairs_tested = 0;   ///< receiver-shooter pairs tested against the boxes
     double unshot_before = 0;       ///< |unshot| power / emitted power before the correction
