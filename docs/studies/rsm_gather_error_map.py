@@ -18,7 +18,9 @@ gather --dump DIR` writes (256x256 float32 RGB, row-major) and
 `table` prints the gather's cells from docs/results/rsm_gather_visibility.json (runs of
 `rsm_visibility_study --configs gather --json`, added with docs/studies/results.py): per scene
 and count, the errors with rays and without and their ratio, the mean over the seeds, and the
-split of each frame with rays (the report's "split"; mean over the seeds).
+split of each frame with rays (the report's "split"; mean over the seeds), one row per count of
+the clamp's compensation rays (the run's parameter; 0 for runs before it) with the share of the
+frame's light they add.
 
 Pure Python (zlib for the PNG): no numpy needed.
 """
@@ -100,14 +102,17 @@ def table():
         for fr in r["frames"]:
             if fr["config"] != "gather":
                 continue
-            c = cells.setdefault((fr["scene"], fr["vpls"]), {}).setdefault(r["parameters"]["seed"], {})
+            k = r["parameters"].get("compensation_rays", 0)
+            c = cells.setdefault((fr["scene"], fr["vpls"], k), {}).setdefault(r["parameters"]["seed"], {})
             c[fr["visibility"]] = fr["rel_rms_debiased"]
+            if fr["visibility"] == "rays":
+                c["share"] = fr.get("compensation_share", 0.0)
             if "split" in fr:
                 c["split"] = fr["split"]
-    print("| scene | samples | seeds | rays / none = ratio | none in occluded units | visibility's change | "
-          "references' rms ratio |")
-    print("|---|---|---|---|---|---|---|")
-    for (scene, n), seeds in sorted(cells.items()):
+    print("| scene | samples | compensation rays | seeds | rays / none = ratio | none in occluded units | "
+          "visibility's change | references' rms ratio | light the compensation adds |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for (scene, n, k), seeds in sorted(cells.items()):
         both = [c for c in seeds.values() if "rays" in c and "none" in c]
         if not both:
             continue
@@ -116,9 +121,10 @@ def table():
         mark = "**" if rays / none > 1.2 else ""
         splits = [c["split"] for c in both if "split" in c]
         sm = lambda k: f"{sum(s[k] for s in splits) / len(splits):.3f}" if splits else "-"
-        print(f"| {scene} | {n} | {','.join(str(k) for k in sorted(seeds))} | {rays:.3f} / {none:.3f} = "
+        share = f"{100 * mean(lambda c: c.get('share', 0.0)):.2f}%" if k else "-"
+        print(f"| {scene} | {n} | {k} | {','.join(str(s) for s in sorted(seeds))} | {rays:.3f} / {none:.3f} = "
               f"{mark}{rays / none:.2f}{mark} | {sm('none_error_in_occluded_units')} | {sm('visibility_change')} | "
-              f"{sm('references_rms_ratio')} |")
+              f"{sm('references_rms_ratio')} | {share} |")
 
 
 def main():

@@ -14,6 +14,7 @@
 // 2012 section 5.1 times it); medians of --repeat renders.
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/accel.hpp>
+#include <bounce/embree/near_field_rays.hpp>
 #include <bounce/embree/occlusion_rays.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
@@ -136,7 +137,8 @@ int run(const options& o) {
     const embree::occlusion_rays rays(bvh);
     std::optional<ism_point_sampler> points;
     if (o.visibility == indirect_visibility::ism) points.emplace(scene.view());
-    cpu::indirect_renderer cpu_renderer({}, &rays, points ? &*points : nullptr);
+    const embree::near_field_rays near(bvh, scene.view());  // the gather's clamp compensation
+    cpu::indirect_renderer cpu_renderer({}, &rays, points ? &*points : nullptr, &near);
     study::indirect_frame frame = [&](const indirect_options& opts, image_view<glm::vec3> out) {
         return cpu_renderer.render(opts, g.view(), cam, caster.views(), out);
     };
