@@ -9,10 +9,11 @@
 /// - near: the charts' area-weighted centroids fall in one cell of a world grid of side h
 ///   (the texel's size at the budget's density), so a cluster spans at most about 2h;
 /// - one material (the element's reflectance and emission are its triangles');
-/// - one normal: every triangle's normal lies within half the chart cone (atlas_options::
-///   cone_degrees) of the cluster's first (largest) chart's normal, so within the cone of
-///   the cluster's area-weighted mean normal (which lies in that half cone too): the
-///   element's normal is every triangle's within the cone, as a chart's is.
+/// - one normal: a chart joins when all its triangles' normals lie within the chart cone
+///   (atlas_options::cone_degrees) of the cluster's first (largest) chart's normal; when the
+///   cell is done, charts with a triangle outside the cone of the cluster's area-weighted
+///   mean normal leave it (and the mean is taken again) until none does, so the element's
+///   normal is every triangle's within the cone, as a chart's is.
 ///
 /// The cluster's element has the triangles' total area, their area-weighted mean normal, and
 /// the point of its triangles nearest their area-weighted centroid (a point on the surface:
@@ -53,11 +54,12 @@ public:
     chart_clusterer(const triangle_faces& faces, std::vector<std::span<const std::uint32_t>> triangles,
                     std::vector<std::uint32_t> material, std::vector<double> extent, double cone_degrees)
         : faces_(&faces), triangles_(std::move(triangles)), material_(std::move(material)), extent_(std::move(extent)),
-          cos_half_cone_(std::cos(0.5 * cone_degrees * std::numbers::pi / 180.0)) {
+          cos_cone_(std::cos(cone_degrees * std::numbers::pi / 180.0)) {
         const std::size_t n = triangles_.size();
         centroid_.assign(n, glm::dvec3(0));
         area_.assign(n, 0.0);
         normal_.assign(n, glm::dvec3(0));
+        sum_.assign(n, glm::dvec3(0));
         for (std::size_t c = 0; c < n; ++c) {
             for (const std::uint32_t t : triangles_[c]) {
                 area_[c] += faces.area[t];
@@ -65,6 +67,7 @@ public:
                 normal_[c] += faces.area[t] * faces.normal[t];
             }
             if (area_[c] > 0) centroid_[c] /= area_[c];
+            sum_[c] = normal_[c];
             if (glm::length(normal_[c]) > 0) normal_[c] = glm::normalize(normal_[c]);
         }
     }
@@ -89,6 +92,15 @@ public:
         std::vector<open_cluster> open;
         const auto close_run = [&]() {
             for (open_cluster& o : open) {
+                for (bool left = true; left && o.charts.size() >= 2;) {
+                    glm::dvec3 mean(0);
+                    for (const std::uint32_t c : o.charts) mean += sum_[c];
+                    mean = glm::normalize(mean);
+                    const auto kept = std::partition(o.charts.begin(), o.charts.end(),
+                                                     [&](std::uint32_t c) { return within_cone(c, mean); });
+                    left = kept != o.charts.end();
+                    o.charts.erase(kept, o.charts.end());
+                }
                 if (o.charts.size() < 2) continue;
                 for (const std::uint32_t c : o.charts) out.cluster_of_chart[c] = std::uint32_t(out.members.size());
                 out.members.push_back(std::move(o.charts));
@@ -102,7 +114,7 @@ public:
                 close_run();
             open_cluster* joined = nullptr;
             for (open_cluster& o : open)
-                if (within_half_cone(c, o.seed)) {
+                if (within_cone(c, o.seed)) {
                     joined = &o;
                     break;
                 }
@@ -114,17 +126,17 @@ public:
     }
 
 private:
-    bool within_half_cone(std::uint32_t c, const glm::dvec3& n) const {
+    bool within_cone(std::uint32_t c, const glm::dvec3& n) const {
         for (const std::uint32_t t : triangles_[c])
-            if (glm::dot(faces_->normal[t], n) < cos_half_cone_) return false;
+            if (glm::dot(faces_->normal[t], n) < cos_cone_) return false;
         return true;
     }
     const triangle_faces* faces_;
     std::vector<std::span<const std::uint32_t>> triangles_;
     std::vector<std::uint32_t> material_;
     std::vector<double> extent_;
-    double cos_half_cone_;
-    std::vector<glm::dvec3> centroid_, normal_;
+    double cos_cone_;
+    std::vector<glm::dvec3> centroid_, normal_, sum_;  ///< sum_: area-weighted normal sums
     std::vector<double> area_;
 };
 
