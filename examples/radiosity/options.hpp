@@ -22,6 +22,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 
 namespace bounce::examples {
@@ -41,6 +42,7 @@ struct options {
     std::size_t elements = 10000;     // target element count of the atlas (before subdivision)
     int block = 8;                    // shooting block side, texels (substructuring)
     double chart_cone = atlas_options{}.cone_degrees;  // charts' cone half-angle, degrees (0: planar charts)
+    tiny_chart_clusters clusters = atlas_options{}.clusters;  // charts smaller than a texel sharing one element
     visibility_kind visibility = visibility_kind::stereo;
     int resolution = 128;             // item buffer side (hemicube: per face)
     float tolerance_px = 0.25f;       // stereographic tessellation: largest edge sagitta, pixels
@@ -87,6 +89,11 @@ inline void add_options(CLI::App& app, options& o) {
     app.add_option("--chart-cone", o.chart_cone,
                    "charts follow surfaces within this cone of their normal, degrees (0: planar charts only)")
         ->check(CLI::Range(0.0, 89.9));
+    app.add_option("--clusters", o.clusters,
+                   "charts smaller than a texel share one element: never, when-needed (the count missed by >10%), always")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, tiny_chart_clusters>{
+            {"never", tiny_chart_clusters::never}, {"when-needed", tiny_chart_clusters::when_needed},
+            {"always", tiny_chart_clusters::always}}));
     app.add_option("--block", o.block, "side of a shooting block in texels (substructuring; 1: shoot elements)")
         ->check(CLI::Range(1, 256))->capture_default_str();
     add_choice(app, "--visibility", o.visibility, visibility_names, "stereo | hemicube | rays")->capture_default_str();
@@ -178,6 +185,7 @@ inline atlas_options atlas_options_for(const options& o) {
     a.elements = o.elements;
     a.block_texels = o.block;
     a.cone_degrees = o.chart_cone;
+    a.clusters = o.clusters;
     a.padding = 1;
     return a;
 }
