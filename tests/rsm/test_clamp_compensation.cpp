@@ -6,6 +6,7 @@
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/near_field_rays.hpp>
 #include <bounce/embree/occlusion_rays.hpp>
+#include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/errors.hpp>
 
@@ -158,4 +159,54 @@ TEST_CASE("the gather's compensation with rays needs a near-field query", "[rsm]
     const embree::near_field_rays near(bvh, s.view());
     o.clamp_compensation_rays = 16;
     CHECK_NOTHROW(cpu::indirect_renderer(o, &occlusion, nullptr, &near));
+}
+
+TEST_CASE("the renderer's compensation is per pixel, the same interleaved or not, zero away from the crease",
+          "[rsm][embree][clamp_compensation]") {
+    // The crease seen from above the floor: every pixel's compensation (the frame with it less
+    // the frame without) is >= 0, is 0 where the floor lies beyond r_c from the wall, and is
+    // the same at 4 x 4 (before the blur) as plain: its rays depend on the receiver alone.
+    crease_gather c(false);
+    camera cam;
+    cam.position = {0.3f, 0.f, 1.2f};
+    cam.look_at = {0.3f, 0.f, 0.f};
+    cam.fov_y_deg = 60.f;
+    gbuffer<float> g = embree::ray_cast_gbuffer(c.bvh, c.s.view(), cam, 32, 32);
+    indirect_options o;
+    o.technique = indirect_technique::rsm_gather;
+    o.visibility = indirect_visibility::rays;
+    o.count = 64;
+    o.blur = false;
+    o.light.min_distance2 = clamp_distance * clamp_distance;
+    cpu::indirect_renderer renderer(o, &c.occlusion, nullptr, &c.near);
+    std::size_t covered = 0;
+    for (std::size_t y = 0; y < 32; ++y)
+        for (std::size_t x = 0; x < 32; ++x) covered += g.view().covered(x, y) ? 1 : 0;
+    const auto added = [&](interleave_pattern p) {
+        image<glm::vec3> with(32, 32), without(32, 32), diff(32, 32);
+        o.pattern = p;
+        o.clamp_compensation_rays = 0;
+        renderer.render(o, g.view(), cam, c.caster.views(), without.view());
+        o.clamp_compensation_rays = 16;
+        const indirect_timings t = renderer.render(o, g.view(), cam, c.caster.views(), with.view());
+        CHECK(t.compensation_rays == covered * 16);
+        CHECK(t.compensation_share > 0.0);
+        for (std::size_t y = 0; y < 32; ++y)
+            for (std::size_t x = 0; x < 32; ++x) diff(x, y) = with(x, y) - without(x, y);
+        return diff;
+    };
+    const image<glm::vec3> plain = added({1, 1}), interleaved = added({4, 4});
+    std::size_t near = 0;
+    for (std::size_t y = 0; y < 32; ++y)
+        for (std::size_t x = 0; x < 32; ++x) {
+            const glm::vec3 p = g.view().position(x, y);
+            CHECK(plain(x, y).x >= 0.f);
+            CHECK(interleaved(x, y).x == Approx(plain(x, y).x).margin(1e-5));
+            if (p.x > clamp_distance * 1.01f) CHECK(plain(x, y).x == 0.f);
+            if (g.view().covered(x, y) && p.z < 1e-4f && p.x < 0.5f * clamp_distance) {
+                CHECK(plain(x, y).x > 0.f);
+                ++near;
+            }
+        }
+    CHECK(near > 0);
 }

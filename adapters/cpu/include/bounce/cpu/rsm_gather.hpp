@@ -145,6 +145,15 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
     return e;
 }
 
+/// One group holding all `count` samples in order (the plain gather's).
+inline light_groups one_group(std::size_t count) {
+    light_groups all;
+    all.begin = {0, std::uint32_t(count)};
+    all.order.resize(count);
+    for (std::size_t k = 0; k < count; ++k) all.order[k] = std::uint32_t(k);
+    return all;
+}
+
 /// The totals of every thread's scratch.
 inline compensation_totals sum_totals(tbb::enumerable_thread_specific<visible_gather_scratch>& scratches) {
     compensation_totals t;
@@ -205,12 +214,8 @@ inline compensation_totals rsm_gather(const gbuffer_view<float>& gb, const inter
 /// The plain gather (no interleaving, DS05): every pixel of `gb` sums the whole `pattern`.
 inline void rsm_gather(const gbuffer_view<float>& gb, std::span<const rsm_view> maps,
                        std::span<const glm::vec3> pattern, const pixel_light_params& lp, image_view<glm::vec3> out) {
-    const interleave_maps imaps({1, 1}, gb.width(), gb.height());
-    light_groups all;
-    all.begin = {0, std::uint32_t(pattern.size())};
-    all.order.resize(pattern.size());
-    for (std::size_t k = 0; k < pattern.size(); ++k) all.order[k] = std::uint32_t(k);
-    rsm_gather(gb, imaps, maps, pattern, all, lp, out);
+    rsm_gather(gb, interleave_maps({1, 1}, gb.width(), gb.height()), maps, pattern, detail::one_group(pattern.size()),
+               lp, out);
 }
 
 /// The plain gather with visibility by `occlusion` and the clamp's compensation `comp`:
@@ -219,12 +224,8 @@ inline compensation_totals rsm_gather(const gbuffer_view<float>& gb, std::span<c
                                       std::span<const glm::vec3> pattern, const pixel_light_params& lp,
                                       image_view<glm::vec3> out, const occlusion_query& occlusion,
                                       const gather_compensation& comp) {
-    const interleave_maps imaps({1, 1}, gb.width(), gb.height());
-    light_groups all;
-    all.begin = {0, std::uint32_t(pattern.size())};
-    all.order.resize(pattern.size());
-    for (std::size_t k = 0; k < pattern.size(); ++k) all.order[k] = std::uint32_t(k);
-    return rsm_gather(gb, imaps, maps, pattern, all, lp, out, true, &occlusion, comp);
+    return rsm_gather(gb, interleave_maps({1, 1}, gb.width(), gb.height()), maps, pattern,
+                      detail::one_group(pattern.size()), lp, out, true, &occlusion, comp);
 }
 
 /// Picks the G-buffer pixel at the centre of each factor x factor block
