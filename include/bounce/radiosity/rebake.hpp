@@ -31,13 +31,20 @@
 ///    solver keeps. The lights' direct deposit is re-evaluated as for a light change (shadows
 ///    of the object).
 /// The deliveries use the solver's own shot (block discs, near-field trees, one visibility
-/// ray from the block's centre), so the correction is exact for it but for two things the
-/// history of the previous solve leaves in B and that S alone does not keep: shots scaled
-/// down to their power (shot_scale; the moved object's own shooters are re-shot whole and
-/// scaled, the others' partial re-shots to unmoved elements are not) and grouped shooters'
-/// sampled visibility (radiosity_options::shooter_groups: the correction uses the blocks'
-/// shot). Both leave an error of the order of the clamp's or the sampling's share of the
-/// corrected light, which the tests and docs/radiosity.md measure against a fresh solve.
+/// ray from the block's centre), linear in the shot radiosity. A shot scaled down to its power
+/// (shot_scale) delivered only its scale's share of what it took from dB, so S = B - dB is
+/// not what (1) holds for; the solver keeps, per element-side, each shot's radiosity times its
+/// scale, summed (S_e, its effective_shot_), for which (1) holds exactly, and the re-bake
+/// re-shoots S_e unscaled: the old pass takes away exactly what was delivered. Left inexact:
+/// a move that changes which shots a fresh solve would scale (the re-shots keep the bake's
+/// scales), and grouped shooters' sampled visibility (radiosity_options::shooter_groups: the
+/// correction uses the blocks' shot). The tests and docs/radiosity.md measure what is left
+/// against a fresh solve on the same elements.
+///
+/// The ambient term shown before convergence (Cohen et al.) estimates the light still to
+/// come from the unshot power, negative after a dimming; the converged indirect irradiance is
+/// not, so the solver shows at least 0 of it (the ambient clamped at minus what the shots
+/// delivered): a projection onto a set that holds the converged answer, never farther from it.
 ///
 /// The solve after a re-bake selects shooters by |unshot power| and checks that the unshot
 /// power in magnitude never rises (radiosity/solve.hpp), so negative shots stay conservative.
@@ -184,6 +191,7 @@ struct radiosity_rebake_report {
     std::size_t pairs_tested = 0;   ///< receiver-shooter pairs tested against the boxes
     double unshot_before = 0;       ///< |unshot| power / emitted power before the correction
     double unshot_after = 0;        ///< the same after it (may exceed 1: a dimmed light)
+    double uncorrected = 0;         ///< of the shot power, the share whose re-shots were left out (rebake_move's share)
 };
 
 }  // namespace bounce::radiosity

@@ -123,7 +123,7 @@ public:
         build_shooters();
         const auto start = clock::now();
         direct_.assign(sides_ * n, vec(0));
-        gathered_.assign(sides_ * n, vec(0));
+        gathered_.assign(sides_ * n, vec(0)), effective_shot_.assign(sides_ * n, vec(0));
         for (const light& l : scene.lights) lights_.push_back(pack(l));
         for (const packed_light& l : lights_) shoot_light(l, false);
         timings_.lights_ms = ms_since(start);
@@ -321,7 +321,7 @@ public:
         if (!split.empty()) {
             atlas_refinement r = refine_lightmap_atlas(scene, atlas_, split);
             const std::size_t m = r.parent.size(), n = atlas_.size();
-            std::vector<vec> radiosity(sides_ * m), unshot(sides_ * m), direct(sides_ * m), gathered(sides_ * m);
+            std::vector<vec> radiosity(sides_ * m), unshot(sides_ * m), direct(sides_ * m), gathered(sides_ * m), shot(sides_ * m);
             for (std::size_t side = 0; side < sides_; ++side)
                 for (std::size_t i = 0; i < m; ++i) {
                     const std::size_t to = side * m + i, from = side * n + r.parent[i];
@@ -329,12 +329,13 @@ public:
                     unshot[to] = unshot_[from];
                     direct[to] = direct_[from];
                     gathered[to] = gathered_[from];
+                    shot[to] = effective_shot_[from];
                 }
             atlas_ = std::move(r.atlas);
             radiosity_ = std::move(radiosity);
             unshot_ = std::move(unshot);
             direct_ = direct;
-            gathered_ = std::move(gathered);
+            gathered_ = std::move(gathered), effective_shot_ = std::move(shot);
             build_shooters();  // the distribution below walks the new shooters' elements
             if (!lights_.empty()) {
                 regather_lights(direct);
@@ -463,7 +464,7 @@ private:
         glm::dvec3 power(0);
         for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot[i]) * double(at.area[i]);
         build_near_tree(std::uint32_t(b), unshot);
-        for (std::uint32_t i = i0; i < i1; ++i) unshot[i] = vec(0);
+        for (std::uint32_t i = i0; i < i1; ++i) shot_elements_.push_back({std::uint32_t(side * at.size() + i), unshot[i]}), unshot[i] = vec(0);
         const glm::vec3 normal = side == 0 ? at.normal[i0] : -at.normal[i0];
 
         auto start = clock::now();
@@ -481,6 +482,8 @@ private:
                      std::uint32_t first) {
         const glm::dvec3 scale = shot_scale(power, incident);
         const chunk_sums total = apply_shot(Real(scale.x), Real(scale.y), Real(scale.z));
+        for (const auto& [j, u] : shot_elements_) effective_shot_[j] += u * vec(scale);
+        shot_elements_.clear();
         shot_ambient_.record(options_, received_, scale, power, total.intercepted, total.absorbed, unshot_total_);
         timings_.distribution_ms += ms_since(start);
         absorbed_ += total.absorbed;
@@ -582,27 +585,7 @@ private:
     // The lights' direct irradiance at every element of the refined atlas, against what the
     // elements inherited (`inherited`): the difference is added as described at subdivide().
     // Elements that were not split get bitwise their old value (same visibility, same sums).
-    void regather_lights(const std::vector<vec>& inherited) {
-        const auto start = clock::now();
-        direct_.assign(inherited.size(), vec(0));
-        for (const packed_light& l : lights_) shoot_light(l, true);
-        glm::dvec3 added(0), absorbed(0);
-        const std::size_t n = atlas_.size();
-        for (std::size_t i = 0; i < direct_.size(); ++i) {
-            const vec d = direct_[i] - inherited[i];
-            if (d == vec(0)) continue;
-            const vec rho = vec(atlas_.albedo[i % n]);
-            radiosity_[i] += rho * d;
-            unshot_[i] += rho * d;
-            const glm::dvec3 power = glm::dvec3(d) * double(atlas_.area[i % n]);
-            added += power;
-            absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * power;
-        }
-        emitted_ += added;
-        intercepted_ += added;
-        absorbed_ += absorbed;
-        timings_.lights_ms += ms_since(start);
-    }
+    void regather_lights(const std::vector<vec>& inherited);  // radiosity_shots.hpp
 
     // Direct light from one light: each element's irradiance E (direct_light.hpp) times
     // visibility, on the side facing the light, becomes incident power and rho E its first
@@ -616,6 +599,11 @@ private:
     std::vector<vec> radiosity_, unshot_;
     std::vector<vec> direct_;             // direct irradiance from lights_ per element (W/m^2)
     std::vector<vec> gathered_;           // irradiance the shots delivered per element (W/m^2)
+    // Per element-side, the unshot radiosity its shots shot, each times its shot's scale
+    // (shot_scale): B = E + rho F effective_shot_ (= B - dB where no shot was scaled), what
+    // the re-bakes re-shoot (radiosity_rebake.hpp); the shot's elements wait in shot_elements_.
+    std::vector<vec> effective_shot_;
+    std::vector<std::pair<std::uint32_t, vec>> shot_elements_;
     std::vector<packed_light> lights_;    // the scene's point, spot and directional lights
     std::vector<std::uint32_t> first_;
     std::vector<glm::vec3> centre_;
@@ -688,7 +676,15 @@ private:
     radiosity_timings timings_;
     std::size_t steps_ = 0, shots_ = 0;
     shot_ambient_state<Real> shot_ambient_;  // the ambient term per element (Cohen's or the shots': radiosity_ambient.hpp)
-    std::vector<glm::vec3> ambient_field(bool on, int side) const { return shot_ambient_.field(on, options_, *this, side); }
+    // Clamped where a re-bake's negative unshot power makes it negative: the indirect irradiance
+    // shown (gathered_ plus the ambient) at least 0, as the converged one is (radiosity/rebake.hpp).
+    std::vector<glm::vec3> ambient_field(bool on, int side) const {
+        std::vector<glm::vec3> a = shot_ambient_.field(on, options_, *this, side);
+        const std::size_t o = atlas_.size() * std::size_t(side);
+        if (on && options_.ambient)
+            for (std::size_t i = 0; i < a.size(); ++i) a[i] = glm::max(a[i], -glm::vec3(gathered_[o + i]));
+        return a;
+    }
 };
 
 }  // namespace bounce::cpu

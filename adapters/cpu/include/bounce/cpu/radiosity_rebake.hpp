@@ -15,19 +15,22 @@
 ///                    embree::radiosity_visibility(moved_bvh, solver.atlas().chart_of_triangle));
 ///   solver.solve(o);                                         // the re-bake
 ///
-/// The cost of a move's correction: every block-side that has shot re-shoots its S twice
-/// (old and new geometry), each time only to the receivers whose delivery can differ: those
-/// whose visibility ray from the shooter's centre meets the object's box before or after the
-/// move, and, with the new geometry, the moved object's elements (what they received before
-/// is their gathered irradiance, taken away as it is); a moved block re-shoots to every
-/// receiver both times. Then one shot per light. With the item buffers, each of those shots
-/// draws its item buffer whole.
+/// The cost of a move's correction: every block-side that has shot re-shoots its S (what its
+/// shots delivered from, their scales applied) twice, old and new geometry, each time only to
+/// the receivers whose delivery can differ: those whose visibility ray from the shooter's
+/// centre meets the object's box before or after the move, and, with the new geometry, the
+/// moved object's elements (what they received before is their gathered irradiance, taken
+/// away as it is); a moved block re-shoots to every other element with the old geometry and
+/// to every element with the new. Then one shot per light. With the item buffers, each of
+/// those shots draws its item buffer whole. rebake_move's `share` < 1 re-shoots only the
+/// largest block-sides holding that share of the shot power.
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/radiosity/rebake.hpp>
 
 #include <atomic>
 #include <chrono>
+#include <numeric>
 #include <span>
 #include <type_traits>
 #include <utility>
@@ -43,18 +46,12 @@ template <class Solver>
 struct rebake_access {
     using vec = typename Solver::vec;
 
-    // S = B - dB per element and side: what each element has shot.
-    static std::vector<vec> shot(const Solver& s) {
-        std::vector<vec> out(s.radiosity_.size());
-        for (std::size_t j = 0; j < out.size(); ++j) out[j] = s.radiosity_[j] - s.unshot_[j];
-        return out;
-    }
-
-    // One pass of a move's correction: every block-side whose S holds power shoots it, as the
-    // solver's shot does, to the receivers keep(shooter centre, element) asks for (a moved
-    // block: to every receiver, scaled to its power as a shot is), and `sign` times what it
-    // delivers is added to `delta` (incident radiosity per element and side), but for the
-    // elements `skip` marks.
+    // One pass of a move's correction: every block-side whose S (the solver's effective_shot_:
+    // what its shots delivered from, each shot's scale applied) holds power shoots it, as the
+    // solver's shot does but unscaled, to the receivers keep(shooter centre, element, moved
+    // shooter) asks for, and `sign` times what it delivers is added to `delta` (incident
+    // radiosity per element and side). The deliveries are linear in S, so the old pass takes
+    // away exactly what the past shots delivered to those receivers.
     // Which receivers a shooter's re-shot asks for: by the block first (the segment from the
     // shooter to the block's centre against the boxes widened by the block's radius: no
     // element of a block that misses can have a segment that meets them), then by element.
@@ -84,44 +81,62 @@ struct rebake_access {
         bool through(const glm::vec3& c, std::uint32_t i) const { return near[block_of[i]] && meets(c, at.position[i], margin); }
     };
 
+    // The block-sides the correction re-shoots: those whose S holds power, the largest first
+    // until they hold `share` of it (all with share 1); the share left out is reported.
+    static std::vector<std::uint8_t> chosen_shooters(const Solver& s, const std::vector<vec>& S, double share, radiosity_rebake_report& r) {
+        const std::size_t blocks = s.first_.size() - 1, n = s.atlas_.size();
+        std::vector<double> magnitude(s.sides_ * blocks, 0.0);
+        for (std::size_t k = 0; k < magnitude.size(); ++k)
+            for (std::uint32_t i = s.first_[k % blocks]; i < s.first_[k % blocks + 1]; ++i)
+                magnitude[k] += Solver::channel_sum(glm::abs(S[(k / blocks) * n + i])) * double(s.atlas_.area[i]);
+        std::vector<std::uint32_t> order(magnitude.size());
+        std::iota(order.begin(), order.end(), 0u);
+        std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return magnitude[a] > magnitude[b]; });
+        const double total = std::accumulate(magnitude.begin(), magnitude.end(), 0.0);
+        std::vector<std::uint8_t> chosen(magnitude.size(), 0);
+        double taken = 0, left = 0;
+        for (const std::uint32_t k : order) {
+            if (!(magnitude[k] > 0)) break;
+            if (share < 1 && taken >= share * total) left += magnitude[k];
+            else chosen[k] = 1, taken += magnitude[k];
+        }
+        r.uncorrected = total > 0 ? left / total : 0.0;
+        return chosen;
+    }
+
     template <class Keep>
-    static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& moved_block, move_filter& filter,
-                        const Keep& keep, double sign, const std::vector<std::uint8_t>& skip, std::vector<glm::dvec3>& delta,
-                        radiosity_rebake_report& r) {
+    static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& chosen,
+                        const std::vector<std::uint8_t>& moved_block, move_filter& filter, const Keep& keep, double sign,
+                        std::vector<glm::dvec3>& delta, radiosity_rebake_report& r) {
         const lightmap_atlas& at = s.atlas_;
         const std::size_t blocks = s.first_.size() - 1, n = at.size();
         std::atomic<std::size_t> pairs{0};
         for (std::size_t k = 0; k < s.sides_ * blocks; ++k) {
+            if (!chosen[k]) continue;
             const std::size_t b = k % blocks, side = k / blocks;
-            const std::uint32_t i0 = s.first_[b], i1 = s.first_[b + 1];
+            const std::uint32_t i0 = s.first_[b];
             const vec* from = S.data() + side * n;
-            glm::dvec3 power(0);
-            double magnitude = 0;
-            for (std::uint32_t i = i0; i < i1; ++i) {
-                power += glm::dvec3(from[i]) * double(at.area[i]);
-                magnitude += Solver::channel_sum(glm::abs(from[i])) * double(at.area[i]);
-            }
-            if (!(magnitude > 0)) continue;
             ++r.shooters;
+            const std::size_t pairs_before = pairs.load();
             s.build_near_tree(std::uint32_t(b), from);
             const glm::vec3 normal = side == 0 ? at.normal[i0] : -at.normal[i0], centre = s.centre_[b];
             s.visibility_.begin_shot(shot_frame{centre, normal, false, at.chart[i0]});
             const bool whole = moved_block[b] != 0;
             if (!whole) filter.begin(centre);
-            const glm::dvec3 got = s.gather_shot(at.chart[i0], vec(normal), [&](std::uint32_t i) {
-                if (!whole && !keep(centre, i)) return false;
+            s.gather_shot(at.chart[i0], vec(normal), [&](std::uint32_t i) {
+                if (!keep(centre, i, whole)) return false;
                 pairs.fetch_add(1, std::memory_order_relaxed);
                 return true;
             });
             if (!whole) r.pairs_tested += n;
-            const glm::dvec3 scale = sign * (whole ? shot_scale(power, got) : glm::dvec3(1.0));
+            else ++r.moved_shooters, r.moved_pairs += pairs.load() - pairs_before;
             // Only the blocks asked for hold deliveries (a moved shooter's: every block).
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.sides_ * blocks, 64), [&](const tbb::blocked_range<std::size_t>& q) {
                 for (std::size_t kb = q.begin(); kb != q.end(); ++kb) {
                     const std::size_t bb = kb % blocks, o = (kb / blocks) * n;
                     if (!whole && !filter.near[bb] && !moved_block[bb]) continue;
                     for (std::uint32_t i = s.first_[bb]; i < s.first_[bb + 1]; ++i)
-                        if (s.received_[o + i] != vec(0) && !skip[i]) delta[o + i] += scale * glm::dvec3(s.received_[o + i]);
+                        if (s.received_[o + i] != vec(0)) delta[o + i] += sign * glm::dvec3(s.received_[o + i]);
                 }
             });
         }
@@ -184,7 +199,8 @@ struct rebake_access {
 
     template <class Visibility>
     static radiosity_rebake_report move_object(Solver& s, const scene_view& moved_scene, std::span<const std::uint32_t> moved,
-                                        const rigid_move& m, Visibility&& visibility) {
+                                        const rigid_move& m, Visibility&& visibility, double share) {
+        require(share > 0 && share <= 1, "share", "must lie in (0, 1]");
         m.validate();
         moved_scene.validate();
         require(moved_scene.triangles.size() == s.atlas_.chart_of_triangle.size(), "moved_scene",
@@ -204,20 +220,23 @@ struct rebake_access {
         // A pair's delivery can change only with a moved end or a ray through either box.
         move_filter filter(s, boxes, margin);
         const auto through = [&](const glm::vec3& c, std::uint32_t i) { return filter.through(c, i); };
-        const std::vector<vec> S = shot(s);
-        // What the moved elements received is known, to the bit of every past shot's scale:
-        // the irradiance the shots delivered (gathered_). The old pass leaves them out.
+        const std::vector<vec>& S = s.effective_shot_;
+        // What the moved elements received is known: the irradiance the shots delivered
+        // (gathered_), taken away as it is. The old pass leaves them out; a moved shooter's
+        // old pass reaches every other element.
         std::vector<glm::dvec3> delta(S.size(), glm::dvec3(0));
         for (std::size_t j = 0; j < delta.size(); ++j)
             if (moved_element[j % n]) delta[j] = -glm::dvec3(s.gathered_[j]);
-        const std::vector<std::uint8_t> none(n, 0);
-        reshoot(s, S, moved_block, filter, [&](const glm::vec3& c, std::uint32_t i) { return !moved_element[i] && through(c, i); },
-                -1.0, moved_element, delta, r);  // the old geometry and visibility
+        const std::vector<std::uint8_t> chosen = chosen_shooters(s, S, share, r);
+        reshoot(s, S, chosen, moved_block, filter,
+                [&](const glm::vec3& c, std::uint32_t i, bool whole) { return !moved_element[i] && (whole || through(c, i)); }, -1.0,
+                delta, r);  // the old geometry and visibility
         move_charts(s.atlas_, charts, m);
         s.visibility_ = std::forward<Visibility>(visibility);
         s.build_shooters();  // the moved blocks' centres, the groups' boxes
-        reshoot(s, S, moved_block, filter, [&](const glm::vec3& c, std::uint32_t i) { return moved_element[i] || through(c, i); },
-                1.0, none, delta, r);  // the new
+        reshoot(s, S, chosen, moved_block, filter,
+                [&](const glm::vec3& c, std::uint32_t i, bool whole) { return whole || moved_element[i] || through(c, i); }, 1.0,
+                delta, r);  // the new
         apply(s, delta, regather_direct(s));
         r.unshot_after = s.unshot_fraction();
         r.ms = Solver::ms_since(start);
@@ -238,13 +257,17 @@ radiosity_rebake_report rebake_light(progressive_radiosity<Visibility, Real>& so
 /// after the move (the same triangles, those vertices moved) and `visibility` the visibility
 /// of it (built with the solver's atlas's chart_of_triangle), which the solver keeps. The
 /// state is corrected as radiosity/rebake.hpp derives; then solve() again. Throws
-/// parameter_error ("moved_triangles": out of range, or sharing a chart with unmoved triangles;
-/// "moved_scene"; "rigid_move.*").
+/// `share` < 1 re-shoots only the block-sides that hold that share of the shot power, the
+/// largest first: cheaper, and no longer exact (what the rest would correct is left out; the
+/// report's `uncorrected`). Throws parameter_error ("moved_triangles": out of range, or
+/// sharing a chart with unmoved triangles; "moved_scene"; "rigid_move.*"; "share").
 template <shot_visibility Visibility, floating Real>
 radiosity_rebake_report rebake_move(progressive_radiosity<Visibility, Real>& solver, const scene_view& moved_scene,
-                                    std::span<const std::uint32_t> moved, const rigid_move& move, Visibility visibility) {
+                                    std::span<const std::uint32_t> moved, const rigid_move& move, Visibility visibility,
+                                    double share = 1.0) {
     static_assert(std::is_move_assignable_v<Visibility>, "the solver takes the moved scene's visibility in place of its own");
-    return rebake_access<progressive_radiosity<Visibility, Real>>::move_object(solver, moved_scene, moved, move, std::move(visibility));
+    return rebake_access<progressive_radiosity<Visibility, Real>>::move_object(solver, moved_scene, moved, move, std::move(visibility),
+                                                                              share);
 }
 
 }  // namespace bounce::cpu

@@ -40,7 +40,10 @@ std::uint32_t progressive_radiosity<Visibility, Real>::build_group_node(std::uin
                 for (std::uint32_t c = 0; c < children; ++c) links_.push_back(base + first_child + c);
                 group_nodes_.push_back(q);
             });
-        for (std::uint32_t i = i0; i < i1; ++i) power += glm::dvec3(unshot[i]) * double(atlas_.area[i]), unshot[i] = vec(0);
+        for (std::uint32_t i = i0; i < i1; ++i) {
+            power += glm::dvec3(unshot[i]) * double(atlas_.area[i]);
+            shot_elements_.push_back({std::uint32_t(side * n + i), unshot[i]}), unshot[i] = vec(0);
+        }
         if (first_element == shooter_group_node::none) first_element = i0;
         return std::uint32_t(group_nodes_.size() - 1);
     }
@@ -230,6 +233,29 @@ void progressive_radiosity<Visibility, Real>::shoot_light(const packed_light& l,
         intercepted_ += total.intercepted;
         absorbed_ += total.absorbed;
     }
+}
+
+template <shot_visibility Visibility, floating Real>
+void progressive_radiosity<Visibility, Real>::regather_lights(const std::vector<vec>& inherited) {
+    const auto start = clock::now();
+    direct_.assign(inherited.size(), vec(0));
+    for (const packed_light& l : lights_) shoot_light(l, true);
+    glm::dvec3 added(0), absorbed(0);
+    const std::size_t n = atlas_.size();
+    for (std::size_t i = 0; i < direct_.size(); ++i) {
+        const vec d = direct_[i] - inherited[i];
+        if (d == vec(0)) continue;
+        const vec rho = vec(atlas_.albedo[i % n]);
+        radiosity_[i] += rho * d;
+        unshot_[i] += rho * d;
+        const glm::dvec3 power = glm::dvec3(d) * double(atlas_.area[i % n]);
+        added += power;
+        absorbed += (glm::dvec3(1.0) - glm::dvec3(rho)) * power;
+    }
+    emitted_ += added;
+    intercepted_ += added;
+    absorbed_ += absorbed;
+    timings_.lights_ms += ms_since(start);
 }
 
 }  // namespace bounce::cpu
