@@ -9,7 +9,11 @@
 // the re-bake's time (correction + solve) to the same error, measured at checkpoints with the
 // clock paused; the re-bake's and the fresh solve's views both converged, against each other;
 // the ratio of the times; and, with --reference on, both against the multi-bounce reference
-// of the changed scene. CPU, ray-cast visibility, uniform atlas.
+// of the changed scene, and the re-bake's time to the fresh solve's error against it. A move's
+// re-bake is measured against a fresh solve on its own elements (the bake's moved), which it
+// converges to; how far that lies from the answer (its atlas built from the moved scene) is
+// reported. An optional fourth number, --rebake-move ...,SHARE, re-shoots only the shooters
+// holding that share of the shot power (cpu::rebake_move's share). CPU, ray-cast visibility.
 #include <bounce/cpu/radiosity_rebake.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
@@ -109,6 +113,7 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     std::vector<std::uint32_t> moved;
     rigid_move move;
     std::size_t light_index = 0;
+    double share = 1;  // of the shot power, the share the correction re-shoots (cpu::rebake_move)
     if (!o.rebake_light.empty()) {
         const auto v = rebake_numbers(o.rebake_light, 2, "--rebake-light", "K,SCALE");
         light_index = std::size_t(v[0]);
@@ -122,9 +127,11 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     } else {
         const std::size_t comma = o.rebake_move.find(',');
         moved = object_triangles(scene, o.rebake_move.substr(0, comma));
-        const auto d = rebake_numbers(comma == std::string::npos ? "" : o.rebake_move.substr(comma + 1), 3, "--rebake-move",
-                                      "MATERIAL[#N],DX,DY,DZ");
+        const std::string numbers = comma == std::string::npos ? "" : o.rebake_move.substr(comma + 1);
+        const bool with_share = std::count(numbers.begin(), numbers.end(), ',') == 3;
+        const auto d = rebake_numbers(numbers, with_share ? 4 : 3, "--rebake-move", "MATERIAL[#N],DX,DY,DZ[,SHARE]");
         move.translation = glm::vec3(float(d[0]), float(d[1]), float(d[2]));
+        if (with_share) share = d[3];
         std::vector<std::uint8_t> vertex(scene.positions.size(), 0);
         for (const std::uint32_t t : moved)
             for (int k = 0; k < 3; ++k) vertex[scene.triangles[t][k]] = 1;
@@ -160,31 +167,60 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     const image<glm::vec3> answer = view(fresh);
     const double fresh_error = error(fresh_view, answer);
 
-    // The bake of the scene as it was, then the re-bake to the fresh solve's error.
+    // The bake of the scene as it was, then the re-bake to the fresh solve's error. A move's
+    // re-bake keeps the bake's elements (moved) and converges to a fresh solve on them: its
+    // answer (the fresh solve's elements, built from the moved scene, may differ: a duplicated
+    // face's coincident charts; "atlases_apart").
     const lightmap_atlas atlas = build_lightmap_atlas(scene, atlas_options_for(o));
+    image<glm::vec3> own_answer = answer;
+    double atlases_apart = 0;
+    if (!moved.empty()) {
+        lightmap_atlas moved_atlas = atlas;
+        move_charts(moved_atlas, moved_charts(atlas, moved), move);
+        cpu::progressive_radiosity same(changed, moved_atlas, embree::radiosity_visibility(changed_bvh, moved_atlas.chart_of_triangle),
+                                        solver_options_for(o));
+        same.solve(check);
+        own_answer = view(same), atlases_apart = error(own_answer, answer);
+    }
     cpu::progressive_radiosity solver(scene, atlas, embree::radiosity_visibility(bvh, atlas.chart_of_triangle), solver_options_for(o));
     const radiosity_solve_report bake = solver.solve(s);
     const radiosity_rebake_report rb =
         moved.empty() ? cpu::rebake_light(solver, light_index, changed.lights[light_index])
-                      : cpu::rebake_move(solver, changed, moved, move, embree::radiosity_visibility(changed_bvh, atlas.chart_of_triangle));
+                      : cpu::rebake_move(solver, changed, moved, move, embree::radiosity_visibility(changed_bvh, atlas.chart_of_triangle), share);
     radiosity_solve_options again = check;
     again.checkpoints = 200;
-    double rebake_error = error(view(solver), answer), at_ms = 0;
+    image<glm::vec3> rebake_view = view(solver);
+    double rebake_error = error(rebake_view, own_answer), at_ms = 0;
     std::size_t at_steps = 0;
     bool reached = rebake_error <= fresh_error;
+    // With --reference on, also the time to the fresh solve's error against the reference.
+    const double ref_target = reference ? error(fresh_view, reference->radiance) : 0;
+    double ref_ms = 0;
+    std::size_t ref_steps = 0;
+    bool ref_reached = !reference || error(rebake_view, reference->radiance) <= ref_target;
     again.checkpoint = [&](const radiosity_progress& p) {
-        if (reached) return;
-        rebake_error = error(view(solver), answer);
-        reached = rebake_error <= fresh_error;
-        at_ms = p.elapsed_ms, at_steps = p.steps - bake.steps;
+        if (reached && ref_reached) return;
+        const image<glm::vec3> v = view(solver);
+        if (!reached) {
+            rebake_error = error(v, own_answer), reached = rebake_error <= fresh_error;
+            at_ms = p.elapsed_ms, at_steps = p.steps - bake.steps, rebake_view = v;
+        }
+        if (!ref_reached) ref_reached = error(v, reference->radiance) <= ref_target, ref_ms = p.elapsed_ms, ref_steps = p.steps - bake.steps;
     };
-    again.progress = [&](const radiosity_progress&) { return !reached; };
+    // The solve's shots from the moved object's elements (a step of one shooter: the default).
+    const std::vector<std::uint8_t> moved_chart = moved.empty() ? std::vector<std::uint8_t>(atlas.charts.size(), 0) : moved_charts(atlas, moved);
+    std::size_t moved_shots = 0;
+    again.progress = [&](const radiosity_progress&) {
+        moved_shots += moved_chart[solver.atlas().chart[solver.last_shot().first_element]];
+        return !reached || !ref_reached;
+    };
     const radiosity_solve_report rr = solver.solve(again);
-    if (!reached) at_ms = rr.solve_ms, at_steps = solver.progress().steps - bake.steps;
+    if (!reached) at_ms = rr.solve_ms, at_steps = solver.progress().steps - bake.steps, rebake_view = view(solver);
+    if (!ref_reached) ref_ms = rr.solve_ms, ref_steps = solver.progress().steps - bake.steps;
     const double rebake_ms = rb.ms + at_ms;
-    const image<glm::vec3> rebake_view = view(solver);
     solver.solve(check);
-    const double converged_apart = error(view(solver), answer);
+    const image<glm::vec3> rebake_converged = view(solver);
+    const double converged_apart = error(rebake_converged, own_answer), fresh_apart = error(rebake_converged, answer);
 
     nlohmann::ordered_json j;
     j["scene"] = scene.name;
@@ -196,8 +232,10 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     j["bvh_ms"] = bvh_ms;
     j["fresh"] = {{"ms", fresh_ms}, {"setup_ms", fresh_setup_ms}, {"steps", fr.steps}, {"error", fresh_error}};
     j["rebake"] = {{"ms", rebake_ms}, {"correction_ms", rb.ms}, {"solve_ms", at_ms}, {"steps", at_steps},
-                   {"error", rebake_error}, {"reached", reached}, {"shooters", rb.shooters}, {"pairs", rb.pairs},
+                   {"error", rebake_error}, {"reached", reached}, {"shooters", rb.shooters}, {"moved_shooters", rb.moved_shooters},
+                   {"moved_shots", moved_shots}, {"pairs", rb.pairs}, {"moved_pairs", rb.moved_pairs},
                    {"pairs_tested", rb.pairs_tested}, {"moved_elements", rb.moved_elements},
+                   {"share", share}, {"uncorrected", rb.uncorrected},
                    {"unshot_before", rb.unshot_before}, {"unshot_after", rb.unshot_after}};
     j["bake"] = {{"steps", bake.steps}, {"ms", bake.solve_ms}};
     j["ratio"] = rebake_ms / fresh_ms;
@@ -206,18 +244,28 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     const double rebake_pairs = double(rb.pairs) + double(at_steps) * double(atlas.size());
     j["pairs"] = {{"fresh", fresh_pairs}, {"rebake", rebake_pairs}, {"ratio", rebake_pairs / fresh_pairs}};
     j["converged_rel_rms"] = converged_apart;
+    j["converged_from_fresh"] = fresh_apart;
+    j["atlases_apart"] = atlases_apart;
     if (reference) {
-        j["reference_rel_rms"] = {{"fresh", error(fresh_view, reference->radiance)}, {"rebake", error(rebake_view, reference->radiance)},
+        j["reference_rel_rms"] = {{"fresh", ref_target}, {"rebake", error(rebake_view, reference->radiance)},
                                   {"converged", error(answer, reference->radiance)}};
+        // The re-bake stopped at the fresh solve's error against the reference instead.
+        j["to_reference_error"] = {{"ms", rb.ms + ref_ms}, {"steps", ref_steps}, {"reached", ref_reached},
+                                   {"ratio", (rb.ms + ref_ms) / fresh_ms},
+                                   {"pairs_ratio", (double(rb.pairs) + double(ref_steps) * double(atlas.size())) / fresh_pairs}};
     }
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
     fmt::print("radiosity re-bake {} ({}): {} elements; fresh {:.0f} ms (setup {:.0f}, {} steps), error {:.4f}; re-bake {:.0f} ms "
-               "(correction {:.0f}, {} steps), error {:.4f}{}; ratio {:.3f} ({:.3f} in pairs); converged apart {:.4f}{}\n",
+               "(correction {:.0f}, {} steps), error {:.4f}{}; ratio {:.3f} ({:.3f} in pairs); converged apart {:.4f}{}{}\n",
                scene.name, j["change"].get<std::string>(), atlas.size(), fresh_ms, fresh_setup_ms, fr.steps, fresh_error,
                rebake_ms, rb.ms, at_steps, rebake_error, reached ? "" : " (not reached)", rebake_ms / fresh_ms,
                rebake_pairs / fresh_pairs, converged_apart,
-               reference ? fmt::format("; against the reference fresh {:.4f}, re-bake {:.4f}",
-                                       j["reference_rel_rms"]["fresh"].get<double>(), j["reference_rel_rms"]["rebake"].get<double>())
+               moved.empty() ? std::string()
+                             : fmt::format(" (from the fresh solve {:.4f}; the atlases apart {:.4f})", fresh_apart, atlases_apart),
+               reference ? fmt::format("; against the reference fresh {:.4f}, re-bake {:.4f}; to the fresh's error against it: {} steps, "
+                                       "ratio {:.3f} ({:.3f} in pairs)",
+                                       ref_target, j["reference_rel_rms"]["rebake"].get<double>(), ref_steps,
+                                       j["to_reference_error"]["ratio"].get<double>(), j["to_reference_error"]["pairs_ratio"].get<double>())
                          : std::string());
     return 0;
 }
