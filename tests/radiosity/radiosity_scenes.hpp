@@ -134,4 +134,31 @@ inline owned_scene cornell_box(bool spot = false) {
     return s;
 }
 
+// A small lamp (5 cm square, facing down) over 3,750 separate 1 mm triangles, 4 mm apart:
+// 2,500 on a floor facing up and 1,250 on a wall facing +x, each triangle its own chart.
+inline owned_scene tiny_triangles_under_a_lamp() {
+    owned_scene s;
+    const auto floor = s.add_material(glm::vec3(0.6f)), wall = s.add_material(glm::vec3(0.4f, 0.5f, 0.6f));
+    const auto lamp = s.add_material(glm::vec3(0.f), glm::vec3(20.f));
+    s.add_quad({0.10f, 0.10f, 0.10f}, {0.10f, 0.15f, 0.10f}, {0.15f, 0.15f, 0.10f}, {0.15f, 0.10f, 0.10f}, lamp);
+    const auto triangle = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t m) {
+        const auto base = std::uint32_t(s.positions.size());
+        s.positions.insert(s.positions.end(), {a, b, c});
+        s.triangles.emplace_back(base, base + 1, base + 2);
+        s.material_of.push_back(m);
+    };
+    const float mm = 0.001f, step = 0.004f;
+    for (int i = 0; i < 50; ++i)
+        for (int j = 0; j < 50; ++j) {
+            const glm::vec3 p(step * float(i), step * float(j), 0.f);
+            triangle(p, p + glm::vec3(mm, 0, 0), p + glm::vec3(0, mm, 0), floor);
+        }
+    for (int j = 0; j < 50; ++j)
+        for (int k = 0; k < 25; ++k) {
+            const glm::vec3 p(0.f, step * float(j), 0.002f + step * float(k));
+            triangle(p, p + glm::vec3(0, mm, 0), p + glm::vec3(0, 0, mm), wall);
+        }
+    return s;
+}
+
 }  // namespace bounce::radiosity_test

@@ -353,7 +353,9 @@ TEST_CASE("a floor running around a column's base is lit: its element's point li
     // the column, where every shot finds it occluded, so the whole floor rendered black. The
     // point moves to the centroid of its largest triangle's overlap, which lies on the floor.
     const auto scene = floor_around_column(0.5f);
-    const lightmap_atlas atlas = build_lightmap_atlas(scene.view(), {.elements = 1});
+    // One texel a chart, the floor's own (no cluster with the column's top, which faces up too).
+    const lightmap_atlas atlas =
+        build_lightmap_atlas(scene.view(), {.elements = 1, .clusters = tiny_chart_clusters::never});
     const lightmap_chart& floor = atlas.charts[atlas.chart_of_triangle[0]];
     REQUIRE(floor.triangle_count == 8);
     REQUIRE(floor.element_count == 1);
@@ -469,4 +471,33 @@ TEST_CASE("a layer of another chart closer to an element than the ray epsilon do
     CHECK(vis_t.visible_from(lamp, lightmap_atlas::none, under, atlas_t.chart_of_triangle[0]) == 0.f);
     vis_t.set_shot({glm::vec3(0.f), glm::vec3(0, -1, 0), true, embree::radiosity_shot::none});
     CHECK(vis_t.visible(under, atlas_t.chart_of_triangle[0]) == 0.f);
+}
+
+TEST_CASE("ray visibility over clusters of tiny charts: every triangle lit, no energy gained",
+          "[radiosity][embree][clusters]") {
+    // Each cluster's point lies on one of its triangles; a ray to it leaves out its own
+    // cluster's triangles (one chart), so no sibling a millimetre away shadows it.
+    const auto scene = tiny_triangles_under_a_lamp();
+    const lightmap_atlas atlas = build_lightmap_atlas(scene.view(), {.elements = 300});
+    REQUIRE(atlas.statistics.clusters > 0);
+    cpu::progressive_radiosity solver(scene.view(), atlas, embree_visibility(scene, atlas));
+    radiosity_solve_options o;
+    o.converge = 0.99;
+    double unshot = 1;
+    o.progress = [&](const radiosity_progress& p) {
+        CHECK(p.unshot_fraction <= unshot * (1 + 1e-6));
+        unshot = p.unshot_fraction;
+        return true;
+    };
+    CHECK(solver.solve(o).stop == radiosity_stop::converged);
+    const auto b = solver.display_radiosity();
+    const glm::vec2 size(float(atlas.width), float(atlas.height));
+    const auto uv = atlas.corner_uvs(scene.view());
+    std::size_t dark = 0;
+    for (std::uint32_t t = 2; t < scene.triangles.size(); ++t) {  // after the lamp's two
+        const glm::vec2 p = (uv[3 * t] + uv[3 * t + 1] + uv[3 * t + 2]) / 3.f * size;
+        const auto e = std::size_t(atlas.element_at(std::uint32_t(p.x), std::uint32_t(p.y)));
+        dark += b[e].x + b[e].y + b[e].z > 0.f ? 0 : 1;
+    }
+    CHECK(dark == 0);
 }

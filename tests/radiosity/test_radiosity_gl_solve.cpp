@@ -4,6 +4,7 @@
 #include "radiosity_scenes.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
+#include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/gl/radiosity.hpp>
 #include <bounce/radiosity/solve.hpp>
 
@@ -58,4 +59,41 @@ TEST_CASE("the GL solver names reversed winding one-sided and refuses a toleranc
     const auto good_atlas = build_lightmap_atlas(good.view(), {.elements = 300, .block_texels = 4});
     CHECK_THROWS_WITH(gl::progressive_radiosity(good.view(), good_atlas, {.resolution = 64, .tolerance_px = 1e-6f}),
                       Catch::Contains("radiosity_options.tolerance_px") && Catch::Contains("0.003906"));
+}
+
+TEST_CASE("the GL solver takes clusters of tiny charts: energy never grows, every triangle lit, as on the CPU",
+          "[radiosity][solve][gl][clusters]") {
+    gl_test::shared_context();
+    const auto s = tiny_triangles_under_a_lamp();
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 300});
+    REQUIRE(atlas.statistics.clusters > 0);
+    gl::progressive_radiosity g(s.view(), atlas, {.resolution = 128});
+    cpu::progressive_radiosity c(s.view(), atlas, cpu::item_buffer_visibility(s.view(), atlas, {.resolution = 128}));
+    radiosity_solve_options o;
+    o.converge = 0.95;
+    double unshot = 1;
+    o.progress = [&](const radiosity_progress& p) {
+        CHECK(p.unshot_fraction <= unshot * (1 + 1e-5));
+        unshot = p.unshot_fraction;
+        return true;
+    };
+    CHECK(g.solve(o).stop == radiosity_stop::converged);
+    unshot = 1;
+    CHECK(c.solve(o).stop == radiosity_stop::converged);
+    const auto bg = g.display_radiosity(), bc = c.display_radiosity();
+    const glm::vec2 size(float(atlas.width), float(atlas.height));
+    const auto uv = atlas.corner_uvs(s.view());
+    std::size_t dark = 0;
+    double sum_g = 0, sum_c = 0;
+    for (std::uint32_t t = 2; t < s.triangles.size(); ++t) {  // after the lamp's two
+        const glm::vec2 p = (uv[3 * t] + uv[3 * t + 1] + uv[3 * t + 2]) / 3.f * size;
+        const auto e = std::size_t(atlas.element_at(std::uint32_t(p.x), std::uint32_t(p.y)));
+        dark += bg[e].x + bg[e].y + bg[e].z > 0.f ? 0 : 1;
+    }
+    for (std::size_t e = 0; e < atlas.size(); ++e) {
+        sum_g += double(bg[e].x + bg[e].y + bg[e].z) * atlas.area[e];
+        sum_c += double(bc[e].x + bc[e].y + bc[e].z) * atlas.area[e];
+    }
+    CHECK(dark == 0);
+    CHECK(sum_g == Approx(sum_c).epsilon(0.02));  // the same radiant exitance within 2%
 }
