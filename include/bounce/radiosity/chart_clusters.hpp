@@ -32,7 +32,9 @@
 #include <tuple>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include <bounce/radiosity/chart_growth.hpp>
