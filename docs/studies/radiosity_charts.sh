@@ -5,7 +5,13 @@
 # made against asked: build/bin/lightmap_atlas), then the radiosity program at 100,000
 # elements, ray casts, to 90% of the indirect power against the 64-path multi-bounce
 # reference (rel_rms, black pixels, steps). Results into docs/results/radiosity_charts.json;
-# the atlas picture (Sponza, 10,000 elements) into docs/figures/radiosity_atlas_sponza.png.
+# the atlas pictures (Sponza and the conference room, 10,000 elements) into
+# docs/figures/radiosity_atlas_sponza.png and radiosity_atlas_conference.png. The atlas
+# reports its clusters of tiny charts (chart_clusters.hpp; issue 30, seventh session); with
+# CLUSTER_RUNS=1 the conference room's solves are also run at 10,000 and 100,000 with the
+# default (--clusters when-needed), at 10,000 with --clusters never
+# and at 100,000 with --clusters always (the clusters' effect at one budget), 256 shooter
+# groups as the headline runs (radiosity_groups.sh).
 # Heavy scenes get --max-seconds 240 (a loaded machine). Minutes per scene on 2 shared cores.
 # Usage: docs/studies/radiosity_charts.sh [SCENE ...]   (BOUNCE_BIN: default build/bin;
 # ATLAS_ONLY=1 skips the solves)
@@ -29,7 +35,18 @@ for s in "${scenes[@]}"; do
     --curve-points 0 "${limit[@]}" --quiet --json "$out/radiosity-$s.json" --out "$out/radiosity-$s.png"
   python3 docs/studies/results.py add "$results" "radiosity-$s" "$out/radiosity-$s.json"
 done
+if [[ -n "${CLUSTER_RUNS:-}" ]]; then
+  for run in "10000 when-needed" "10000 never" "100000 when-needed" "100000 always"; do
+    set -- $run
+    "$bin/radiosity" --scene conference --elements "$1" --clusters "$2" --shooter-groups 256 --visibility rays \
+      --converge 0.9 --reference-paths 64 --curve-points 0 --max-seconds 240 --quiet --json "$out/radiosity-conference-$1-$2.json"
+    python3 docs/studies/results.py add "$results" "radiosity-conference-$1-clusters-$2" "$out/radiosity-conference-$1-$2.json"
+  done
+fi
 # The picture: Sponza's atlas at 10,000 elements, 2 pixels a texel.
 if [[ -d "${BOUNCE_SCENES:-../shared/scenes}/sponza" ]]; then
   "$bin/lightmap_atlas" --scene sponza --elements 10000 --zoom 2 --png docs/figures/radiosity_atlas_sponza.png > /dev/null
+fi
+if [[ -d "${BOUNCE_SCENES:-../shared/scenes}/conference" ]]; then
+  "$bin/lightmap_atlas" --scene conference --elements 10000 --zoom 2 --png docs/figures/radiosity_atlas_conference.png > /dev/null
 fi
