@@ -1,6 +1,7 @@
 #pragma once
 // Scenes built by hand for the radiosity tests: quads (two triangles each) in owned arrays
 // that hand out a scene_view.
+#include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/scene_view.hpp>
 
 #include <cstdint>
@@ -159,6 +160,24 @@ inline owned_scene tiny_triangles_under_a_lamp() {
             triangle(p, p + glm::vec3(0, mm, 0), p + glm::vec3(0, 0, mm), wall);
         }
     return s;
+}
+
+// The triangles from `first` on whose element (the texel their centroid's lightmap
+// coordinates fall in) has no radiosity in `b` (one value per element): what a view shows black.
+inline std::size_t unlit_triangles(const owned_scene& s, const lightmap_atlas& atlas, const std::vector<glm::vec3>& b,
+                                   std::size_t first) {
+    const glm::vec2 size(float(atlas.width), float(atlas.height));
+    const auto uv = atlas.corner_uvs(s.view());
+    std::size_t dark = 0;
+    for (std::size_t t = first; t < s.triangles.size(); ++t) {
+        const glm::vec2 p = (uv[3 * t] + uv[3 * t + 1] + uv[3 * t + 2]) / 3.f * size;
+        const std::int32_t e = atlas.element_at(std::uint32_t(p.x), std::uint32_t(p.y));
+        dark += e >= 0 && atlas.chart[std::size_t(e)] == atlas.chart_of_triangle[t] &&
+                        b[std::size_t(e)].x + b[std::size_t(e)].y + b[std::size_t(e)].z > 0.f
+                    ? 0
+                    : 1;
+    }
+    return dark;
 }
 
 }  // namespace bounce::radiosity_test

@@ -81,19 +81,11 @@ TEST_CASE("the GL solver takes clusters of tiny charts: energy never grows, ever
     unshot = 1;
     CHECK(c.solve(o).stop == radiosity_stop::converged);
     const auto bg = g.display_radiosity(), bc = c.display_radiosity();
-    const glm::vec2 size(float(atlas.width), float(atlas.height));
-    const auto uv = atlas.corner_uvs(s.view());
-    std::size_t dark = 0;
+    CHECK(unlit_triangles(s, atlas, bg, 2) == 0);  // after the lamp's two
     double sum_g = 0, sum_c = 0;
-    for (std::uint32_t t = 2; t < s.triangles.size(); ++t) {  // after the lamp's two
-        const glm::vec2 p = (uv[3 * t] + uv[3 * t + 1] + uv[3 * t + 2]) / 3.f * size;
-        const auto e = std::size_t(atlas.element_at(std::uint32_t(p.x), std::uint32_t(p.y)));
-        dark += bg[e].x + bg[e].y + bg[e].z > 0.f ? 0 : 1;
-    }
     for (std::size_t e = 0; e < atlas.size(); ++e) {
         sum_g += double(bg[e].x + bg[e].y + bg[e].z) * atlas.area[e];
         sum_c += double(bc[e].x + bc[e].y + bc[e].z) * atlas.area[e];
     }
-    CHECK(dark == 0);
     CHECK(sum_g == Approx(sum_c).epsilon(0.02));  // the same radiant exitance within 2%
 }
