@@ -20,6 +20,7 @@
 #include "view.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -56,8 +57,9 @@ struct options {
     double max_seconds = 0;           // also stop after this much solving (0: no limit)
     int shooters_per_step = 1;
     double near_field = 4;
-    bool ambient = true;  // Cohen's uniform term, the library's default
-    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  // with ambient: Cohen's, or from the shots
+    bool ambient = true;  // the ambient term (ambient_shape_for: the mixed one on the CPU, Cohen's on GL)
+    radiosity_ambient ambient_shape = radiosity_ambient::mixed;  // with ambient: Cohen's, the shots', or mixed
+    bool ambient_given = false;       // --ambient was given (else ambient_shape_for chooses by backend)
     bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
     int light_samples = 4;            // the lights' shot at k x k points of each whole texel (CPU)
     int shooter_groups = 0;           // grouped shooters: at most N groups of blocks (0: off; rays only)
@@ -124,12 +126,16 @@ inline void add_options(CLI::App& app, options& o) {
            "--ambient",
            [&o](const std::string& v) {
                o.ambient = v != "off";
-               o.ambient_shape = v == "shots" ? radiosity_ambient::shots : radiosity_ambient::uniform;
+               o.ambient_given = true;
+               o.ambient_shape = v == "shots"   ? radiosity_ambient::shots
+                                 : v == "mixed" ? radiosity_ambient::mixed
+                                                : radiosity_ambient::uniform;
            },
            "show the ambient term: off | on (= uniform, Cohen et al. 1988) | uniform | shots (amount and shape "
-           "measured from the recent shots, radiosity/ambient.hpp; CPU)")
-        ->check(CLI::IsMember({"off", "on", "uniform", "shots"}))
-        ->default_str("off");
+           "measured from the recent shots, radiosity/ambient.hpp; CPU) | mixed (the shots' amount, their shape above "
+           "an even floor of its reflected share; CPU)")
+        ->check(CLI::IsMember({"off", "on", "uniform", "shots", "mixed"}))
+        ->default_str("mixed on the CPU, uniform on GL and in re-bakes");
     app.add_option("--light-samples", o.light_samples,
                    "point, spot and directional lights taken at k x k points of each whole texel (1: its element's point)")
         ->check(CLI::Range(1, 16))->capture_default_str();
@@ -190,13 +196,21 @@ inline atlas_options atlas_options_for(const options& o) {
     return a;
 }
 
+/// The ambient term's shape the solver gets: --ambient's when given; else the mixed term on the
+/// CPU, Cohen's uniform one on GL (the GL solver's only term) and in re-bakes (a negative
+/// unshot power has no shaped amount, Cohen's term is signed).
+inline radiosity_ambient ambient_shape_for(const options& o) {
+    const bool rebake = !o.rebake_light.empty() || !o.rebake_move.empty();
+    return o.ambient_given || (o.backend != backend::gl && !rebake) ? o.ambient_shape : radiosity_ambient::uniform;
+}
+
 // The shooting options, the same for both backends (include/bounce/radiosity/options.hpp).
 inline radiosity_options solver_options_for(const options& o) {
     radiosity_options r;
     r.shoot_blocks = o.block > 1;
     r.shooters_per_step = o.shooters_per_step;
     r.ambient = o.ambient;
-    r.ambient_shape = o.ambient_shape;
+    r.ambient_shape = ambient_shape_for(o);
     r.near_field = o.near_field;
     r.two_sided = !o.one_sided;
     r.light_samples = o.light_samples;
@@ -236,8 +250,8 @@ inline void check_options(const options& o) {
         throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
     if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
     if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
-    if (o.ambient && o.ambient_shape == radiosity_ambient::shots)
-        throw parameter_error("--ambient", "'shots' runs on the CPU backend only");
+    if (o.ambient && ambient_shape_for(o) != radiosity_ambient::uniform)
+        throw parameter_error("--ambient", "'shots' and 'mixed' run on the CPU backend only");
 }
 
 inline cpu::item_buffer_visibility::options item_options_for(const options& o) {
@@ -270,7 +284,7 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"threshold", o.threshold}, {"subdivide_steps", o.subdivide_steps},
             {"converge", o.converge}, {"converge_on", name_of(measure_names, o.converge_on)}, {"max_seconds", o.max_seconds},
             {"shooters_per_step", o.shooters_per_step}, {"near_field", o.near_field},
-            {"ambient", !o.ambient ? "off" : o.ambient_shape == radiosity_ambient::shots ? "shots" : "on"}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
+            {"ambient", !o.ambient ? "off" : std::array{"on", "shots", "mixed"}[int(ambient_shape_for(o))]}, {"sides", o.one_sided ? 1 : 2}, {"light_samples", o.light_samples},
             {"shooter_groups", o.shooter_groups}, {"group_rays", o.group_rays},
             {"group_near_field", o.group_near_field},
             {"view", name_of(view_names, o.view != view_kind::automatic ? o.view : view_kind::direct_indirect)},

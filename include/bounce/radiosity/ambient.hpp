@@ -45,4 +45,41 @@ V future_delivered_power(const V& unshot, const V& shot, const V& delivered, con
     return shot_ambient_factor<T, V>(unshot, shot, reflected) * delivered;
 }
 
+/// The mixed term's floor (radiosity_ambient::mixed), W/m^2 per channel. Of the shaped term's
+/// total E = U D / (S - R), the first bounce, U D / S, lands as the window's shots delivered
+/// theirs; the rest, E R / S (its reflections, bounced on from wherever it landed), is light
+/// whose landing the window does not show, and Cohen et al.'s assumption spreads it evenly:
+/// (R / S) E / A over `area` = A, every side's area that shows the ambient. 0 where nothing
+/// was shot. `factor` = shot_ambient_factor, so E = factor D.
+template <floating T, class V>
+V mixed_ambient_floor(const V& factor, const V& shot, const V& delivered, const V& reflected, T area) {
+    V f(T(0));
+    for (int c = 0; c < 3; ++c)
+        if (shot[c] > T(0) && area > T(0)) f[c] = factor[c] * delivered[c] * std::max(reflected[c], T(0)) / shot[c] / area;
+    return f;
+}
+
+/// The mixed ambient irradiance of an element-side (W/m^2 per channel): the larger of the
+/// shaped term `shaped` = h_i factor and the floor, times `scale`, which keeps the total at E:
+///   a_i = scale max(h_i factor, floor),  scale = E / (E + sum_j A_j max(0, floor - h_j factor)),
+/// the sum over every element-side (mixed_ambient_scale). Where the shots delivered more than
+/// the floor, their shape; elsewhere (an element no shot reached included) Cohen's even level.
+template <floating T, class V>
+V mixed_ambient(const V& shaped, const V& floor, const V& scale) {
+    V a(T(0));
+    for (int c = 0; c < 3; ++c) a[c] = scale[c] * std::max(shaped[c], floor[c]);
+    return a;
+}
+
+/// mixed_ambient's scale from the total E (`total`, = factor D) and `deficit`, the floor's
+/// excess over the shaped term summed over every side, sum_j A_j max(0, floor - h_j factor): 1
+/// where both are 0.
+template <floating T, class V>
+V mixed_ambient_scale(const V& total, const V& deficit) {
+    V k(T(1));
+    for (int c = 0; c < 3; ++c)
+        if (total[c] + deficit[c] > T(0)) k[c] = total[c] / (total[c] + deficit[c]);
+    return k;
+}
+
 }  // namespace bounce::radiosity

@@ -23,8 +23,9 @@
 namespace bounce::inline radiosity {
 
 /// The ambient term's amount and shape (radiosity_options::ambient_shape): Cohen et al. 1988's
-/// uniform one, or the one measured from the solve's recent shots (radiosity/ambient.hpp).
-enum class radiosity_ambient { uniform, shots };
+/// uniform one, the one measured from the solve's recent shots, or mixed: the shots' amount in
+/// their shape above an even floor of its reflected share (radiosity/ambient.hpp).
+enum class radiosity_ambient { uniform, shots, mixed };
 
 /// How a solver shoots.
 struct radiosity_options {
@@ -32,8 +33,9 @@ struct radiosity_options {
     int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16;
                                    ///< the GL solver shoots one)
     bool ambient = true;           ///< display_radiosity adds the ambient term (Cohen et al. 1988)
-    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  ///< with ambient: uniform, or shaped
-                                   ///< by the recent shots (radiosity/ambient.hpp; CPU solver only)
+    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  ///< with ambient: uniform (as on GL and
+                                   ///< in re-bakes), shaped by the recent shots, or mixed (CPU solver
+                                   ///< only; the radiosity program's CPU default; radiosity/ambient.hpp)
     double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
                                    ///< times its side (sqrt of its area), else as its quadrants,
                                    ///< recursively; 0: always one disc (typical: 2-4)

@@ -1,7 +1,7 @@
 #pragma once
 /// \file radiosity_ambient.hpp
 /// The CPU solver's state for the ambient term shaped by its shots (radiosity/ambient.hpp,
-/// radiosity_ambient::shots): over an exponentially decayed window of recent shots, each
+/// radiosity_ambient::shots and ::mixed): over an exponentially decayed window of recent shots, each
 /// element-side's received irradiance h_i and the shots' power S, delivered power D and
 /// reflected power R. The window is measured in power, not in shots: a shot's weight falls by
 /// exp(-p / (window U)) for each later shot of power p, U the unshot power then, so it spans
@@ -65,16 +65,32 @@ public:
     /// The ambient irradiance per element of `side` of `solver` (W/m^2): 0 unless `on` and
     /// `options` ask for the term; Cohen's uniform solver.ambient() when they ask for it, and
     /// also before the first shot or after the atlas changed; else h_i U / (S - R) for the
-    /// unshot power U = solver.unshot_power().
+    /// unshot power U = solver.unshot_power() (shots), or the larger of that and the floor
+    /// of the reflections spread evenly, scaled to keep the total (mixed, radiosity/ambient.hpp).
     template <class Solver>
     std::vector<glm::vec3> field(bool on, const radiosity_options& options, const Solver& solver, int side) const {
         const std::size_t n = solver.atlas().size(), o = std::size_t(side) * n;
         if (!on || !options.ambient) return std::vector<glm::vec3>(n, glm::vec3(0.f));
         if (!shaped(options) || recent_.size() < o + n || shot_ == glm::dvec3(0))
             return std::vector<glm::vec3>(n, glm::vec3(solver.ambient()));
-        const glm::vec3 f(shot_ambient_factor<double, glm::dvec3>(solver.unshot_power(), shot_, reflected_));
+        const glm::dvec3 f = shot_ambient_factor<double, glm::dvec3>(solver.unshot_power(), shot_, reflected_);
         std::vector<glm::vec3> out(n);
-        for (std::size_t i = 0; i < n; ++i) out[i] = glm::vec3(recent_[o + i]) * f;
+        if (options.ambient_shape == radiosity_ambient::shots) {
+            for (std::size_t i = 0; i < n; ++i) out[i] = glm::vec3(glm::dvec3(recent_[o + i]) * f);
+            return out;
+        }
+        // Mixed: the floor over every side's area, and the scale that keeps the total at f D.
+        const std::span<const float> area = solver.atlas().area;
+        double total_area = 0;
+        for (float a : area) total_area += double(a);
+        const glm::dvec3 floor = mixed_ambient_floor<double, glm::dvec3>(f, shot_, delivered_, reflected_,
+                                                                         total_area * double(recent_.size() / n));
+        glm::dvec3 deficit(0);
+        for (std::size_t j = 0; j < recent_.size(); ++j)
+            deficit += double(area[j % n]) * glm::max(floor - glm::dvec3(recent_[j]) * f, glm::dvec3(0));
+        const glm::dvec3 scale = mixed_ambient_scale<double, glm::dvec3>(f * delivered_, deficit);
+        for (std::size_t i = 0; i < n; ++i)
+            out[i] = glm::vec3(mixed_ambient<double, glm::dvec3>(glm::dvec3(recent_[o + i]) * f, floor, scale));
         return out;
     }
 
@@ -84,7 +100,7 @@ public:
     glm::dvec3 reflected() const { return reflected_ / weight_; }
 
 private:
-    static bool shaped(const radiosity_options& o) { return o.ambient && o.ambient_shape == radiosity_ambient::shots; }
+    static bool shaped(const radiosity_options& o) { return o.ambient && o.ambient_shape != radiosity_ambient::uniform; }
     void rescale(double k) {
         for (vec& h : recent_) h *= Real(k);
         shot_ *= k, delivered_ *= k, reflected_ *= k, weight_ *= k;

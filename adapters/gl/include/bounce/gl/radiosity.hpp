@@ -161,6 +161,8 @@ public:
     std::vector<glm::vec3> radiosity(int side = 0) const;
     std::vector<glm::vec3> unshot(int side = 0) const;
     /// The ambient radiosity (Cohen et al. 1988) and B plus rho times it when the options ask.
+    /// Cohen's uniform term whatever radiosity_options::ambient_shape says: the shaped and mixed
+    /// terms need each shot's per-element deliveries, kept by the CPU solver only.
     glm::dvec3 ambient() const;
     std::vector<glm::vec3> display_radiosity(int side = 0) const;
     /// Per element, the light of `paths` as `quantity` (output.hpp), as
