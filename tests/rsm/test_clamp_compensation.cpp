@@ -2,7 +2,9 @@
 // the kernel is the exact complement of pixel_light_irradiance's clamp; at a crease (a lit
 // wall meeting a receiver floor) the clamped texel sum plus the compensation converges to
 // Lambert's unclamped irradiance; no surface within the clamp's distance, or a shadowed one,
-// gives exactly zero; and the renderer refuses the compensation without a near-field query.
+// gives exactly zero; without visibility the compensation counts every surface its rays cross
+// (a wall behind a screen), with rays only the first; and the renderer refuses the
+// compensation without a near-field query.
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/near_field_rays.hpp>
 #include <bounce/embree/occlusion_rays.hpp>
@@ -16,6 +18,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 using namespace bounce;
@@ -39,9 +42,21 @@ hand_built::scene crease(bool shadowed) {
     return s;
 }
 
+// The crease with a black screen (x = screen_x, |y| <= 2, z in [0, screen_top], facing +x)
+// between the wall and a receiver on the floor at x = 2 screen_x: the screen keeps the light
+// off the wall below screen_top and hides the wall below 2 screen_top from the receiver.
+constexpr float screen_x = 0.025f, screen_top = 0.02f;
+hand_built::scene screened_crease() {
+    hand_built::scene s = crease(false);
+    const auto black = hand_built::add_material(s, glm::vec3(0.f));
+    hand_built::add_quad(s, {screen_x, -2, 0}, {screen_x, 2, 0}, {screen_x, 2, screen_top},
+                         {screen_x, -2, screen_top}, {1, 0, 0}, black);
+    return s;
+}
+
 // The scene's accel, its 512^2 map, and the gather of one receiver over every lit texel
 // exactly once (a pattern of weight-1 offsets from the receiver's disc centre), with
-// visibility by rays and, with `rays` > 0, the clamp's compensation.
+// visibility by rays (or none, `visible` false) and, with `rays` > 0, the clamp's compensation.
 struct crease_gather {
     hand_built::scene s;
     embree::accel bvh{s.view()};
@@ -49,13 +64,14 @@ struct crease_gather {
     embree::occlusion_rays occlusion{bvh};
     embree::near_field_rays near{bvh, s.view()};
 
-    explicit crease_gather(bool shadowed) : s(crease(shadowed)) { caster.render(); }
+    explicit crease_gather(bool shadowed) : crease_gather(crease(shadowed)) {}
+    explicit crease_gather(hand_built::scene scene) : s(std::move(scene)) { caster.render(); }
 
     struct result {
         glm::vec3 e;
         cpu::compensation_totals totals;
     };
-    result at(glm::vec3 x, std::uint32_t rays, std::uint64_t seed = 1) {
+    result at(glm::vec3 x, std::uint32_t rays, std::uint64_t seed = 1, bool visible = true) {
         gbuffer<float> g(1, 1);
         g.view().position(0, 0) = x;
         g.view().normal(0, 0) = {0, 0, 1};
@@ -71,9 +87,11 @@ struct crease_gather {
         pixel_light_params lp;
         lp.min_distance2 = clamp_distance * clamp_distance;
         cpu::gather_compensation comp;
-        if (rays > 0) comp = {&near, compensation_grid(rays), lp.min_distance2, seed};
+        if (rays > 0) comp = {&near, compensation_grid(rays), lp.min_distance2, seed, !visible};
         image<glm::vec3> out(1, 1);
-        const auto totals = cpu::rsm_gather(g.view(), caster.views(), pattern, lp, out.view(), occlusion, comp);
+        const auto totals = cpu::rsm_gather(g.view(), cpu::interleave_maps({1, 1}, 1, 1), caster.views(), pattern,
+                                            cpu::detail::one_group(pattern.size()), lp, out.view(), true,
+                                            visible ? &occlusion : nullptr, comp);
         return {out(0, 0), totals};
     }
 };
@@ -145,6 +163,56 @@ TEST_CASE("a shadowed surface within the clamp's distance gives zero compensatio
     CHECK(compensated.totals.added == 0.0);
 }
 
+TEST_CASE("without visibility the compensation counts every surface its rays cross, with rays the first",
+          "[rsm][embree][clamp_compensation]") {
+    // Behind the screen the receiver sees no wall (rays), but the unoccluded reference counts
+    // the wall's lit part (z >= screen_top) through it: the gather without visibility plus its
+    // compensation converges to Lambert's irradiance of that part, the gather with rays plus
+    // its compensation to that of the part the receiver sees (z >= 2 screen_top).
+    crease_gather c(screened_crease());
+    const glm::vec3 x(2 * screen_x, 0, 0);
+    const double m = double(rho) * double(e0);
+    const auto lit_above = [&](double z) {
+        const std::vector<glm::dvec3> part{{0, -1, z}, {0, 1, z}, {0, 1, 1}, {0, -1, 1}};
+        return m / std::numbers::pi * hand_built::lambert_polygon(glm::dvec3(x), {0, 0, 1}, part);
+    };
+    const double unoccluded = lit_above(screen_top), occluded = lit_above(2 * screen_top);
+    const std::uint32_t rays = 16384;
+    const auto none = c.at(x, rays, 1, false), with_rays = c.at(x, rays, 1, true);
+    const auto none_clamped = c.at(x, 0, 1, false);
+    const double tolerance = 4 * m / (2 * std::sqrt(double(rays))) + 0.01 * unoccluded;
+    CAPTURE(unoccluded, occluded, none.e.x, with_rays.e.x, none_clamped.e.x, tolerance);
+    CHECK(unoccluded - occluded > 2 * tolerance);  // the hidden strip is seen
+    CHECK(std::abs(double(none.e.x) - unoccluded) < tolerance);
+    CHECK(std::abs(double(with_rays.e.x) - occluded) < tolerance);
+    CHECK(unoccluded - double(none_clamped.e.x) > 2 * tolerance);  // the clamp's loss, given back
+    CHECK(none.totals.added > with_rays.totals.added + 2 * tolerance);
+
+    // One ray through the screen to the wall's lit part: the first surface (the black screen)
+    // sends nothing; every surface: the screen, then the wall at M / pi.
+    const glm::vec3 wall_point(0, 0, 0.03f);  // seen through the screen (at z 0.015)
+    const near_field_ray r{x, {0, 0, 1}, glm::normalize(wall_point - x), clamp_distance, 3};
+    glm::vec3 radiance(1.f);
+    float d2 = 0.f;
+    c.near.radiance({&r, 1}, {&radiance, 1}, {&d2, 1});
+    CHECK(radiance == glm::vec3(0.f));
+    std::vector<near_field_crossing> crossed;
+    c.near.crossings({&r, 1}, crossed);
+    REQUIRE(crossed.size() == 2);
+    CHECK(crossed[0].radiance == glm::vec3(0.f));
+    CHECK(crossed[0].distance2 == Approx(d2).epsilon(1e-4));
+    CHECK(crossed[1].ray == 0);
+    CHECK(crossed[1].radiance.x == Approx(m / std::numbers::pi).epsilon(1e-4));
+    const glm::vec3 origin = x + c.bvh.ray_epsilon() * r.normal;  // where the ray starts
+    const glm::vec3 on_wall = origin + r.direction * (-origin.x / r.direction.x);
+    CHECK(crossed[1].distance2 == Approx(glm::dot(on_wall - x, on_wall - x)).epsilon(1e-3));
+
+    // Nothing within the clamp's distance: exactly zero, with or without visibility.
+    const auto far = c.at(glm::vec3(0.5f, 0, 0), 64, 1, false);
+    CHECK(far.totals.rays == compensation_grid(64).count());
+    CHECK(far.totals.added == 0.0);
+}
+
 TEST_CASE("the gather's compensation with rays needs a near-field query", "[rsm][clamp_compensation]") {
     hand_built::scene s = crease(false);
     const embree::accel bvh(s.view());
@@ -159,6 +227,9 @@ TEST_CASE("the gather's compensation with rays needs a near-field query", "[rsm]
     const embree::near_field_rays near(bvh, s.view());
     o.clamp_compensation_rays = 16;
     CHECK_NOTHROW(cpu::indirect_renderer(o, &occlusion, nullptr, &near));
+    o.visibility = indirect_visibility::none;  // the compensation of every surface
+    CHECK_THROWS_WITH(cpu::indirect_renderer(o), Catch::Contains("clamp_compensation_rays"));
+    CHECK_NOTHROW(cpu::indirect_renderer(o, nullptr, nullptr, &near));
 }
 
 TEST_CASE("the renderer's compensation is per pixel, the same interleaved or not, zero away from the crease",

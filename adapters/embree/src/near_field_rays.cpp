@@ -10,7 +10,8 @@
 
 namespace bounce::embree {
 
-near_field_rays::near_field_rays(const accel& bvh, const scene_view& scene) : integrator_(bvh, scene) {}
+near_field_rays::near_field_rays(const accel& bvh, const scene_view& scene)
+    : integrator_(bvh, scene), unoccluded_(bvh, scene) {}
 
 void near_field_rays::radiance(std::span<const bounce::indirect::near_field_ray> rays, std::span<glm::vec3> radiance,
                                std::span<float> distance2) const {
@@ -37,6 +38,20 @@ void near_field_rays::radiance(std::span<const bounce::indirect::near_field_ray>
         }
         const glm::vec3 v = traced[i].origin + traced[i].direction * distance[i] - rays[i].receiver;
         distance2[i] = glm::dot(v, v);
+    }
+}
+
+void near_field_rays::crossings(std::span<const bounce::indirect::near_field_ray> rays,
+                                std::vector<bounce::indirect::near_field_crossing>& out) const {
+    out.clear();
+    const float eps = unoccluded_.ray_epsilon();
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const auto& r = rays[i];
+        const ray traced{r.receiver + eps * r.normal, r.direction, 0.f, r.length};
+        unoccluded_.for_each_sender(traced, [&](float t, const glm::dvec3& l) {
+            const glm::vec3 v = traced.origin + traced.direction * t - r.receiver;
+            out.push_back({std::uint32_t(i), glm::dot(v, v), glm::vec3(l)});
+        });
     }
 }
 

@@ -73,14 +73,7 @@ glm::vec3 unoccluded_reference::indirect_irradiance(glm::vec3 p, glm::vec3 n, st
             r.direction = glm::normalize(local.x * tb[0] + local.y * tb[1] + local.z * n);
             r.tnear = 0.f;
             // Every surface along the ray sends its reflected light to p: no visibility.
-            for (std::uint32_t s = 0; s < settings_.max_surfaces; ++s) {
-                const hit h = bvh_.intersect(r);
-                if (!h.found()) break;
-                const surface q = surface_at(scene_, r, h);
-                const glm::vec3 e = direct_irradiance(q.position, q.normal, q.geometric_normal);
-                sum += glm::dvec3(q.albedo) * (1.0 / pi) * glm::dvec3(e);
-                r.tnear = h.t + epsilon_;  // the direction is unit: t is a distance
-            }
+            for_each_sender(r, [&](float, const glm::dvec3& l) { sum += l; });
         }
     return glm::vec3(sum * (pi / double(grid.count())));
 }

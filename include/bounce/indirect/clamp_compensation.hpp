@@ -15,7 +15,17 @@
 /// cosine-distributed rays of length r_c (pdf cos_x / pi) estimate it without bias:
 ///   E_missing ~ pi / K sum_k L(y_k) (1 - d_k^2 / r_c^2)_+
 /// (clamp_compensation_term; a ray that finds nothing within r_c adds exactly 0). Gather plus
-/// compensation then converges to the unclamped integral of the light x sees. With an offset
+/// compensation then converges to the unclamped integral of the light x sees.
+///
+/// Without visibility the gather sums every lit texel whatever lies between, and the clamp
+/// removes the light of every surface q along each direction within r_c, not only the first:
+///   E_missing_u(x) = int cos_x sum_{q on (x, w), d_q < r_c} L(q) (1 - d_q^2 / r_c^2)_+ dw,
+/// where L(q) is q's light towards x as the unoccluded reference shades its senders (lit on
+/// the side facing x, with the light's shadow ray; embree/rsm_unoccluded_reference.hpp). The
+/// same rays estimate it by the same term summed over each ray's crossings
+/// (near_field_query::crossings), and the gather plus it converges to that reference's
+/// unclamped integral. The frames with and without visibility then carry the same
+/// compensation of the same clamp, each of its own near field. With an offset
 /// > 0 the gather's kernel also moves its senders: the compensation is the complement of the
 /// clamp alone.
 ///
@@ -30,6 +40,7 @@
 #include <cstdint>
 #include <numbers>
 #include <span>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -77,8 +88,17 @@ struct near_field_ray {
     std::uint64_t seed = 0;
 };
 
+/// One surface a near-field ray crosses: the ray's index in its batch, the surface's squared
+/// distance from the receiver and its outgoing radiance towards the receiver.
+struct near_field_crossing {
+    std::uint32_t ray = 0;
+    float distance2 = 0.f;
+    glm::vec3 radiance{0.f};
+};
+
 /// What the compensation asks of a ray tracer (embree::near_field_rays on the CPU): the first
-/// surface along each ray and the one-bounce light it sends back. An implementation must be
+/// surface along each ray (or every one, without visibility) and the one-bounce light it sends
+/// back. An implementation must be
 /// safe to call from several threads at once.
 class near_field_query {
 public:
@@ -89,6 +109,10 @@ public:
     /// receiver, +infinity (and radiance 0) where the ray meets nothing. Sizes match.
     virtual void radiance(std::span<const near_field_ray> rays, std::span<glm::vec3> radiance,
                           std::span<float> distance2) const = 0;
+    /// Every surface each ray crosses within its length, not only the first (the frame without
+    /// visibility), shaded as the unoccluded one-bounce reference shades its senders, appended
+    /// to `out` ray by ray in order along each ray (`out` is cleared first).
+    virtual void crossings(std::span<const near_field_ray> rays, std::vector<near_field_crossing>& out) const = 0;
 
 protected:
     near_field_query() = default;

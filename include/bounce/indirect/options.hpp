@@ -138,10 +138,12 @@ struct indirect_options {
     /// as DS05/DS06 do; rays tests every pair the frame sums (the renderer needs an
     /// occlusion_query, CPU only).
     indirect_visibility visibility = indirect_visibility::none;
-    /// With visibility rays, the RSM gather (CPU): cosine rays per pixel that give back the light
-    /// the clamp (light.min_distance2) removes within its distance (indirect/clamp_compensation.hpp;
-    /// docs section 15, seventh session); the renderer then needs a near_field_query. 0: off
-    /// (the library's default); typical 16. Ignored without rays and by SII.
+    /// The RSM gather (CPU) with visibility rays or none: cosine rays per pixel that give back
+    /// the light the clamp (light.min_distance2) removes within its distance, from each ray's
+    /// first surface with rays, from every surface it crosses without visibility
+    /// (indirect/clamp_compensation.hpp; docs section 15, seventh session); the renderer then
+    /// needs a near_field_query. 0: off (the library's default); typical 16. Ignored with ism
+    /// and by SII.
     std::uint32_t clamp_compensation_rays = 0;
     /// With visibility rays (CPU): SII's VPLs drawn again from a larger pool by their
     /// visible contribution to a sparse grid of pixels (indirect/view_selection.hpp; docs

@@ -43,7 +43,8 @@ public:
     /// `occlusion` answers the visibility queries of options.visibility == rays
     /// (embree::occlusion_query); `points` samples the scene for visibility ism. Both must
     /// outlive the frames that use them. `near_field` answers the rays of the RSM gather's
-    /// clamp compensation (options.clamp_compensation_rays > 0 with rays; embree::near_field_rays).
+    /// clamp compensation (options.clamp_compensation_rays > 0 with visibility rays or none;
+    /// embree::near_field_rays).
     explicit indirect_renderer(const indirect_options& options = {}, const occlusion_query* occlusion = nullptr,
                                const ism_point_sampler* points = nullptr, const near_field_query* near_field = nullptr)
         : options_(options), occlusion_(occlusion), points_(points), near_field_(near_field) {
@@ -250,10 +251,12 @@ private:
         add_totals(c, t);
     }
 
-    /// The gather's clamp compensation: active with rays, a positive ray count and a clamp.
+    /// The gather's clamp compensation: active with a positive ray count, a clamp and
+    /// visibility rays (each ray's first surface) or none (every surface it crosses).
     gather_compensation compensation() const {
         gather_compensation c;
-        if (occlusion() == nullptr || options_.clamp_compensation_rays == 0) return c;
+        if (!compensated(options_)) return c;
+        c.every_surface = options_.visibility == indirect_visibility::none;
         c.query = near_field_;
         c.grid = compensation_grid(options_.clamp_compensation_rays);
         c.min_distance2 = options_.light.min_distance2;
@@ -325,9 +328,14 @@ private:
                                                 "renderer");
     }
 
+    /// Whether `o` asks for the gather's clamp compensation (visibility rays or none).
+    static bool compensated(const indirect_options& o) {
+        return o.clamp_compensation_rays > 0 &&
+               (o.visibility == indirect_visibility::rays || o.visibility == indirect_visibility::none);
+    }
+
     static void require_near_field(const indirect_options& o, const near_field_query* q) {
-        if (o.visibility == indirect_visibility::rays && o.technique == indirect_technique::rsm_gather &&
-            o.clamp_compensation_rays > 0 && !q)
+        if (compensated(o) && o.technique == indirect_technique::rsm_gather && !q)
             throw parameter_error("clamp_compensation_rays", "needs a near_field_query (embree::near_field_rays) "
                                                              "given to the renderer");
     }

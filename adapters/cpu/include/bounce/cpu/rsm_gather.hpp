@@ -36,13 +36,16 @@
 
 namespace bounce::cpu {
 
-/// The clamp's compensation of a gather with visibility by rays (indirect/clamp_compensation.hpp):
-/// `grid` cosine rays per receiver of length sqrt(min_distance2) asked of `query`.
+/// The clamp's compensation of a gather (indirect/clamp_compensation.hpp): `grid` cosine rays
+/// per receiver of length sqrt(min_distance2) asked of `query`; each ray's first surface (the
+/// gather with visibility by rays) or, with `every_surface` (the gather without visibility),
+/// every surface it crosses.
 struct gather_compensation {
     const near_field_query* query = nullptr;
     compensation_grid grid{16};
     float min_distance2 = 0.f;
     std::uint64_t seed = 1;
+    bool every_surface = false;
     bool active() const noexcept { return query != nullptr && min_distance2 > 0.f; }
 };
 
@@ -91,23 +94,32 @@ struct visible_gather_scratch {
     std::vector<near_field_ray> rays;
     std::vector<glm::vec3> radiance;
     std::vector<float> distance2;
+    std::vector<near_field_crossing> crossings;
     compensation_totals totals;  // what this thread's compensation added
 };
 
 /// The clamp's compensation at receiver x (unit normal n): the light of the surfaces its
-/// rays meet within the clamp's distance, weighted by the clamp's complement.
+/// rays meet (the first, or every one with comp.every_surface) within the clamp's distance,
+/// weighted by the clamp's complement.
 inline glm::vec3 compensation_at(const glm::vec3& x, const glm::vec3& n, const gather_compensation& comp,
                                  visible_gather_scratch& sc) {
     sc.rays.clear();
     clamp_compensation_rays(x, n, comp.min_distance2, comp.grid, comp.seed, sc.rays);
-    sc.radiance.resize(sc.rays.size());
-    sc.distance2.resize(sc.rays.size());
-    comp.query->radiance(sc.rays, sc.radiance, sc.distance2);
     glm::vec3 e(0.f);
     const float count = float(sc.rays.size());
-    for (std::size_t k = 0; k < sc.rays.size(); ++k)
-        if (sc.distance2[k] < comp.min_distance2)
-            e += clamp_compensation_term<float, glm::vec3>(sc.radiance[k], sc.distance2[k], comp.min_distance2, count);
+    const auto add = [&](const glm::vec3& radiance, float d2) {
+        if (d2 < comp.min_distance2)
+            e += clamp_compensation_term<float, glm::vec3>(radiance, d2, comp.min_distance2, count);
+    };
+    if (comp.every_surface) {
+        comp.query->crossings(sc.rays, sc.crossings);
+        for (const near_field_crossing& c : sc.crossings) add(c.radiance, c.distance2);
+    } else {
+        sc.radiance.resize(sc.rays.size());
+        sc.distance2.resize(sc.rays.size());
+        comp.query->radiance(sc.rays, sc.radiance, sc.distance2);
+        for (std::size_t k = 0; k < sc.rays.size(); ++k) add(sc.radiance[k], sc.distance2[k]);
+    }
     sc.totals.rays += sc.rays.size();
     sc.totals.added += double(e.x + e.y + e.z);
     return e;
@@ -116,18 +128,21 @@ inline glm::vec3 compensation_at(const glm::vec3& x, const glm::vec3& n, const g
 /// Irradiance the samples `pattern` (already grouped, weights times `scale`) gather at one
 /// receiver from every map; with `occlusion`, only from the texels it sees (one segment a
 /// sample that gives light, asked in one batch), plus the clamp's compensation when `comp`
-/// is active.
+/// is active (with or without `occlusion`).
 inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<const rsm_view> maps,
                            std::span<const glm::vec3> pattern, float scale, const pixel_light_params& lp,
                            const occlusion_query* occlusion = nullptr, visible_gather_scratch* scratch = nullptr,
                            const gather_compensation& comp = {}) {
     glm::vec3 e(0.f);
-    if (!occlusion) {
-        for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
-        return e;
-    }
     visible_gather_scratch own;  // for a caller without scratch of its own
     visible_gather_scratch& sc = scratch ? *scratch : own;
+    if (!occlusion) {
+        for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
+        if (!comp.active()) return e;
+        e += compensation_at(x, n, comp, sc);
+        sc.totals.total += double(e.x + e.y + e.z);
+        return e;
+    }
     sc.segments.clear();
     sc.terms.clear();
     const auto collect = [&](const glm::vec3& t, const glm::vec3& xp, const glm::vec3& np) {
@@ -172,8 +187,8 @@ inline compensation_totals sum_totals(tbb::enumerable_thread_specific<visible_ga
 /// times interleaved_weight_scale(n, m) (weight 1 with `energy_correct` false, the thesis's
 /// choice, for comparison). `out` (irradiance, W/m^2) is written everywhere; 0 where the
 /// G-buffer sees nothing. With a 1 x 1 pattern this is the plain DS05 gather. With
-/// `occlusion`, a pixel sums only the samples whose texel it sees (indirect/visibility.hpp),
-/// and with an active `comp` gets back the light the clamp removes (clamp_compensation.hpp).
+/// `occlusion`, a pixel sums only the samples whose texel it sees (indirect/visibility.hpp);
+/// with an active `comp` it gets back the light the clamp removes (clamp_compensation.hpp).
 /// Returns what the compensation added (zeros without it).
 inline compensation_totals rsm_gather(const gbuffer_view<float>& gb, const interleave_maps& imaps,
                                       std::span<const rsm_view> maps, std::span<const glm::vec3> pattern,

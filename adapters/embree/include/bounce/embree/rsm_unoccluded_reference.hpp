@@ -36,6 +36,7 @@
 #include <bounce/scene_view.hpp>
 
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -72,6 +73,22 @@ public:
     /// Direct irradiance (W/m^2) at `p` with unit normal `n` from the point, spot and
     /// directional lights, each times its shadow ray, which leaves along `offset_normal`.
     glm::vec3 direct_irradiance(glm::vec3 p, glm::vec3 n, glm::vec3 offset_normal) const;
+    /// Calls f(t, L) for each surface along `r` (unit direction, from r.tnear to r.tfar) in
+    /// order, as E_u counts them: each at least ray_epsilon() past the previous, at most
+    /// settings().max_surfaces; t its distance along r, L = rho / pi E_d (a dvec3) its
+    /// radiance towards r's origin. indirect_irradiance's senders, and the unoccluded near
+    /// field of the RSM gather's clamp compensation (embree::near_field_rays).
+    template <class F>
+    void for_each_sender(ray r, F&& f) const {
+        for (std::uint32_t s = 0; s < settings_.max_surfaces; ++s) {
+            const hit h = bvh_.intersect(r);
+            if (!h.found()) break;
+            const surface q = surface_at(scene_, r, h);
+            const glm::vec3 e = direct_irradiance(q.position, q.normal, q.geometric_normal);
+            f(h.t, glm::dvec3(q.albedo) * (1.0 / std::numbers::pi) * glm::dvec3(e));
+            r.tnear = h.t + epsilon_;  // the direction is unit: t is a distance
+        }
+    }
     /// E_u(p, n) (W/m^2) from about `samples` stratified rays drawn from `seed`. Throws
     /// parameter_error on a non-finite p or a non-unit n.
     glm::vec3 indirect_irradiance(glm::vec3 p, glm::vec3 n, std::uint32_t samples, std::uint64_t seed) const;
