@@ -26,7 +26,10 @@
 ///    the shooter's centre to the receiver) meets the object's box before or after the move.
 ///    Every shooter that shot re-shoots its S to exactly those receivers, negatively with the
 ///    old geometry and visibility and positively with the new; every other pair's delivery is
-///    the same both times and is skipped (segment_meets_box). What the moved elements received
+///    the same both times and is skipped (segment_meets_box). The moved object's own shooters
+///    are re-shot with the old geometry only: their S returns to their unshot radiosity
+///    (S = 0, dB = B there), which (1) allows, and the solve shoots it with the new geometry,
+///    together with what else they hold, the largest first. What the moved elements received
 ///    before needs no re-shot: it is the irradiance the shots delivered to them, which the
 ///    solver keeps. The lights' direct deposit is re-evaluated as for a light change (shadows
 ///    of the object).
@@ -185,8 +188,8 @@ struct radiosity_rebake_report {
     double ms = 0;                  ///< wall-clock time of the correction (2), lights included
     std::size_t moved_elements = 0; ///< elements of the moved charts (0 for a light)
     std::size_t shooters = 0;       ///< block-sides that had shot and re-shot their S, both passes counted
-    std::size_t moved_shooters = 0; ///< of them the moved object's (to every receiver), both passes counted
-    std::size_t moved_pairs = 0;    ///< pairs the moved object's shooters re-evaluated, both passes
+    std::size_t moved_shooters = 0; ///< of them the moved object's (to every other element, old geometry only)
+    std::size_t moved_pairs = 0;    ///< pairs the moved object's shooters re-evaluated
     std::size_t pairs = 0;          ///< receiver-shooter pairs re-evaluated, both passes counted
     std::size_t pairs_tested = 0;   ///< receiver-shooter pairs tested against the boxes
     double unshot_before = 0;       ///< |unshot| power / emitted power before the correction

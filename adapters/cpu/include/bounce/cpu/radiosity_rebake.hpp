@@ -20,8 +20,8 @@
 /// the receivers whose delivery can differ: those whose visibility ray from the shooter's
 /// centre meets the object's box before or after the move, and, with the new geometry, the
 /// moved object's elements (what they received before is their gathered irradiance, taken
-/// away as it is); a moved block re-shoots to every other element with the old geometry and
-/// to every element with the new. Then one shot per light. With the item buffers, each of
+/// away as it is); a moved block re-shoots to every other element with the old geometry only:
+/// what it shot returns to its unshot radiosity, for the solve. Then one shot per light. With the item buffers, each of
 /// those shots draws its item buffer whole. rebake_move's `share` < 1 re-shoots only the
 /// largest block-sides holding that share of the shot power.
 
@@ -182,6 +182,25 @@ struct rebake_access {
         s.refresh_powers();
     }
 
+    // The shot radiosity of the moved block-sides `chosen` handed back to the solve as unshot
+    // radiosity: their deliveries with the old geometry were taken away and none made with the
+    // new, so they have shot nothing (S = 0, dB = B); the power, counted as escaped when taken
+    // away, is unshot.
+    static void unshoot(Solver& s, const std::vector<std::uint8_t>& chosen, const std::vector<std::uint8_t>& moved_block) {
+        const std::size_t n = s.atlas_.size(), blocks = s.first_.size() - 1;
+        glm::dvec3 returned(0);
+        for (std::size_t k = 0; k < chosen.size(); ++k) {
+            if (!chosen[k] || !moved_block[k % blocks]) continue;
+            for (std::size_t j = (k / blocks) * n + s.first_[k % blocks]; j < (k / blocks) * n + s.first_[k % blocks + 1]; ++j) {
+                returned += glm::dvec3(s.radiosity_[j] - s.unshot_[j]) * double(s.atlas_.area[j % n]);
+                s.unshot_[j] = s.radiosity_[j], s.effective_shot_[j] = vec(0);
+            }
+        }
+        s.escaped_ -= returned;
+        s.shot_power_ -= returned.x + returned.y + returned.z;
+        s.refresh_powers();
+    }
+
     static radiosity_rebake_report change_light(Solver& s, std::size_t index, const bounce::light& changed) {
         if (index >= s.lights_.size())
             throw parameter_error("index", "is light " + std::to_string(index) + " of the scene's " +
@@ -234,10 +253,16 @@ struct rebake_access {
         move_charts(s.atlas_, charts, m);
         s.visibility_ = std::forward<Visibility>(visibility);
         s.build_shooters();  // the moved blocks' centres, the groups' boxes
-        reshoot(s, S, chosen, moved_block, filter,
-                [&](const glm::vec3& c, std::uint32_t i, bool whole) { return whole || moved_element[i] || through(c, i); }, 1.0,
-                delta, r);  // the new
+        // The moved object's own S is not re-shot with the new geometry: it goes back to the
+        // solve as unshot radiosity (unshoot), which shoots it with the rest of its dB, the
+        // largest first (0.62 of a fresh solve's pairs on the Cornell box against 0.76 re-shot).
+        std::vector<std::uint8_t> unmoved = chosen;
+        for (std::size_t k = 0; k < unmoved.size(); ++k) unmoved[k] = chosen[k] && !moved_block[k % blocks];
+        reshoot(s, S, unmoved, moved_block, filter,
+                [&](const glm::vec3& c, std::uint32_t i, bool) { return moved_element[i] || through(c, i); }, 1.0, delta,
+                r);  // the new
         apply(s, delta, regather_direct(s));
+        unshoot(s, chosen, moved_block);
         r.unshot_after = s.unshot_fraction();
         r.ms = Solver::ms_since(start);
         return r;
