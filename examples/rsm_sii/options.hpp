@@ -46,7 +46,7 @@ struct options {
     float footprint_clamp = -1.f;      // SII: d^2 clamped at the disc of each VPL's area times this^2; 0: --clamp;
                                        // unset (< 0): default_pixel_light's (1 plain, 0 interleaved)
     float offset = 0.f;                // sender moved along -n_p (m), DS05's remedy
-    std::uint32_t compensation_rays = 16;  // RSM gather with rays: rays per pixel giving back the clamp's light
+    std::uint32_t compensation_rays = 16;  // RSM gather (CPU), rays or none: rays per pixel giving back the clamp's light
     bool blur = true;
     bool thesis_weights = false;       // interleaved lights at weight 1 (Hahn 2012), not N M
     std::uint64_t seed = 1;
@@ -93,7 +93,7 @@ inline indirect_options indirect_options_for(const options& o, indirect_techniqu
     c.seed = o.seed;
     c.visibility = o.visibility;
     c.ism = o.ism;
-    c.clamp_compensation_rays = o.compensation_rays;
+    c.clamp_compensation_rays = o.backend == backend::gl ? 0 : o.compensation_rays;  // the GL gather has none
     try {
         c.validate();
     } catch (const parameter_error& e) {
@@ -175,8 +175,8 @@ inline void add_options(CLI::App& app, options& o) {
         ->check(examples::finite_non_negative)
         ->capture_default_str();
     app.add_option("--compensation-rays", o.compensation_rays,
-                   "--technique rsm --visibility rays: cosine rays a pixel that give back the light the clamp removes "
-                   "(docs/rsm-sii-interleaved.md section 15; 0: off)")
+                   "--technique rsm (CPU), --visibility rays or none: cosine rays a pixel that give back the light the "
+                   "clamp removes, from the first surface or every one (docs/rsm-sii-interleaved.md section 15; 0: off)")
         ->check(CLI::Range(0, 4096))
         ->capture_default_str();
     app.add_flag("!--no-blur", o.blur, "skip the geometry-aware blur after interleaving");

@@ -3,6 +3,7 @@
 #include <bounce/study/benchmark_parts.hpp>
 
 #include <bounce/cpu/indirect_renderer.hpp>
+#include <bounce/embree/near_field_rays.hpp>
 #include <bounce/embree/occlusion_rays.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/output.hpp>
@@ -21,8 +22,11 @@ namespace {
 // rsm_sii's defaults (examples/rsm_sii/options.hpp): the settings' lights a frame (1,024 by
 // default; SII: VPLs by flux warping; the gather: disc samples per pixel and map over a disc
 // of radius 1.5 map units), 256^2 texels per map, d^2 clamped at each VPL's footprint (plain SII) or at
-// scene_clamp_distance (interleaved SII, the gather; default_pixel_light), the geometry-aware blur after interleaving, energy-correct weights, seed 1.
+// scene_clamp_distance (interleaved SII, the gather; default_pixel_light), the geometry-aware blur after interleaving, energy-correct weights, seed 1;
+// the gather's clamp compensated by 16 rays a pixel with visibility rays or none.
 constexpr std::size_t map_resolution = 256;
+// The gather's clamp compensation with visibility rays or none (rsm_sii's --compensation-rays).
+constexpr std::uint32_t compensation_rays = 16;
 
 indirect_options options_for(bench_technique t, std::size_t lights, const pixel_light_params& light,
                              indirect_visibility visibility) {
@@ -32,6 +36,8 @@ indirect_options options_for(bench_technique t, std::size_t lights, const pixel_
     o.pattern = t == bench_technique::sii_interleaved ? interleave_pattern{4, 4} : interleave_pattern{1, 1};
     o.light = light;
     o.visibility = visibility;
+    if (t == bench_technique::rsm_gather && visibility != indirect_visibility::ism)
+        o.clamp_compensation_rays = compensation_rays;
     o.validate();
     return o;
 }
@@ -65,7 +71,8 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
     const embree::occlusion_rays rays(s.bvh);
     std::optional<ism_point_sampler> points;
     if (visibility == indirect_visibility::ism) points.emplace(s.scene.view());
-    cpu::indirect_renderer renderer(options, &rays, points ? &*points : nullptr);
+    const embree::near_field_rays near(s.bvh, s.scene.view());  // the gather's clamp compensation
+    cpu::indirect_renderer renderer(options, &rays, points ? &*points : nullptr, &near);
     image<glm::vec3> e(s.g.width(), s.g.height());
     // ISM: the scene's point set is made once (a static scene's), outside the timed frames.
     if (points) renderer.render(s.g.view(), s.scene.camera, caster.views(), e.view());
@@ -101,6 +108,7 @@ technique_run run_rsm_sii(const scene_setup& s, bench_technique t, indirect_visi
                     {"r_max", options.r_max},
                     {"blur", options.blur},
                     {"visibility", visibility_name(visibility)},
+                    {"compensation_rays", options.clamp_compensation_rays},
                     {"selection", "warping"},
                     {"repeat", std::max(1, s.settings.repeat)}};
     if (points) {
