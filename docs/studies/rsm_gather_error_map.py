@@ -19,8 +19,9 @@ gather --dump DIR` writes (256x256 float32 RGB, row-major) and
 `rsm_visibility_study --configs gather --json`, added with docs/studies/results.py): per scene
 and count, the errors with rays and without and their ratio, the mean over the seeds, and the
 split of each frame with rays (the report's "split"; mean over the seeds), one row per count of
-the clamp's compensation rays (the run's parameter; 0 for runs before it) with the share of the
-frame's light they add.
+the clamp's compensation rays (the run's parameter; 0 for runs before it; "K both" where the
+frame without visibility is compensated too, by its unoccluded near field) with the share of
+the frame's light they add to the frame with rays.
 
 Pure Python (zlib for the PNG): no numpy needed.
 """
@@ -99,11 +100,15 @@ def table():
         runs = json.load(f)["runs"]
     cells = {}
     for r in runs:
+        # Runs whose frame without visibility is compensated too (its unoccluded near field).
+        both = any(fr["visibility"] == "none" and fr.get("compensation_share", 0.0) > 0 for fr in r["frames"])
         for fr in r["frames"]:
             if fr["config"] != "gather":
                 continue
             k = r["parameters"].get("compensation_rays", 0)
-            c = cells.setdefault((fr["scene"], fr["vpls"], k), {}).setdefault(r["parameters"]["seed"], {})
+            key = (fr["scene"], fr["vpls"], f"{k} both" if both else str(k) if "compensation_rays" in r["parameters"]
+                   else "0")
+            c = cells.setdefault(key, {}).setdefault(r["parameters"]["seed"], {})
             c[fr["visibility"]] = fr["rel_rms_debiased"]
             if fr["visibility"] == "rays":
                 c["share"] = fr.get("compensation_share", 0.0)
@@ -121,7 +126,7 @@ def table():
         mark = "**" if rays / none > 1.2 else ""
         splits = [c["split"] for c in both if "split" in c]
         sm = lambda k: f"{sum(s[k] for s in splits) / len(splits):.3f}" if splits else "-"
-        share = f"{100 * mean(lambda c: c.get('share', 0.0)):.2f}%" if k else "-"
+        share = f"{100 * mean(lambda c: c.get('share', 0.0)):.2f}%" if k != "0" else "-"
         print(f"| {scene} | {n} | {k} | {','.join(str(s) for s in sorted(seeds))} | {rays:.3f} / {none:.3f} = "
               f"{mark}{rays / none:.2f}{mark} | {sm('none_error_in_occluded_units')} | {sm('visibility_change')} | "
               f"{sm('references_rms_ratio')} | {share} |")
