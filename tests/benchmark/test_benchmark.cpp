@@ -223,8 +223,13 @@ TEST_CASE("one scene: every technique runs and the results have their shape", "[
     for (const auto& v : j["visibility"]) {
         INFO(v.dump());
         CHECK(finite_number(v.at("rays_vs_occluded")));
-        CHECK(finite_number(v.at("none_vs_unoccluded")));
-        CHECK(finite_number(v.at("ratio")));
+        REQUIRE(finite_number(v.at("none_vs_unoccluded")));
+        // The debiased error is 0 where the frame is within the reference's own noise (the
+        // gather without visibility, its clamp compensated, on this small frame): no ratio.
+        if (v["none_vs_unoccluded"].get<double>() > 0.0)
+            CHECK(finite_number(v.at("ratio")));
+        else
+            CHECK(v.at("ratio").is_null());
     }
     CHECK(techniques[0]["counts"]["records"].get<std::size_t>() > 0);
     CHECK(techniques[7]["counts"]["elements"].get<std::size_t>() > 0);

@@ -40,6 +40,7 @@
 ///             "mc_equal_error_unoccluded": {...} } ],    // RSM gather and SII only
 ///       "monte_carlo": { "<quantity>": [ {"spp", "ms", "rel_rms", "rel_rms_debiased", "ssim"} ] },
 ///       "visibility": [ {"technique", "rays_vs_occluded", "none_vs_unoccluded", "ratio"} ] } ] }
+///                      // ratio null when none_vs_unoccluded is 0 (within the reference's noise)
 /// ```
 /// Non-finite numbers are written as null. A technique that fails on a scene is listed with
 /// `failed` (the message) instead of its figures.
