@@ -14,12 +14,11 @@
 #include <bounce/cpu/indirect_renderer.hpp>
 #include <bounce/embree/accel.hpp>
 #include <bounce/embree/near_field_rays.hpp>
-#include <bounce/embree/occlusion_rays.hpp>
 #include <bounce/embree/rsm_ray_cast.hpp>
 #include <bounce/io/scene.hpp>
-#include <bounce/luminance.hpp>
 #include <bounce/output.hpp>
 #include <bounce/study/benchmark_parts.hpp>
+#include <bounce/study/indirect_diagnostics.hpp>
 
 #include "../common/run_program.hpp"
 
@@ -29,10 +28,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
-#include <array>
-#include <atomic>
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -58,136 +54,8 @@ struct options {
     std::uint32_t compensation_rays = 16;  // the gather with rays: the clamp's compensation (0: off)
 };
 
-/// The occlusion queries --occlusion compares (the RSM gather's bias with rays, issue 29):
-/// "rays" answers as embree::occlusion_rays (each end moved off its surface along the given,
-/// shading, normal); "geometric" moves each end along its triangle's geometric normal instead
-/// (found by a probe ray back along the shading normal); "shortened" keeps the receiver's end
-/// and stops the ray 2 epsilon before the sender itself, whatever the sender's normal says.
-/// Each counts where blocked segments meet their first surface: within 3, 30 or 300 epsilon
-/// of the receiver's end, of the sender's, or further from both.
-class diagnostic_occlusion final : public occlusion_query {
-public:
-    diagnostic_occlusion(const embree::accel& bvh, const io::scene& scene, std::string mode)
-        : bvh_(bvh), scene_(scene), mode_(std::move(mode)), eps_(bvh.ray_epsilon()) {
-        if (mode_ != "rays" && mode_ != "geometric" && mode_ != "shortened")
-            throw parameter_error("--occlusion", "must be rays, geometric or shortened");
-    }
-    void occluded(std::span<const visibility_segment> segments, std::span<std::uint8_t> blocked) const override {
-        thread_local std::vector<embree::ray> rays;
-        thread_local std::vector<embree::hit> hits;
-        rays.resize(segments.size());
-        hits.resize(segments.size());
-        for (std::size_t i = 0; i < segments.size(); ++i) {
-            const visibility_segment& s = segments[i];
-            const bool geo = mode_ == "geometric";
-            const glm::vec3 rn = geo ? geometric_normal(s.receiver, s.receiver_normal) : s.receiver_normal;
-            const glm::vec3 sn = geo ? geometric_normal(s.sender, s.sender_normal) : s.sender_normal;
-            const glm::vec3 from = segment_end(s.receiver, rn, s.sender, eps_);
-            const glm::vec3 to = mode_ == "shortened" ? s.sender : segment_end(s.sender, sn, s.receiver, eps_);
-            const float len = glm::length(to - from);
-            rays[i] = {from, to - from, 0.f, mode_ == "shortened" ? std::max(0.f, 1.f - 2.f * eps_ / len) : 1.f};
-        }
-        bvh_.intersect(rays, hits);
-        for (std::size_t i = 0; i < segments.size(); ++i) {
-            blocked[i] = hits[i].found() ? 1 : 0;
-            if (!hits[i].found()) continue;
-            const float len = glm::length(rays[i].direction);
-            const float near = hits[i].t * len / eps_, far = (1.f - hits[i].t) * len / eps_;
-            const std::size_t end = near <= far ? 0 : 1;
-            const float d = std::min(near, far);
-            counts_[end][d < 3.f ? 0 : d < 30.f ? 1 : d < 300.f ? 2 : 3] += 1;
-        }
-        total_ += segments.size();
-    }
-    void report(const std::string& scene) const {
-        fmt::print("{} occlusion {}: {} segments; blocked within 3/30/300/more eps of the receiver {} {} {} {}, "
-                   "of the sender {} {} {} {}\n",
-                   scene, mode_, total_.load(), counts_[0][0].load(), counts_[0][1].load(), counts_[0][2].load(),
-                   counts_[0][3].load(), counts_[1][0].load(), counts_[1][1].load(), counts_[1][2].load(),
-                   counts_[1][3].load());
-    }
-
-private:
-    glm::vec3 geometric_normal(const glm::vec3& p, const glm::vec3& n) const {
-        const float probe = 4.f * eps_;
-        const embree::ray r{p + n * probe, -n, 0.f, 2.f * probe};
-        const embree::hit h = bvh_.intersect(r);
-        return h.found() ? embree::surface_at(scene_.view(), r, h).geometric_normal : n;
-    }
-    embree::accel bvh_;
-    const io::scene& scene_;
-    std::string mode_;
-    float eps_;
-    mutable std::array<std::array<std::atomic<std::uint64_t>, 4>, 2> counts_{};
-    mutable std::atomic<std::uint64_t> total_{0};
-};
-
-/// `s` with every triangle's corners its own vertices carrying the triangle's geometric normal
-/// (the per-face normals an OBJ without `vn` stands for, instead of the loader's smoothed ones).
-io::scene flat_shaded(const io::scene& s) {
-    io::scene f = s;
-    f.name = s.name + "-flat";
-    f.positions.clear();
-    f.normals.clear();
-    f.triangles.clear();
-    for (const glm::uvec3& t : s.triangles) {
-        const glm::vec3 a = s.positions[t.x], b = s.positions[t.y], c = s.positions[t.z];
-        glm::vec3 n = glm::cross(b - a, c - a);
-        const float len = glm::length(n);
-        n = len > 0.f ? n / len : s.normals[t.x];
-        // Keep the side the smoothed normals gave (the winding's side, as the loader's).
-        if (glm::dot(n, s.normals[t.x] + s.normals[t.y] + s.normals[t.z]) < 0.f) n = -n;
-        const std::uint32_t k = std::uint32_t(f.positions.size());
-        for (const glm::vec3& p : {a, b, c}) {
-            f.positions.push_back(p);
-            f.normals.push_back(n);
-        }
-        f.triangles.push_back({k, k + 1, k + 2});
-    }
-    return f;
-}
-
 void dump_image(const options& o, const std::string& scene, const std::string& name, image_view<const glm::vec3> img) {
-    if (o.dump.empty()) return;
-    std::filesystem::create_directories(o.dump);
-    const auto file = std::filesystem::path(o.dump) / (scene + "." + name + ".f32");
-    std::FILE* f = std::fopen(file.string().c_str(), "wb");
-    if (f == nullptr) throw parameter_error("--dump", "cannot write " + file.string());
-    for (std::size_t y = 0; y < img.height(); ++y) std::fwrite(img.row(y).data(), sizeof(glm::vec3), img.width(), f);
-    std::fclose(f);
-}
-
-/// Irradiance from the references' radiance rho / pi E (0 where rho is 0), blurred by the
-/// frame's own 4x4 geometry-aware tent, and back to radiance.
-image<glm::vec3> blurred_reference(const gbuffer_view<float>& g, image_view<const glm::vec3> radiance,
-                                   const indirect_options& o) {
-    const std::size_t w = g.width(), h = g.height();
-    image<glm::vec3> e(w, h), scratch(w, h), out(w, h);
-    image<glm::vec2> edges(w, h);
-    for (std::size_t y = 0; y < h; ++y)
-        for (std::size_t x = 0; x < w; ++x) {
-            const glm::vec3 rho = g.albedo(x, y);
-            for (int c = 0; c < 3; ++c)
-                e(x, y)[c] = rho[c] > 0.f ? radiance(x, y)[c] * float(std::numbers::pi) / rho[c] : 0.f;
-        }
-    cpu::discontinuity_buffer(g, o.discontinuity, edges.view());
-    cpu::geometry_aware_blur(e.view(), edges.view(), g.depth, o.pattern, scratch.view(), out.view());
-    apply_output(output_quantity::radiance, image_view<const glm::vec3>(g.albedo), out.view());
-    return out;
-}
-
-/// How many of the pattern's sub-buffers the blur of geometry alone reaches at each pixel
-/// (cpu::reached_sub_buffers: 16 inside a surface at 4x4, fewer where depth or normal edges
-/// cut the tent short), in every channel, for --dump.
-image<glm::vec3> reached_sub_buffers(const gbuffer_view<float>& g, const indirect_options& o) {
-    image<glm::vec2> edges(g.width(), g.height());
-    image<float> reached(g.width(), g.height());
-    cpu::discontinuity_buffer(g, o.discontinuity, edges.view());
-    cpu::reached_sub_buffers(edges.view(), g.depth, o.pattern, reached.view());
-    image<glm::vec3> out(g.width(), g.height());
-    for (std::size_t y = 0; y < g.height(); ++y)
-        for (std::size_t x = 0; x < g.width(); ++x) out(x, y) = glm::vec3(reached(x, y));
-    return out;
+    if (!o.dump.empty()) study::write_raw_f32(std::filesystem::path(o.dump) / (scene + "." + name + ".f32"), img, "--dump");
 }
 
 int run(const options& o) {
@@ -206,7 +74,7 @@ int run(const options& o) {
     bench::run_clock clock({}, o.scenes.size(), 1.0);
     for (std::size_t si = 0; si < o.scenes.size(); ++si) {
         const io::scene loaded = io::load_scene_arg(o.scenes[si]);
-        const io::scene scene = o.flat_normals ? flat_shaded(loaded) : loaded;
+        const io::scene scene = o.flat_normals ? study::flat_shaded(loaded) : loaded;
         const embree::accel bvh(scene);
         clock.begin_scene(scene.name, si);
         const bench::scene_setup s = bench::make_scene_setup(scene, bvh, settings, clock);
@@ -232,7 +100,7 @@ int run(const options& o) {
         rs.resolution = 256;
         embree::rsm_ray_caster caster(bvh, scene, rs);
         caster.render();
-        const diagnostic_occlusion rays(bvh, scene, o.occlusion);
+        const study::diagnostic_occlusion rays(bvh, scene, o.occlusion);
         const embree::near_field_rays near(bvh, scene.view());
         cpu::indirect_renderer renderer({}, &rays, nullptr, &near);
 
@@ -246,10 +114,10 @@ int run(const options& o) {
             indirect_options b = base;
             b.pattern = p44;
             if (!o.dump.empty())
-                dump_image(o, scene.name, "reached_sub_buffers", reached_sub_buffers(s.g.view(), b).view());
+                dump_image(o, scene.name, "reached_sub_buffers", study::reached_sub_buffers_image(s.g.view(), b).view());
             for (const bool vis : {false, true}) {
                 const bench::halves_reference& ref = vis ? occluded : unoccluded;
-                const image<glm::vec3> blurred = blurred_reference(s.g.view(), ref.mean.view(), b);
+                const image<glm::vec3> blurred = study::blurred_reference(s.g.view(), ref.mean.view(), b);
                 const bench::measured_error e = bench::measure_error(blurred.view(), ref, s.mask.view());
                 fmt::print("{} reference {} blurred 4x4: raw {:.4f} debiased {:.4f}\n", scene.name,
                            vis ? "occluded" : "unoccluded", e.rel_rms, e.rel_rms_debiased);
@@ -339,7 +207,7 @@ int run(const options& o) {
                 report["frames"].back()["split"] = std::move(split);
             }
         }
-        rays.report(scene.name);
+        fmt::print("{} {}\n", scene.name, rays.summary());
     }
     if (!o.json.empty()) io::write_text_file(o.json, report.dump(2) + "\n");
     return 0;
