@@ -2,6 +2,7 @@
 // caster and the item buffers, and the multi-bounce reference against the closed form of a
 // uniformly emitting enclosure.
 #include "radiosity_scenes.hpp"
+#include "unshot_never_rises.hpp"
 #include "ray_cast_visibility.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
@@ -484,11 +485,7 @@ TEST_CASE("ray visibility over clusters of tiny charts: every triangle lit, no e
     radiosity_solve_options o;
     o.converge = 0.99;
     double unshot = 1;
-    o.progress = [&](const radiosity_progress& p) {
-        CHECK(p.unshot_fraction <= unshot * (1 + 1e-6));
-        unshot = p.unshot_fraction;
-        return true;
-    };
+    o.progress = unshot_never_rises(unshot, 1e-6);
     CHECK(solver.solve(o).stop == radiosity_stop::converged);
     CHECK(unlit_triangles(scene, atlas, solver.display_radiosity(), 2) == 0);  // after the lamp's two
 }

@@ -2,6 +2,7 @@
 // the same steps, the same checks (reversed winding, the tolerance floor). llvmpipe via EGL.
 #include "../gl/shared_context.hpp"
 #include "radiosity_scenes.hpp"
+#include "unshot_never_rises.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
 #include <bounce/cpu/radiosity_item_buffer.hpp>
@@ -72,11 +73,7 @@ TEST_CASE("the GL solver takes clusters of tiny charts: energy never grows, ever
     radiosity_solve_options o;
     o.converge = 0.95;
     double unshot = 1;
-    o.progress = [&](const radiosity_progress& p) {
-        CHECK(p.unshot_fraction <= unshot * (1 + 1e-5));
-        unshot = p.unshot_fraction;
-        return true;
-    };
+    o.progress = unshot_never_rises(unshot, 1e-5);
     CHECK(g.solve(o).stop == radiosity_stop::converged);
     unshot = 1;
     CHECK(c.solve(o).stop == radiosity_stop::converged);
