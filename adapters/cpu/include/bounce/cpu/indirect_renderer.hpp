@@ -266,9 +266,7 @@ private:
 
     /// Accumulates a gather pass's compensation into the frame's timings.
     void add_totals(const compensation_totals& c, indirect_timings& t) {
-        totals_.added += c.added;
-        totals_.total += c.total;
-        totals_.rays += c.rays;
+        totals_ += c;
         t.compensation_rays = totals_.rays;
         t.compensation_share = totals_.share();
     }

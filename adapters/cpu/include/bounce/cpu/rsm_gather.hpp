@@ -55,6 +55,10 @@ struct compensation_totals {
     double added = 0, total = 0;
     std::size_t rays = 0;
     double share() const noexcept { return total > 0 ? added / total : 0.0; }
+    compensation_totals& operator+=(const compensation_totals& o) noexcept {
+        added += o.added, total += o.total, rays += o.rays;
+        return *this;
+    }
 };
 
 namespace detail {
@@ -134,11 +138,13 @@ inline glm::vec3 gather_at(const glm::vec3& x, const glm::vec3& n, std::span<con
                            const occlusion_query* occlusion = nullptr, visible_gather_scratch* scratch = nullptr,
                            const gather_compensation& comp = {}) {
     glm::vec3 e(0.f);
+    if (!occlusion) {
+        for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
+        if (!comp.active()) return e;  // the plain gather needs no scratch
+    }
     visible_gather_scratch own;  // for a caller without scratch of its own
     visible_gather_scratch& sc = scratch ? *scratch : own;
     if (!occlusion) {
-        for_each_gather_term(x, n, maps, pattern, scale, lp, [&](const glm::vec3& t, auto&, auto&) { e += t; });
-        if (!comp.active()) return e;
         e += compensation_at(x, n, comp, sc);
         sc.totals.total += double(e.x + e.y + e.z);
         return e;
@@ -172,11 +178,7 @@ inline light_groups one_group(std::size_t count) {
 /// The totals of every thread's scratch.
 inline compensation_totals sum_totals(tbb::enumerable_thread_specific<visible_gather_scratch>& scratches) {
     compensation_totals t;
-    for (const auto& sc : scratches) {
-        t.added += sc.totals.added;
-        t.total += sc.totals.total;
-        t.rays += sc.totals.rays;
-    }
+    for (const auto& sc : scratches) t += sc.totals;
     return t;
 }
 }  // namespace detail
