@@ -2,7 +2,7 @@
 // changes or a block moves in a closed box, the solver corrected from its previous solution
 // converges to what a fresh solve of the changed scene converges to; negative unshot power is
 // shot; the energy check counts the unshot power in magnitude and still fires.
-#include "radiosity_scenes.hpp"
+#include "rebake_scenes.hpp"
 #include "ray_cast_visibility.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
@@ -23,71 +23,12 @@ using namespace bounce::radiosity_test;
 namespace {
 
 using solver_type = cpu::progressive_radiosity<ray_cast_visibility>;
-constexpr float albedo = 0.7f;
-
-// A closed box 2 m wide with a glowing lamp under its ceiling, a point light and a block
-// 0.4 m on the floor (its top and four sides: triangles 14-23, the last ones).
-owned_scene box_with_block() {
-    owned_scene s = closed_box(2.f, albedo, 3.f);
-    const auto m = s.add_material(glm::vec3(0.6f, 0.7f, 0.5f));
-    const glm::vec3 lo(0.5f, 0.f, 0.5f), hi(0.9f, 0.4f, 0.9f);
-    const auto p = [&](int x, int y, int z) { return glm::vec3(x ? hi.x : lo.x, y ? hi.y : lo.y, z ? hi.z : lo.z); };
-    s.add_quad(p(0, 1, 0), p(0, 1, 1), p(1, 1, 1), p(1, 1, 0), m);  // top, +y
-    s.add_quad(p(0, 0, 0), p(1, 0, 0), p(1, 1, 0), p(0, 1, 0), m);  // -z
-    s.add_quad(p(0, 0, 1), p(0, 1, 1), p(1, 1, 1), p(1, 0, 1), m);  // +z
-    s.add_quad(p(0, 0, 0), p(0, 1, 0), p(0, 1, 1), p(0, 0, 1), m);  // -x
-    s.add_quad(p(1, 0, 0), p(1, 0, 1), p(1, 1, 1), p(1, 1, 0), m);  // +x
-    s.lights.push_back(point_light{glm::vec3(1.3f, 1.5f, 1.2f), glm::vec3(2.f)});
-    return s;
-}
-
-std::vector<std::uint32_t> block_triangles() {
-    std::vector<std::uint32_t> t(10);
-    std::iota(t.begin(), t.end(), 14u);
-    return t;
-}
 
 radiosity_solve_options to(double converge) {
     radiosity_solve_options o;
     o.converge = converge;
     o.measure = radiosity_measure::emitted;
     return o;
-}
-
-// |B_a - B_b| summed over elements, sides and channels, times area, over the same of |B_b|.
-double relative_l1(const solver_type& a, const solver_type& b) {
-    double diff = 0, total = 0;
-    for (int side = 0; side < a.sides(); ++side) {
-        const auto ra = a.radiosity(side), rb = b.radiosity(side);
-        for (std::size_t i = 0; i < ra.size(); ++i) {
-            const double area = a.atlas().area[i];
-            const glm::dvec3 d = glm::abs(glm::dvec3(ra[i]) - glm::dvec3(rb[i]));
-            diff += (d.x + d.y + d.z) * area;
-            total += (std::abs(rb[i].x) + std::abs(rb[i].y) + std::abs(rb[i].z)) * area;
-        }
-    }
-    return diff / total;
-}
-
-// How far two solves that each left `u` of the emitted power unshot (in magnitude) may lie
-// apart: the unshot power dB of a solve is what separates it from the converged answer,
-// which it would raise by (I - rho F)^-1 rho F dB, at most rho / (1 - rho) |dB| in power.
-double convergence_bound(const solver_type& a, const solver_type& b) {
-    double total = 0;
-    for (int side = 0; side < b.sides(); ++side) {
-        const auto rb = b.radiosity(side);
-        for (std::size_t i = 0; i < rb.size(); ++i) total += (rb[i].x + rb[i].y + rb[i].z) * b.atlas().area[i];
-    }
-    const double e = a.emitted_power().x + a.emitted_power().y + a.emitted_power().z;
-    const double f = b.emitted_power().x + b.emitted_power().y + b.emitted_power().z;
-    return albedo / (1 - albedo) * (a.unshot_fraction() * e + b.unshot_fraction() * f) / total;
-}
-
-double negative_unshot(const solver_type& s) {
-    double neg = 0;
-    for (int side = 0; side < s.sides(); ++side)
-        for (const auto& u : s.unshot(side)) neg += std::min(0.f, u.x) + std::min(0.f, u.y) + std::min(0.f, u.z);
-    return neg;
 }
 
 // A solver whose unshot fraction (in magnitude) follows a script from `start`.
@@ -145,9 +86,7 @@ move_result move_block(const owned_scene& s, const std::vector<std::uint32_t>& t
     const lightmap_atlas atlas = build_lightmap_atlas(s.view(), {.elements = 600});
     rigid_move move;
     move.translation = {0.5f, 0.f, 0.3f};
-    owned_scene moved = s;
-    for (const std::uint32_t t : tris)  // add_quad's triangles share no vertex with another quad's
-        for (int k = 0; k < 3; ++k) moved.positions[s.triangles[t][k]] = move.point(s.positions[s.triangles[t][k]]);
+    const owned_scene moved = moved_scene(s, tris, move);
     // The fresh solve on the same elements moved (the atlas of the moved scene may differ by rounding).
     lightmap_atlas moved_atlas = atlas;
     move_charts(moved_atlas, moved_charts(atlas, tris), move);

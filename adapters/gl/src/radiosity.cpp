@@ -52,7 +52,7 @@ progressive_radiosity::progressive_radiosity(const scene_view& scene, const ligh
     }
     s_ = std::make_unique<state>(scene, atlas, options);
     const auto start = clock_type::now();
-    for (const light& l : scene.lights) s_->shoot_light(pack(l));
+    for (const packed_light& l : s_->lights) s_->shoot_light(l);
     finish();
     s_->timings.lights_ms = ms_since(start);
     for (int side = 0; side < sides(); ++side) {

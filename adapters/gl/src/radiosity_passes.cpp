@@ -28,15 +28,12 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     if (sides == 2) emits_back = emission_sides(scene, atlas);
     // Element attributes per texel, and the initial radiosity and unshot radiosity E (each
     // side's rows).
-    std::vector<texel_attributes> attributes(std::size_t(width) * height);
     std::vector<glm::vec4> initial(std::size_t(width) * height * sides, glm::vec4(0.f));
     std::vector<std::uint32_t> packed(std::max<std::size_t>(n, 1), 0u);
     glm::dvec3 emitted_surfaces(0.0);
     for (std::size_t i = 0; i < n; ++i) {
         const glm::uvec2 tx = atlas.texel[i];
         const std::size_t at = std::size_t(tx.y) * width + tx.x;
-        attributes[at] = {glm::vec4(atlas.position[i], atlas.area[i]), glm::vec4(atlas.normal[i], float(atlas.chart[i])),
-                          glm::vec4(atlas.albedo[i], 0.f)};
         initial[at + (emits_on(i, 0) ? 0 : std::size_t(width) * height)] = glm::vec4(atlas.emission[i], 0.f);
         packed[i] = tx.x | (tx.y << 16);
         emitted_surfaces += glm::dvec3(atlas.emission[i]) * double(atlas.area[i]);
@@ -44,7 +41,9 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
         albedo_area += glm::dvec3(atlas.albedo[i]) * double(atlas.area[i]);
     }
     emitted = emitted_surfaces;
-    texels.write(0, attributes.data(), attributes.size() * sizeof(texel_attributes));
+    upload_texel_attributes();
+    effective_shot.assign(sides * n, glm::vec3(0.f));
+    for (const light& l : scene.lights) lights.push_back(pack(l));
     element_texel.write(0, packed.data(), packed.size() * sizeof(std::uint32_t));
     {
         detail::unpack_state unpack;
@@ -59,7 +58,6 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     // Shooters: blocks or elements, their centres and texel rectangles.
     first = shooter_ranges(atlas, options.shooting.shoot_blocks);
     const std::size_t shooters = first.size() - 1;
-    centre.resize(shooters);
     rect.resize(shooters);
     for (std::size_t k = 0; k < shooters; ++k) {
         glm::uvec2 mn(std::numeric_limits<std::uint32_t>::max()), mx(0u);
@@ -67,9 +65,9 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
             mn = glm::min(mn, atlas.texel[i]);
             mx = glm::max(mx, atlas.texel[i]);
         }
-        centre[k] = shooter_disc_of(atlas, first[k], first[k + 1]).centre;
         rect[k] = glm::uvec4(mn, mx - mn + 1u);
     }
+    place_shooters();
     std::vector<std::uint32_t> first_padded(first);
     first_buffer = buffer(first_padded.size() * sizeof(std::uint32_t), first_padded.data());
     partials = buffer((shooters * sides + 2) * partial_doubles * sizeof(double));
@@ -90,6 +88,31 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     }
     nodes = buffer(std::size_t(max_nodes) * sizeof(gpu_node));
 
+    place_triangles(scene);
+    local_plane.assign(std::max<std::size_t>(corners.size(), 1), glm::vec4(0.f, 0.f, 1.f, 0.f));
+
+    item_fbo.attach_color(0, item_color);
+    item_fbo.attach_depth(item_depth);
+    item_fbo.set_draw_buffers(1);
+    item_fbo.check_complete();
+    compile();
+}
+
+void progressive_radiosity::state::upload_texel_attributes() {
+    std::vector<texel_attributes> attributes(std::size_t(width) * height);
+    for (std::size_t i = 0; i < atlas.size(); ++i)
+        attributes[std::size_t(atlas.texel[i].y) * width + atlas.texel[i].x] = {
+            glm::vec4(atlas.position[i], atlas.area[i]), glm::vec4(atlas.normal[i], float(atlas.chart[i])),
+            glm::vec4(atlas.albedo[i], 0.f)};
+    texels.write(0, attributes.data(), attributes.size() * sizeof(texel_attributes));
+}
+
+void progressive_radiosity::state::place_shooters() {
+    centre.resize(first.size() - 1);
+    for (std::size_t k = 0; k + 1 < first.size(); ++k) centre[k] = shooter_disc_of(atlas, first[k], first[k + 1]).centre;
+}
+
+void progressive_radiosity::state::place_triangles(const scene_view& scene) {
     // Triangles that have a chart (the CPU item buffer's).
     item_triangles triangles = item_buffer_triangles(scene, atlas);
     corners = std::move(triangles.corners);
@@ -99,13 +122,7 @@ progressive_radiosity::state::state(const scene_view& scene, const lightmap_atla
     lo = blo;
     hi = bhi;
     diagonal = std::max(glm::length(hi - lo), 1e-30f);
-    local_plane.assign(std::max<std::size_t>(corners.size(), 1), glm::vec4(0.f, 0.f, 1.f, 0.f));
-
-    item_fbo.attach_color(0, item_color);
-    item_fbo.attach_depth(item_depth);
-    item_fbo.set_draw_buffers(1);
-    item_fbo.check_complete();
-    compile();
+    cube_vertices.reset();  // the hemicube's and directional lights' world vertices, made again when drawn
 }
 
 void progressive_radiosity::state::compile() {

@@ -248,19 +248,25 @@ std::string distribute_compute(int max_nodes, int stack_size) {
     fs.add("radiosity_near_field", near_field_opens<f32, vec3>, "receiver", "node_position", "node_area", "near2");
     fs.add("radiosity_receiving_side", receiving_side<f32, vec3>, "receiver", "receiver_normal", "source", "two_sided");
     return version_line + "layout(local_size_x = 64) in;\n" + shot_uniforms() +
-           uniforms({{distribute_uniform::node_count, "int node_count"}, {distribute_uniform::near2, "float near2"}}) +
+           uniforms({{distribute_uniform::node_count, "int node_count"},
+                     {distribute_uniform::near2, "float near2"},
+                     {distribute_uniform::masked, "int masked"}}) +
            lookup_functions() + fs.source() + shot_common() + "const int max_nodes = " + std::to_string(max_nodes) +
            ";\n" + "const int stack_size = " + std::to_string(stack_size) + ";\n" + R"(
 struct near_node { vec4 position_area; vec4 unshot; ivec4 meta; };
-)" + storage_block(nodes_binding, "readonly buffer nodes_block { near_node node[]; }") + R"(
+)" + storage_block(nodes_binding, "readonly buffer nodes_block { near_node node[]; }") +
+           storage_block(keep_binding, "readonly buffer keep_block { uint keep_bits[]; }") + R"(
 void main() {
     // One invocation per element, at its texel (the atlas's padding and empty texels cost nothing).
-    if (gl_GlobalInvocationID.x >= element_count) return;
-    uint code = element_texel[gl_GlobalInvocationID.x];
+    uint e = gl_GlobalInvocationID.x;
+    if (e >= element_count) return;
+    uint code = element_texel[e];
     ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
     texel_attributes a = texel[xy.y * atlas_width + xy.x];
     if (!(a.position_area.w > 0.0)) return;
     if (a.normal_chart.w == shot_chart) { intercept_nothing(xy); return; }
+    // A re-bake's re-shot reaches only the receivers whose bit is set (keep_bits, element order).
+    if (masked != 0 && (keep_bits[e >> 5u] & (1u << (e & 31u))) == 0u) { intercept_nothing(xy); return; }
     vec3 pr = a.position_area.xyz, nr = a.normal_chart.xyz, rho = a.albedo.rgb;
     float ar = a.position_area.w;
     // precise: no fused multiply-add in the sums, so they round as the CPU's do (a shooter's
@@ -290,9 +296,8 @@ void main() {
         if (top == 0) break;
         current = stack[--top];
     }
-    bool front_lit = incident.x > 0.0 || incident.y > 0.0 || incident.z > 0.0;
-    bool back_lit = incident_back.x > 0.0 || incident_back.y > 0.0 || incident_back.z > 0.0;
-    if (!front_lit && !back_lit) { intercept_nothing(xy); return; }
+    // Either sign: a re-bake shoots negative unshot radiosity (radiosity/rebake.hpp).
+    if (incident == vec3(0.0) && incident_back == vec3(0.0)) { intercept_nothing(xy); return; }
     float v = shot_visibility(pr, a.normal_chart.w);
     if (!(v > 0.0)) { intercept_nothing(xy); return; }
     vec3 received = incident * v;
@@ -335,7 +340,7 @@ void main() {
         if (got == vec3(0.0)) continue;
         vec3 change = a.albedo.rgb * (got / a.position_area.w * (scale - vec3(1.0)));
         imageStore(radiosity_image, at, imageLoad(radiosity_image, at) + vec4(change, 0.0));
-        imageStore(unshot_image, at, max(imageLoad(unshot_image, at) + vec4(change, 0.0), vec4(0.0)));
+        imageStore(unshot_image, at, imageLoad(unshot_image, at) + vec4(change, 0.0));
         imageStore(intercepted_image, at, vec4(got * scale, 0.0));
     }
 }
@@ -395,11 +400,11 @@ void main() {
     // The side facing the light: the front, or (two-sided) the back, as the CPU solver takes it.
     vec3 e = light_irradiance(p, n);
     int side = 0;
-    if (two_sided != 0 && !(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) {
+    if (two_sided != 0 && e == vec3(0.0)) {
         side = 1;
         e = light_irradiance(p, radiosity_side_normal(n, 1.0));
     }
-    if (!(e.x > 0.0 || e.y > 0.0 || e.z > 0.0)) return;
+    if (e == vec3(0.0)) return;  // either sign: a re-bake takes a light's old light away with -intensity
     float v = parallel != 0 ? parallel_visibility(p, a.normal_chart.w) : shot_visibility(p, a.normal_chart.w);
     if (!(v > 0.0)) return;
     receive(side_texel(xy, side), a.albedo.rgb * (e * v), e * (v * a.position_area.w));
@@ -439,7 +444,8 @@ void main() {
         ivec2 xy = ivec2(int(code & 0xffffu), int(code >> 16u));
         texel_attributes a = texel[xy.y * atlas_width + xy.x];
         vec4 u = imageLoad(unshot_image, xy + rows);
-        power += (double(u.r) + double(u.g) + double(u.b)) * double(a.position_area.w);
+        // In magnitude, as the CPU solver counts it: a re-bake's unshot radiosity may be negative.
+        power += (abs(double(u.r)) + abs(double(u.g)) + abs(double(u.b))) * double(a.position_area.w);
         dvec3 got = dvec3(imageLoad(intercepted_image, xy + rows).rgb);
         ic += got;
         ab += (dvec3(1.0) - dvec3(a.albedo.rgb)) * got;

@@ -10,7 +10,7 @@ namespace bounce::gl::radiosity_glsl {
 
 // Storage-buffer bindings and image units.
 constexpr unsigned texels_binding = 0, nodes_binding = 1, planes_binding = 2, first_binding = 3, element_binding = 4,
-                   partial_binding = 5;
+                   partial_binding = 5, keep_binding = 6;
 constexpr unsigned radiosity_unit = 0, unshot_unit = 1, intercepted_unit = 2, item_unit = 3;
 // The lightmap pass's: the atlas texel each lightmap texel shows, where the passes keep the
 // element texels, and the lightmap image, where they keep the intercepted power.
@@ -72,9 +72,10 @@ enum : int {
 };
 }
 
-// The distribution pass, beside shot_uniform: the shooter's near-field tree.
+// The distribution pass, beside shot_uniform: the shooter's near-field tree, and whether a
+// re-bake's receiver mask (keep_binding) limits the receivers.
 namespace distribute_uniform {
-enum : int { node_count = 10, near2 = 11 };
+enum : int { node_count = 10, near2 = 11, masked = 12 };
 }
 
 // The light pass, beside shot_uniform: the light and a directional light's buffer.

@@ -280,37 +280,14 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     };
     glm::dvec3 power(0.0);
     for (std::uint32_t i = i0; i < i1; ++i) power += unshot_of(i) * double(atlas.area[i]);
-    near.clear();
-    build_near_field_tree(atlas, i0, i1, options.shooting.shoot_blocks, block, unshot_of,
-                          [&](glm::dvec3 position, double area, glm::dvec3 mean_unshot, std::uint32_t first_child,
-                              std::uint32_t children) {
-                              near.push_back({glm::vec4(glm::vec3(position), float(area)),
-                                              glm::vec4(glm::vec3(mean_unshot), 0.f),
-                                              {std::int32_t(first_child), std::int32_t(children), 0, 0}});
-                          });
-    require(near.size() <= std::size_t(max_nodes), "atlas", "a shooter's near-field tree outgrew its bound");
-    nodes.write(0, near.data(), near.size() * sizeof(gpu_node));
-
-    const float chart = float(atlas.chart[i0]);
-    set_shot(centre[block], side_normal<float, glm::vec3>(atlas.normal[i0], float(side)), chart);
+    upload_near_tree(block, unshot_of);
+    set_block_shot(block, side);
     draw_visibility();
     if (options.timed_stages) finish();
     timings.visibility_ms += ms_since(start);
 
     start = clock_type::now();
-    {
-        binding_state saved;
-        bind_common();
-        glMemoryBarrier(GL_ALL_BARRIER_BITS);
-        const program& p = *distribute_program;
-        glUseProgram(p.id());
-        set_shot_uniforms(p, chart, options.visibility == radiosity_visibility::hemicube);
-        p.set(radiosity_glsl::distribute_uniform::node_count, int(near.size()));
-        p.set(radiosity_glsl::distribute_uniform::near2,
-              float(options.shooting.near_field * options.shooting.near_field));
-        glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
-        check_error("progressive_radiosity: the distribution pass");
-    }
+    distribute(shot_chart, false);
     if (options.timed_stages) finish();
     timings.distribution_ms += ms_since(start);
     reduction got = reduce();
@@ -321,11 +298,33 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
         got = reduce();
         ++clamped_shots;
     }
+    for (std::uint32_t i = i0; i < i1; ++i) effective_shot[side * atlas.size() + i] += glm::vec3(unshot_of(i) * scale);
     absorbed += got.absorbed;
     escaped += power - got.intercepted;
     intercepted_power += got.intercepted;
     shot_power += power.x + power.y + power.z;
     ++shots;
+}
+
+void progressive_radiosity::state::set_block_shot(std::uint32_t block, std::uint32_t side) {
+    const std::uint32_t i0 = first[block];
+    set_shot(centre[block], side_normal<float, glm::vec3>(atlas.normal[i0], float(side)), float(atlas.chart[i0]));
+}
+
+void progressive_radiosity::state::distribute(float chart, bool masked) {
+    binding_state saved;
+    bind_common();
+    if (masked) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, radiosity_glsl::keep_binding, keep->id());
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    const program& p = *distribute_program;
+    glUseProgram(p.id());
+    set_shot_uniforms(p, chart, options.visibility == radiosity_visibility::hemicube);
+    namespace u = radiosity_glsl::distribute_uniform;
+    p.set(u::node_count, int(near.size()));
+    p.set(u::near2, float(options.shooting.near_field * options.shooting.near_field));
+    p.set(u::masked, masked ? 1 : 0);
+    glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
+    check_error("progressive_radiosity: the distribution pass");
 }
 
 void progressive_radiosity::state::rescale(glm::vec3 scale) {
@@ -364,11 +363,11 @@ void progressive_radiosity::state::set_shot_uniforms(const program& p, float cha
 }
 
 void progressive_radiosity::state::set_light_uniforms(const program& p, const packed_light& l, bool spot,
-                                                      bool strict_side, bool parallel) const {
+                                                      bool strict_side, bool parallel, float sign) const {
     namespace u = radiosity_glsl::light_uniform;
     p.set(u::spot, spot ? 1 : 0);
     p.set(u::light_axis, l.direction());
-    p.set(u::intensity, l.intensity());
+    p.set(u::intensity, sign * l.intensity());
     p.set(u::cos_cone, l.cos_cone());
     p.set(u::cosine_falloff, l.cosine_falloff());
     p.set(u::strict_side, strict_side ? 1 : 0);
@@ -378,7 +377,7 @@ void progressive_radiosity::state::set_light_uniforms(const program& p, const pa
     p.set(u::parallel_resolution, float(options.parallel_resolution));
 }
 
-void progressive_radiosity::state::light_pass(const packed_light& l, bool spot, bool strict_side, bool parallel) {
+void progressive_radiosity::state::light_pass(const packed_light& l, bool spot, bool strict_side, bool parallel, float sign) {
     {
         binding_state saved;
         bind_common();
@@ -389,7 +388,7 @@ void progressive_radiosity::state::light_pass(const packed_light& l, bool spot, 
         const program& p = *light_program;
         glUseProgram(p.id());
         set_shot_uniforms(p, -2.f, !parallel && options.visibility == radiosity_visibility::hemicube);
-        set_light_uniforms(p, l, spot, strict_side, parallel);
+        set_light_uniforms(p, l, spot, strict_side, parallel, sign);
         glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
         check_error(parallel ? "progressive_radiosity: shooting a directional light" : "progressive_radiosity: shooting a light");
     }
@@ -399,12 +398,12 @@ void progressive_radiosity::state::light_pass(const packed_light& l, bool spot, 
     absorbed += got.absorbed;
 }
 
-void progressive_radiosity::state::shoot_light(const packed_light& l) {
+void progressive_radiosity::state::shoot_light(const packed_light& l, float sign) {
     const light_kind kind = l.kind();
     if (kind == light_kind::directional) {
         set_shot(glm::vec3(0.f), l.direction(), -2.f);
         if (options.visibility != radiosity_visibility::none) draw_parallel();
-        light_pass(l, false, false, true);
+        light_pass(l, false, false, true, sign);
         return;
     }
     const glm::vec3 axis = kind == light_kind::spot ? l.direction() : glm::vec3(0, 0, 1);
@@ -414,7 +413,7 @@ void progressive_radiosity::state::shoot_light(const packed_light& l) {
     for (std::size_t h = 0; h < axes.size(); ++h) {
         set_shot(l.position(), axes[h], -2.f);
         draw_visibility();
-        light_pass(l, kind == light_kind::spot, h != 0, false);
+        light_pass(l, kind == light_kind::spot, h != 0, false, sign);
     }
 }
 

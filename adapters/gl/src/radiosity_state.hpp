@@ -8,6 +8,7 @@
 #include <bounce/light.hpp>
 #include <bounce/direct_light.hpp>
 #include <bounce/radiosity/kernels.hpp>
+#include <bounce/radiosity/rebake.hpp>
 #include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/sides.hpp>
 #include <bounce/radiosity/solve.hpp>
@@ -96,7 +97,7 @@ private:
         GLint name = 0, level = 0, layered = 0, layer = 0, access = GL_READ_ONLY, format = GL_RGBA32F;
     };
     GLint program_ = 0, generic_ = 0;
-    std::array<storage, 6> storage_{};
+    std::array<storage, 7> storage_{};
     std::array<image, 4> images_{};
 };
 
@@ -138,6 +139,11 @@ struct progressive_radiosity::state {
     // is block k % blocks on side k / blocks, as on the CPU.
     std::uint32_t sides = 1;
     std::vector<std::uint8_t> emits_back;  // per chart, 1 when it emits from its back (emission_sides)
+    std::vector<packed_light> lights;      // the scene's point, spot and directional lights (re-bakes change them)
+    // Per element-side (side-major), what its shots delivered from: each shot's unshot
+    // radiosity times its scale (shot_scale), summed, as cpu::progressive_radiosity keeps it
+    // (its effective_shot_): B = E + rho F S holds for it, and a re-bake re-shoots it.
+    std::vector<glm::vec3> effective_shot;
     // Shooters.
     std::vector<std::uint32_t> first;
     std::vector<glm::vec3> centre;
@@ -157,6 +163,7 @@ struct progressive_radiosity::state {
     framebuffer item_fbo;
     vertex_array item_vao;
     buffer texels, nodes, planes, first_buffer, element_texel, partials;
+    std::unique_ptr<buffer> keep;  // a re-bake's receiver mask, one bit per element (keep_binding)
     std::unique_ptr<buffer> vertices;
     std::size_t vertex_capacity = 0;
     vertex_array cube_vao;
@@ -194,6 +201,20 @@ struct progressive_radiosity::state {
 
     state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o);
     void compile();
+    // The element attributes per texel (texel_attributes) from the atlas, uploaded.
+    void upload_texel_attributes();
+    // The shooters' centres from the atlas's element positions.
+    void place_shooters();
+    // The triangles the item buffers draw, the scene's box and diagonal, from `scene`.
+    void place_triangles(const scene_view& scene);
+    // A re-bake's re-shot of block-side k (k % blocks on side k / blocks): its radiosity
+    // `shot` (per element-side) times `sign`, unscaled, to the receivers whose bit is set in
+    // `keep_bits`, with the geometry as it is; the balance's sums corrected (what it delivers
+    // is intercepted, not escaped).
+    void reshoot(std::uint32_t k, float sign, const std::vector<glm::vec3>& shot, const std::vector<std::uint32_t>& keep_bits);
+    // Every side's element values of t (side-major), read back; and written into t.
+    std::vector<glm::vec3> read_sides(const texture& t) const;
+    void write_sides(const texture& t, const std::vector<glm::vec3>& values);
     struct reduction {
         glm::dvec3 intercepted{0.0}, absorbed{0.0};
     };
@@ -205,17 +226,39 @@ struct progressive_radiosity::state {
     void draw_visibility();
     void set_shot(glm::vec3 position, glm::vec3 axis, float chart);
     void shoot(std::uint32_t k);
+    // The near-field tree of block `block` (the CPU solver's build_near_tree) from its
+    // elements' radiosity_of(i) (glm::dvec3), uploaded for the distribution.
+    template <class Radiosity>
+    void upload_near_tree(std::uint32_t block, const Radiosity& radiosity_of) {
+        near.clear();
+        build_near_field_tree(atlas, first[block], first[block + 1], options.shooting.shoot_blocks, block, radiosity_of,
+                              [&](glm::dvec3 position, double area, glm::dvec3 mean, std::uint32_t first_child,
+                                  std::uint32_t children) {
+                                  near.push_back({glm::vec4(glm::vec3(position), float(area)), glm::vec4(glm::vec3(mean), 0.f),
+                                                  {std::int32_t(first_child), std::int32_t(children), 0, 0}});
+                              });
+        require(near.size() <= std::size_t(max_nodes), "atlas", "a shooter's near-field tree outgrew its bound");
+        nodes.write(0, near.data(), near.size() * sizeof(gpu_node));
+    }
+    // The distribution pass of the shot set (set_shot) from chart `chart` with the tree
+    // uploaded; `masked`: only the receivers whose bit is set in `keep`.
+    void distribute(float chart, bool masked);
+    // Side `side` of block `block` as the shot's position, axis and chart.
+    void set_block_shot(std::uint32_t block, std::uint32_t side);
     // The last distribution's deliveries times `scale` (per channel, each at most 1).
     void rescale(glm::vec3 scale);
-    void shoot_light(const packed_light& l);
+    // The shot of light l; `sign` -1 takes away exactly what it delivered (the same passes,
+    // linear in the intensity): a re-bake's old light.
+    void shoot_light(const packed_light& l, float sign = 1.f);
     // The light pass for the current shot of light l (the uniforms of set_light_uniforms),
     // then the reduction, whose intercepted power the light emitted.
-    void light_pass(const packed_light& l, bool spot, bool strict_side, bool parallel);
+    void light_pass(const packed_light& l, bool spot, bool strict_side, bool parallel, float sign);
     // The uniforms of shot_uniform on the distribution or light program p, for a shot from
     // chart `chart` (-2: a light) whose visibility is looked up on the hemicube or not.
     void set_shot_uniforms(const program& p, float chart, bool hemicube) const;
     // light_uniform: the light l, its kind flags and the directional light's buffer.
-    void set_light_uniforms(const program& p, const packed_light& l, bool spot, bool strict_side, bool parallel) const;
+    void set_light_uniforms(const program& p, const packed_light& l, bool spot, bool strict_side, bool parallel,
+                            float sign) const;
     // The shooter's frame (t, b, shot_axis) at p's locations for shot_t, shot_b, shot_n.
     void set_frame_uniforms(const program& p, int t_location, int b_location, int n_location) const;
     // The farthest corner of the scene's box from the shot's position.

@@ -60,6 +60,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numeric>
 #include <span>
 #include <string>
 #include <vector>
@@ -182,7 +183,80 @@ inline moved_boxes boxes_of_move(const scene_view& moved_scene, std::span<const 
     return b;
 }
 
-/// What a re-bake did (cpu::rebake_light, cpu::rebake_move); the solve that follows is the
+/// The margin the boxes of a move are widened by in rebake_filter: float rounding of the
+/// segment test at the scale of the object and of its move.
+inline float rebake_margin(const moved_boxes& boxes, const rigid_move& move) {
+    const glm::vec3 extent = glm::max(boxes.before.hi - boxes.before.lo, glm::vec3(0.f));
+    return 1e-4f * (glm::length(extent) + glm::length(move.translation)) + 1e-6f;
+}
+
+/// Which receivers a shooter's re-shot after a move must reach (besides the moved elements):
+/// those whose visibility segment from the shooter's centre meets the object's box before or
+/// after the move. Tested by block first (the segment to the block's centre against the boxes
+/// widened by the block's radius: no element of a block that misses can have a segment that
+/// meets them), then by element. `first`: the shooters' element ranges (blocks), `centre`
+/// their centres, as the solvers keep them (before the move).
+class rebake_filter {
+public:
+    rebake_filter(const lightmap_atlas& atlas, std::span<const std::uint32_t> first, std::span<const glm::vec3> centre,
+                  const moved_boxes& boxes, float margin)
+        : atlas_(atlas), boxes_(boxes), margin_(margin), centre_(centre.begin(), centre.end()),
+          radius_(centre.size(), 0.f), block_of_(atlas.size()), near_(centre.size()) {
+        for (std::size_t k = 0; k + 1 < first.size(); ++k)
+            for (std::uint32_t i = first[k]; i < first[k + 1]; ++i)
+                block_of_[i] = std::uint32_t(k), radius_[k] = std::max(radius_[k], glm::length(atlas.position[i] - centre_[k]));
+    }
+    /// Starts a shooter at `c`: which blocks can hold receivers whose segment meets a box.
+    void begin(const glm::vec3& c) {
+        for (std::size_t k = 0; k < near_.size(); ++k) near_[k] = meets(c, centre_[k], margin_ + radius_[k] * 1.0001f);
+    }
+    /// Whether block `block` may hold such receivers (after begin).
+    bool near(std::size_t block) const { return near_[block] != 0; }
+    /// Whether element i's segment from `c` (the shooter begun) meets either box.
+    bool through(const glm::vec3& c, std::uint32_t i) const { return near_[block_of_[i]] && meets(c, atlas_.position[i], margin_); }
+
+private:
+    bool meets(const glm::vec3& a, const glm::vec3& b, float m) const {
+        return segment_meets_box(a, b, boxes_.before, m) || segment_meets_box(a, b, boxes_.after, m);
+    }
+    const lightmap_atlas& atlas_;
+    moved_boxes boxes_;
+    float margin_;
+    std::vector<glm::vec3> centre_;  // per block: its elements' bounding sphere
+    std::vector<float> radius_;
+    std::vector<std::uint32_t> block_of_;  // per element
+    std::vector<std::uint8_t> near_;       // per block, for the shooter begun
+};
+
+/// The block-sides (side-major: k = side * blocks + block) a re-bake re-shoots: those whose
+/// shot radiosity `shot` (per element-side, side-major) holds power, the largest first until
+/// they hold `share` of it (all with share 1). Writes the share left out to `uncorrected`.
+template <class V>
+std::vector<std::uint8_t> chosen_rebake_shooters(const lightmap_atlas& atlas, std::span<const std::uint32_t> first,
+                                                 std::span<const V> shot, std::size_t sides, double share, double& uncorrected) {
+    const std::size_t blocks = first.size() - 1, n = atlas.size();
+    std::vector<double> magnitude(sides * blocks, 0.0);
+    for (std::size_t k = 0; k < magnitude.size(); ++k)
+        for (std::uint32_t i = first[k % blocks]; i < first[k % blocks + 1]; ++i) {
+            const V& s = shot[(k / blocks) * n + i];
+            magnitude[k] += (double(std::abs(s.x)) + double(std::abs(s.y)) + double(std::abs(s.z))) * double(atlas.area[i]);
+        }
+    std::vector<std::uint32_t> order(magnitude.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return magnitude[a] > magnitude[b]; });
+    const double total = std::accumulate(magnitude.begin(), magnitude.end(), 0.0);
+    std::vector<std::uint8_t> chosen(magnitude.size(), 0);
+    double taken = 0, left = 0;
+    for (const std::uint32_t k : order) {
+        if (!(magnitude[k] > 0)) break;
+        if (share < 1 && taken >= share * total) left += magnitude[k];
+        else chosen[k] = 1, taken += magnitude[k];
+    }
+    uncorrected = total > 0 ? left / total : 0.0;
+    return chosen;
+}
+
+/// What a re-bake did (cpu::rebake_light, cpu::rebake_move, gl::progressive_radiosity::rebake_*); the solve that follows is the
 /// caller's (solve(radiosity_solve_options) again).
 struct radiosity_rebake_report {
     double ms = 0;                  ///< wall-clock time of the correction (2), lights included

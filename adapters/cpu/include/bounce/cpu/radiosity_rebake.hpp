@@ -52,61 +52,13 @@ struct rebake_access {
     // shooter) asks for, and `sign` times what it delivers is added to `delta` (incident
     // radiosity per element and side). The deliveries are linear in S, so the old pass takes
     // away exactly what the past shots delivered to those receivers.
-    // Which receivers a shooter's re-shot asks for: by the block first (the segment from the
-    // shooter to the block's centre against the boxes widened by the block's radius: no
-    // element of a block that misses can have a segment that meets them), then by element.
-    struct move_filter {
-        const lightmap_atlas& at;
-        const moved_boxes& boxes;
-        float margin;
-        std::vector<glm::vec3> centre;       // per block: its elements' bounding sphere
-        std::vector<float> radius;
-        std::vector<std::uint32_t> block_of; // per element
-        std::vector<std::uint8_t> near;      // per block, for the shooter begun
-        move_filter(const Solver& s, const moved_boxes& b, float m) : at(s.atlas_), boxes(b), margin(m) {
-            const std::size_t blocks = s.first_.size() - 1;
-            centre.resize(blocks), radius.assign(blocks, 0.f), block_of.resize(at.size()), near.resize(blocks);
-            for (std::size_t k = 0; k < blocks; ++k) {
-                centre[k] = s.centre_[k];
-                for (std::uint32_t i = s.first_[k]; i < s.first_[k + 1]; ++i)
-                    block_of[i] = std::uint32_t(k), radius[k] = std::max(radius[k], glm::length(at.position[i] - centre[k]));
-            }
-        }
-        bool meets(const glm::vec3& a, const glm::vec3& b, float m) const {
-            return segment_meets_box(a, b, boxes.before, m) || segment_meets_box(a, b, boxes.after, m);
-        }
-        void begin(const glm::vec3& c) {
-            for (std::size_t k = 0; k < near.size(); ++k) near[k] = meets(c, centre[k], margin + radius[k] * 1.0001f);
-        }
-        bool through(const glm::vec3& c, std::uint32_t i) const { return near[block_of[i]] && meets(c, at.position[i], margin); }
-    };
-
-    // The block-sides the correction re-shoots: those whose S holds power, the largest first
-    // until they hold `share` of it (all with share 1); the share left out is reported.
-    static std::vector<std::uint8_t> chosen_shooters(const Solver& s, const std::vector<vec>& S, double share, radiosity_rebake_report& r) {
-        const std::size_t blocks = s.first_.size() - 1, n = s.atlas_.size();
-        std::vector<double> magnitude(s.sides_ * blocks, 0.0);
-        for (std::size_t k = 0; k < magnitude.size(); ++k)
-            for (std::uint32_t i = s.first_[k % blocks]; i < s.first_[k % blocks + 1]; ++i)
-                magnitude[k] += Solver::channel_sum(glm::abs(S[(k / blocks) * n + i])) * double(s.atlas_.area[i]);
-        std::vector<std::uint32_t> order(magnitude.size());
-        std::iota(order.begin(), order.end(), 0u);
-        std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return magnitude[a] > magnitude[b]; });
-        const double total = std::accumulate(magnitude.begin(), magnitude.end(), 0.0);
-        std::vector<std::uint8_t> chosen(magnitude.size(), 0);
-        double taken = 0, left = 0;
-        for (const std::uint32_t k : order) {
-            if (!(magnitude[k] > 0)) break;
-            if (share < 1 && taken >= share * total) left += magnitude[k];
-            else chosen[k] = 1, taken += magnitude[k];
-        }
-        r.uncorrected = total > 0 ? left / total : 0.0;
-        return chosen;
+    static rebake_filter filter_of(const Solver& s, const moved_boxes& boxes, float margin) {
+        return rebake_filter(s.atlas_, s.first_, s.centre_, boxes, margin);
     }
 
     template <class Keep>
     static void reshoot(Solver& s, const std::vector<vec>& S, const std::vector<std::uint8_t>& chosen,
-                        const std::vector<std::uint8_t>& moved_block, move_filter& filter, const Keep& keep, double sign,
+                        const std::vector<std::uint8_t>& moved_block, rebake_filter& filter, const Keep& keep, double sign,
                         std::vector<glm::dvec3>& delta, radiosity_rebake_report& r) {
         const lightmap_atlas& at = s.atlas_;
         const std::size_t blocks = s.first_.size() - 1, n = at.size();
@@ -134,7 +86,7 @@ struct rebake_access {
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.sides_ * blocks, 64), [&](const tbb::blocked_range<std::size_t>& q) {
                 for (std::size_t kb = q.begin(); kb != q.end(); ++kb) {
                     const std::size_t bb = kb % blocks, o = (kb / blocks) * n;
-                    if (!whole && !filter.near[bb] && !moved_block[bb]) continue;
+                    if (!whole && !filter.near(bb) && !moved_block[bb]) continue;
                     for (std::uint32_t i = s.first_[bb]; i < s.first_[bb + 1]; ++i)
                         if (s.received_[o + i] != vec(0)) delta[o + i] += sign * glm::dvec3(s.received_[o + i]);
                 }
@@ -229,15 +181,14 @@ struct rebake_access {
         r.unshot_before = s.unshot_fraction();
         const std::vector<std::uint8_t> charts = moved_charts(s.atlas_, moved);
         const moved_boxes boxes = boxes_of_move(moved_scene, moved, m);
-        const glm::vec3 extent = glm::max(boxes.before.hi - boxes.before.lo, glm::vec3(0.f));
-        const float margin = 1e-4f * (glm::length(extent) + glm::length(m.translation)) + 1e-6f;
+        const float margin = rebake_margin(boxes, m);
         const lightmap_atlas& at = s.atlas_;
         const std::size_t n = at.size(), blocks = s.first_.size() - 1;
         std::vector<std::uint8_t> moved_element(n), moved_block(blocks);
         for (std::size_t i = 0; i < n; ++i) moved_element[i] = charts[at.chart[i]], r.moved_elements += charts[at.chart[i]];
         for (std::size_t b = 0; b < blocks; ++b) moved_block[b] = charts[at.chart[s.first_[b]]];
         // A pair's delivery can change only with a moved end or a ray through either box.
-        move_filter filter(s, boxes, margin);
+        rebake_filter filter = filter_of(s, boxes, margin);
         const auto through = [&](const glm::vec3& c, std::uint32_t i) { return filter.through(c, i); };
         const std::vector<vec>& S = s.effective_shot_;
         // What the moved elements received is known: the irradiance the shots delivered
@@ -246,7 +197,8 @@ struct rebake_access {
         std::vector<glm::dvec3> delta(S.size(), glm::dvec3(0));
         for (std::size_t j = 0; j < delta.size(); ++j)
             if (moved_element[j % n]) delta[j] = -glm::dvec3(s.gathered_[j]);
-        const std::vector<std::uint8_t> chosen = chosen_shooters(s, S, share, r);
+        const std::vector<std::uint8_t> chosen =
+            chosen_rebake_shooters<vec>(at, s.first_, std::span<const vec>(S), s.sides_, share, r.uncorrected);
         reshoot(s, S, chosen, moved_block, filter,
                 [&](const glm::vec3& c, std::uint32_t i, bool whole) { return !moved_element[i] && (whole || through(c, i)); }, -1.0,
                 delta, r);  // the old geometry and visibility

@@ -31,7 +31,8 @@
 ///
 /// Visibility can also come from a hemicube (five perspective faces drawn by GL, no
 /// tessellation needed) or be left out. Not here (the CPU solver has them): several shooters
-/// per step, grouped shooters, adaptive subdivision.
+/// per step, grouped shooters, adaptive subdivision. Re-bakes after a light changes or an
+/// object moves: rebake_light, rebake_move.
 ///
 /// Elements are two-sided by default, as on the CPU (radiosity/sides.hpp): a radiosity per
 /// side, the backs in rows [height, 2 height) of the textures, shooter k block k % blocks on
@@ -49,6 +50,7 @@
 #include <bounce/output.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/radiosity/options.hpp>
+#include <bounce/radiosity/rebake.hpp>
 #include <bounce/radiosity/solve.hpp>
 #include <bounce/scene_view.hpp>
 
@@ -57,6 +59,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -123,6 +126,28 @@ public:
     /// during checkpoints). Throws radiosity_error when energy is created or every shot
     /// escapes without reaching a surface's front side, parameter_error on bad options.
     radiosity_solve_report solve(const radiosity_solve_options& options);
+
+    /// Re-baking what changed (radiosity/rebake.hpp; cpu::rebake_light and cpu::rebake_move on
+    /// the CPU, the same correction): the state is corrected from the previous solution so
+    /// that solve() again converges to the changed scene's answer; the unshot power may turn
+    /// negative, and is shot by magnitude. Light `index` of the scene's point, spot and
+    /// directional lights (in its order) becomes `changed`: its old light is shot again with
+    /// -1 times its intensity (the same passes, so exactly what it delivered is taken away),
+    /// then the new one. Throws parameter_error ("index", "changed").
+    radiosity_rebake_report rebake_light(std::size_t index, const light& changed);
+    /// The triangles `moved` of the scene moved by `move`; `moved_scene` is the scene after the
+    /// move (those vertices moved), which the solver draws from then on. Every block-side that
+    /// has shot re-shoots what it shot from (its shots' radiosity times their scales) with -1
+    /// before the move and +1 after, each time to the receivers whose visibility segment meets
+    /// the object's box before or after it (rebake_filter) and the moved elements: one item
+    /// buffer and one masked distribution per re-shot, the moved object's own shooters with
+    /// the old geometry only (what they shot goes back to their unshot radiosity). The lights
+    /// are shot again (-1 before, +1 after). `share` < 1 re-shoots only the block-sides that
+    /// hold that share of the shot power, the largest first (the report's `uncorrected`).
+    /// Throws parameter_error as cpu::rebake_move ("moved_triangles", "moved_scene",
+    /// "rigid_move.*", "share").
+    radiosity_rebake_report rebake_move(const scene_view& moved_scene, std::span<const std::uint32_t> moved,
+                                        const rigid_move& move, double share = 1.0);
 
     /// Unshot power / emitted power, channels summed (from the last reduction); 0 for a
     /// scene that emits nothing.
