@@ -1,9 +1,8 @@
 #pragma once
-// radiosity's re-bakes (docs/radiosity.md, "Re-baking what changed"): with
-// --rebake-light K,SCALE (light K's intensity times SCALE) or --rebake-move OBJECT,DX,DY,DZ
-// (OBJECT: a material's name, with #N for its N-th group of connected triangles, moved by
-// DX, DY, DZ), the scene is baked as the options ask, changed, re-baked from that solution
-// (cpu::rebake_light, cpu::rebake_move) and solved fresh (atlas, lights, solve). The fresh
+// radiosity's re-bakes (docs/radiosity.md, "Re-baking what changed"): with --rebake-light or
+// --rebake-move (rebake_change.hpp), the scene is baked as the options ask, changed, re-baked
+// from that solution (cpu::rebake_light and cpu::rebake_move, or the GL solver's rebake_light
+// and rebake_move) and solved fresh (atlas, lights, solve). The fresh
 // solve is then converged on to --rebake-check of the same measure: the answer both should
 // reach. Reported: the fresh solve's time to --converge and its error against that answer;
 // the re-bake's time (correction + solve) to the same error, measured at checkpoints with the
@@ -12,8 +11,7 @@
 // of the changed scene, and the re-bake's time to the fresh solve's error against it. A move's
 // re-bake is measured against a fresh solve on its own elements (the bake's moved), which it
 // converges to; how far that lies from the answer (its atlas built from the moved scene) is
-// reported. An optional fourth number, --rebake-move ...,SHARE, re-shoots only the shooters
-// holding that share of the shot power (cpu::rebake_move's share). CPU, ray-cast visibility.
+// reported. CPU with ray-cast visibility, or GL (stereographic or hemicube item buffers).
 #include <bounce/cpu/radiosity_rebake.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
@@ -24,120 +22,59 @@
 #include <bounce/study/multi_bounce_cache.hpp>
 #include <bounce/study/stage_timer.hpp>
 
+#ifdef BOUNCE_WITH_GL
+#include <bounce/gl/context.hpp>
+#include <bounce/gl/radiosity.hpp>
+#endif
+
 #include "options.hpp"
+#include "rebake_change.hpp"
 #include "view.hpp"
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include <chrono>
-#include <map>
-#include <numeric>
 #include <optional>
-#include <sstream>
-#include <tuple>
-#include <variant>
-#include <vector>
 
 namespace bounce::examples {
 
-// "a,b,c" as numbers; `count` of them, else parameter_error naming `option`.
-inline std::vector<double> rebake_numbers(const std::string& text, std::size_t count, const char* option, const char* form) {
-    std::vector<double> v;
-    std::stringstream in(text);
-    for (std::string item; std::getline(in, item, ',');) {
-        std::size_t used = 0;
-        double x = 0;
-        try {
-            x = std::stod(item, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used == 0 || used != item.size() || !std::isfinite(x)) throw parameter_error(option, "must be " + std::string(form));
-        v.push_back(x);
+// The solvers a re-bake run measures: make one, re-bake it, and count the receiver-shooter
+// pairs its correction evaluated.
+struct cpu_rebaker {
+    const options& o;
+    auto make(const scene_view& s, const lightmap_atlas& a, const embree::accel& bvh) const {
+        return cpu::progressive_radiosity(s, a, embree::radiosity_visibility(bvh, a.chart_of_triangle), solver_options_for(o));
     }
-    if (v.size() != count) throw parameter_error(option, "must be " + std::string(form));
-    return v;
-}
+    template <class Solver>
+    radiosity_rebake_report rebake(Solver& s, const scene_change& c, const embree::accel& changed_bvh) const {
+        if (c.moved.empty()) return cpu::rebake_light(s, c.light_index, c.changed.lights[c.light_index]);
+        return cpu::rebake_move(s, c.changed, c.moved, c.move, embree::radiosity_visibility(changed_bvh, s.atlas().chart_of_triangle),
+                                c.share);
+    }
+    static double pairs(const radiosity_rebake_report& r, std::size_t) { return double(r.pairs); }
+};
+#ifdef BOUNCE_WITH_GL
+struct gl_rebaker {
+    const options& o;
+    gl::progressive_radiosity make(const scene_view& s, const lightmap_atlas& a, const embree::accel&) const {
+        return gl::progressive_radiosity(s, a, gl_options_for(o));
+    }
+    radiosity_rebake_report rebake(gl::progressive_radiosity& s, const scene_change& c, const embree::accel&) const {
+        if (c.moved.empty()) return s.rebake_light(c.light_index, c.changed.lights[c.light_index]);
+        return s.rebake_move(c.changed, c.moved, c.move, c.share);
+    }
+    // A GL re-shot's pass evaluates every element (its mask keeps the unchanged pairs as they are).
+    static double pairs(const radiosity_rebake_report& r, std::size_t elements) { return double(r.shooters) * double(elements); }
+};
+#endif
 
-// The triangles of `spec` (MATERIAL[#N]): the material's triangles grouped by shared vertex
-// positions, groups numbered by their first triangle.
-inline std::vector<std::uint32_t> object_triangles(const io::scene& s, const std::string& spec) {
-    const std::size_t hash = spec.find('#');
-    const std::string name = spec.substr(0, hash);
-    const std::size_t index = hash == std::string::npos ? 0 : std::size_t(rebake_numbers(spec.substr(hash + 1), 1, "--rebake-move", "MATERIAL[#N],DX,DY,DZ")[0]);
-    const auto m = std::find(s.material_names.begin(), s.material_names.end(), name);
-    if (m == s.material_names.end()) {
-        std::string names;
-        for (const auto& n : s.material_names) names += (names.empty() ? "" : ", ") + n;
-        throw parameter_error("--rebake-move", "no material '" + name + "' in " + s.name + " (" + names + ")");
-    }
-    const auto material = std::uint32_t(m - s.material_names.begin());
-    std::vector<std::uint32_t> parent(s.triangles.size());
-    std::iota(parent.begin(), parent.end(), 0u);
-    const auto root = [&](std::uint32_t t) {
-        while (parent[t] != t) t = parent[t] = parent[parent[t]];
-        return t;
-    };
-    std::map<std::tuple<float, float, float>, std::uint32_t> first_at;
-    for (std::uint32_t t = 0; t < s.triangles.size(); ++t) {
-        if (s.material_of[t] != material) continue;
-        for (int k = 0; k < 3; ++k) {
-            const glm::vec3 p = s.positions[s.triangles[t][k]];
-            const auto [it, added] = first_at.emplace(std::tuple{p.x, p.y, p.z}, t);
-            if (!added) parent[root(t)] = root(it->second);
-        }
-    }
-    std::vector<std::uint32_t> roots;  // in order of their first triangle
-    for (std::uint32_t t = 0; t < s.triangles.size(); ++t)
-        if (s.material_of[t] == material && std::find(roots.begin(), roots.end(), root(t)) == roots.end()) roots.push_back(root(t));
-    if (index >= roots.size())
-        throw parameter_error("--rebake-move", fmt::format("{} has {} groups of connected triangles: #0 .. #{}", name, roots.size(),
-                                                           roots.size() - 1));
-    std::vector<std::uint32_t> out;
-    for (std::uint32_t t = 0; t < s.triangles.size(); ++t)
-        if (s.material_of[t] == material && root(t) == roots[index]) out.push_back(t);
-    return out;
-}
-
-// The re-bake's run: see the file comment.
-inline int run_rebake(const options& o, const io::scene& scene, const embree::accel& bvh) {
-    if (o.backend != backend::cpu || o.visibility != visibility_kind::rays || o.adaptive)
-        throw parameter_error(o.rebake_move.empty() ? "--rebake-light" : "--rebake-move",
-                              "needs --backend cpu, --visibility rays and --adaptive off");
-    if (!o.rebake_light.empty() && !o.rebake_move.empty())
-        throw parameter_error("--rebake-move", "one change at a time: not with --rebake-light");
-    if (!o.json.empty()) io::check_output_file("--json", o.json);
+// The re-bake's measurement with `backend`'s solvers: see the file comment.
+template <class Rebaker>
+int measure_rebake(const options& o, const io::scene& scene, const embree::accel& bvh, const scene_change& c, const Rebaker& backend) {
     using clock = std::chrono::steady_clock;
-    io::scene changed = scene;
-    std::vector<std::uint32_t> moved;
-    rigid_move move;
-    std::size_t light_index = 0;
-    double share = 1;  // of the shot power, the share the correction re-shoots (cpu::rebake_move)
-    if (!o.rebake_light.empty()) {
-        const auto v = rebake_numbers(o.rebake_light, 2, "--rebake-light", "K,SCALE");
-        light_index = std::size_t(v[0]);
-        if (v[0] < 0 || light_index >= scene.lights.size() || v[1] < 0)
-            throw parameter_error("--rebake-light", fmt::format("K must be a light of {} (0 .. {}) and SCALE non-negative",
-                                                                scene.name, int(scene.lights.size()) - 1));
-        std::visit([&](auto& l) {
-            if constexpr (requires { l.intensity; }) l.intensity *= float(v[1]);
-            else l.irradiance *= float(v[1]);
-        }, changed.lights[light_index]);
-    } else {
-        const std::size_t comma = o.rebake_move.find(',');
-        moved = object_triangles(scene, o.rebake_move.substr(0, comma));
-        const std::string numbers = comma == std::string::npos ? "" : o.rebake_move.substr(comma + 1);
-        const bool with_share = std::count(numbers.begin(), numbers.end(), ',') == 3;
-        const auto d = rebake_numbers(numbers, with_share ? 4 : 3, "--rebake-move", "MATERIAL[#N],DX,DY,DZ[,SHARE]");
-        move.translation = glm::vec3(float(d[0]), float(d[1]), float(d[2]));
-        if (with_share) share = d[3];
-        std::vector<std::uint8_t> vertex(scene.positions.size(), 0);
-        for (const std::uint32_t t : moved)
-            for (int k = 0; k < 3; ++k) vertex[scene.triangles[t][k]] = 1;
-        for (std::size_t v = 0; v < vertex.size(); ++v)
-            if (vertex[v]) changed.positions[v] = move.point(changed.positions[v]);
-    }
+    const io::scene& changed = c.changed;
+    const std::vector<std::uint32_t>& moved = c.moved;
     auto t0 = clock::now();
     const embree::accel changed_bvh(changed);
     const double bvh_ms = study::ms_since(t0);
@@ -155,8 +92,7 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     // The fresh solve of the changed scene, then on to --rebake-check: the answer.
     t0 = clock::now();
     const lightmap_atlas fresh_atlas = build_lightmap_atlas(changed, atlas_options_for(o));
-    cpu::progressive_radiosity fresh(changed, fresh_atlas, embree::radiosity_visibility(changed_bvh, fresh_atlas.chart_of_triangle),
-                                     solver_options_for(o));
+    auto fresh = backend.make(changed, fresh_atlas, changed_bvh);
     const double fresh_setup_ms = study::ms_since(t0);
     const radiosity_solve_report fr = fresh.solve(s);
     const double fresh_ms = fresh_setup_ms + fr.solve_ms;
@@ -176,17 +112,14 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     double atlases_apart = 0;
     if (!moved.empty()) {
         lightmap_atlas moved_atlas = atlas;
-        move_charts(moved_atlas, moved_charts(atlas, moved), move);
-        cpu::progressive_radiosity same(changed, moved_atlas, embree::radiosity_visibility(changed_bvh, moved_atlas.chart_of_triangle),
-                                        solver_options_for(o));
+        move_charts(moved_atlas, moved_charts(atlas, moved), c.move);
+        auto same = backend.make(changed, moved_atlas, changed_bvh);
         same.solve(check);
         own_answer = view(same), atlases_apart = error(own_answer, answer);
     }
-    cpu::progressive_radiosity solver(scene, atlas, embree::radiosity_visibility(bvh, atlas.chart_of_triangle), solver_options_for(o));
+    auto solver = backend.make(scene, atlas, bvh);
     const radiosity_solve_report bake = solver.solve(s);
-    const radiosity_rebake_report rb =
-        moved.empty() ? cpu::rebake_light(solver, light_index, changed.lights[light_index])
-                      : cpu::rebake_move(solver, changed, moved, move, embree::radiosity_visibility(changed_bvh, atlas.chart_of_triangle), share);
+    const radiosity_rebake_report rb = backend.rebake(solver, c, changed_bvh);
     radiosity_solve_options again = check;
     again.checkpoints = 200;
     image<glm::vec3> rebake_view = view(solver);
@@ -207,11 +140,12 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
         }
         if (!ref_reached) ref_reached = error(v, reference->radiance) <= ref_target, ref_ms = p.elapsed_ms, ref_steps = p.steps - bake.steps;
     };
-    // The solve's shots from the moved object's elements (a step of one shooter: the default).
+    // The solve's shots from the moved object's elements (a step of one shooter: the default;
+    // the CPU solver names its last shot's).
     const std::vector<std::uint8_t> moved_chart = moved.empty() ? std::vector<std::uint8_t>(atlas.charts.size(), 0) : moved_charts(atlas, moved);
     std::size_t moved_shots = 0;
     again.progress = [&](const radiosity_progress&) {
-        moved_shots += moved_chart[solver.atlas().chart[solver.last_shot().first_element]];
+        if constexpr (requires { solver.last_shot(); }) moved_shots += moved_chart[solver.atlas().chart[solver.last_shot().first_element]];
         return !reached || !ref_reached;
     };
     const radiosity_solve_report rr = solver.solve(again);
@@ -225,6 +159,7 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     nlohmann::ordered_json j;
     j["scene"] = scene.name;
     j["change"] = moved.empty() ? "light " + o.rebake_light : "move " + o.rebake_move;
+    j["backend"] = name_of(backend_names, o.backend);
     j["elements"] = atlas.size();
     j["moved_triangles"] = moved.size();
     j["converge"] = o.converge;
@@ -235,13 +170,13 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
                    {"error", rebake_error}, {"reached", reached}, {"shooters", rb.shooters}, {"moved_shooters", rb.moved_shooters},
                    {"moved_shots", moved_shots}, {"pairs", rb.pairs}, {"moved_pairs", rb.moved_pairs},
                    {"pairs_tested", rb.pairs_tested}, {"moved_elements", rb.moved_elements},
-                   {"share", share}, {"uncorrected", rb.uncorrected},
+                   {"share", c.share}, {"uncorrected", rb.uncorrected},
                    {"unshot_before", rb.unshot_before}, {"unshot_after", rb.unshot_after}};
     j["bake"] = {{"steps", bake.steps}, {"ms", bake.solve_ms}};
     j["ratio"] = rebake_ms / fresh_ms;
     // Without the load: receiver-shooter pairs evaluated (a shot walks every element).
     const double fresh_pairs = double(fr.steps) * double(fresh_atlas.size());
-    const double rebake_pairs = double(rb.pairs) + double(at_steps) * double(atlas.size());
+    const double rebake_pairs = backend.pairs(rb, atlas.size()) + double(at_steps) * double(atlas.size());
     j["pairs"] = {{"fresh", fresh_pairs}, {"rebake", rebake_pairs}, {"ratio", rebake_pairs / fresh_pairs}};
     j["converged_rel_rms"] = converged_apart;
     j["converged_from_fresh"] = fresh_apart;
@@ -252,7 +187,7 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
         // The re-bake stopped at the fresh solve's error against the reference instead.
         j["to_reference_error"] = {{"ms", rb.ms + ref_ms}, {"steps", ref_steps}, {"reached", ref_reached},
                                    {"ratio", (rb.ms + ref_ms) / fresh_ms},
-                                   {"pairs_ratio", (double(rb.pairs) + double(ref_steps) * double(atlas.size())) / fresh_pairs}};
+                                   {"pairs_ratio", (backend.pairs(rb, atlas.size()) + double(ref_steps) * double(atlas.size())) / fresh_pairs}};
     }
     if (!o.json.empty()) io::write_text_file(o.json, j.dump(2) + "\n");
     fmt::print("radiosity re-bake {} ({}): {} elements; fresh {:.0f} ms (setup {:.0f}, {} steps), error {:.4f}; re-bake {:.0f} ms "
@@ -268,6 +203,23 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
                                        j["to_reference_error"]["ratio"].get<double>(), j["to_reference_error"]["pairs_ratio"].get<double>())
                          : std::string());
     return 0;
+}
+
+// The re-bake's run: checks, the change, the backend's measurement.
+inline int run_rebake(const options& o, const io::scene& scene, const embree::accel& bvh) {
+    const char* option = o.rebake_move.empty() ? "--rebake-light" : "--rebake-move";
+    if (o.adaptive) throw parameter_error(option, "needs --adaptive off");
+    if (o.backend == backend::cpu && o.visibility != visibility_kind::rays)
+        throw parameter_error(option, "needs --visibility rays on the CPU backend (GL: stereo or hemicube)");
+    if (!o.json.empty()) io::check_output_file("--json", o.json);
+    const scene_change c = parse_change(o, scene);
+#ifdef BOUNCE_WITH_GL
+    if (o.backend == backend::gl) {
+        const gl::context context;  // current on this thread while it lives
+        return measure_rebake(o, scene, bvh, c, gl_rebaker{o});
+    }
+#endif
+    return measure_rebake(o, scene, bvh, c, cpu_rebaker{o});
 }
 
 }  // namespace bounce::examples

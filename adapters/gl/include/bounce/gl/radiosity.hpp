@@ -149,7 +149,8 @@ public:
     radiosity_rebake_report rebake_move(const scene_view& moved_scene, std::span<const std::uint32_t> moved,
                                         const rigid_move& move, double share = 1.0);
 
-    /// Unshot power / emitted power, channels summed (from the last reduction); 0 for a
+    /// Unshot power in magnitude (|dB| A per channel, summed: a re-bake's may be negative) /
+    /// emitted power (from the last reduction), as cpu::progressive_radiosity counts it; 0 for a
     /// scene that emits nothing.
     double unshot_fraction() const noexcept;
     /// Of the power the surfaces reflect, the share still to shoot, its bounces to come
