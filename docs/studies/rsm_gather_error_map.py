@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Where the RSM gather's error with occlusion rays sits (issue 29; docs/rsm-sii-interleaved.md,
-section 15, "Issue 29: the gather's ratio"). Reads the raw frames `rsm_visibility_study --configs
+section 15.5). Reads the raw frames `rsm_visibility_study --configs
 gather --dump DIR` writes (256x256 float32 RGB, row-major) and
 
   - prints each frame's debiased rel_rms (as bench::measure_error, luminance over the covered

@@ -15,7 +15,7 @@ process) and adds each report to docs/results/rsm_visibility_table.json (docs/st
 with its commit and machine); `table` prints the markdown table from that file: seed 1's
 cells, as the earlier sections report them, and over the seeds measured the mean of each
 error and the ratio of the means (a single seed's error is one draw of a heavy-tailed
-estimate at few VPLs, docs section 15, fifth session). BIN=DIR/bin for another build folder,
+estimate at few VPLs, docs/rsm-sii-interleaved.md section 15.4). BIN=DIR/bin for another build folder,
 RUNS=DIR for the raw reports (default build/runs). Needs BOUNCE_CACHE and BOUNCE_SCENES as
 the benchmark does; the references are computed once and cached.
 """

@@ -2,8 +2,8 @@
 /// \file indirect/clamp_compensation.hpp
 /// The light the 1/d^2 clamp removes, given back by short rays where visibility is exact
 /// (Kollig and Keller 2004, "Illumination in the presence of weak singularities"; the "bias
-/// compensation" of instant radiosity). docs/rsm-sii-interleaved.md, section 15, "Issue 29,
-/// seventh session".
+/// compensation" of instant radiosity). docs/rsm-sii-interleaved.md, section
+/// 15.5.
 ///
 /// The RSM gather estimates, over the lit surfaces y its maps hold (radiance L(y) = M(y) / pi),
 ///   E_clamped(x) = int L(y) cos_x cos_y / max(d^2, r_c^2) dA_y = int L(y) cos_x min(1, d^2 / r_c^2) dw

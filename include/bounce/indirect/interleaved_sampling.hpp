@@ -164,7 +164,7 @@ T geometry_discontinuity(T depth_a, const V& n_a, T depth_b, const V& n_b, T rel
 
 /// Whether two neighbouring pixels of the gathered buffer see different shares of their
 /// senders (a visibility edge the G-buffer does not show: the rim of a shadow on one surface,
-/// docs/rsm-sii-interleaved.md, "Issue 29, fourth session"). Each pixel brings the sums of its
+/// docs/rsm-sii-interleaved.md, section 15.3). Each pixel brings the sums of its
 /// own sub-buffer's terms before visibility: `sum` = sum_k e_k, `visible` = sum_k e_k V_k and
 /// `sum_sq` = sum_k e_k^2 (e_k a term's brightness, V_k in {0, 1}). Its visible fraction is
 /// r = visible / sum, from Kish's effective number of terms n = sum^2 / sum_sq; r's variance

@@ -141,7 +141,7 @@ struct indirect_options {
     /// The RSM gather (CPU) with visibility rays or none: cosine rays per pixel that give back
     /// the light the clamp (light.min_distance2) removes within its distance, from each ray's
     /// first surface with rays, from every surface it crosses without visibility
-    /// (indirect/clamp_compensation.hpp; docs section 15, seventh session); the renderer then
+    /// (indirect/clamp_compensation.hpp; docs/rsm-sii-interleaved.md section 15.5); the renderer then
     /// needs a near_field_query. 0: off (the library's default); typical 16. Ignored with ism
     /// and by SII.
     std::uint32_t clamp_compensation_rays = 0;

@@ -21,7 +21,7 @@
 /// E ~ pi / (M N) sum over rays of the sum of L over the ray's surfaces. Bias: surfaces
 /// closer than the ray offset epsilon to x along the ray, or to the previous surface on it,
 /// are skipped, and a ray counts at most `max_surfaces` surfaces (docs/rsm-sii-interleaved.md
-/// section 11); no other. Variance: the integrand is bounded by pi max L times the number of
+/// section 12); no other. Variance: the integrand is bounded by pi max L times the number of
 /// layers a ray crosses (unlike a sum over light-traced points, whose cos cos / d^2 term is
 /// unbounded at creases), so the per-pixel standard deviation falls as (M N)^(-1/2) or
 /// faster (stratification). render_unoccluded_reference measures it: two halves of the
