@@ -127,10 +127,11 @@ radiosity_rebake_report progressive_radiosity::rebake_move(const scene_view& mov
             std::size_t pairs = 0;
             for (std::uint32_t i = 0; i < n; ++i)
                 if (keep(k % blocks, i, whole)) bits[i >> 5] |= 1u << (i & 31u), ++pairs;
+            if (!whole) r.pairs_tested += n;
+            if (pairs == 0) continue;  // no delivery of this shooter can change
             st.reshoot(k, sign, shot, bits);
             ++r.shooters, r.pairs += pairs;
             if (whole) ++r.moved_shooters, r.moved_pairs += pairs;
-            else r.pairs_tested += n;
         }
     };
     // The old geometry: every chosen block-side takes back what it delivered to the moved
