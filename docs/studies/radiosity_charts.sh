@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Charts that follow surfaces and the element budget (issue 30; docs/radiosity.md sections 2
-# and 9): on the built-in Cornell box and every shared scene, the lightmap atlas at 10,000 and
+# Charts that follow surfaces and the element budget (issue 30; docs/radiosity.md section 2,
+# "Measured: charts, clusters and the element budget"): on the built-in Cornell box and every shared scene, the lightmap atlas at 10,000 and
 # 100,000 elements asked (charts, elements per chart, packing efficiency, stretch, elements
 # made against asked: build/bin/lightmap_atlas), then the radiosity program at 100,000
 # elements, ray casts, to 90% of the indirect power against the 64-path multi-bounce
