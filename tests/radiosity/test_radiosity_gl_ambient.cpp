@@ -136,3 +136,17 @@ TEST_CASE("the GL solver's shaped ambient term is 0 once no unshot power is left
         for (const glm::vec3& a : g.ambient_field(0)) CHECK(a == glm::vec3(0.f));
     }
 }
+
+TEST_CASE("the GL solver records surface shots only: after its lights, Cohen's term", "[radiosity][ambient][gl]") {
+    gl_test::shared_context();
+    const auto scene = cornell_box(true);  // lit by its spot light
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 200, .block_texels = 4});
+    gl::progressive_radiosity g(scene.view(), atlas, {.shooting = {.ambient = true, .ambient_shape = radiosity_ambient::mixed},
+                                                      .resolution = 64});
+    CHECK(g.ambient_window().empty());  // the light was shot, not recorded (as on the CPU)
+    const glm::vec3 cohen(g.ambient());
+    REQUIRE(cohen.x > 0);
+    for (const glm::vec3& a : g.ambient_field(1)) CHECK(a == cohen);
+    REQUIRE(g.step());
+    CHECK(!g.ambient_window().empty());
+}

@@ -25,24 +25,29 @@ void progressive_radiosity::state::record_ambient(const glm::dvec3& power, const
     const auto start = clock_type::now();
     {
         binding_state saved;
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, texels.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, element_binding, element_texel.id());
-        glBindImageTexture(radiosity_glsl::window_unit, window_irradiance->id(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(intercepted_unit, intercepted.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glMemoryBarrier(GL_ALL_BARRIER_BITS);
         const program& p = *window_record_program;
-        glUseProgram(p.id());
+        use_window_pass(p, GL_READ_WRITE);
         namespace u = radiosity_glsl::window_uniform;
-        p.set(u::atlas_width, int(width));
-        p.set(u::atlas_height, int(height));
-        p.set(u::element_count, unsigned(atlas.size()));
-        p.set(u::sides, int(sides));
         p.set(u::keep, float(k));
         p.set(u::weight, float(w * k));
         glDispatchCompute(GLuint((atlas.size() + 63) / 64), 1, 1);
         check_error("progressive_radiosity: recording a shot for the ambient term");
     }
     timings.distribution_ms += ms_since(start);
+}
+
+void progressive_radiosity::state::use_window_pass(const program& p, GLenum access) const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, texels.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, element_binding, element_texel.id());
+    glBindImageTexture(radiosity_glsl::window_unit, window_irradiance->id(), 0, GL_FALSE, 0, access, GL_RGBA32F);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    glUseProgram(p.id());
+    namespace u = radiosity_glsl::window_uniform;
+    p.set(u::atlas_width, int(width));
+    p.set(u::atlas_height, int(height));
+    p.set(u::element_count, unsigned(atlas.size()));
+    p.set(u::sides, int(sides));
 }
 
 std::optional<shot_ambient_terms> progressive_radiosity::state::ambient_terms(const glm::dvec3& unshot,
@@ -66,18 +71,10 @@ std::optional<shot_ambient_terms> progressive_radiosity::state::ambient_terms(co
     if (t.shape != radiosity_ambient::mixed) return t;
     {
         binding_state saved;
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, texels.id());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, element_binding, element_texel.id());
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, partial_binding, window_deficit->id());
-        glBindImageTexture(radiosity_glsl::window_unit, window_irradiance->id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-        glMemoryBarrier(GL_ALL_BARRIER_BITS);
         const program& p = *window_deficit_program;
-        glUseProgram(p.id());
+        use_window_pass(p, GL_READ_ONLY);
         namespace u = radiosity_glsl::window_uniform;
-        p.set(u::atlas_width, int(width));
-        p.set(u::atlas_height, int(height));
-        p.set(u::element_count, unsigned(atlas.size()));
-        p.set(u::sides, int(sides));
         p.set(u::factor, glm::vec3(t.factor));
         p.set(u::floor, glm::vec3(t.floor));
         glDispatchCompute(1, 1, 1);

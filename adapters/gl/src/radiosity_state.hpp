@@ -215,6 +215,8 @@ struct progressive_radiosity::state {
     // (not asked for, or no shot recorded yet). With `h`, the window read back into it (per
     // element-side, side-major) and the mixed deficit summed from it; else summed on the GPU.
     std::optional<shot_ambient_terms> ambient_terms(const glm::dvec3& unshot, std::vector<glm::vec3>* h) const;
+    // Binds what both window passes read (the window with `access`), uses `p`, sets their uniforms.
+    void use_window_pass(const program& p, GLenum access) const;
     void draw_item_buffer();
     void draw_hemicube();
     void draw_parallel();

@@ -33,6 +33,11 @@
 /// tessellation needed) or be left out. Not here (the CPU solver has them): several shooters
 /// per step, grouped shooters, adaptive subdivision.
 ///
+/// The ambient term shown before convergence (radiosity_options::ambient_shape) is the CPU
+/// solver's: Cohen's uniform one, or shots or mixed (radiosity/ambient.hpp), shaped by a window
+/// of recent surface shots (radiosity/ambient_window.hpp) whose irradiance per element-side
+/// the solver keeps in a texture, raised by a compute pass after each shot (ambient_field).
+///
 /// Elements are two-sided by default, as on the CPU (radiosity/sides.hpp): a radiosity per
 /// side, the backs in rows [height, 2 height) of the textures, shooter k block k % blocks on
 /// side k / blocks; a receiver takes each node of a shot on the side that faces it
