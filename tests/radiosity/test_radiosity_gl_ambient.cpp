@@ -2,15 +2,20 @@
 // radiosity/ambient.hpp) against the CPU solver's on the same scene and options, its total
 // against the shaped total E = U D / (S - R), and the lightmap pass's (GPU) against the
 // read-back path's. llvmpipe via EGL.
+#include "../gl/agreement_inputs.hpp"
 #include "../gl/shared_context.hpp"
 #include "radiosity_scenes.hpp"
 
 #include <bounce/cpu/radiosity.hpp>
+#include <bounce/gl/kernel_map.hpp>
 #include <bounce/gl/radiosity.hpp>
+#include <bounce/radiosity/ambient.hpp>
 
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <tuple>
+#include <vector>
 
 using namespace bounce;
 using namespace bounce::radiosity_test;
@@ -149,4 +154,26 @@ TEST_CASE("the GL solver records surface shots only: after its lights, Cohen's t
     for (const glm::vec3& a : g.ambient_field(1)) CHECK(a == cohen);
     REQUIRE(g.step());
     CHECK(!g.ambient_window().empty());
+}
+
+TEST_CASE("the mixed ambient and its deficit agree on the GPU and the CPU, shaped term and floor equal included",
+          "[glsl][radiosity][ambient]") {
+    gl_test::shared_context();
+    pcg32 rng(57);
+    const auto random3 = [&] { return glm::vec3(rng.next_float(), rng.next_float(), rng.next_float()); };
+    std::vector<std::tuple<glm::vec3, glm::vec3, glm::vec3>> mixed;
+    std::vector<std::tuple<glm::vec3, glm::vec3, float>> deficit;
+    for (int k = 0; k < 5000; ++k) {
+        const glm::vec3 shaped = random3() * 5.f, floor = k % 10 == 0 ? shaped : random3() * 5.f;
+        mixed.emplace_back(shaped, floor, random3());
+        deficit.emplace_back(shaped, floor, rng.next_float() * 2.f);
+    }
+    std::vector<glm::vec3> cpu_mixed, cpu_deficit;
+    for (const auto& a : mixed) cpu_mixed.push_back(std::apply(mixed_ambient<float, glm::vec3>, a));
+    for (const auto& a : deficit) cpu_deficit.push_back(std::apply(mixed_ambient_deficit<float, glm::vec3>, a));
+    // One product (of a max or a difference): a few ulp of terms up to 5 (the agreement tests' 1e-5).
+    const auto scale = [](std::size_t) { return 10.0; };
+    CHECK(gl_test::worst_scaled(gl::map_kernel(mixed_ambient<glsl::f32, glsl::vec3>, mixed), cpu_mixed, scale) <= 1e-5);
+    CHECK(gl_test::worst_scaled(gl::map_kernel(mixed_ambient_deficit<glsl::f32, glsl::vec3>, deficit), cpu_deficit, scale) <=
+          1e-5);
 }
