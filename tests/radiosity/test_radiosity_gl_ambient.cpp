@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 using namespace bounce;
@@ -49,9 +50,11 @@ TEST_CASE("the GL solver's shots and mixed ambient fields are the CPU solver's p
     gl_test::shared_context();
     const auto scene = cornell_box();
     const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 400, .block_texels = 4});
-    for (const radiosity_ambient shape : {radiosity_ambient::shots, radiosity_ambient::mixed}) {
-        INFO("shape " << int(shape));
-        const radiosity_options shooting{.ambient = true, .ambient_shape = shape};
+    for (const auto& [shape, two_sided] : {std::pair(radiosity_ambient::shots, true), std::pair(radiosity_ambient::mixed, true),
+                                          std::pair(radiosity_ambient::mixed, false)}) {
+        INFO("shape " << int(shape) << ", two-sided " << two_sided);
+        radiosity_options shooting{.ambient = true, .ambient_shape = shape};
+        shooting.two_sided = two_sided;
         gl::progressive_radiosity g(scene.view(), atlas, {.shooting = shooting, .visibility = gl::radiosity_visibility::none});
         cpu::progressive_radiosity c(scene.view(), atlas, cpu::all_visible{}, shooting);
         for (int s = 0; s < 25; ++s) {
@@ -60,7 +63,8 @@ TEST_CASE("the GL solver's shots and mixed ambient fields are the CPU solver's p
         }
         REQUIRE(g.unshot_fraction() > 0.05);  // partway: the ambient term is a large share
         double largest = 0, worst = 0, spread_lo = 1e30, spread_hi = 0;
-        for (int side = 0; side < 2; ++side) {
+        REQUIRE(g.sides() == c.sides());
+        for (int side = 0; side < g.sides(); ++side) {
             const auto ag = g.ambient_field(side), ac = cpu_ambient_field(c, side);
             const auto b = c.radiosity(side);
             for (std::size_t i = 0; i < ag.size(); ++i)
