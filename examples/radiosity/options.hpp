@@ -57,7 +57,7 @@ struct options {
     double max_seconds = 0;           // also stop after this much solving (0: no limit)
     int shooters_per_step = 1;
     double near_field = 4;
-    bool ambient = true;  // the ambient term (ambient_shape_for: the mixed one on the CPU, Cohen's on GL)
+    bool ambient = true;  // the ambient term (ambient_shape_for: the mixed one, Cohen's in re-bakes)
     radiosity_ambient ambient_shape = radiosity_ambient::mixed;  // with ambient: Cohen's, the shots', or mixed
     bool ambient_given = false;       // --ambient was given (else ambient_shape_for chooses by backend)
     bool one_sided = false;           // only the front (counter-clockwise) side receives and shoots
@@ -132,10 +132,10 @@ inline void add_options(CLI::App& app, options& o) {
                                                 : radiosity_ambient::uniform;
            },
            "show the ambient term: off | on (= uniform, Cohen et al. 1988) | uniform | shots (amount and shape "
-           "measured from the recent shots, radiosity/ambient.hpp; CPU) | mixed (the shots' amount, their shape above "
-           "an even floor of its reflected share; CPU)")
+           "measured from the recent shots, radiosity/ambient.hpp) | mixed (the shots' amount, their shape above "
+           "an even floor of its reflected share)")
         ->check(CLI::IsMember({"off", "on", "uniform", "shots", "mixed"}))
-        ->default_str("mixed on the CPU, uniform on GL and in re-bakes");
+        ->default_str("mixed; uniform in re-bakes");
     app.add_option("--light-samples", o.light_samples,
                    "point, spot and directional lights taken at k x k points of each whole texel (1: its element's point)")
         ->check(CLI::Range(1, 16))->capture_default_str();
@@ -196,12 +196,12 @@ inline atlas_options atlas_options_for(const options& o) {
     return a;
 }
 
-/// The ambient term's shape the solver gets: --ambient's when given; else the mixed term on the
-/// CPU, Cohen's uniform one on GL (the GL solver's only term) and in re-bakes (a negative
-/// unshot power has no shaped amount, Cohen's term is signed).
+/// The ambient term's shape the solver gets: --ambient's when given; else the mixed term (both
+/// backends), Cohen's uniform one in re-bakes (a negative unshot power has no shaped amount,
+/// Cohen's term is signed).
 inline radiosity_ambient ambient_shape_for(const options& o) {
     const bool rebake = !o.rebake_light.empty() || !o.rebake_move.empty();
-    return o.ambient_given || (o.backend != backend::gl && !rebake) ? o.ambient_shape : radiosity_ambient::uniform;
+    return o.ambient_given || !rebake ? o.ambient_shape : radiosity_ambient::uniform;
 }
 
 // The shooting options, the same for both backends (include/bounce/radiosity/options.hpp).
@@ -250,8 +250,6 @@ inline void check_options(const options& o) {
         throw parameter_error("--visibility", "'rays' runs on the CPU backend only");
     if (o.adaptive) throw parameter_error("--adaptive", "'on' runs on the CPU backend only");
     if (o.shooters_per_step != 1) throw parameter_error("--shooters-per-step", "must be 1 on the GL backend");
-    if (o.ambient && ambient_shape_for(o) != radiosity_ambient::uniform)
-        throw parameter_error("--ambient", "'shots' and 'mixed' run on the CPU backend only");
 }
 
 inline cpu::item_buffer_visibility::options item_options_for(const options& o) {

@@ -122,9 +122,9 @@ glm::dvec3 progressive_radiosity::ambient() const {
 }
 std::vector<glm::vec3> progressive_radiosity::display_radiosity(int side) const {
     std::vector<glm::vec3> out = radiosity(side);
-    const glm::vec3 amb = s_->options.shooting.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+    const std::vector<glm::vec3> amb = ambient_field(side);
     for (std::size_t i = 0; i < out.size(); ++i)
-        out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb);
+        out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb[i]);
     return out;
 }
 std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, light_paths paths, int side) const {
@@ -132,12 +132,12 @@ std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, l
     std::vector<glm::vec3> out = radiosity(side);  // checks the side
     const std::size_t o = at.size() * std::size_t(side);
     const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
-    const glm::vec3 amb = s_->options.shooting.ambient && indirect ? glm::vec3(ambient()) : glm::vec3(0.f);
+    const std::vector<glm::vec3> amb = indirect ? ambient_field(side) : std::vector<glm::vec3>(out.size(), glm::vec3(0.f));
     for (std::size_t i = 0; i < out.size(); ++i) {
         // Reflected radiosity of the parts asked for: rho E (the emission on the side that emits).
         const glm::vec3 emission = s_->emits_on(i, side) ? at.emission[i] : glm::vec3(0.f);
         const glm::vec3 reflected = (direct ? direct_[o + i] - emission : glm::vec3(0.f)) +
-                                    (indirect ? out[i] - direct_[o + i] + at.albedo[i] * amb : glm::vec3(0.f));
+                                    (indirect ? out[i] - direct_[o + i] + at.albedo[i] * amb[i] : glm::vec3(0.f));
         if (quantity == output_quantity::radiance) {
             out[i] = (reflected + (direct ? emission : glm::vec3(0.f))) * float(1.0 / std::numbers::pi);
             continue;
@@ -170,7 +170,11 @@ texture_ref progressive_radiosity::update_lightmap_texture(int side) {
                 }
         st.source_texel = std::make_unique<buffer>(src.size() * sizeof(std::uint32_t), src.data());
     }
-    const glm::vec3 amb = st.options.shooting.ambient ? glm::vec3(ambient()) : glm::vec3(0.f);
+    const glm::dvec3 unshot_now = unshot_power();
+    const auto shaped = st.ambient_terms(unshot_now, nullptr);  // none: Cohen's uniform term
+    const glm::vec3 amb = st.options.shooting.ambient && !shaped
+                              ? glm::vec3(cohen_ambient(unshot_now, st.total_area, st.albedo_area, int(st.sides)))
+                              : glm::vec3(0.f);
     {
         binding_state saved;
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, texels_binding, st.texels.id());
@@ -186,6 +190,14 @@ texture_ref progressive_radiosity::update_lightmap_texture(int side) {
         p.set(u::atlas_height, int(st.height));
         p.set(u::ambient, amb);
         p.set(u::source_row, side * int(st.height));
+        p.set(u::shape, shaped ? (shaped->shape == radiosity_ambient::mixed ? 2 : 1) : 0);
+        if (shaped) {
+            glBindImageTexture(radiosity_glsl::window_unit, st.window_irradiance->id(), 0, GL_FALSE, 0, GL_READ_ONLY,
+                               GL_RGBA32F);
+            p.set(u::factor, glm::vec3(shaped->factor));
+            p.set(u::floor, glm::vec3(shaped->floor));
+            p.set(u::scale, glm::vec3(shaped->scale));
+        }
         glDispatchCompute((st.width + 7) / 8, (st.height + 7) / 8, 1);
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
         check_error("progressive_radiosity: the lightmap pass");

@@ -7,6 +7,7 @@
 
 #include <bounce/direct_light.hpp>
 #include <bounce/glsl/emit.hpp>
+#include <bounce/radiosity/ambient.hpp>
 #include <bounce/radiosity/kernels.hpp>
 #include <bounce/radiosity/sides.hpp>
 
@@ -497,20 +498,26 @@ void main() {
 // The display lightmap: each lightmap texel shows its element's radiosity with the ambient
 // term (radiosity_with_ambient, emitted), on the side whose rows start at source_row;
 // source_texel holds the element's atlas texel packed as x | y << 16, or 0xffffffff where the
-// texel shows no element.
+// texel shows no element. The ambient: uniform, or shaped from the window's irradiance h
+// (h factor; mixed: mixed_ambient, emitted).
 std::string lightmap_compute() {
     using namespace lightmap_uniform;
     glsl::function_set fs;
     fs.add("radiosity_display", radiosity_with_ambient<f32, vec3>, "radiosity", "albedo", "ambient");
+    fs.add("radiosity_mixed_ambient", mixed_ambient<f32, vec3>, "shaped", "floor_level", "scale");
     return version_line + "layout(local_size_x = 8, local_size_y = 8) in;\n" + fs.source() + texel_attributes_struct +
            storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
            storage_block(source_binding, "readonly buffer source_block { uint source_texel[]; }") +
            image(radiosity_unit, "readonly image2D radiosity_image") +
-           image(lightmap_unit, "writeonly image2D lightmap_image") +
+           image(lightmap_unit, "writeonly image2D lightmap_image") + image(window_unit, "readonly image2D window_image") +
            uniforms({{atlas_width, "int atlas_width"},
                      {atlas_height, "int atlas_height"},
                      {ambient, "vec3 ambient"},
-                     {source_row, "int source_row"}}) +
+                     {source_row, "int source_row"},
+                     {shape, "int shape"},
+                     {factor, "vec3 factor"},
+                     {floor, "vec3 floor_level"},
+                     {scale, "vec3 scale"}}) +
            R"(
 void main() {
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
@@ -520,7 +527,87 @@ void main() {
     ivec2 from = ivec2(int(code & 0xffffu), int(code >> 16u));
     vec3 b = imageLoad(radiosity_image, from + ivec2(0, source_row)).rgb;
     vec3 rho = texel[from.y * atlas_width + from.x].albedo.rgb;
-    imageStore(lightmap_image, xy, vec4(radiosity_display(b, rho, ambient), 1.0));
+    vec3 a = ambient;
+    if (shape != 0) {
+        vec3 shaped = imageLoad(window_image, from + ivec2(0, source_row)).rgb * factor;
+        a = shape == 2 ? radiosity_mixed_ambient(shaped, floor_level, scale) : shaped;
+    }
+    imageStore(lightmap_image, xy, vec4(radiosity_display(b, rho, a), 1.0));
+}
+)";
+}
+
+// The window passes' common head: their uniforms, the element texels and the window's image.
+std::string window_head() {
+    using namespace window_uniform;
+    return version_line + "layout(local_size_x = 64) in;\n" +
+           uniforms({{atlas_width, "int atlas_width"},
+                     {atlas_height, "int atlas_height"},
+                     {element_count, "uint element_count"},
+                     {sides, "int sides"}}) +
+           "\n" + texel_attributes_struct +
+           storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
+           storage_block(element_binding, "readonly buffer element_block { uint element_texel[]; }") + R"(
+// Element e's texel in the fronts' rows, and its area (0: not an element's texel).
+ivec2 element_xy(uint e) { uint code = element_texel[e]; return ivec2(int(code & 0xffffu), int(code >> 16u)); }
+float element_area(ivec2 xy) { return texel[xy.y * atlas_width + xy.x].position_area.w; }
+)";
+}
+
+// A surface shot added to the window (shot_ambient_window): each element-side's received
+// irradiance, its intercepted power (the shot's scale applied) over its area, times the weight;
+// keep < 1 rescales the older sum.
+std::string window_record_compute() {
+    using namespace window_uniform;
+    return window_head() + uniforms({{keep, "float keep"}, {weight, "float weight"}}) +
+           image(window_unit, "image2D window_image") + image(intercepted_unit, "readonly image2D intercepted_image") +
+           R"(
+void main() {
+    if (gl_GlobalInvocationID.x >= element_count) return;
+    ivec2 xy = element_xy(gl_GlobalInvocationID.x);
+    float area = element_area(xy);
+    if (!(area > 0.0)) return;
+    for (int side = 0; side < sides; ++side) {
+        ivec2 at = xy + ivec2(0, side * atlas_height);
+        vec3 got = imageLoad(intercepted_image, at).rgb;
+        if (got == vec3(0.0) && keep == 1.0) continue;
+        imageStore(window_image, at, vec4(imageLoad(window_image, at).rgb * keep + got / area * weight, 0.0));
+    }
+}
+)";
+}
+
+// The mixed term's deficit (mixed_ambient_deficit, emitted) summed in double over every
+// element-side by one work group of 64, striding, then a shared-memory tree.
+std::string window_deficit_compute() {
+    using namespace window_uniform;
+    glsl::function_set fs;
+    fs.add("radiosity_mixed_deficit", mixed_ambient_deficit<f32, vec3>, "shaped", "floor_level", "area");
+    return window_head() + fs.source() + uniforms({{factor, "vec3 factor"}, {floor, "vec3 floor_level"}}) +
+           image(window_unit, "readonly image2D window_image") +
+           storage_block(partial_binding, "buffer deficit_block { double deficit[]; }") + R"(
+shared double s[64 * 3];
+void main() {
+    uint i = gl_LocalInvocationID.x;
+    dvec3 d = dvec3(0.0);
+    for (uint e = i; e < element_count; e += 64u) {
+        ivec2 xy = element_xy(e);
+        float area = element_area(xy);
+        if (!(area > 0.0)) continue;
+        for (int side = 0; side < sides; ++side) {
+            vec3 h = imageLoad(window_image, xy + ivec2(0, side * atlas_height)).rgb;
+            d += dvec3(radiosity_mixed_deficit(h * factor, floor_level, area));
+        }
+    }
+    s[i * 3u] = d.x; s[i * 3u + 1u] = d.y; s[i * 3u + 2u] = d.z;
+    for (uint stride = 32u; stride > 0u; stride >>= 1u) {
+        barrier();
+        if (i < stride)
+            for (uint c = 0u; c < 3u; ++c) s[i * 3u + c] += s[(i + stride) * 3u + c];
+    }
+    barrier();
+    if (i == 0u)
+        for (uint c = 0u; c < 3u; ++c) deficit[c] = s[c];
 }
 )";
 }

@@ -94,10 +94,19 @@ enum : int {
 };
 }
 
-// The display lightmap's pass (update_lightmap_texture).
+// The display lightmap's pass (update_lightmap_texture); the ambient's shape: 0 the uniform
+// `ambient`, 1 shots, 2 mixed (shot_ambient_terms, read at window_unit).
 namespace lightmap_uniform {
-enum : int { atlas_width = 0, atlas_height = 1, ambient = 2, source_row = 3 };
+enum : int { atlas_width = 0, atlas_height = 1, ambient = 2, source_row = 3, shape = 4, factor = 5, floor = 6, scale = 7 };
 }
+
+// The shaped ambient term's passes (radiosity_ambient.cpp): a shot added to the window's
+// irradiance, h = h keep + intercepted / area weight; the mixed term's deficit summed into the
+// buffer at partial_binding. The window's texture at window_unit (the lightmap pass's too).
+namespace window_uniform {
+enum : int { atlas_width = 0, atlas_height = 1, element_count = 2, sides = 3, keep = 4, weight = 5, factor = 6, floor = 7 };
+}
+constexpr unsigned window_unit = unshot_unit;
 
 // The reduction's two passes.
 namespace reduce_uniform {
@@ -125,5 +134,7 @@ std::string reduce_compute();
 std::string finish_compute();
 std::string rescale_compute();
 std::string lightmap_compute();
+std::string window_record_compute();
+std::string window_deficit_compute();
 
 }  // namespace bounce::gl::radiosity_glsl

@@ -302,6 +302,7 @@ void progressive_radiosity::state::shoot(std::uint32_t k) {
     absorbed += got.absorbed;
     escaped += power - got.intercepted;
     intercepted_power += got.intercepted;
+    record_ambient(power, got);
     shot_power += power.x + power.y + power.z;
     ++shots;
 }

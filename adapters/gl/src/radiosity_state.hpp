@@ -7,6 +7,7 @@
 #include <bounce/glsl/emit.hpp>
 #include <bounce/light.hpp>
 #include <bounce/direct_light.hpp>
+#include <bounce/radiosity/ambient_window.hpp>
 #include <bounce/radiosity/kernels.hpp>
 #include <bounce/radiosity/rebake.hpp>
 #include <bounce/radiosity/shooters.hpp>
@@ -24,6 +25,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -199,6 +201,14 @@ struct progressive_radiosity::state {
     double shot_power = 0;          // power shot by surfaces so far, channels summed (W)
     radiosity_timings timings;
 
+    // The shaped ambient terms (radiosity_ambient.cpp, radiosity/ambient_window.hpp): the window
+    // of recent surface shots; its irradiance h per element-side in a texture with the
+    // radiosity's rows, made with its passes at the first shot recorded.
+    shot_ambient_window ambient_window;
+    std::unique_ptr<texture> window_irradiance;
+    std::unique_ptr<program> window_record_program, window_deficit_program;
+    std::unique_ptr<buffer> window_deficit;
+
     state(const scene_view& scene, const lightmap_atlas& a, const radiosity_options& o);
     void compile();
     // The element attributes per texel (texel_attributes) from the atlas, uploaded.
@@ -219,6 +229,15 @@ struct progressive_radiosity::state {
         glm::dvec3 intercepted{0.0}, absorbed{0.0};
     };
     reduction reduce();
+    // Adds the surface shot just distributed, of `power`, whose reduction after its scale is
+    // `got`, to the window when the options ask for a shaped ambient term.
+    void record_ambient(const glm::dvec3& power, const reduction& got);
+    // The shaped ambient's terms for the unshot power `unshot`, or none for Cohen's uniform term
+    // (not asked for, or no shot recorded yet). With `h`, the window read back into it (per
+    // element-side, side-major) and the mixed deficit summed from it; else summed on the GPU.
+    std::optional<shot_ambient_terms> ambient_terms(const glm::dvec3& unshot, std::vector<glm::vec3>* h) const;
+    // Binds what both window passes read (the window with `access`), uses `p`, sets their uniforms.
+    void use_window_pass(const program& p, GLenum access) const;
     void draw_item_buffer();
     void draw_hemicube();
     void draw_parallel();

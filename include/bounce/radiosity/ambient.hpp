@@ -62,13 +62,20 @@ V mixed_ambient_floor(const V& factor, const V& shot, const V& delivered, const 
 /// The mixed ambient irradiance of an element-side (W/m^2 per channel): the larger of the
 /// shaped term `shaped` = h_i factor and the floor, times `scale`, which keeps the total at E:
 ///   a_i = scale max(h_i factor, floor),  scale = E / (E + sum_j A_j max(0, floor - h_j factor)),
-/// the sum over every element-side (mixed_ambient_scale). Where the shots delivered more than
-/// the floor, their shape; elsewhere (an element no shot reached included) Cohen's even level.
-template <floating T, class V>
+/// the sum over every element-side (mixed_ambient_deficit, mixed_ambient_scale). Where the shots
+/// delivered more than the floor, their shape; elsewhere (an element no shot reached included)
+/// Cohen's even level. Emitted as GLSL for the GL solver's lightmap pass.
+template <real T, class V>
 V mixed_ambient(const V& shaped, const V& floor, const V& scale) {
-    V a(T(0));
-    for (int c = 0; c < 3; ++c) a[c] = scale[c] * std::max(shaped[c], floor[c]);
-    return a;
+    return scale * max(shaped, floor);
+}
+
+/// One element-side's term of mixed_ambient_scale's deficit: its area `area` times the floor's
+/// excess over its shaped term, A_j max(0, floor - h_j factor), per channel. Emitted as GLSL
+/// for the GL solver's sum.
+template <real T, class V>
+V mixed_ambient_deficit(const V& shaped, const V& floor, const T& area) {
+    return max(floor - shaped, T(0)) * area;
 }
 
 /// mixed_ambient's scale from the total E (`total`, = factor D) and `deficit`, the floor's

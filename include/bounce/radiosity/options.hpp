@@ -33,9 +33,9 @@ struct radiosity_options {
     int shooters_per_step = 1;     ///< shooters taken from one choice, shot in turn (typical: 1-16;
                                    ///< the GL solver shoots one)
     bool ambient = true;           ///< display_radiosity adds the ambient term (Cohen et al. 1988)
-    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  ///< with ambient: uniform (as on GL and
-                                   ///< in re-bakes), shaped by the recent shots, or mixed (CPU solver
-                                   ///< only; the radiosity program's CPU default; radiosity/ambient.hpp)
+    radiosity_ambient ambient_shape = radiosity_ambient::uniform;  ///< with ambient: uniform (as in
+                                   ///< re-bakes), shaped by the recent shots, or mixed (the radiosity
+                                   ///< program's default; radiosity/ambient.hpp). Both solvers, CPU and GL
     double near_field = 4;         ///< a block shoots as one disc to receivers farther than this many
                                    ///< times its side (sqrt of its area), else as its quadrants,
                                    ///< recursively; 0: always one disc (typical: 2-4)

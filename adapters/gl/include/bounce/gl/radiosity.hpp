@@ -34,6 +34,11 @@
 /// per step, grouped shooters, adaptive subdivision. Re-bakes after a light changes or an
 /// object moves: rebake_light, rebake_move.
 ///
+/// The ambient term shown before convergence (radiosity_options::ambient_shape) is the CPU
+/// solver's: Cohen's uniform one, or shots or mixed (radiosity/ambient.hpp), shaped by a window
+/// of recent surface shots (radiosity/ambient_window.hpp) whose irradiance per element-side
+/// the solver keeps in a texture, raised by a compute pass after each shot (ambient_field).
+///
 /// Elements are two-sided by default, as on the CPU (radiosity/sides.hpp): a radiosity per
 /// side, the backs in rows [height, 2 height) of the textures, shooter k block k % blocks on
 /// side k / blocks; a receiver takes each node of a shot on the side that faces it
@@ -48,6 +53,7 @@
 #include <bounce/gl/objects.hpp>
 #include <bounce/image.hpp>
 #include <bounce/output.hpp>
+#include <bounce/radiosity/ambient_window.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
 #include <bounce/radiosity/options.hpp>
 #include <bounce/radiosity/rebake.hpp>
@@ -186,10 +192,19 @@ public:
     /// 1 the back, two-sided only), read back, W/m^2 per channel.
     std::vector<glm::vec3> radiosity(int side = 0) const;
     std::vector<glm::vec3> unshot(int side = 0) const;
-    /// The ambient radiosity (Cohen et al. 1988) and B plus rho times it when the options ask.
-    /// Cohen's uniform term whatever radiosity_options::ambient_shape says: the shaped and mixed
-    /// terms need each shot's per-element deliveries, kept by the CPU solver only.
+    /// Cohen et al. 1988's uniform ambient term (W/m^2 per channel), as
+    /// cpu::progressive_radiosity::ambient() gives it.
     glm::dvec3 ambient() const;
+    /// The ambient irradiance per element of `side` that display_radiosity, output, the
+    /// lightmaps and update_lightmap_texture show (W/m^2 per channel), as the CPU solver
+    /// shows it: 0 without radiosity_options::ambient; with ambient_shape uniform (and before
+    /// the first surface shot) ambient() everywhere; shots or mixed (radiosity/ambient.hpp)
+    /// shaped by a window of recent surface shots (radiosity/ambient_window.hpp) whose
+    /// irradiance per element-side the solver keeps in a texture, raised after each shot.
+    std::vector<glm::vec3> ambient_field(int side = 0) const;
+    /// That window's sums and weight (empty unless the options ask for shots or mixed).
+    const shot_ambient_window& ambient_window() const noexcept;
+    /// B plus rho times ambient_field(side).
     std::vector<glm::vec3> display_radiosity(int side = 0) const;
     /// Per element, the light of `paths` as `quantity` (output.hpp), as
     /// cpu::progressive_radiosity::output gives it. The parts come from B and the B read back
