@@ -152,6 +152,46 @@ TEST_CASE("a GL re-bake converges to the fresh GL solve of the changed scene", "
     }
 }
 
+TEST_CASE("after a dimming GL re-bake the ambient is shown at most down to no indirect light, as on the CPU",
+          "[radiosity][rebake][gl][ambient]") {
+    // The light turned off: Cohen's term of the negative unshot power is negative, and both
+    // solvers show it clamped where it would take away more than the shots delivered. Without
+    // occlusion their states are the same, so what they show is too; the GPU's lightmap pass
+    // shows what the read-back path does.
+    gl_test::shared_context();
+    const owned_scene s = box_with_block();
+    const auto atlas = build_lightmap_atlas(s.view(), {.elements = 300, .block_texels = 4});
+    gl::progressive_radiosity g(s.view(), atlas, {.visibility = gl::radiosity_visibility::none});
+    cpu::progressive_radiosity c(s.view(), atlas, cpu::all_visible{});
+    REQUIRE(g.solve(to(0.99)).steps == c.solve(to(0.99)).steps);
+    const light off = point_light{glm::vec3(1.3f, 1.5f, 1.2f), glm::vec3(0.f)};
+    g.rebake_light(0, off);
+    cpu::rebake_light(c, 0, off);
+    REQUIRE(c.ambient().x < 0);
+    std::size_t clamped = 0;
+    for (int side = 0; side < 2; ++side) {
+        const auto shown_g = g.display_radiosity(side), shown_c = c.display_radiosity(side);
+        const auto indirect = g.output(output_quantity::irradiance, light_paths::indirect, side);
+        const auto b = g.radiosity(side);
+        double largest = 0;
+        for (const auto& v : shown_c) largest = std::max(largest, double(v.x));
+        for (std::size_t i = 0; i < shown_g.size(); ++i) {
+            CHECK(std::abs(shown_g[i].x - shown_c[i].x) <= 1e-4 * largest);
+            CHECK(indirect[i].x >= 0.f);
+            clamped += shown_g[i].x > b[i].x + float(atlas.albedo[i].x * g.ambient().x) + 1e-6f ? 1 : 0;
+        }
+        const auto expected = g.radiosity_lightmap(0, side);
+        const auto got = g.update_lightmap_texture(side).read_floats();
+        double worst = 0;
+        for (std::uint32_t y = 0; y < atlas.height; ++y)
+            for (std::uint32_t x = 0; x < atlas.width; ++x)
+                if (atlas.element_at(x, y) >= 0)
+                    worst = std::max(worst, double(std::abs(got[4 * (std::size_t(y) * atlas.width + x)] - expected(x, y).x)));
+        CHECK(worst <= 1e-5 * largest);
+    }
+    CHECK(clamped > 0);
+}
+
 TEST_CASE("a GL re-bake's bad input is refused by name", "[radiosity][rebake][gl][errors]") {
     gl_test::shared_context();
     const owned_scene s = box_with_block();

@@ -59,6 +59,7 @@ progressive_radiosity::progressive_radiosity(const scene_view& scene, const ligh
         const auto d = radiosity(side);
         direct_.insert(direct_.end(), d.begin(), d.end());
     }
+    s_->upload_direct(direct_);
     s_->reduce();
     check_lights_reach_surfaces(scene, s_->atlas, s_->emitted, two_sided());
 }
@@ -191,6 +192,8 @@ texture_ref progressive_radiosity::update_lightmap_texture(int side) {
         p.set(u::ambient, amb);
         p.set(u::source_row, side * int(st.height));
         p.set(u::shape, shaped ? (shaped->shape == radiosity_ambient::mixed ? 2 : 1) : 0);
+        p.set(u::at_least_direct, st.options.shooting.ambient ? 1 : 0);
+        glBindImageTexture(radiosity_glsl::direct_unit, st.direct_texture->id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
         if (shaped) {
             glBindImageTexture(radiosity_glsl::window_unit, st.window_irradiance->id(), 0, GL_FALSE, 0, GL_READ_ONLY,
                                GL_RGBA32F);

@@ -95,9 +95,16 @@ std::vector<glm::vec3> progressive_radiosity::ambient_field(int side) const {
     const glm::dvec3 u = unshot_power();
     std::vector<glm::vec3> h;
     const auto t = st.ambient_terms(u, &h);
-    if (!t) return std::vector<glm::vec3>(n, glm::vec3(cohen_ambient(u, st.total_area, st.albedo_area, int(st.sides))));
-    std::vector<glm::vec3> out(n);
-    for (std::size_t i = 0; i < n; ++i) out[i] = t->at(h[std::size_t(side) * n + i]);
+    std::vector<glm::vec3> out(n, glm::vec3(cohen_ambient(u, st.total_area, st.albedo_area, int(st.sides))));
+    if (t)
+        for (std::size_t i = 0; i < n; ++i) out[i] = t->at(h[std::size_t(side) * n + i]);
+    // At least minus what the shots delivered, (B - direct) / rho, as the CPU solver clamps it at
+    // its gathered irradiance: negative after a re-bake dims a light (radiosity/rebake.hpp).
+    const std::vector<glm::vec3> b = radiosity(side);
+    const std::size_t o = std::size_t(side) * n;
+    for (std::size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c)
+            if (const float rho = st.atlas.albedo[i][c]; rho > 0.f) out[i][c] = std::max(out[i][c], (direct_[o + i][c] - b[i][c]) / rho);
     return out;
 }
 

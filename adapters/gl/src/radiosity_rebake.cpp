@@ -33,6 +33,15 @@ void progressive_radiosity::state::write_sides(const texture& t, const std::vect
     check_error("progressive_radiosity: writing a re-bake's correction");
 }
 
+void progressive_radiosity::state::upload_direct(const std::vector<glm::vec3>& direct) {
+    if (!direct_texture) {
+        direct_texture = std::make_unique<texture>(texel_format::rgba32f, width, std::size_t(height) * sides);
+        const glm::vec4 zero(0.f);
+        glClearTexImage(direct_texture->id(), 0, GL_RGBA, GL_FLOAT, &zero);
+    }
+    write_sides(*direct_texture, direct);
+}
+
 void progressive_radiosity::state::reshoot(std::uint32_t k, float sign, const std::vector<glm::vec3>& shot,
                                            const std::vector<std::uint32_t>& keep_bits) {
     const std::uint32_t block = std::uint32_t(k % blocks()), side = std::uint32_t(k / blocks());
@@ -86,6 +95,7 @@ radiosity_rebake_report progressive_radiosity::rebake_light(std::size_t index, c
     st.shoot_light(st.lights[index], 1.f);
     const auto after = st.read_sides(st.radiosity);
     for (std::size_t j = 0; j < direct_.size(); ++j) direct_[j] += after[j] - before[j];
+    st.upload_direct(direct_);
     st.reduce();
     st.timings.lights_ms += ms_since(start);
     r.unshot_after = unshot_fraction();
@@ -164,6 +174,7 @@ radiosity_rebake_report progressive_radiosity::rebake_move(const scene_view& mov
         }
     }
     st.write_sides(st.unshot, unshot_now);
+    st.upload_direct(direct_);
     st.escaped -= returned;
     st.shot_power -= returned.x + returned.y + returned.z;
     st.reduce();

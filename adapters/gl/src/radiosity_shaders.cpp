@@ -504,12 +504,15 @@ std::string lightmap_compute() {
     using namespace lightmap_uniform;
     glsl::function_set fs;
     fs.add("radiosity_display", radiosity_with_ambient<f32, vec3>, "radiosity", "albedo", "ambient");
+    fs.add("radiosity_display_at_least", radiosity_with_ambient_at_least_direct<f32, vec3>, "radiosity", "albedo",
+           "ambient", "direct");
     fs.add("radiosity_mixed_ambient", mixed_ambient<f32, vec3>, "shaped", "floor_level", "scale");
     return version_line + "layout(local_size_x = 8, local_size_y = 8) in;\n" + fs.source() + texel_attributes_struct +
            storage_block(texels_binding, "readonly buffer texels_block { texel_attributes texel[]; }") +
            storage_block(source_binding, "readonly buffer source_block { uint source_texel[]; }") +
            image(radiosity_unit, "readonly image2D radiosity_image") +
            image(lightmap_unit, "writeonly image2D lightmap_image") + image(window_unit, "readonly image2D window_image") +
+           image(direct_unit, "readonly image2D direct_image") +
            uniforms({{atlas_width, "int atlas_width"},
                      {atlas_height, "int atlas_height"},
                      {ambient, "vec3 ambient"},
@@ -517,7 +520,8 @@ std::string lightmap_compute() {
                      {shape, "int shape"},
                      {factor, "vec3 factor"},
                      {floor, "vec3 floor_level"},
-                     {scale, "vec3 scale"}}) +
+                     {scale, "vec3 scale"},
+                     {at_least_direct, "int at_least_direct"}}) +
            R"(
 void main() {
     ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
@@ -532,7 +536,10 @@ void main() {
         vec3 shaped = imageLoad(window_image, from + ivec2(0, source_row)).rgb * factor;
         a = shape == 2 ? radiosity_mixed_ambient(shaped, floor_level, scale) : shaped;
     }
-    imageStore(lightmap_image, xy, vec4(radiosity_display(b, rho, a), 1.0));
+    vec3 shown = at_least_direct != 0
+        ? radiosity_display_at_least(b, rho, a, imageLoad(direct_image, from + ivec2(0, source_row)).rgb)
+        : radiosity_display(b, rho, a);
+    imageStore(lightmap_image, xy, vec4(shown, 1.0));
 }
 )";
 }

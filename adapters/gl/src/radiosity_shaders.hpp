@@ -97,8 +97,12 @@ enum : int {
 // The display lightmap's pass (update_lightmap_texture); the ambient's shape: 0 the uniform
 // `ambient`, 1 shots, 2 mixed (shot_ambient_terms, read at window_unit).
 namespace lightmap_uniform {
-enum : int { atlas_width = 0, atlas_height = 1, ambient = 2, source_row = 3, shape = 4, factor = 5, floor = 6, scale = 7 };
+enum : int { atlas_width = 0, atlas_height = 1, ambient = 2, source_row = 3, shape = 4, factor = 5, floor = 6, scale = 7,
+             at_least_direct = 8 };
 }
+// With the ambient term, the lightmap pass shows at least the direct radiosity (B once the
+// lights were shot), read at direct_unit (radiosity_with_ambient_at_least_direct).
+constexpr unsigned direct_unit = item_unit;
 
 // The shaped ambient term's passes (radiosity_ambient.cpp): a shot added to the window's
 // irradiance, h = h keep + intercepted / area weight; the mixed term's deficit summed into the

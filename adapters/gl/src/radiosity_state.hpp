@@ -166,6 +166,9 @@ struct progressive_radiosity::state {
     vertex_array item_vao;
     buffer texels, nodes, planes, first_buffer, element_texel, partials;
     std::unique_ptr<buffer> keep;  // a re-bake's receiver mask, one bit per element (keep_binding)
+    // B once the lights were shot, per element-side (the radiosity's rows): the display lightmap
+    // shows at least it with the ambient term (radiosity_with_ambient_at_least_direct).
+    std::unique_ptr<texture> direct_texture;
     std::unique_ptr<buffer> vertices;
     std::size_t vertex_capacity = 0;
     vertex_array cube_vao;
@@ -225,6 +228,8 @@ struct progressive_radiosity::state {
     // Every side's element values of t (side-major), read back; and written into t.
     std::vector<glm::vec3> read_sides(const texture& t) const;
     void write_sides(const texture& t, const std::vector<glm::vec3>& values);
+    // `direct` (per element-side, side-major) into direct_texture.
+    void upload_direct(const std::vector<glm::vec3>& direct);
     struct reduction {
         glm::dvec3 intercepted{0.0}, absorbed{0.0};
     };

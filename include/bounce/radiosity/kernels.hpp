@@ -108,6 +108,17 @@ V radiosity_with_ambient(const V& radiosity, const V& albedo, const V& ambient) 
     return radiosity + albedo * ambient;
 }
 
+/// radiosity_with_ambient, at least `direct` (the element's radiosity once the lights were
+/// shot: emission plus rho times the lights' direct irradiance). After a re-bake dims a light
+/// the ambient term is negative (radiosity/rebake.hpp) and the converged indirect light is
+/// not: this is the ambient irradiance clamped at minus what the shots delivered,
+/// (B - direct) / rho, written without the division (the GL solver, which keeps B and direct,
+/// shows it; the CPU solver clamps the ambient at its gathered irradiance).
+template <real T, vec3_of<T> V>
+V radiosity_with_ambient_at_least_direct(const V& radiosity, const V& albedo, const V& ambient, const V& direct) {
+    return max(radiosity_with_ambient<T, V>(radiosity, albedo, ambient), direct);
+}
+
 /// Cohen et al. 1988's ambient radiosity (W/m^2 per channel): the unshot power spread over
 /// the area the radiosity lives on, times the interreflection factor 1 / (1 - rho_avg)
 /// (rho_avg = albedo_area / area, at most 0.999). `area` is one side's total area and
