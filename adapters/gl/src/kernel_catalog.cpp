@@ -12,6 +12,7 @@
 #include <bounce/indirect/rsm.hpp>
 #include <bounce/indirect/rsm_layout.hpp>
 #include <bounce/indirect/rsm_sampling.hpp>
+#include <bounce/radiosity/ambient.hpp>
 #include <bounce/radiosity/kernels.hpp>
 #include <bounce/radiosity/shooters.hpp>
 #include <bounce/radiosity/sides.hpp>
@@ -158,7 +159,10 @@ void radiosity(catalog& c) {
         .add("radiosity direct", "radiosity_point_irradiance", BOUNCE_KERNEL(point_light_irradiance<f32, vec3>))
         .add("radiosity direct", "radiosity_directional_irradiance", BOUNCE_KERNEL(directional_light_irradiance<f32, vec3>))
         .add("radiosity direct", "radiosity_spot_irradiance", BOUNCE_KERNEL(spot_light_irradiance<f32, vec3>))
-        .add("radiosity display", "radiosity_display", BOUNCE_KERNEL(radiosity_with_ambient<f32, vec3>));
+        .add("radiosity display", "radiosity_display", BOUNCE_KERNEL(radiosity_with_ambient<f32, vec3>))
+        .add("radiosity display", "radiosity_display_at_least", BOUNCE_KERNEL(radiosity_with_ambient_at_least_direct<f32, vec3>))
+        .add("radiosity display", "radiosity_mixed_ambient", BOUNCE_KERNEL(mixed_ambient<f32, vec3>))
+        .add("radiosity ambient window", "radiosity_mixed_deficit", BOUNCE_KERNEL(mixed_ambient_deficit<f32, vec3>));
 }
 
 #undef BOUNCE_KERNEL
