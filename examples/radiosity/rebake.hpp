@@ -15,6 +15,7 @@
 // reported. An optional fourth number, --rebake-move ...,SHARE, re-shoots only the shooters
 // holding that share of the shot power (cpu::rebake_move's share). CPU, ray-cast visibility.
 #include <bounce/cpu/radiosity_rebake.hpp>
+#include <bounce/embree/radiosity_object_visibility.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/output_files.hpp>
@@ -184,9 +185,17 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     }
     cpu::progressive_radiosity solver(scene, atlas, embree::radiosity_visibility(bvh, atlas.chart_of_triangle), solver_options_for(o));
     const radiosity_solve_report bake = solver.solve(s);
-    const radiosity_rebake_report rb =
-        moved.empty() ? cpu::rebake_light(solver, light_index, changed.lights[light_index])
-                      : cpu::rebake_move(solver, changed, moved, move, embree::radiosity_visibility(changed_bvh, atlas.chart_of_triangle), share);
+    radiosity_rebake_report rb;
+    if (moved.empty()) rb = cpu::rebake_light(solver, light_index, changed.lights[light_index]);
+    else {  // the unmoved pairs tested against the object alone (its BVHs timed with the correction)
+        t0 = clock::now();
+        const embree::radiosity_visibility after(changed_bvh, atlas.chart_of_triangle);
+        auto object = embree::object_visibility(scene, embree::radiosity_visibility(bvh, atlas.chart_of_triangle), changed, after, moved,
+                                                atlas.chart_of_triangle);
+        const double object_ms = study::ms_since(t0);
+        rb = cpu::rebake_move(solver, changed, moved, move, after, std::move(object), share);
+        rb.ms += object_ms;
+    }
     radiosity_solve_options again = check;
     again.checkpoints = 200;
     image<glm::vec3> rebake_view = view(solver);
@@ -234,7 +243,8 @@ inline int run_rebake(const options& o, const io::scene& scene, const embree::ac
     j["rebake"] = {{"ms", rebake_ms}, {"correction_ms", rb.ms}, {"solve_ms", at_ms}, {"steps", at_steps},
                    {"error", rebake_error}, {"reached", reached}, {"shooters", rb.shooters}, {"moved_shooters", rb.moved_shooters},
                    {"moved_shots", moved_shots}, {"pairs", rb.pairs}, {"moved_pairs", rb.moved_pairs},
-                   {"pairs_tested", rb.pairs_tested}, {"moved_elements", rb.moved_elements},
+                   {"pairs_tested", rb.pairs_tested}, {"object_tests", rb.object_tests}, {"moved_elements", rb.moved_elements},
+                   {"stages_ms", {{"moved", rb.moved_ms}, {"unmoved", rb.unmoved_ms}, {"lights", rb.lights_ms}}},
                    {"share", share}, {"uncorrected", rb.uncorrected},
                    {"unshot_before", rb.unshot_before}, {"unshot_after", rb.unshot_after}};
     j["bake"] = {{"steps", bake.steps}, {"ms", bake.solve_ms}};

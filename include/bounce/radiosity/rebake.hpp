@@ -26,7 +26,13 @@
 ///    the shooter's centre to the receiver) meets the object's box before or after the move.
 ///    Every shooter that shot re-shoots its S to exactly those receivers, negatively with the
 ///    old geometry and visibility and positively with the new; every other pair's delivery is
-///    the same both times and is skipped (segment_meets_box). The moved object's own shooters
+///    the same both times and is skipped (segment_meets_box). Between two unmoved elements the
+///    form factor is the same both times and V_old = V_rest and not blocked by the object where
+///    it was, V_new = V_rest and not blocked where it is: a pair blocked in both places or in
+///    neither delivers the same both times too, one blocked only after the move needs only its
+///    old delivery taken away, one blocked only before only its new one; tested against the
+///    object alone, the rays the solver casts (cpu::rebake_move with an object visibility,
+///    embree::object_visibility). The moved object's own shooters
 ///    are re-shot with the old geometry only: their S returns to their unshot radiosity
 ///    (S = 0, dB = B there), which (1) allows, and the solve shoots it with the new geometry,
 ///    together with what else they hold, the largest first. What the moved elements received
@@ -192,6 +198,10 @@ struct radiosity_rebake_report {
     std::size_t moved_pairs = 0;    ///< pairs the moved object's shooters re-evaluated
     std::size_t pairs = 0;          ///< receiver-shooter pairs re-evaluated, both passes counted
     std::size_t pairs_tested = 0;   ///< receiver-shooter pairs tested against the boxes
+    std::size_t object_tests = 0;   ///< of them, pairs tested against the moved object alone (rebake_move with an object)
+    double moved_ms = 0;            ///< of ms: the moved object's shooters' old pass
+    double unmoved_ms = 0;          ///< the other shooters' two passes (the object tests included)
+    double lights_ms = 0;           ///< the lights' direct deposit re-evaluated, and the state corrected
     double unshot_before = 0;       ///< |unshot| power / emitted power before the correction
     double unshot_after = 0;        ///< the same after it (may exceed 1: a dimmed light)
     double uncorrected = 0;         ///< of the shot power, the share whose re-shots were left out (rebake_move's share)
