@@ -81,7 +81,9 @@ struct rebake_access {
             return segment_meets_box(a, b, boxes.before, m) || segment_meets_box(a, b, boxes.after, m);
         }
         void begin(const glm::vec3& c) {
-            for (std::size_t k = 0; k < near.size(); ++k) near[k] = meets(c, centre[k], margin + radius[k] * 1.0001f);
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, near.size(), 256), [&](const tbb::blocked_range<std::size_t>& q) {
+                for (std::size_t k = q.begin(); k != q.end(); ++k) near[k] = meets(c, centre[k], margin + radius[k] * 1.0001f);
+            });
         }
         bool through(const glm::vec3& c, std::uint32_t i) const { return near[block_of[i]] && meets(c, at.position[i], margin); }
     };
@@ -304,12 +306,15 @@ struct rebake_access {
             test.begin(shot_frame{centre, k / blocks == 0 ? at.normal[i0] : -at.normal[i0], false, at.chart[i0]});
             test.classify(s, filter, centre, moved_element, need);
             const auto old_pass = [&](std::uint32_t i) { return filter.near[filter.block_of[i]] && (need[i] & 1) != 0; };
-            reshoot_one(s, S, k, filter.near, moved_block, false, old_pass, -1.0, delta, pairs);
+            bool any = false;  // an old pass with no receiver is skipped (its walk of every element)
+            for (std::size_t bb = 0; bb < blocks && !any; ++bb)
+                for (std::uint32_t i = s.first_[bb]; filter.near[bb] && i < s.first_[bb + 1] && !any; ++i) any = (need[i] & 1) != 0;
+            if (any) reshoot_one(s, S, k, filter.near, moved_block, false, old_pass, -1.0, delta, pairs);
             std::swap(s.visibility_, other);
             const auto new_pass = [&](std::uint32_t i) { return moved_element[i] || (filter.near[filter.block_of[i]] && (need[i] & 2) != 0); };
             reshoot_one(s, S, k, filter.near, moved_block, false, new_pass, 1.0, delta, pairs);
             std::swap(s.visibility_, other);
-            r.shooters += 2, r.pairs_tested += 2 * n;
+            r.shooters += any ? 2 : 1, r.pairs_tested += 2 * n;
         }
         r.pairs += pairs.load();
     }
