@@ -13,6 +13,7 @@
 // converges to; how far that lies from the answer (its atlas built from the moved scene) is
 // reported. CPU with ray-cast visibility, or GL (stereographic or hemicube item buffers).
 #include <bounce/cpu/radiosity_rebake.hpp>
+#include <bounce/embree/radiosity_object_visibility.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
 #include <bounce/embree/ray_cast_gbuffer.hpp>
 #include <bounce/io/output_files.hpp>
@@ -46,11 +47,20 @@ struct cpu_rebaker {
     auto make(const scene_view& s, const lightmap_atlas& a, const embree::accel& bvh) const {
         return cpu::progressive_radiosity(s, a, embree::radiosity_visibility(bvh, a.chart_of_triangle), solver_options_for(o));
     }
+    // A move's unmoved pairs are tested against the object alone (embree::object_visibility;
+    // its BVHs timed with the correction).
     template <class Solver>
-    radiosity_rebake_report rebake(Solver& s, const scene_change& c, const embree::accel& changed_bvh) const {
+    radiosity_rebake_report rebake(Solver& s, const io::scene& scene, const embree::accel& bvh, const scene_change& c,
+                                   const embree::accel& changed_bvh) const {
         if (c.moved.empty()) return cpu::rebake_light(s, c.light_index, c.changed.lights[c.light_index]);
-        return cpu::rebake_move(s, c.changed, c.moved, c.move, embree::radiosity_visibility(changed_bvh, s.atlas().chart_of_triangle),
-                                c.share);
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::vector<std::uint32_t>& charts = s.atlas().chart_of_triangle;
+        const embree::radiosity_visibility after(changed_bvh, charts);
+        auto object = embree::object_visibility(scene, embree::radiosity_visibility(bvh, charts), c.changed, after, c.moved, charts);
+        const double object_ms = study::ms_since(t0);
+        radiosity_rebake_report r = cpu::rebake_move(s, c.changed, c.moved, c.move, after, std::move(object), c.share);
+        r.ms += object_ms;
+        return r;
     }
     static double pairs(const radiosity_rebake_report& r, std::size_t) { return double(r.pairs); }
 };
@@ -60,7 +70,8 @@ struct gl_rebaker {
     gl::progressive_radiosity make(const scene_view& s, const lightmap_atlas& a, const embree::accel&) const {
         return gl::progressive_radiosity(s, a, gl_options_for(o));
     }
-    radiosity_rebake_report rebake(gl::progressive_radiosity& s, const scene_change& c, const embree::accel&) const {
+    radiosity_rebake_report rebake(gl::progressive_radiosity& s, const io::scene&, const embree::accel&, const scene_change& c,
+                                   const embree::accel&) const {
         if (c.moved.empty()) return s.rebake_light(c.light_index, c.changed.lights[c.light_index]);
         return s.rebake_move(c.changed, c.moved, c.move, c.share);
     }
@@ -119,7 +130,7 @@ int measure_rebake(const options& o, const io::scene& scene, const embree::accel
     }
     auto solver = backend.make(scene, atlas, bvh);
     const radiosity_solve_report bake = solver.solve(s);
-    const radiosity_rebake_report rb = backend.rebake(solver, c, changed_bvh);
+    const radiosity_rebake_report rb = backend.rebake(solver, scene, bvh, c, changed_bvh);
     radiosity_solve_options again = check;
     again.checkpoints = 200;
     image<glm::vec3> rebake_view = view(solver);
@@ -169,7 +180,8 @@ int measure_rebake(const options& o, const io::scene& scene, const embree::accel
     j["rebake"] = {{"ms", rebake_ms}, {"correction_ms", rb.ms}, {"solve_ms", at_ms}, {"steps", at_steps},
                    {"error", rebake_error}, {"reached", reached}, {"shooters", rb.shooters}, {"moved_shooters", rb.moved_shooters},
                    {"moved_shots", moved_shots}, {"pairs", rb.pairs}, {"moved_pairs", rb.moved_pairs},
-                   {"pairs_tested", rb.pairs_tested}, {"moved_elements", rb.moved_elements},
+                   {"pairs_tested", rb.pairs_tested}, {"object_tests", rb.object_tests}, {"moved_elements", rb.moved_elements},
+                   {"stages_ms", {{"moved", rb.moved_ms}, {"unmoved", rb.unmoved_ms}, {"lights", rb.lights_ms}}},
                    {"share", c.share}, {"uncorrected", rb.uncorrected},
                    {"unshot_before", rb.unshot_before}, {"unshot_after", rb.unshot_after}};
     j["bake"] = {{"steps", bake.steps}, {"ms", bake.solve_ms}};

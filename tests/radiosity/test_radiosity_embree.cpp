@@ -9,10 +9,12 @@
 #include <bounce/cpu/radiosity_item_buffer.hpp>
 #include <bounce/embree/lightmap_view.hpp>
 #include <bounce/embree/multi_bounce_reference.hpp>
+#include <bounce/embree/radiosity_object_visibility.hpp>
 #include <bounce/embree/radiosity_visibility.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/output.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
+#include <bounce/radiosity/rebake.hpp>
 #include <bounce/sampling.hpp>
 
 #include <catch2/catch.hpp>
@@ -78,6 +80,54 @@ TEST_CASE("Embree ray-cast visibility gives the brute-force ray caster's answers
     CHECK(asked > 10000);
     CHECK(hidden > asked / 20);  // the boxes and the light's housing do occlude
     CHECK(wrong == 0);
+}
+
+TEST_CASE("Embree rays through a moved object alone: the whole scene blocks a ray where the rest or the object does",
+          "[radiosity][embree][rebake]") {
+    // cpu::rebake_move skips the unmoved pairs whose ray the object blocks in both places or
+    // in neither (embree::object_visibility): exact only if the whole scene's answer is the
+    // rest's and the object's together, ray by ray, before and after the move.
+    const auto scene = cornell_box();
+    const auto atlas = build_lightmap_atlas(scene.view(), {.elements = 3000});
+    std::vector<std::uint32_t> tall(10);  // the tall box: quads 10-14
+    for (std::uint32_t t = 0; t < 10; ++t) tall[t] = 20 + t;
+    rigid_move move;
+    move.translation = {0.25f, 0.f, 0.2f};
+    owned_scene moved = scene;
+    for (const std::uint32_t t : tall)  // add_quad's triangles share no vertex with another quad's
+        for (int k = 0; k < 3; ++k) moved.positions[scene.triangles[t][k]] = move.point(scene.positions[scene.triangles[t][k]]);
+    std::vector<std::uint32_t> rest_charts(atlas.chart_of_triangle.begin(), atlas.chart_of_triangle.end());
+    for (const std::uint32_t t : tall) rest_charts[t] = embree::radiosity_shot::none;
+    const embree::device dev;
+    embree::radiosity_visibility before(dev, scene.view(), atlas.chart_of_triangle), after(dev, moved.view(), atlas.chart_of_triangle);
+    embree::radiosity_visibility rest_before(dev, scene.view(), rest_charts), rest_after(dev, moved.view(), rest_charts);
+    auto object = embree::object_visibility(scene.view(), before, moved.view(), after, tall, atlas.chart_of_triangle);
+    const auto moved_chart = moved_charts(atlas, tall);
+    std::size_t asked = 0, changed = 0, wrong = 0;
+    for (std::size_t e = 0; e < atlas.size(); e += 7) {  // shots from unmoved elements to unmoved elements
+        if (moved_chart[atlas.chart[e]]) continue;
+        const cpu::shot_frame shot{atlas.position[e], atlas.normal[e], false, atlas.chart[e]};
+        for (auto* v : {&before, &after, &rest_before, &rest_after, &object.before, &object.after}) v->begin_shot(shot);
+        for (std::size_t i = 0; i < atlas.size(); i += 3) {
+            if (moved_chart[atlas.chart[i]] || !in_front(shot, atlas.position[i])) continue;
+            const glm::vec3 p = atlas.position[i];
+            const std::uint32_t c = atlas.chart[i];
+            ++asked;
+            const float was = object.before.visible(p, c), is = object.after.visible(p, c);
+            changed += was != is ? 1 : 0;
+            wrong += before.visible(p, c) != std::min(rest_before.visible(p, c), was) ? 1 : 0;
+            wrong += after.visible(p, c) != std::min(rest_after.visible(p, c), is) ? 1 : 0;
+        }
+    }
+    CAPTURE(asked, changed);
+    CHECK(asked > 100000);
+    CHECK(changed > asked / 100);
+    CHECK(wrong == 0);
+    // The object's rays end where the whole scene's do: its offset is the scene's, not its own BVH's.
+    CHECK(object.before.ray_epsilon() == before.ray_epsilon());
+    CHECK(object.before.bvh().triangle_count() == tall.size());
+    CHECK_THROWS_WITH(embree::object_visibility(scene.view(), before, moved.view(), after, {}, atlas.chart_of_triangle),
+                      Catch::Contains("moved_triangles"));
 }
 
 TEST_CASE("Embree visibility in packets of eight equals one ray at a time", "[radiosity][embree]") {

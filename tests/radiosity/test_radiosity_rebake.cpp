@@ -79,30 +79,60 @@ struct move_result {
     double error, bound, stale;  // relative_l1 from the fresh solve: the re-bake's, and the unmoved solution's
 };
 
-// Bakes `s` to 99%, moves its triangles `tris` by (0.5, 0, 0.3), re-bakes (rebake_move with `share`) and solves to 99.9%, and compares
+// How rebake_move tests an unmoved pair: its ray against the boxes only; against the object
+// alone too (the brute-force caster with every other triangle left without a chart, the
+// object where it was and where it is); or, wrong on purpose, against the object where it was
+// both times (every unmoved pair skipped: what a correction that missed changed pairs does).
+enum class pair_test { boxes, object, blind };
+
+// The scene `s` with triangles `tris` moved by (0.5, 0, 0.3), and its atlas.
+struct moved_box {
+    rigid_move move;
+    owned_scene scene;
+    lightmap_atlas atlas;     // the bake's atlas moved
+    lightmap_atlas object;    // the bake's atlas, charts only on `tris`
+    moved_box(const owned_scene& s, const lightmap_atlas& at, const std::vector<std::uint32_t>& tris)
+        : move(rigid_move{glm::mat3(1.f), glm::vec3(0.5f, 0.f, 0.3f)}), scene(moved_scene(s, tris, move)), atlas(at), object(at) {
+        move_charts(atlas, moved_charts(at, tris), move);
+        std::vector<std::uint8_t> keep(at.chart_of_triangle.size(), 0);
+        for (const std::uint32_t t : tris) keep[t] = 1;
+        for (std::size_t t = 0; t < keep.size(); ++t)
+            if (!keep[t]) object.chart_of_triangle[t] = lightmap_atlas::none;
+    }
+};
+
+struct object_rays {
+    ray_cast_visibility before, after;
+};
+
+radiosity_rebake_report rebake(solver_type& solver, const owned_scene& s, const moved_box& m, const std::vector<std::uint32_t>& tris,
+                               pair_test test, double share = 1) {
+    const ray_cast_visibility after{&m.scene, &m.atlas};
+    if (test == pair_test::boxes) return cpu::rebake_move(solver, m.scene.view(), tris, m.move, after, share);
+    const object_rays object{{&s, &m.object}, {test == pair_test::object ? &m.scene : &s, &m.object}};
+    return cpu::rebake_move(solver, m.scene.view(), tris, m.move, after, object, share);
+}
+
+// Bakes `s` to 99%, moves its triangles `tris` (moved_box), re-bakes (rebake_move with `share`) and solves to 99.9%, and compares
 // the result with a fresh solve of the moved scene on the same elements; `bound`: what their
 // unshot power allows (convergence_bound).
-move_result move_block(const owned_scene& s, const std::vector<std::uint32_t>& tris, double share = 1) {
+move_result move_block(const owned_scene& s, const std::vector<std::uint32_t>& tris, double share = 1,
+                       pair_test test = pair_test::boxes) {
     const lightmap_atlas atlas = build_lightmap_atlas(s.view(), {.elements = 600});
-    rigid_move move;
-    move.translation = {0.5f, 0.f, 0.3f};
-    const owned_scene moved = moved_scene(s, tris, move);
     // The fresh solve on the same elements moved (the atlas of the moved scene may differ by rounding).
-    lightmap_atlas moved_atlas = atlas;
-    move_charts(moved_atlas, moved_charts(atlas, tris), move);
-
+    const moved_box m(s, atlas, tris);
     solver_type rebaked(s.view(), atlas, ray_cast_visibility{&s, &atlas});
     rebaked.solve(to(0.99));
-    const auto r = cpu::rebake_move(rebaked, moved.view(), tris, move, ray_cast_visibility{&moved, &moved_atlas}, share);
+    const auto r = rebake(rebaked, s, m, tris, test, share);
     CHECK(r.moved_elements > 0);
     CHECK(r.shooters > 0);
     // Pairs whose rays miss the block's two boxes were skipped.
     CHECK(r.pairs < r.pairs_tested);
     CHECK(negative_unshot(rebaked) < 0);  // the block's old shadow's light taken back and its old place's light
     rebaked.solve(to(0.999));
-    CHECK(rebaked.atlas().position == moved_atlas.position);
+    CHECK(rebaked.atlas().position == m.atlas.position);
 
-    solver_type fresh(moved.view(), moved_atlas, ray_cast_visibility{&moved, &moved_atlas});
+    solver_type fresh(m.scene.view(), m.atlas, ray_cast_visibility{&m.scene, &m.atlas});
     fresh.solve(to(0.999));
     const double bound = convergence_bound(rebaked, fresh);
     // Without the correction (the moved state solved on), the error is the block's move itself.
@@ -113,8 +143,8 @@ move_result move_block(const owned_scene& s, const std::vector<std::uint32_t>& t
 
 // The re-bake re-shoots what the past shots delivered (their scales applied: the closed box's
 // corners scale many), so it agrees with the fresh solve within what their unshot power allows.
-void check_move(const owned_scene& s, const std::vector<std::uint32_t>& tris) {
-    const move_result m = move_block(s, tris);
+void check_move(const owned_scene& s, const std::vector<std::uint32_t>& tris, pair_test test = pair_test::boxes) {
+    const move_result m = move_block(s, tris, 1, test);
     CAPTURE(m.error, m.bound, m.stale);
     CHECK(m.report.uncorrected == 0);
     CHECK(m.error <= 2 * m.bound);
@@ -125,6 +155,41 @@ void check_move(const owned_scene& s, const std::vector<std::uint32_t>& tris) {
 
 TEST_CASE("a re-bake after moving the block converges to the fresh solve of the moved scene", "[radiosity][rebake]") {
     check_move(box_with_block(), block_triangles());
+}
+
+TEST_CASE("a re-bake that tests pairs against the object alone corrects as the boxes do, from fewer pairs", "[radiosity][rebake]") {
+    // Between unmoved elements only the rays the object blocks in exactly one of its places
+    // change; the rest are skipped, and the corrected state is the box filter's (to rounding).
+    const owned_scene s = box_with_block();
+    const auto tris = block_triangles();
+    const lightmap_atlas atlas = build_lightmap_atlas(s.view(), {.elements = 600});
+    const moved_box m(s, atlas, tris);
+    std::vector<std::vector<glm::vec3>> state;
+    std::vector<radiosity_rebake_report> report;
+    for (const pair_test test : {pair_test::boxes, pair_test::object, pair_test::blind}) {
+        solver_type solver(s.view(), atlas, ray_cast_visibility{&s, &atlas});
+        solver.solve(to(0.99));
+        report.push_back(rebake(solver, s, m, tris, test));
+        state.emplace_back();
+        for (int side = 0; side < solver.sides(); ++side)
+            for (const auto& b : solver.radiosity(side)) state.back().push_back(b);
+    }
+    // |difference| over |state| (area ignored: the same elements), from the box filter's.
+    const auto apart = [&](std::size_t k) {
+        double d = 0, t = 0;
+        for (std::size_t j = 0; j < state[0].size(); ++j)
+            for (int c = 0; c < 3; ++c) d += std::abs(double(state[k][j][c]) - state[0][j][c]), t += std::abs(state[0][j][c]);
+        return d / t;
+    };
+    CAPTURE(report[0].pairs, report[1].pairs, report[1].object_tests, report[2].pairs, apart(1), apart(2));
+    CHECK(report[0].object_tests == 0);
+    CHECK(report[1].object_tests > 0);
+    CHECK(report[1].pairs < report[0].pairs);
+    CHECK(apart(1) <= 1e-5);
+    // Skipping the changed pairs too leaves the block's old shadow and its new one as they were.
+    CHECK(report[2].pairs < report[1].pairs);
+    CHECK(apart(2) > 1e3 * std::max(apart(1), 1e-7));
+    check_move(s, tris, pair_test::object);
 }
 
 TEST_CASE("a re-bake converges with faces repeated, whose shots are scaled hard", "[radiosity][rebake]") {

@@ -60,6 +60,7 @@ radiosity_visibility::radiosity_visibility(const accel& bvh, std::span<const std
                                                        std::to_string(bvh.triangle_count()) + "), has " +
                                                        std::to_string(chart_of_triangle.size()));
     require(opt.end_tolerance >= 0.f && opt.end_tolerance < 0.5f, "options.end_tolerance", "must lie in [0, 0.5)");
+    require(opt.ray_epsilon >= 0.f && std::isfinite(opt.ray_epsilon), "options.ray_epsilon", "must be finite and non-negative");
     chart_ = std::make_shared<const std::vector<std::uint32_t>>(chart_of_triangle.begin(), chart_of_triangle.end());
 }
 
@@ -110,7 +111,7 @@ float radiosity_visibility::visible(const glm::vec3& point, std::uint32_t chart)
     chart_context ctx = context_for(*chart_, shot_.chart, false);
     glm::vec3 o, d;
     float tnear, tfar;
-    set_ray(shot_, options_.end_tolerance, bvh_.ray_epsilon(), point, o, d, tnear, tfar);
+    set_ray(shot_, options_.end_tolerance, ray_epsilon(), point, o, d, tnear, tfar);
     RTCRay r;
     r.org_x = o.x;
     r.org_y = o.y;
@@ -141,7 +142,7 @@ float radiosity_visibility::visible_from(const glm::vec3& origin, std::uint32_t 
     r.dir_y = point.y - origin.y;
     r.dir_z = point.z - origin.z;
     r.time = 0.f;
-    r.tfar = ray_end(origin, point, options_.end_tolerance, bvh_.ray_epsilon());
+    r.tfar = ray_end(origin, point, options_.end_tolerance, ray_epsilon());
     r.mask = ~0u;
     r.id = chart;
     r.flags = 0;
@@ -154,7 +155,7 @@ void radiosity_visibility::visible(std::span<const glm::vec3> points, std::span<
     require(charts.size() == points.size(), "charts", "must have one chart per point");
     require(out.size() == points.size(), "out", "must have one entry per point");
     chart_context ctx = context_for(*chart_, shot_.chart, true);  // coherent: a shot's rays share their origin
-    const float epsilon = bvh_.ray_epsilon();
+    const float epsilon = ray_epsilon();
     for (std::size_t first = 0; first < points.size(); first += 8) {
         const std::size_t n = std::min<std::size_t>(8, points.size() - first);
         alignas(32) std::array<int, 8> valid{};

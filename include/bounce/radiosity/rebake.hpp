@@ -26,7 +26,13 @@
 ///    the shooter's centre to the receiver) meets the object's box before or after the move.
 ///    Every shooter that shot re-shoots its S to exactly those receivers, negatively with the
 ///    old geometry and visibility and positively with the new; every other pair's delivery is
-///    the same both times and is skipped (segment_meets_box). The moved object's own shooters
+///    the same both times and is skipped (segment_meets_box). Between two unmoved elements the
+///    form factor is the same both times and V_old = V_rest and not blocked by the object where
+///    it was, V_new = V_rest and not blocked where it is: a pair blocked in both places or in
+///    neither delivers the same both times too, one blocked only after the move needs only its
+///    old delivery taken away, one blocked only before only its new one; tested against the
+///    object alone, the rays the solver casts (cpu::rebake_move with an object visibility,
+///    embree::object_visibility). The moved object's own shooters
 ///    are re-shot with the old geometry only: their S returns to their unshot radiosity
 ///    (S = 0, dB = B there), which (1) allows, and the solve shoots it with the new geometry,
 ///    together with what else they hold, the largest first. What the moved elements received
@@ -206,19 +212,28 @@ public:
             for (std::uint32_t i = first[k]; i < first[k + 1]; ++i)
                 block_of_[i] = std::uint32_t(k), radius_[k] = std::max(radius_[k], glm::length(atlas.position[i] - centre_[k]));
     }
-    /// Starts a shooter at `c`: which blocks can hold receivers whose segment meets a box.
-    void begin(const glm::vec3& c) {
-        for (std::size_t k = 0; k < near_.size(); ++k) near_[k] = meets(c, centre_[k], margin_ + radius_[k] * 1.0001f);
+    /// Starts a shooter at `c`: which blocks can hold receivers whose segment meets a box
+    /// (blocks [first, last) of them: a caller may split the blocks over threads).
+    void begin(const glm::vec3& c) { begin(c, 0, near_.size()); }
+    void begin(const glm::vec3& c, std::size_t first, std::size_t last) {
+        for (std::size_t k = first; k < last; ++k) near_[k] = meets(c, centre_[k], margin_ + radius_[k] * 1.0001f);
     }
-    /// Whether block `block` may hold such receivers (after begin).
+    /// Whether block `block` may hold such receivers (after begin), per block.
     bool near(std::size_t block) const { return near_[block] != 0; }
+    const std::vector<std::uint8_t>& near_blocks() const noexcept { return near_; }
+    std::size_t blocks() const noexcept { return near_.size(); }
+    std::uint32_t block_of(std::uint32_t i) const { return block_of_[i]; }
     /// Whether element i's segment from `c` (the shooter begun) meets either box.
     bool through(const glm::vec3& c, std::uint32_t i) const { return near_[block_of_[i]] && meets(c, atlas_.position[i], margin_); }
-
-private:
+    /// Whether the segment from a to b meets either box widened by m.
     bool meets(const glm::vec3& a, const glm::vec3& b, float m) const {
         return segment_meets_box(a, b, boxes_.before, m) || segment_meets_box(a, b, boxes_.after, m);
     }
+    const lightmap_atlas& atlas() const noexcept { return atlas_; }
+    const moved_boxes& boxes() const noexcept { return boxes_; }
+    float margin() const noexcept { return margin_; }
+
+private:
     const lightmap_atlas& atlas_;
     moved_boxes boxes_;
     float margin_;
@@ -266,6 +281,10 @@ struct radiosity_rebake_report {
     std::size_t moved_pairs = 0;    ///< pairs the moved object's shooters re-evaluated
     std::size_t pairs = 0;          ///< receiver-shooter pairs re-evaluated, both passes counted
     std::size_t pairs_tested = 0;   ///< receiver-shooter pairs tested against the boxes
+    std::size_t object_tests = 0;   ///< of them, pairs tested against the moved object alone (rebake_move with an object)
+    double moved_ms = 0;            ///< of ms: the moved object's shooters' old pass
+    double unmoved_ms = 0;          ///< the other shooters' two passes (the object tests included)
+    double lights_ms = 0;           ///< the lights' direct deposit re-evaluated, and the state corrected
     double unshot_before = 0;       ///< |unshot| power / emitted power before the correction
     double unshot_after = 0;        ///< the same after it (may exceed 1: a dimmed light)
     double uncorrected = 0;         ///< of the shot power, the share whose re-shots were left out (rebake_move's share)

@@ -51,6 +51,10 @@ public:
         /// rays leave a point that far off its surface, so a layer closer than that never
         /// shadows it there).
         float end_tolerance = 1e-5f;
+        /// The offset of a ray's end (above); 0: the accel's ray_epsilon(). A visibility of
+        /// part of a scene (a moved object alone: radiosity_object_visibility.hpp) casts the
+        /// whole scene's rays, so it takes the whole scene's offset.
+        float ray_epsilon = 0.f;
     };
 
     /// Visibility through `bvh` (its device, triangles and BVH), with the chart of each of
@@ -69,6 +73,9 @@ public:
 
     /// The accel the rays go through (the caller's, or the one built for the scene).
     const accel& bvh() const noexcept { return bvh_; }
+    /// The offset of a ray's end: options.ray_epsilon, or the accel's.
+    float ray_epsilon() const noexcept { return options_.ray_epsilon > 0.f ? options_.ray_epsilon : bvh_.ray_epsilon(); }
+    const options& settings() const noexcept { return options_; }
 
     /// Prepares for a shot. `Frame` has position, axis, parallel and chart (cpu::shot_frame).
     template <class Frame>
