@@ -5,7 +5,6 @@
 #include <bounce/embree/multi_bounce_reference.hpp>
 #include <bounce/errors.hpp>
 #include <bounce/radiosity/lightmap_atlas.hpp>
-#include <bounce/luminance.hpp>
 #include <bounce/radiosity/options.hpp>
 #include <bounce/radiosity/subdivision.hpp>
 
@@ -287,28 +286,6 @@ inline nlohmann::ordered_json parameters_json(const options& o) {
             {"group_near_field", o.group_near_field},
             {"view", name_of(view_names, o.view != view_kind::automatic ? o.view : view_kind::direct_indirect)},
             {"reference_paths", o.reference_paths}, {"seed", o.seed}};
-}
-
-/// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),
-/// and how many bounces reach 1% and 0.1% of it (the rest of the series after them).
-inline nlohmann::ordered_json reference_json(const options& o, const embree::multi_bounce_image& ref) {
-    const auto luminance = [](const glm::dvec3& c) { return rec709_luminance<double, glm::dvec3>(c); };
-    double total = 0;
-    for (const auto& b : ref.per_bounce) total += luminance(b);
-    nlohmann::ordered_json shares = nlohmann::ordered_json::array();
-    for (const auto& b : ref.per_bounce) shares.push_back(total > 0 ? luminance(b) / total : 0.0);
-    const auto needed = [&](double tol) {
-        double rest = total;
-        for (std::size_t k = 0; k < ref.per_bounce.size(); ++k) {
-            rest -= luminance(ref.per_bounce[k]);
-            if (rest <= tol * total) return int(k);
-        }
-        return int(ref.per_bounce.size());
-    };
-    const auto s = reference_settings_for(o);
-    return {{"kind", "multi-bounce path tracing"}, {"paths", s.paths}, {"max_bounces", s.max_bounces},
-            {"roulette_after", s.roulette_after}, {"area_samples", s.area_samples}, {"seed", s.seed},
-            {"bounce_share", shares}, {"bounces_for_1pct", needed(1e-2)}, {"bounces_for_0.1pct", needed(1e-3)}};
 }
 
 }  // namespace bounce::examples

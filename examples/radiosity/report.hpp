@@ -1,5 +1,6 @@
 #pragma once
-// What one radiosity solve gives the report, and its JSON beside study::run_report's fields.
+// What one radiosity solve gives the report, and its JSON beside study::run_report's fields;
+// the reference's summary (reference_json).
 #include <bounce/image.hpp>
 #include <bounce/luminance.hpp>
 #include <bounce/radiosity/solve.hpp>
@@ -12,6 +13,8 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+
+#include "options.hpp"
 
 namespace bounce::examples {
 
@@ -85,6 +88,28 @@ inline void add_solve_json(nlohmann::ordered_json& j, const solve_result& r) {
         curve.push_back({{"step", c.step}, {"shots", c.shots}, {"elements", c.elements}, {"time_ms", c.time_ms},
                          {"unshot_fraction", c.unshot_fraction}, {"rel_rms", c.rel_rms}});
     j["convergence"] = curve;
+}
+
+/// The reference's settings, each bounce's share of the view's luminance (rec709_luminance),
+/// and how many bounces reach 1% and 0.1% of it (the rest of the series after them).
+inline nlohmann::ordered_json reference_json(const options& o, const embree::multi_bounce_image& ref) {
+    const auto luminance = [](const glm::dvec3& c) { return rec709_luminance<double, glm::dvec3>(c); };
+    double total = 0;
+    for (const auto& b : ref.per_bounce) total += luminance(b);
+    nlohmann::ordered_json shares = nlohmann::ordered_json::array();
+    for (const auto& b : ref.per_bounce) shares.push_back(total > 0 ? luminance(b) / total : 0.0);
+    const auto needed = [&](double tol) {
+        double rest = total;
+        for (std::size_t k = 0; k < ref.per_bounce.size(); ++k) {
+            rest -= luminance(ref.per_bounce[k]);
+            if (rest <= tol * total) return int(k);
+        }
+        return int(ref.per_bounce.size());
+    };
+    const auto s = reference_settings_for(o);
+    return {{"kind", "multi-bounce path tracing"}, {"paths", s.paths}, {"max_bounces", s.max_bounces},
+            {"roulette_after", s.roulette_after}, {"area_samples", s.area_samples}, {"seed", s.seed},
+            {"bounce_share", shares}, {"bounces_for_1pct", needed(1e-2)}, {"bounces_for_0.1pct", needed(1e-3)}};
 }
 
 }  // namespace bounce::examples
