@@ -36,7 +36,7 @@ else
     run cornell-tall cornell 0.98 --rebake-move 'white#2,0.1,0,0.1' --reference on $cpu
     run living-table living-room 0.97 --rebake-move 'TableWood#1,0.2,0,0.2' --reference off $cpu
     run cornellbox-tall cornell-box 0.98 --rebake-move 'tallBox,0.1,0,0.1' --reference off $cpu
-    run conference-chair conference 0.97 --rebake-move 'default#160,30,0,0' --reference off $cpu --clusters never  # a chair's charts may share a cluster
+    run conference-chair conference 0.97 --rebake-move 'default#160,30,0,0' --reference off $cpu --clusters never  # the chair's tiny charts share a cluster with others'
     run cornell-light cornell 0.98 --rebake-light 0,0.5 --reference on $cpu
     run bunny-light bunny 0.97 --rebake-light 0,0.5 --reference off $cpu
 fi
