@@ -1,5 +1,6 @@
 // The benchmark's radiosity: cpu::progressive_radiosity with the stereographic item buffer,
-// seen through embree::lightmap_view, against the all-bounce reference.
+// seen as the radiosity program sees it by default (embree::lightmap_direct_view: the lights'
+// direct light per pixel, the rest of B from the lightmap), against the all-bounce reference.
 #include <bounce/study/benchmark_parts.hpp>
 
 #include <bounce/cpu/radiosity.hpp>
@@ -19,8 +20,9 @@ namespace bounce::study::bench {
 technique_run run_radiosity(const scene_setup& s) {
     // radiosity's defaults (examples/radiosity/options.hpp): 10,000 elements shot in 8 x 8
     // blocks with the near-field rule at 4 sides, visibility from the stereographic item
-    // buffer of 128^2 pixels (edges within 0.25 px), uniform elements, until 90% of the
-    // emitted power is shot.
+    // buffer of 128^2 pixels (edges within 0.25 px), lights shot at 4 x 4 points a texel, the
+    // mixed ambient term, until 90% of the power the surfaces reflect is shot (the indirect
+    // measure: a scene lit mostly by direct light is not "converged" before any bounce).
     constexpr std::size_t elements = 10000;
     constexpr int block = 8, resolution = 128;
     constexpr float tolerance_px = 0.25f;
@@ -42,12 +44,15 @@ technique_run run_radiosity(const scene_setup& s) {
     radiosity_options ro;
     ro.shoot_blocks = block > 1;
     ro.near_field = 4;
+    ro.light_samples = 4;
+    ro.ambient_shape = radiosity_ambient::mixed;
     s.clock.report(name, "lights");
     cpu::progressive_radiosity solver(s.scene, atlas, cpu::item_buffer_visibility(s.scene, atlas, vo), ro);
     // The library's solve (radiosity/solve.hpp): to the target, within the run's time cap,
     // refusing energy created or light reaching no surface's front with radiosity_error.
     radiosity_solve_options so;
     so.converge = converge;
+    so.measure = radiosity_measure::indirect;
     so.max_seconds = s.settings.radiosity_max_seconds;
     auto last_report = std::chrono::steady_clock::now();
     so.progress = [&](const radiosity_progress& p) {
@@ -65,12 +70,13 @@ technique_run run_radiosity(const scene_setup& s) {
     r.technique = bench_technique::radiosity;
     r.quantity = bench_quantity::all_bounces;
     const auto tv = std::chrono::steady_clock::now();
-    const image<glm::vec3> lightmap = solver.radiosity_lightmap(0), back = solver.radiosity_lightmap(0, 1);  // two-sided
-    r.radiance = embree::lightmap_view(s.bvh, s.scene, solver.atlas(), lightmap.view(), back.view(), 0, s.scene.camera,
-                                       s.g.width(), s.g.height());
+    const image<glm::vec3> front = bounced_radiosity_lightmap(solver, 0, 0), back = bounced_radiosity_lightmap(solver, 0, 1);
+    r.radiance = embree::lightmap_direct_view(s.bvh, s.scene, solver.atlas(), front.view(), back.view(), 0, s.scene.camera,
+                                              s.g.width(), s.g.height());
     const double view_ms = ms_since(tv);
-    // The solve is the technique's work; the view from the lightmap is a texture lookup in
-    // a renderer's raster pass (here a ray cast), reported beside, as the shared G-buffer is.
+    // The solve is the technique's work; the view (a lookup of the lightmap in a renderer's
+    // raster pass and its direct-light pass; here ray casts) is reported beside, as the shared
+    // G-buffer is.
     r.ms = solve_ms;
     const radiosity_timings& t = solver.timings();
     r.timings_ms = {{"atlas", atlas_ms},           {"lights", t.lights_ms},     {"visibility", t.visibility_ms},
@@ -87,7 +93,8 @@ technique_run run_radiosity(const scene_setup& s) {
                 {"solve_ms", report.solve_ms}};
     r.parameters = {{"elements", elements},      {"block", block},       {"visibility", "stereo"},
                     {"resolution", resolution},  {"tolerance_px", tolerance_px}, {"adaptive", false},
-                    {"converge", converge},      {"max_seconds", s.settings.radiosity_max_seconds}};
+                    {"converge", converge},      {"converge_on", "indirect"}, {"light_samples", 4},
+                    {"ambient", "mixed"},        {"view", "direct+indirect"}, {"max_seconds", s.settings.radiosity_max_seconds}};
     return r;
 }
 
