@@ -123,7 +123,7 @@ glm::dvec3 progressive_radiosity::ambient() const {
 }
 std::vector<glm::vec3> progressive_radiosity::display_radiosity(int side) const {
     std::vector<glm::vec3> out = radiosity(side);
-    const std::vector<glm::vec3> amb = ambient_field(side);
+    const std::vector<glm::vec3> amb = ambient_field(side, out);
     for (std::size_t i = 0; i < out.size(); ++i)
         out[i] = radiosity_with_ambient<float, glm::vec3>(out[i], s_->atlas.albedo[i], amb[i]);
     return out;
@@ -133,7 +133,7 @@ std::vector<glm::vec3> progressive_radiosity::output(output_quantity quantity, l
     std::vector<glm::vec3> out = radiosity(side);  // checks the side
     const std::size_t o = at.size() * std::size_t(side);
     const bool direct = paths != light_paths::indirect, indirect = paths != light_paths::direct;
-    const std::vector<glm::vec3> amb = indirect ? ambient_field(side) : std::vector<glm::vec3>(out.size(), glm::vec3(0.f));
+    const std::vector<glm::vec3> amb = indirect ? ambient_field(side, out) : std::vector<glm::vec3>(out.size(), glm::vec3(0.f));
     for (std::size_t i = 0; i < out.size(); ++i) {
         // Reflected radiosity of the parts asked for: rho E (the emission on the side that emits).
         const glm::vec3 emission = s_->emits_on(i, side) ? at.emission[i] : glm::vec3(0.f);

@@ -88,8 +88,12 @@ std::optional<shot_ambient_terms> progressive_radiosity::state::ambient_terms(co
 }
 
 std::vector<glm::vec3> progressive_radiosity::ambient_field(int side) const {
-    const state& st = *s_;
     require(side >= 0 && side < sides(), "side", two_sided() ? "must be 0 or 1" : "must be 0 (one-sided)");
+    return ambient_field(side, radiosity(side));
+}
+
+std::vector<glm::vec3> progressive_radiosity::ambient_field(int side, const std::vector<glm::vec3>& b) const {
+    const state& st = *s_;
     const std::size_t n = st.atlas.size();
     if (!st.options.shooting.ambient) return std::vector<glm::vec3>(n, glm::vec3(0.f));
     const glm::dvec3 u = unshot_power();
@@ -100,7 +104,6 @@ std::vector<glm::vec3> progressive_radiosity::ambient_field(int side) const {
         for (std::size_t i = 0; i < n; ++i) out[i] = t->at(h[std::size_t(side) * n + i]);
     // At least minus what the shots delivered, (B - direct) / rho, as the CPU solver clamps it at
     // its gathered irradiance: negative after a re-bake dims a light (radiosity/rebake.hpp).
-    const std::vector<glm::vec3> b = radiosity(side);
     const std::size_t o = std::size_t(side) * n;
     for (std::size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c)

@@ -68,14 +68,22 @@ void progressive_radiosity::state::reshoot(std::uint32_t k, float sign, const st
 
 namespace {
 
-// Shoots every light of `lights` with `sign` and adds the change of the radiosity (every side,
+// Runs `shots` (light shots) and adds the change of the radiosity they made (every side,
 // side-major) to `direct` (B once the lights were shot).
-template <class State>
-void reshoot_lights(State& st, float sign, std::vector<glm::vec3>& direct) {
+template <class State, class Shots>
+void shoot_lights_into(State& st, std::vector<glm::vec3>& direct, const Shots& shots) {
     const auto before = st.read_sides(st.radiosity);
-    for (const packed_light& l : st.lights) st.shoot_light(l, sign);
+    shots();
     const auto after = st.read_sides(st.radiosity);
     for (std::size_t j = 0; j < direct.size(); ++j) direct[j] += after[j] - before[j];
+}
+
+// Every light of the scene shot with `sign`, into `direct`.
+template <class State>
+void reshoot_lights(State& st, float sign, std::vector<glm::vec3>& direct) {
+    shoot_lights_into(st, direct, [&] {
+        for (const packed_light& l : st.lights) st.shoot_light(l, sign);
+    });
 }
 
 }  // namespace
@@ -89,12 +97,11 @@ radiosity_rebake_report progressive_radiosity::rebake_light(std::size_t index, c
     const auto start = clock_type::now();
     radiosity_rebake_report r;
     r.unshot_before = unshot_fraction();
-    const auto before = st.read_sides(st.radiosity);
-    st.shoot_light(st.lights[index], -1.f);
-    st.lights[index] = pack(changed);
-    st.shoot_light(st.lights[index], 1.f);
-    const auto after = st.read_sides(st.radiosity);
-    for (std::size_t j = 0; j < direct_.size(); ++j) direct_[j] += after[j] - before[j];
+    shoot_lights_into(st, direct_, [&] {
+        st.shoot_light(st.lights[index], -1.f);
+        st.lights[index] = pack(changed);
+        st.shoot_light(st.lights[index], 1.f);
+    });
     st.upload_direct(direct_);
     st.reduce();
     st.timings.lights_ms += ms_since(start);

@@ -257,6 +257,8 @@ private:
     std::unique_ptr<state> s_;
     std::vector<glm::vec3> direct_;  // B once the lights were shot (emission + rho E_d), per side and element (side-major)
     std::optional<texture> output_texture_;  // update_output_texture's
+    // ambient_field(side) for the side's radiosity `b`, already read back by the caller.
+    std::vector<glm::vec3> ambient_field(int side, const std::vector<glm::vec3>& b) const;
 };
 
 }  // namespace bounce::gl
