@@ -21,7 +21,9 @@ std::vector<glm::vec3> progressive_radiosity::state::read_sides(const texture& t
 }
 
 void progressive_radiosity::state::write_sides(const texture& t, const std::vector<glm::vec3>& values) {
-    std::vector<float> all = t.read_floats();
+    // Padding and empty texels hold 0 in the solver's element textures (radiosity_texture()):
+    // written whole, nothing needs reading back first.
+    std::vector<float> all(std::size_t(4) * width * height * sides, 0.f);
     const std::size_t n = atlas.size();
     for (std::size_t j = 0; j < values.size(); ++j) {
         const std::size_t row = std::size_t(atlas.texel[j % n].y) + (j / n) * height;
@@ -34,11 +36,7 @@ void progressive_radiosity::state::write_sides(const texture& t, const std::vect
 }
 
 void progressive_radiosity::state::upload_direct(const std::vector<glm::vec3>& direct) {
-    if (!direct_texture) {
-        direct_texture = std::make_unique<texture>(texel_format::rgba32f, width, std::size_t(height) * sides);
-        const glm::vec4 zero(0.f);
-        glClearTexImage(direct_texture->id(), 0, GL_RGBA, GL_FLOAT, &zero);
-    }
+    if (!direct_texture) direct_texture = std::make_unique<texture>(texel_format::rgba32f, width, std::size_t(height) * sides);
     write_sides(*direct_texture, direct);
 }
 
