@@ -53,9 +53,7 @@ void progressive_radiosity::state::use_window_pass(const program& p, GLenum acce
 std::optional<shot_ambient_terms> progressive_radiosity::state::ambient_terms(const glm::dvec3& unshot,
                                                                               std::vector<glm::vec3>* h) const {
     if (!shot_ambient_window::shaped(options.shooting) || !window_irradiance || ambient_window.empty()) return std::nullopt;
-    double area = 0;
-    for (float a : atlas.area) area += double(a);
-    shot_ambient_terms t = ambient_window.terms(options.shooting.ambient_shape, unshot, area * double(sides));
+    shot_ambient_terms t = ambient_window.terms(options.shooting.ambient_shape, unshot, total_area * double(sides));
     if (h) {
         const std::vector<float> all = window_irradiance->read_floats();
         const std::size_t n = atlas.size();
